@@ -1,0 +1,495 @@
+"""The one planar mechanism model shared by every seed, with its pose solver and sweep.
+
+A :class:`Mechanism` is a set of rigid bodies (named points in body coordinates), joints between them
+(revolute, slider), gear couplings (a law between two bodies' rotations relative to a carrier) and
+drivers (a relative angle or a slide as a function of the one scalar input). The solver finds every
+body's world pose ``(x, y, theta)`` by Newton's method on the constraint residuals; the sweep follows
+the assembly branch of the first pose by continuation, and reports a lock-up or a branch change as a
+:class:`~fabricate.errors.LockupError` with the input value where it happened.
+
+Conventions
+-----------
+- A revolute joint named ``J`` connects two bodies that both have a point named ``J``.
+- Angles are radians inside; the input is in ``Mechanism.input_unit`` (``"deg"`` or ``"mm"``).
+- Body poses are unwrapped angles: continuous over a sweep, never reduced to (-pi, pi].
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from fabricate.errors import LockupError, SpecError
+from fabricate.planar import rotation, transform_points
+
+#: Residual norm (mm or rad) below which a pose is accepted as assembled.
+ASSEMBLY_TOLERANCE = 1e-12
+
+
+class Law(Protocol):
+    """A smooth scalar function with derivatives, like :class:`scipy.interpolate.CubicSpline`."""
+
+    def __call__(self, x: np.ndarray | float, nu: int = 0) -> np.ndarray | float: ...
+
+
+@dataclass(frozen=True)
+class LinearLaw:
+    """``y = slope * x + offset``; the identity by default. Usable wherever a :class:`Law` is."""
+
+    slope: float = 1.0
+    offset: float = 0.0
+
+    def __call__(self, x: np.ndarray | float, nu: int = 0) -> np.ndarray | float:
+        x = np.asarray(x, dtype=np.float64)
+        if nu == 0:
+            return self.slope * x + self.offset
+        if nu == 1:
+            return np.full_like(x, self.slope)
+        return np.zeros_like(x)
+
+
+@dataclass(frozen=True)
+class Body:
+    """A rigid body.
+
+    Attributes
+    ----------
+    name : str
+    points : Mapping[str, tuple[float, float]]
+        Named points (joint centres, markers such as the fingertip) in body coordinates, mm.
+    """
+
+    name: str
+    points: Mapping[str, tuple[float, float]]
+
+    def point(self, name: str) -> np.ndarray:
+        return np.asarray(self.points[name], dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class Revolute:
+    """A pin joint: point ``name`` of ``body_a`` coincides with point ``name`` of ``body_b``."""
+
+    name: str
+    body_a: str
+    body_b: str
+
+
+@dataclass(frozen=True)
+class Slider:
+    """A prismatic joint: point ``name`` of ``body_b`` stays on the line through point ``name`` of
+    ``body_a`` with direction ``axis`` (body_a coordinates); the relative rotation is locked at
+    ``angle`` (rad, theta_b - theta_a)."""
+
+    name: str
+    body_a: str
+    body_b: str
+    axis: tuple[float, float]
+    angle: float = 0.0
+
+
+@dataclass(frozen=True)
+class GearCoupling:
+    """Two bodies whose rotations relative to ``carrier`` follow ``law``:
+    ``theta_b - theta_c = law(theta_a - theta_c)`` (rad).
+
+    ``axis_a`` / ``axis_b`` name the joints about which the gears turn (their distance is the centre
+    distance); ``working_range`` is the range of ``theta_a - theta_c`` (rad) the pair must cover.
+    """
+
+    name: str
+    carrier: str
+    gear_a: str
+    gear_b: str
+    law: Law
+    axis_a: str = ""
+    axis_b: str = ""
+    working_range: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Driver:
+    """What the input drives.
+
+    ``kind="angle"``: ``theta_body - theta_reference = law(s)`` (rad).
+    ``kind="slide"``: displacement of point ``joint`` of ``body`` along slider ``joint`` of ``reference``
+    measured from point ``joint`` of ``reference``, ``= law(s)`` (mm).
+    ``law`` maps the input ``s`` (in the mechanism's input unit) to that coordinate; ``None`` means
+    identity (degrees converted to radians for an angle driver).
+    """
+
+    kind: str
+    body: str
+    reference: str
+    joint: str = ""
+    law: Law | None = None
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """A planar mechanism.
+
+    Attributes
+    ----------
+    name : str
+    bodies : tuple of Body
+    ground : str
+        Name of the fixed body (its pose is the identity).
+    joints : tuple of Revolute or Slider
+    gears : tuple of GearCoupling
+    drivers : tuple of Driver
+    input_range : (float, float)
+        Start and end of the motion, in ``input_unit``.
+    input_unit : str
+        ``"deg"`` or ``"mm"``.
+    assembly : Mapping[str, (3,) array]
+        World pose guess for every non-ground body at ``input_range[0]``; it selects the assembly branch.
+    """
+
+    name: str
+    bodies: tuple[Body, ...]
+    ground: str
+    joints: tuple[Revolute | Slider, ...]
+    gears: tuple[GearCoupling, ...]
+    drivers: tuple[Driver, ...]
+    input_range: tuple[float, float]
+    input_unit: str = "deg"
+    assembly: Mapping[str, tuple[float, float, float]] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        names = [b.name for b in self.bodies]
+        if len(set(names)) != len(names):
+            raise SpecError("mechanism.bodies", "body names must be unique")
+        if self.ground not in names:
+            raise SpecError("mechanism.ground", f"unknown body {self.ground!r}")
+        by_name = {b.name: b for b in self.bodies}
+        for j in self.joints:
+            for b in (j.body_a, j.body_b):
+                if b not in by_name:
+                    raise SpecError(f"mechanism.joints.{j.name}", f"unknown body {b!r}")
+                if j.name not in by_name[b].points:
+                    raise SpecError(f"mechanism.joints.{j.name}", f"body {b!r} has no point {j.name!r}")
+        if self.input_unit not in ("deg", "mm"):
+            raise SpecError("mechanism.input_unit", f"expected 'deg' or 'mm', got {self.input_unit!r}")
+        n_eq = sum(2 for _ in self.joints) + len(self.gears) + len(self.drivers)
+        n_q = 3 * (len(self.bodies) - 1)
+        if n_eq < n_q:
+            raise SpecError("mechanism", f"under-constrained: {n_q - n_eq} degree(s) of freedom are not driven")
+
+    # -- look-ups ------------------------------------------------------------------------------
+    @property
+    def body_names(self) -> tuple[str, ...]:
+        return tuple(b.name for b in self.bodies)
+
+    def body(self, name: str) -> Body:
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        raise KeyError(name)
+
+    def point_owner(self, point: str) -> str:
+        """Name of the first body that has a point named ``point``."""
+        for b in self.bodies:
+            if point in b.points:
+                return b.name
+        raise KeyError(point)
+
+    def point_names(self) -> tuple[str, ...]:
+        """Every named point, in body order, without repeats."""
+        seen: dict[str, None] = {}
+        for b in self.bodies:
+            for p in b.points:
+                seen.setdefault(p, None)
+        return tuple(seen)
+
+    def degrees_of_freedom(self) -> int:
+        """Mobility before drivers (planar Gruebler count with gears as one constraint each)."""
+        return 3 * (len(self.bodies) - 1) - 2 * len(self.joints) - len(self.gears)
+
+    # -- solving ---------------------------------------------------------------------------------
+    def solve(self, s: float) -> dict[str, np.ndarray]:
+        """World pose ``(x, y, theta)`` of every body at input ``s``, on the first pose's branch."""
+        motion = self.sweep(np.array([self.input_range[0], s]) if s != self.input_range[0]
+                            else np.array([s]))
+        return motion.poses_at(len(motion.inputs) - 1)
+
+    def sweep(self, inputs: np.ndarray | int | None = None) -> Motion:
+        """Solve every input value by continuation from the assembled first pose.
+
+        Parameters
+        ----------
+        inputs : (n,) array, int or None
+            Input values in order of motion (the first is assembled from ``assembly``), or a count of
+            evenly spaced values over ``input_range`` (default 361).
+
+        Raises
+        ------
+        LockupError
+            Where the mechanism cannot be assembled or would have to change branch to go on.
+        """
+        if inputs is None:
+            inputs = 361
+        if np.isscalar(inputs):
+            inputs = np.linspace(self.input_range[0], self.input_range[1], int(inputs))
+        inputs = np.asarray(inputs, dtype=np.float64)
+        system = _System(self)
+        q = system.assemble(inputs[0])
+        out = np.empty((len(inputs), len(system.free), 3))
+        out[0] = q.reshape(-1, 3)
+        previous = None
+        for i in range(1, len(inputs)):
+            q, previous = system.continue_to(q, previous, inputs[i - 1], inputs[i])
+            out[i] = q.reshape(-1, 3)
+        return Motion(inputs=inputs, body_names=self.body_names, ground=self.ground,
+                      free=tuple(system.free), q=out, mechanism=self)
+
+    def velocity(self, poses: Mapping[str, np.ndarray], s: float) -> dict[str, np.ndarray]:
+        """d(pose)/ds of every body at a solved pose (per input unit)."""
+        system = _System(self)
+        q = np.concatenate([poses[name] for name in system.free])
+        jac, ds = system.jacobian(q, s)
+        dq = np.linalg.lstsq(jac, -ds, rcond=None)[0]
+        result = {self.ground: np.zeros(3)}
+        for k, name in enumerate(system.free):
+            result[name] = dq[3 * k:3 * k + 3]
+        return result
+
+
+@dataclass(frozen=True)
+class Motion:
+    """World poses of every body over a sweep.
+
+    Attributes
+    ----------
+    inputs : (n,) array
+        Input values (``Mechanism.input_unit``).
+    q : (n, m, 3) array
+        Poses (x mm, y mm, theta rad) of the ``m`` non-ground bodies named in ``free``.
+    """
+
+    inputs: np.ndarray
+    body_names: tuple[str, ...]
+    ground: str
+    free: tuple[str, ...]
+    q: np.ndarray
+    mechanism: Mechanism
+
+    def pose(self, body: str) -> np.ndarray:
+        """Poses of ``body`` over the sweep, shape (n, 3)."""
+        if body == self.ground:
+            return np.zeros((len(self.inputs), 3))
+        return self.q[:, self.free.index(body)]
+
+    def poses_at(self, i: int) -> dict[str, np.ndarray]:
+        """Every body's pose at sweep index ``i``."""
+        return {name: self.pose(name)[i].copy() for name in self.body_names}
+
+    def point(self, name: str, body: str | None = None) -> np.ndarray:
+        """World positions (n, 2) of named point ``name`` (of ``body``, default its first owner)."""
+        body = body or self.mechanism.point_owner(name)
+        local = self.mechanism.body(body).point(name)
+        pose = self.pose(body)
+        return np.einsum("nij,j->ni", rotation(pose[:, 2]), local) + pose[:, :2]
+
+    def relative_angle(self, body: str, reference: str) -> np.ndarray:
+        """theta_body - theta_reference over the sweep (n,), rad."""
+        return self.pose(body)[:, 2] - self.pose(reference)[:, 2]
+
+
+class _System:
+    """Residuals and Jacobian of a mechanism's constraints in the free bodies' poses."""
+
+    def __init__(self, mech: Mechanism) -> None:
+        self.mech = mech
+        self.free = [b.name for b in mech.bodies if b.name != mech.ground]
+        self.index = {name: k for k, name in enumerate(self.free)}
+        self.bodies = {b.name: b for b in mech.bodies}
+        self.n = 3 * len(self.free)
+        self.scale = max(1.0, max((float(np.hypot(*p)) for b in mech.bodies for p in b.points.values()),
+                                  default=1.0))
+
+    def _pose(self, q: np.ndarray, name: str) -> np.ndarray:
+        k = self.index.get(name)
+        return np.zeros(3) if k is None else q[3 * k:3 * k + 3]
+
+    def _driver_value(self, d: Driver, s: float) -> tuple[float, float]:
+        if d.law is not None:
+            return float(d.law(s)), float(d.law(s, 1))
+        if d.kind == "angle" and self.mech.input_unit == "deg":
+            return float(np.radians(s)), float(np.pi / 180.0)
+        return float(s), 1.0
+
+    def residual(self, q: np.ndarray, s: float) -> np.ndarray:
+        return self.jacobian(q, s, want_jacobian=False)[0]
+
+    def jacobian(self, q: np.ndarray, s: float, want_jacobian: bool = True):
+        """Residual vector (m,), Jacobian (m, n) and d(residual)/ds (m,) at poses ``q``."""
+        rows: list[np.ndarray] = []
+        res: list[float] = []
+        dres_ds: list[float] = []
+        n = self.n
+
+        def row() -> np.ndarray:
+            r = np.zeros(n)
+            rows.append(r)
+            return r
+
+        def add_point_terms(r2: list[np.ndarray], body: str, local: np.ndarray, sign: float) -> None:
+            k = self.index.get(body)
+            if k is None:
+                return
+            th = q[3 * k + 2]
+            dR = np.array([[-np.sin(th), -np.cos(th)], [np.cos(th), -np.sin(th)]]) @ local
+            for axis in (0, 1):
+                r2[axis][3 * k + axis] += sign
+                r2[axis][3 * k + 2] += sign * dR[axis]
+
+        def world(body: str, local: np.ndarray) -> np.ndarray:
+            return transform_points(self._pose(q, body), local)
+
+        def angle_row(body: str, reference: str) -> np.ndarray:
+            r = row()
+            if body in self.index:
+                r[3 * self.index[body] + 2] += 1.0
+            if reference in self.index:
+                r[3 * self.index[reference] + 2] -= 1.0
+            return r
+
+        for j in self.mech.joints:
+            pa_local = self.bodies[j.body_a].point(j.name)
+            pb_local = self.bodies[j.body_b].point(j.name)
+            pa, pb = world(j.body_a, pa_local), world(j.body_b, pb_local)
+            if isinstance(j, Revolute):
+                r2 = [row(), row()]
+                add_point_terms(r2, j.body_a, pa_local, 1.0)
+                add_point_terms(r2, j.body_b, pb_local, -1.0)
+                res.extend(pa - pb)
+                dres_ds.extend([0.0, 0.0])
+            else:
+                tha = self._pose(q, j.body_a)[2]
+                thb = self._pose(q, j.body_b)[2]
+                angle_row(j.body_b, j.body_a)
+                res.append(thb - tha - j.angle)
+                dres_ds.append(0.0)
+                # (pb - pa) . n_world = 0, n = axis turned +90 deg in body_a's frame
+                axis = np.asarray(j.axis, dtype=np.float64)
+                axis = axis / np.hypot(*axis)
+                n_local = np.array([-axis[1], axis[0]])
+                n_world = rotation(tha) @ n_local
+                r = row()
+                gx = [np.zeros(n), np.zeros(n)]
+                add_point_terms(gx, j.body_b, pb_local, 1.0)
+                add_point_terms(gx, j.body_a, pa_local, -1.0)
+                r += gx[0] * n_world[0] + gx[1] * n_world[1]
+                if j.body_a in self.index:
+                    dn = np.array([-n_world[1], n_world[0]])
+                    r[3 * self.index[j.body_a] + 2] += float(np.dot(pb - pa, dn))
+                res.append(float(np.dot(pb - pa, n_world)))
+                dres_ds.append(0.0)
+        for g in self.mech.gears:
+            thc = self._pose(q, g.carrier)[2]
+            xa = self._pose(q, g.gear_a)[2] - thc
+            xb = self._pose(q, g.gear_b)[2] - thc
+            slope = float(g.law(xa, 1))
+            r = row()
+            for body, coef in ((g.gear_b, 1.0), (g.gear_a, -slope), (g.carrier, slope - 1.0)):
+                if body in self.index:
+                    r[3 * self.index[body] + 2] += coef
+            res.append(xb - float(g.law(xa)))
+            dres_ds.append(0.0)
+        for d in self.mech.drivers:
+            value, dvalue = self._driver_value(d, s)
+            if d.kind == "angle":
+                angle_row(d.body, d.reference)
+                res.append(self._pose(q, d.body)[2] - self._pose(q, d.reference)[2] - value)
+            else:
+                slider = next(j for j in self.mech.joints if j.name == d.joint)
+                pa_local = self.bodies[d.reference].point(d.joint)
+                pb_local = self.bodies[d.body].point(d.joint)
+                pa, pb = world(d.reference, pa_local), world(d.body, pb_local)
+                axis = np.asarray(slider.axis, dtype=np.float64)
+                axis = axis / np.hypot(*axis)
+                tha = self._pose(q, d.reference)[2]
+                a_world = rotation(tha) @ axis
+                r = row()
+                gx = [np.zeros(n), np.zeros(n)]
+                add_point_terms(gx, d.body, pb_local, 1.0)
+                add_point_terms(gx, d.reference, pa_local, -1.0)
+                r += gx[0] * a_world[0] + gx[1] * a_world[1]
+                if d.reference in self.index:
+                    da = np.array([-a_world[1], a_world[0]])
+                    r[3 * self.index[d.reference] + 2] += float(np.dot(pb - pa, da))
+                res.append(float(np.dot(pb - pa, a_world)) - value)
+            dres_ds.append(-dvalue)
+        jac = np.array(rows) if want_jacobian else None
+        return np.asarray(res), jac, np.asarray(dres_ds)
+
+    def newton(self, q: np.ndarray, s: float, max_iter: int = 30) -> tuple[np.ndarray, bool]:
+        """Gauss-Newton from ``q``; returns (q, converged)."""
+        q = q.copy()
+        for _ in range(max_iter):
+            res, jac, _ = self.jacobian(q, s)
+            err = float(np.max(np.abs(res))) if res.size else 0.0
+            if err < ASSEMBLY_TOLERANCE * self.scale:
+                return q, True
+            step = np.linalg.lstsq(jac, -res, rcond=None)[0]
+            if not np.all(np.isfinite(step)):
+                return q, False
+            q = q + step
+        res = self.residual(q, s)
+        return q, bool(np.max(np.abs(res)) < ASSEMBLY_TOLERANCE * self.scale)
+
+    def assemble(self, s: float) -> np.ndarray:
+        guess = []
+        for name in self.free:
+            if name not in self.mech.assembly:
+                raise SpecError(f"mechanism.assembly.{name}", "missing assembly guess for body")
+            guess.extend(np.asarray(self.mech.assembly[name], dtype=np.float64))
+        q, ok = self.newton(np.asarray(guess), s)
+        if not ok:
+            raise LockupError(s, f"{self.mech.name}: cannot assemble the first pose")
+        return q
+
+    def _step_ok(self, q_old: np.ndarray, q_new: np.ndarray, s: float) -> bool:
+        # a step is suspicious when a body turns more than 0.3 rad or moves more than 30 % of the
+        # mechanism's size: the predictor landed near another branch rather than following this one
+        d = (q_new - q_old).reshape(-1, 3)
+        return bool(np.all(np.abs(d[:, 2]) < 0.3) and np.all(np.hypot(d[:, 0], d[:, 1]) < 0.3 * self.scale))
+
+    def _orientation(self, q: np.ndarray, s: float) -> float:
+        _, jac, _ = self.jacobian(q, s)
+        if jac.shape[0] != jac.shape[1]:
+            return 0.0
+        return float(np.sign(np.linalg.det(jac)))
+
+    def continue_to(self, q: np.ndarray, previous: tuple[np.ndarray, float] | None, s0: float,
+                    s1: float) -> tuple[np.ndarray, tuple[np.ndarray, float]]:
+        """Follow the branch from (q at s0) to s1 with an adaptive step; raise at lock-up."""
+        s = s0
+        sign0 = self._orientation(q, s)
+        direction = 1.0 if s1 >= s0 else -1.0
+        h_mag = abs(s1 - s0)
+        min_h = abs(s1 - s0) * 1e-6 + 1e-12
+        while direction * (s1 - s) > 1e-15:
+            h = direction * min(h_mag, abs(s1 - s))
+            # first-order (tangent) predictor keeps the corrector on this branch
+            _, jac, ds = self.jacobian(q, s)
+            tangent = np.linalg.lstsq(jac, -ds, rcond=None)[0]
+            q_new, ok = self.newton(q + tangent * h, s + h)
+            if ok and self._step_ok(q, q_new, s + h):
+                sign = self._orientation(q_new, s + h)
+                if sign0 != 0.0 and sign != 0.0 and sign != sign0:
+                    raise LockupError(s + h, f"{self.mech.name}: the motion passes a singular pose "
+                                             "(branch change)")
+                previous = (q, s)
+                q, s = q_new, s + h
+                h_mag *= 1.5
+                continue
+            h_mag *= 0.5
+            if h_mag < min_h:
+                raise LockupError(s, f"{self.mech.name}: lock-up, no assembly beyond this input")
+        return q, previous if previous is not None else (q, s)
+

@@ -1,0 +1,410 @@
+"""Template loading and validation.
+
+A template is a TOML file. This module reads it and offers :class:`Table`, a strict reader that every
+spec parser (the generic sections here, the kind-specific ones in :mod:`fabricate.synthesis`) uses so
+that every error names the field path and what was expected. Nothing here writes files.
+
+Generic sections
+----------------
+``[design]``   name, kind (selects the synthesis method), description.
+``[process]``  profile (``"sla"`` or ``"laser"``, read from ``templates/process_<profile>.toml``) and any
+               field of that profile to override.
+``[checks]``   sweep_poses, min_clearance_mm.
+Every other top-level table belongs to the kind's parser.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fabricate.errors import SpecError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+#: Folder of the shipped templates (next to the package in a source checkout).
+TEMPLATE_DIR = Path(__file__).resolve().parent.parent / "templates"
+
+_MISSING = object()
+
+
+def _describe(value: Any) -> str:
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, Mapping):
+        return "a table"
+    if isinstance(value, (list, tuple)):
+        return f"a list of {len(value)}"
+    return repr(value)
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+class Table:
+    """Strict, path-aware reader over one TOML table.
+
+    Parameters
+    ----------
+    data : Mapping
+        The table.
+    path : str
+        Its dotted path in the template ('' for the root).
+
+    Notes
+    -----
+    Every getter records the key as used; :meth:`finish` raises on keys never read, so a typo in a
+    template is an error and not a silently ignored field.
+    """
+
+    def __init__(self, data: Mapping[str, Any], path: str = "") -> None:
+        if not isinstance(data, Mapping):
+            raise SpecError(path, f"expected a table, got {_describe(data)}")
+        self.data = data
+        self.path = path
+        self._used: set[str] = set()
+
+    # -- helpers -----------------------------------------------------------------------------
+    def field(self, key: str) -> str:
+        """Dotted path of ``key`` in this table."""
+        return f"{self.path}.{key}" if self.path else key
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def _get(self, key: str, default: Any) -> Any:
+        self._used.add(key)
+        if key in self.data:
+            return self.data[key]
+        if default is _MISSING:
+            raise SpecError(self.field(key), "missing required field")
+        return default
+
+    # -- getters -----------------------------------------------------------------------------
+    def number(
+        self,
+        key: str,
+        default: Any = _MISSING,
+        *,
+        min: float | None = None,
+        max: float | None = None,
+        positive: bool = False,
+        integer: bool = False,
+    ) -> float:
+        """A finite number, optionally bounded. ``positive`` means strictly greater than zero."""
+        value = self._get(key, default)
+        if value is default and default is not _MISSING:
+            return value
+        return check_number(value, self.field(key), min=min, max=max, positive=positive, integer=integer)
+
+    def integer(self, key: str, default: Any = _MISSING, *, min: int | None = None,
+                max: int | None = None) -> int:
+        """A whole number, optionally bounded."""
+        return int(self.number(key, default, min=min, max=max, integer=True))
+
+    def string(self, key: str, default: Any = _MISSING, *, choices: Sequence[str] | None = None) -> str:
+        """A string, optionally one of ``choices``."""
+        value = self._get(key, default)
+        if value is default and default is not _MISSING:
+            return value
+        if not isinstance(value, str):
+            raise SpecError(self.field(key), f"expected a string, got {_describe(value)}")
+        if choices is not None and value not in choices:
+            raise SpecError(self.field(key), f"expected one of {', '.join(map(repr, choices))}, got \"{value}\"")
+        return value
+
+    def boolean(self, key: str, default: Any = _MISSING) -> bool:
+        value = self._get(key, default)
+        if not isinstance(value, bool):
+            raise SpecError(self.field(key), f"expected true or false, got {_describe(value)}")
+        return value
+
+    def array(
+        self,
+        key: str,
+        default: Any = _MISSING,
+        *,
+        shape: tuple[int | None, ...] | None = None,
+        min_rows: int = 0,
+        min: float | None = None,
+        max: float | None = None,
+        positive: bool = False,
+    ) -> np.ndarray:
+        """A list (or nested list) of finite numbers as a float64 array.
+
+        ``shape`` may use ``None`` for a free dimension, e.g. ``(None, 3)``.
+        """
+        value = self._get(key, default)
+        if value is default and default is not _MISSING:
+            return value
+        return check_array(value, self.field(key), shape=shape, min_rows=min_rows, min=min, max=max,
+                           positive=positive)
+
+    def strings(self, key: str, default: Any = _MISSING) -> tuple[str, ...]:
+        value = self._get(key, default)
+        if value is default and default is not _MISSING:
+            return value
+        if not isinstance(value, list):
+            raise SpecError(self.field(key), f"expected a list of strings, got {_describe(value)}")
+        for i, item in enumerate(value):
+            if not isinstance(item, str):
+                raise SpecError(f"{self.field(key)}[{i}]", f"expected a string, got {_describe(item)}")
+        return tuple(value)
+
+    def table(self, key: str, default: Any = _MISSING) -> Table:
+        """A sub-table; with a default of ``{}`` a missing table reads as empty."""
+        value = self._get(key, default)
+        return Table(value, self.field(key))
+
+    def tables(self, key: str, default: Any = _MISSING) -> list[Table]:
+        """An array of tables (``[[key]]``)."""
+        value = self._get(key, default)
+        if not isinstance(value, list):
+            raise SpecError(self.field(key), f"expected an array of tables, got {_describe(value)}")
+        return [Table(item, f"{self.field(key)}[{i}]") for i, item in enumerate(value)]
+
+    def raw(self, key: str, default: Any = _MISSING) -> Any:
+        return self._get(key, default)
+
+    def finish(self) -> None:
+        """Raise on the first key that no getter read (a typo or a field this kind does not know)."""
+        for key in self.data:
+            if key not in self._used:
+                raise SpecError(self.field(key), "unknown field")
+
+
+def check_number(value: Any, path: str, *, min: float | None = None, max: float | None = None,
+                 positive: bool = False, integer: bool = False) -> float:
+    """Validate one number; see :meth:`Table.number`."""
+    if not _is_number(value):
+        raise SpecError(path, f"expected a number, got {_describe(value)}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise SpecError(path, f"expected a finite number, got {value}")
+    if integer and value != round(value):
+        raise SpecError(path, f"expected a whole number, got {value:g}")
+    if positive and value <= 0:
+        raise SpecError(path, f"expected a positive number, got {value:g}")
+    if min is not None and value < min:
+        raise SpecError(path, f"expected a number >= {min:g}, got {value:g}")
+    if max is not None and value > max:
+        raise SpecError(path, f"expected a number <= {max:g}, got {value:g}")
+    return value
+
+
+def check_array(value: Any, path: str, *, shape: tuple[int | None, ...] | None = None, min_rows: int = 0,
+                min: float | None = None, max: float | None = None, positive: bool = False) -> np.ndarray:
+    """Validate a (nested) list of numbers element by element so the error names the bad index."""
+
+    def walk(item: Any, where: str, depth: int) -> Any:
+        if isinstance(item, list):
+            if shape is not None and depth < len(shape) and shape[depth] is not None \
+                    and len(item) != shape[depth]:
+                raise SpecError(where, f"expected {shape[depth]} values, got {len(item)}")
+            return [walk(x, f"{where}[{i}]", depth + 1) for i, x in enumerate(item)]
+        if shape is not None and depth < len(shape):
+            raise SpecError(where, f"expected a list, got {_describe(item)}")
+        return check_number(item, where, min=min, max=max, positive=positive)
+
+    if not isinstance(value, list):
+        raise SpecError(path, f"expected a list, got {_describe(value)}")
+    nested = walk(value, path, 0)
+    if len(nested) < min_rows:
+        raise SpecError(path, f"expected at least {min_rows} entries, got {len(nested)}")
+    try:
+        arr = np.asarray(nested, dtype=np.float64)
+    except ValueError as exc:  # ragged lists
+        raise SpecError(path, "expected rows of equal length") from exc
+    if shape is not None and arr.ndim != len(shape):
+        raise SpecError(path, f"expected a {len(shape)}-dimensional list, got {arr.ndim} dimensions")
+    return arr
+
+
+# -- templates -------------------------------------------------------------------------------
+
+def find_template(name_or_path: str | Path) -> Path:
+    """Resolve a template argument: an existing path, or a shipped template's name (with or without .toml)."""
+    candidate = Path(name_or_path)
+    if candidate.is_file():
+        return candidate
+    stem = candidate.name[:-5] if candidate.name.endswith(".toml") else candidate.name
+    shipped = TEMPLATE_DIR / f"{stem}.toml"
+    if shipped.is_file() and candidate.parent == Path("."):
+        return shipped
+    raise SpecError("", f"template not found: {name_or_path} (see 'fabricate list')")
+
+
+def shipped_templates() -> list[Path]:
+    """Design templates shipped in ``templates/`` (process profiles excluded)."""
+    return sorted(p for p in TEMPLATE_DIR.glob("*.toml") if not p.name.startswith("process_"))
+
+
+def read_toml(path: Path) -> dict[str, Any]:
+    """Parse a TOML file; syntax errors become :class:`SpecError` naming the file and line."""
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(str(path), f"invalid TOML: {exc}") from exc
+    except OSError as exc:
+        raise SpecError(str(path), f"cannot read: {exc.strerror}") from exc
+
+
+@dataclass(frozen=True)
+class ProcessSpec:
+    """Manufacturing process profile. Lengths in mm.
+
+    Attributes
+    ----------
+    name : str
+        ``"sla"`` or ``"laser"``.
+    running_clearance_mm : float
+        Radial clearance between a pin and its hole, and between moving faces.
+    hole_compensation_mm : float
+        Added to a hole's diameter in the model (SLA holes print undersize); laser uses kerf instead.
+    min_wall_mm, min_pin_mm, layer_gap_mm : float
+        Smallest wall around a hole, smallest pin diameter, axial gap between stacked layers.
+    thickness_mm : float
+        Plate thickness of a link layer (SLA) or the sheet thickness (laser).
+    kerf_mm : float
+        Laser kerf width (0 for SLA); outlines are offset out and holes in by kerf / 2.
+    min_feature_mm : float
+        Smallest feature the process resolves (tooth tip land, web).
+    build_volume_mm : tuple of float
+        SLA build volume (x, y, z) or laser sheet (x, y, thickness).
+    pin_diameter_mm : float
+        Nominal pin diameter used at joints.
+    """
+
+    name: str
+    running_clearance_mm: float
+    hole_compensation_mm: float
+    min_wall_mm: float
+    min_pin_mm: float
+    layer_gap_mm: float
+    thickness_mm: float
+    kerf_mm: float
+    min_feature_mm: float
+    build_volume_mm: tuple[float, float, float]
+    pin_diameter_mm: float
+    chord_tolerance_mm: float
+
+
+def parse_process(table: Table) -> ProcessSpec:
+    """Read ``[process]``: a profile name plus overrides of the profile's fields."""
+    profile = table.string("profile", "sla", choices=("sla", "laser"))
+    base_path = TEMPLATE_DIR / f"process_{profile}.toml"
+    base = read_toml(base_path) if base_path.is_file() else {}
+    merged = dict(base)
+    for key in table.data:
+        if key != "profile":
+            merged[key] = table.data[key]
+            table._used.add(key)
+    t = Table(merged, table.path or "process")
+    spec = ProcessSpec(
+        name=profile,
+        running_clearance_mm=t.number("running_clearance_mm", min=0.0, max=5.0),
+        hole_compensation_mm=t.number("hole_compensation_mm", 0.0, min=-2.0, max=2.0),
+        min_wall_mm=t.number("min_wall_mm", positive=True),
+        min_pin_mm=t.number("min_pin_mm", positive=True),
+        layer_gap_mm=t.number("layer_gap_mm", min=0.0),
+        thickness_mm=t.number("thickness_mm", positive=True),
+        kerf_mm=t.number("kerf_mm", 0.0, min=0.0, max=2.0),
+        min_feature_mm=t.number("min_feature_mm", positive=True),
+        build_volume_mm=tuple(t.array("build_volume_mm", shape=(3,), positive=True).tolist()),
+        pin_diameter_mm=t.number("pin_diameter_mm", positive=True),
+        chord_tolerance_mm=t.number("chord_tolerance_mm", 0.005, positive=True, max=1.0),
+    )
+    t.finish()
+    if spec.pin_diameter_mm < spec.min_pin_mm:
+        raise SpecError(t.field("pin_diameter_mm"),
+                        f"pin {spec.pin_diameter_mm:g} mm is below the process minimum {spec.min_pin_mm:g} mm")
+    return spec
+
+
+@dataclass(frozen=True)
+class ChecksSpec:
+    """``[checks]``: sweep resolution and pass thresholds."""
+
+    sweep_poses: int = 360
+    min_clearance_mm: float | None = None  # None: the process's running clearance
+
+
+def parse_checks(table: Table) -> ChecksSpec:
+    spec = ChecksSpec(
+        sweep_poses=table.integer("sweep_poses", 360, min=2, max=100000),
+        min_clearance_mm=table.number("min_clearance_mm", None, min=0.0),
+    )
+    table.finish()
+    return spec
+
+
+@dataclass(frozen=True)
+class DesignSpec:
+    """A whole validated template.
+
+    Attributes
+    ----------
+    name, kind, description : str
+    template : Path
+        Where it was read from.
+    process : ProcessSpec
+    checks : ChecksSpec
+    gears : fabricate.gears.spec.GearSpec
+        ``[gears]``: module, pressure angle, method, backlash (defaults when the table is absent).
+    parts : fabricate.parts.spec.PartsSpec
+        ``[parts]``: pad, hub and mounting options (defaults when the table is absent).
+    method : object
+        The kind's own frozen spec (see :mod:`fabricate.synthesis`).
+    """
+
+    name: str
+    kind: str
+    description: str
+    template: Path
+    process: ProcessSpec
+    checks: ChecksSpec
+    gears: Any
+    parts: Any
+    method: Any
+
+
+def load_design(path: str | Path) -> DesignSpec:
+    """Load and validate a template into a :class:`DesignSpec`.
+
+    Raises
+    ------
+    SpecError
+        On the first invalid field, naming its path.
+    """
+    from fabricate.gears.spec import parse_gear_spec
+    from fabricate.parts.spec import parse_parts_spec
+    from fabricate.synthesis import KINDS
+
+    path = find_template(path)
+    root = Table(read_toml(path))
+    design = root.table("design")
+    name = design.string("name")
+    if not name or any(c in name for c in "/\\:") or name.startswith("."):
+        raise SpecError("design.name", f"expected a plain file name, got \"{name}\"")
+    kind = design.string("kind", choices=tuple(sorted(KINDS)))
+    description = design.string("description", "")
+    design.finish()
+    process = parse_process(root.table("process", {}))
+    checks = parse_checks(root.table("checks", {}))
+    gears = parse_gear_spec(root.table("gears", {}))
+    parts = parse_parts_spec(root.table("parts", {}))
+    method = KINDS[kind].parse_spec(root)
+    root.finish()
+    return DesignSpec(name=name, kind=kind, description=description, template=path, process=process,
+                      checks=checks, gears=gears, parts=parts, method=method)

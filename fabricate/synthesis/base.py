@@ -1,0 +1,36 @@
+"""What every synthesis method hands to the rest of the pipeline."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from fabricate.mechanism import Mechanism
+
+
+@dataclass(frozen=True)
+class SynthesisResult:
+    """Outcome of one synthesis method.
+
+    Attributes
+    ----------
+    mechanism : Mechanism or None
+        The selected design as a solvable mechanism (None for a standalone gear pair).
+    report : dict
+        JSON-ready ``synthesis`` section of report.json (numbers as floats/lists, angles in degrees
+        where the key says ``_deg``).
+    figures : callable
+        Returns ``{file name: PNG bytes}``; called by the pipeline only (plots are slow and optional).
+    data : object
+        Method-specific results (curves, regions, candidates) for tests and plots.
+    parts : Mapping
+        Method-specific hints for the parts layer (e.g. which body carries the fingertip pad, springs
+        for the bill of materials). Keys are documented in :mod:`fabricate.parts`.
+    """
+
+    mechanism: Mechanism | None
+    report: dict[str, Any]
+    figures: Callable[[], dict[str, bytes]] = lambda: {}
+    data: Any = None
+    parts: Mapping[str, Any] = field(default_factory=dict)
