@@ -1,0 +1,164 @@
+"""The generic ``[gears]`` template table: how gear teeth are cut and checked.
+
+Every template may carry a ``[gears]`` table; when it is absent the defaults below apply. The table
+describes the *teeth* (module, pressure angle, proportions, method) and the *checks*; the ratio law
+and the centre distance come from the mechanism (a :class:`~fabricate.mechanism.GearCoupling`).
+
+Keys (all optional)
+-------------------
+``module_mm``            float > 0. Module m in mm. Absent: chosen automatically — for a closed pair from
+                         the tooth count and centre distance, for a sector 0.5 mm (an SLA-sized module).
+``pressure_angle_deg``   float in [10, 35], default 20. Pressure angle of the generating rack.
+``addendum``             float in [0.3, 1.5] × m, default 1.0.
+``dedendum``             float in [0.5, 2.0] × m, default 1.25; must exceed ``addendum`` (tip clearance).
+``root_fillet``          float in [0, 0.5] × m, default 0.38. Rack tip round radius (cuts the fillet).
+``backlash_mm``          float in [0, 1], default 0.05. Circumferential backlash of the pair; each gear's
+                         flanks are moved inwards by half of it as a true normal offset.
+``method``               ``"exact"`` (default: both gears cut by one virtual rack rolling on the pitch
+                         curves) or ``"approx"`` (each tooth an involute tooth of the local osculating
+                         circle).
+``compare_methods``      bool, default true. Also build the other method and report the largest deviation
+                         between the two outlines in µm.
+``spare_teeth``          int >= 1, default 1. Extra engagements beyond each end of a sector's range.
+``mesh_steps``           int >= 720, default 720. Poses of the mesh check over the working range.
+``closed``               bool. Absent: as the design kind says (sector for a finger, closed for a gear pair).
+``teeth``                [z_a, z_b], integers >= 3. Tooth counts of a closed pair (with the centre distance
+                         they fix the module, unless ``module_mm`` is given, which then fixes the
+                         centre distance).
+``min_teeth``            int >= 3, default 8. Fewest teeth a closed gear may have (a check).
+``bore_mm``              float > 0. Bore of each gear on its axis. Absent: the process pin diameter.
+``hub_diameter_mm``      float > 0. Hub around the bore. Absent: the parts layer decides.
+
+Example
+-------
+.. code-block:: toml
+
+    [gears]
+    module_mm = 1.0
+    method = "exact"
+    backlash_mm = 0.08
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from fabricate.errors import SpecError
+from fabricate.spec import Table
+
+METHODS = ("exact", "approx")
+
+
+@dataclass(frozen=True)
+class GearSpec:
+    """Validated ``[gears]`` table. Lengths in mm; ``addendum``, ``dedendum``, ``root_fillet`` × module.
+
+    Attributes
+    ----------
+    module_mm : float or None
+        Module in mm; None means "choose" (see the module docstring).
+    pressure_angle_deg : float
+        Rack pressure angle, degrees.
+    addendum, dedendum, root_fillet : float
+        Tooth proportions as multiples of the module.
+    backlash_mm : float
+        Circumferential backlash of the pair at the pitch curve, mm.
+    method : str
+        ``"exact"`` or ``"approx"``.
+    compare_methods : bool
+        Build the other method too and report the deviation.
+    spare_teeth : int
+        Extra engagements at each end of a sector.
+    mesh_steps : int
+        Poses in the mesh check.
+    closed : bool or None
+        Closed gears, sectors, or None for the kind's default.
+    teeth : tuple of int or None
+        (z_a, z_b) for a closed pair.
+    min_teeth : int
+        Smallest acceptable tooth count of a closed gear.
+    bore_mm, hub_diameter_mm : float or None
+        Bore and hub diameters; None lets the pipeline use the process pin / parts defaults.
+    """
+
+    module_mm: float | None = None
+    pressure_angle_deg: float = 20.0
+    addendum: float = 1.0
+    dedendum: float = 1.25
+    root_fillet: float = 0.38
+    backlash_mm: float = 0.05
+    method: str = "exact"
+    compare_methods: bool = True
+    spare_teeth: int = 1
+    mesh_steps: int = 720
+    closed: bool | None = None
+    teeth: tuple[int, int] | None = None
+    min_teeth: int = 8
+    bore_mm: float | None = None
+    hub_diameter_mm: float | None = None
+
+    @property
+    def pressure_angle(self) -> float:
+        """Pressure angle in radians."""
+        return math.radians(self.pressure_angle_deg)
+
+    def module_or(self, default_mm: float) -> float:
+        """The module, or ``default_mm`` when the template leaves it to the method."""
+        return self.module_mm if self.module_mm is not None else float(default_mm)
+
+
+def parse_gear_spec(table: Table) -> GearSpec:
+    """Read the ``[gears]`` table (an empty table gives the defaults).
+
+    Parameters
+    ----------
+    table : Table
+        The ``[gears]`` table, ``{}`` when absent.
+
+    Returns
+    -------
+    GearSpec
+
+    Raises
+    ------
+    SpecError
+        On a field out of range, naming ``gears.<key>`` and the accepted range.
+    """
+    module = table.number("module_mm", None, positive=True, max=50.0)
+    pressure = table.number("pressure_angle_deg", 20.0, min=10.0, max=35.0)
+    addendum = table.number("addendum", 1.0, min=0.3, max=1.5)
+    dedendum = table.number("dedendum", 1.25, min=0.5, max=2.0)
+    fillet = table.number("root_fillet", 0.38, min=0.0, max=0.5)
+    backlash = table.number("backlash_mm", 0.05, min=0.0, max=1.0)
+    method = table.string("method", "exact", choices=METHODS)
+    compare = table.boolean("compare_methods", True)
+    spare = table.integer("spare_teeth", 1, min=1, max=20)
+    steps = table.integer("mesh_steps", 720, min=720, max=200000)
+    closed = table.boolean("closed") if table.has("closed") else None
+    teeth_arr = table.array("teeth", None, shape=(2,), min=3, max=2000)
+    teeth: tuple[int, int] | None = None
+    if teeth_arr is not None:
+        for i, z in enumerate(teeth_arr):
+            if z != round(z):
+                raise SpecError(f"{table.field('teeth')}[{i}]", f"expected a whole number, got {z:g}")
+        teeth = (int(teeth_arr[0]), int(teeth_arr[1]))
+    min_teeth = table.integer("min_teeth", 8, min=3, max=1000)
+    bore = table.number("bore_mm", None, positive=True, max=500.0)
+    hub = table.number("hub_diameter_mm", None, positive=True, max=1000.0)
+    table.finish()
+    if dedendum <= addendum:
+        raise SpecError(table.field("dedendum"),
+                        f"dedendum {dedendum:g} m must exceed addendum {addendum:g} m (tip clearance); "
+                        f"use dedendum >= {addendum + 0.25:g}")
+    if hub is not None and bore is not None and hub <= bore:
+        raise SpecError(table.field("hub_diameter_mm"),
+                        f"hub {hub:g} mm must be larger than the bore {bore:g} mm")
+    if teeth is not None and min(teeth) < min_teeth:
+        raise SpecError(table.field("teeth"),
+                        f"{min(teeth)} teeth is below min_teeth = {min_teeth}; "
+                        "use more teeth (a smaller module)")
+    return GearSpec(module_mm=module, pressure_angle_deg=pressure, addendum=addendum, dedendum=dedendum,
+                    root_fillet=fillet, backlash_mm=backlash, method=method, compare_methods=compare,
+                    spare_teeth=spare, mesh_steps=steps, closed=closed, teeth=teeth, min_teeth=min_teeth,
+                    bore_mm=bore, hub_diameter_mm=hub)
