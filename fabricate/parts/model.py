@@ -1,0 +1,189 @@
+"""Part model: exact 2D profiles (lines and arcs as bulge paths, circles for holes), their polygonisation
+by a chord tolerance, and the :class:`Part` record every exporter and check reads.
+
+A profile is kept exact so the DXF exporter can write true arcs (LWPOLYLINE bulges) and CIRCLEs; meshes
+and booleans use :meth:`BulgePath.polygon` with an explicit chord tolerance (sagitta, mm).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fabricate.planar import polygon_area
+
+
+@dataclass(frozen=True)
+class BulgePath:
+    """A closed path of straight and circular segments (the DXF LWPOLYLINE model).
+
+    Attributes
+    ----------
+    vertices : (n, 2) float64 array
+        Vertices in mm, counter-clockwise for an outer contour. The path closes from the last vertex
+        back to the first.
+    bulges : (n,) float64 array
+        ``tan(included_angle / 4)`` of the segment from vertex i to vertex i+1: 0 for a line, positive
+        for a counter-clockwise arc.
+    """
+
+    vertices: np.ndarray
+    bulges: np.ndarray
+
+    @staticmethod
+    def polyline(vertices: np.ndarray) -> BulgePath:
+        """A path of straight segments only."""
+        v = np.asarray(vertices, dtype=np.float64)
+        return BulgePath(v, np.zeros(len(v)))
+
+    def polygon(self, chord_tolerance_mm: float) -> np.ndarray:
+        """Vertices of the path with every arc split so its sagitta is at most ``chord_tolerance_mm``.
+
+        Returns
+        -------
+        (m, 2) float64 array
+            Polygon vertices (closed implicitly), on the exact curve.
+        """
+        out: list[np.ndarray] = []
+        n = len(self.vertices)
+        for i in range(n):
+            p0 = self.vertices[i]
+            p1 = self.vertices[(i + 1) % n]
+            b = float(self.bulges[i])
+            out.append(p0[None, :])
+            if b != 0.0:
+                out.append(arc_points(p0, p1, b, chord_tolerance_mm)[1:-1])
+        return np.concatenate(out, axis=0)
+
+    def area(self) -> float:
+        """Exact signed area (mm^2): polygon area plus the circular segments of the arcs."""
+        area = polygon_area(self.vertices)
+        n = len(self.vertices)
+        for i in range(n):
+            b = float(self.bulges[i])
+            if b == 0.0:
+                continue
+            chord = float(np.hypot(*(self.vertices[(i + 1) % n] - self.vertices[i])))
+            theta = 4.0 * math.atan(b)
+            radius = chord / (2.0 * abs(math.sin(theta / 2.0)))
+            area += math.copysign(0.5 * radius * radius * (abs(theta) - math.sin(abs(theta))), theta)
+        return area
+
+
+def arc_points(p0: np.ndarray, p1: np.ndarray, bulge: float, chord_tolerance_mm: float) -> np.ndarray:
+    """Points on the arc from ``p0`` to ``p1`` with ``bulge`` (ends included), sagitta ≤ tolerance; (k, 2)."""
+    theta = 4.0 * math.atan(bulge)
+    chord_vec = p1 - p0
+    chord = float(np.hypot(*chord_vec))
+    radius = chord / (2.0 * abs(math.sin(theta / 2.0)))
+    segments = circle_segments(radius, chord_tolerance_mm, abs(theta))
+    # centre lies left of the chord for a positive (counter-clockwise) bulge
+    mid = 0.5 * (p0 + p1)
+    normal = np.array([-chord_vec[1], chord_vec[0]]) / chord
+    offset = radius * math.cos(theta / 2.0)
+    centre = mid + math.copysign(1.0, theta) * normal * offset
+    a0 = math.atan2(p0[1] - centre[1], p0[0] - centre[0])
+    angles = a0 + np.linspace(0.0, theta, segments + 1)
+    pts = centre + radius * np.column_stack([np.cos(angles), np.sin(angles)])
+    pts[0], pts[-1] = p0, p1
+    return pts
+
+
+def circle_segments(radius: float, chord_tolerance_mm: float, sweep: float = 2.0 * math.pi) -> int:
+    """Number of chords so that an arc of ``radius`` and ``sweep`` (rad) has sagitta ≤ tolerance."""
+    if radius <= chord_tolerance_mm:
+        return max(3, int(math.ceil(sweep / (2.0 * math.pi / 3.0))))
+    step = 2.0 * math.acos(1.0 - chord_tolerance_mm / radius)
+    return max(1 if sweep < 2.0 * math.pi else 3, int(math.ceil(sweep / step - 1e-9)))
+
+
+def circle_polygon(centre: np.ndarray, diameter: float, chord_tolerance_mm: float,
+                   clockwise: bool = False) -> np.ndarray:
+    """Polygon inscribed in a circle with sagitta ≤ tolerance; (k, 2), counter-clockwise unless asked."""
+    n = max(8, circle_segments(diameter / 2.0, chord_tolerance_mm))
+    angles = np.arange(n) * (2.0 * math.pi / n)
+    if clockwise:
+        angles = -angles
+    return np.asarray(centre, dtype=np.float64) + 0.5 * diameter * np.column_stack(
+        [np.cos(angles), np.sin(angles)])
+
+
+@dataclass(frozen=True)
+class Hole:
+    """A round hole through a part.
+
+    Attributes
+    ----------
+    joint : str
+        Joint (or mounting point) it serves.
+    centre : (2,) array
+        Centre in part (body) coordinates, mm.
+    diameter_mm : float
+        Diameter as modelled (nominal pin plus clearance and process compensation).
+    pin_diameter_mm : float
+        Nominal diameter of the pin it takes (0 for mounting holes with no pin).
+    """
+
+    joint: str
+    centre: np.ndarray
+    diameter_mm: float
+    pin_diameter_mm: float = 0.0
+
+
+@dataclass(frozen=True)
+class Part:
+    """One manufacturable part: a plate of ``thickness_mm`` from ``z_mm`` up, outline with holes,
+    fixed to ``body`` of the mechanism (coordinates are the body's).
+
+    Attributes
+    ----------
+    name : str
+        Unique part name (file stem).
+    body : str
+        Mechanism body it moves with.
+    outline : BulgePath
+        Outer contour, counter-clockwise, mm, body coordinates.
+    holes : tuple of Hole
+    thickness_mm, z_mm : float
+        Plate thickness and height of its bottom face in the assembly.
+    layer : int
+        Layer index in the stack (0 at the bottom).
+    process : str
+        ``"sla"`` or ``"laser"``.
+    role : str
+        ``"link"``, ``"gear"``, ``"ground"``, ``"rod"``, ``"spacer"``.
+    gear : str
+        Name of the gear pair whose gear is fused into this part ('' if none).
+    """
+
+    name: str
+    body: str
+    outline: BulgePath
+    holes: tuple[Hole, ...]
+    thickness_mm: float
+    z_mm: float
+    layer: int
+    process: str
+    role: str = "link"
+    gear: str = ""
+    extra: dict = field(default_factory=dict, compare=False)
+
+    def polygons(self, chord_tolerance_mm: float) -> list[np.ndarray]:
+        """Outer contour (CCW) then every hole (CW) as polygons, for meshing and booleans."""
+        outer = self.outline.polygon(chord_tolerance_mm)
+        if polygon_area(outer) < 0:
+            outer = outer[::-1]
+        rings = [outer]
+        for hole in self.holes:
+            rings.append(circle_polygon(hole.centre, hole.diameter_mm, chord_tolerance_mm, clockwise=True))
+        return rings
+
+    def area_mm2(self) -> float:
+        """Exact plate area: outline minus holes (mm^2)."""
+        return abs(self.outline.area()) - sum(math.pi * h.diameter_mm ** 2 / 4.0 for h in self.holes)
+
+    def volume_mm3(self) -> float:
+        """Exact volume of the plate (mm^3)."""
+        return self.area_mm2() * self.thickness_mm

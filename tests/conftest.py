@@ -1,0 +1,62 @@
+"""Shared fixtures: small mechanisms built from first principles (no template, no synthesis)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fabricate.mechanism import Body, Driver, Mechanism, Revolute
+from fabricate.planar import circle_circle_intersection
+from fabricate.spec import ProcessSpec
+
+
+def make_four_bar(crank: float = 15.0, coupler: float = 40.0, rocker: float = 30.0, ground: float = 40.0,
+                  start_deg: float = 60.0, end_deg: float = 420.0, upper: bool = True) -> Mechanism:
+    """A crank-rocker four-bar O-A-B-D (ground O-D on +x), crank driven from ``start_deg``.
+
+    Bodies: ground (O, D), crank (O, A), coupler (A, B), rocker (D, B); each body's frame has its
+    first joint at the origin and its second on +x.
+    """
+    th = math.radians(start_deg)
+    a = np.array([crank * math.cos(th), crank * math.sin(th)])
+    d = np.array([ground, 0.0])
+    b = circle_circle_intersection(a, coupler, d, rocker)[0 if upper else 1]
+
+    def frame(p0: np.ndarray, p1: np.ndarray) -> tuple[float, float, float]:
+        return (float(p0[0]), float(p0[1]), math.atan2(p1[1] - p0[1], p1[0] - p0[0]))
+
+    return Mechanism(
+        name="four_bar",
+        bodies=(Body("ground", {"O": (0.0, 0.0), "D": (ground, 0.0)}),
+                Body("crank", {"O": (0.0, 0.0), "A": (crank, 0.0)}),
+                Body("coupler", {"A": (0.0, 0.0), "B": (coupler, 0.0)}),
+                Body("rocker", {"D": (0.0, 0.0), "B": (rocker, 0.0)})),
+        ground="ground",
+        joints=(Revolute("O", "ground", "crank"), Revolute("A", "crank", "coupler"),
+                Revolute("B", "coupler", "rocker"), Revolute("D", "ground", "rocker")),
+        gears=(),
+        drivers=(Driver("angle", "crank", "ground"),),
+        input_range=(start_deg, end_deg),
+        assembly={"crank": (0.0, 0.0, th), "coupler": frame(a, b), "rocker": frame(d, b)},
+    )
+
+
+@pytest.fixture
+def four_bar() -> Mechanism:
+    return make_four_bar()
+
+
+@pytest.fixture
+def sla_process() -> ProcessSpec:
+    return ProcessSpec(name="sla", running_clearance_mm=0.25, hole_compensation_mm=0.2, min_wall_mm=0.8,
+                       min_pin_mm=1.5, layer_gap_mm=0.3, thickness_mm=3.0, kerf_mm=0.0, min_feature_mm=0.3,
+                       build_volume_mm=(130.0, 80.0, 160.0), pin_diameter_mm=2.0, chord_tolerance_mm=0.005)
+
+
+@pytest.fixture
+def laser_process() -> ProcessSpec:
+    return ProcessSpec(name="laser", running_clearance_mm=0.1, hole_compensation_mm=0.0, min_wall_mm=3.0,
+                       min_pin_mm=2.0, layer_gap_mm=0.5, thickness_mm=3.0, kerf_mm=0.2, min_feature_mm=0.5,
+                       build_volume_mm=(600.0, 400.0, 3.0), pin_diameter_mm=3.0, chord_tolerance_mm=0.005)
