@@ -250,7 +250,7 @@ class Mechanism:
         """d(pose)/ds of every body at a solved pose (per input unit)."""
         system = _System(self)
         q = np.concatenate([poses[name] for name in system.free])
-        jac, ds = system.jacobian(q, s)
+        _, jac, ds = system.jacobian(q, s)
         dq = np.linalg.lstsq(jac, -ds, rcond=None)[0]
         result = {self.ground: np.zeros(3)}
         for k, name in enumerate(system.free):
@@ -310,6 +310,35 @@ class _System:
         self.n = 3 * len(self.free)
         self.scale = max(1.0, max((float(np.hypot(*p)) for b in mech.bodies for p in b.points.values()),
                                   default=1.0))
+        revolutes = [j for j in mech.joints if isinstance(j, Revolute)]
+        self.others = [j for j in mech.joints if not isinstance(j, Revolute)]
+        # revolute constraints are most of every mechanism: keep them as index arrays
+        self.rev_a = np.array([self.index.get(j.body_a, -1) for j in revolutes], dtype=np.int64)
+        self.rev_b = np.array([self.index.get(j.body_b, -1) for j in revolutes], dtype=np.int64)
+        self.rev_la = np.array([self.bodies[j.body_a].point(j.name) for j in revolutes]).reshape(-1, 2)
+        self.rev_lb = np.array([self.bodies[j.body_b].point(j.name) for j in revolutes]).reshape(-1, 2)
+
+    def _revolute_block(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Residuals (2k,) and Jacobian rows (2k, n) of the k revolute joints."""
+        k = len(self.rev_a)
+        poses = np.vstack([q.reshape(-1, 3), np.zeros((1, 3))])  # index -1 is the ground
+        jac = np.zeros((2 * k, self.n))
+        res = np.zeros(2 * k)
+        rows = np.arange(k)
+        for idx, local, sign in ((self.rev_a, self.rev_la, 1.0), (self.rev_b, self.rev_lb, -1.0)):
+            th = poses[idx, 2]
+            c, s = np.cos(th), np.sin(th)
+            wx = c * local[:, 0] - s * local[:, 1]
+            wy = s * local[:, 0] + c * local[:, 1]
+            res[0::2] += sign * (wx + poses[idx, 0])
+            res[1::2] += sign * (wy + poses[idx, 1])
+            free = idx >= 0
+            r, b = rows[free], idx[free]
+            jac[2 * r, 3 * b] += sign
+            jac[2 * r + 1, 3 * b + 1] += sign
+            jac[2 * r, 3 * b + 2] += sign * -wy[free]
+            jac[2 * r + 1, 3 * b + 2] += sign * wx[free]
+        return res, jac
 
     def _pose(self, q: np.ndarray, name: str) -> np.ndarray:
         k = self.index.get(name)
@@ -358,17 +387,15 @@ class _System:
                 r[3 * self.index[reference] + 2] -= 1.0
             return r
 
-        for j in self.mech.joints:
+        rev_res, rev_jac = self._revolute_block(q)
+        rows.extend(rev_jac)
+        res.extend(rev_res)
+        dres_ds.extend([0.0] * len(rev_res))
+        for j in self.others:
             pa_local = self.bodies[j.body_a].point(j.name)
             pb_local = self.bodies[j.body_b].point(j.name)
             pa, pb = world(j.body_a, pa_local), world(j.body_b, pb_local)
-            if isinstance(j, Revolute):
-                r2 = [row(), row()]
-                add_point_terms(r2, j.body_a, pa_local, 1.0)
-                add_point_terms(r2, j.body_b, pb_local, -1.0)
-                res.extend(pa - pb)
-                dres_ds.extend([0.0, 0.0])
-            else:
+            if True:
                 tha = self._pose(q, j.body_a)[2]
                 thb = self._pose(q, j.body_b)[2]
                 angle_row(j.body_b, j.body_a)
@@ -424,23 +451,32 @@ class _System:
                     r[3 * self.index[d.reference] + 2] += float(np.dot(pb - pa, da))
                 res.append(float(np.dot(pb - pa, a_world)) - value)
             dres_ds.append(-dvalue)
-        jac = np.array(rows) if want_jacobian else None
+        jac = np.array(rows).reshape(len(res), n) if want_jacobian else None
         return np.asarray(res), jac, np.asarray(dres_ds)
 
-    def newton(self, q: np.ndarray, s: float, max_iter: int = 30) -> tuple[np.ndarray, bool]:
-        """Gauss-Newton from ``q``; returns (q, converged)."""
+    def newton(self, q: np.ndarray, s: float, max_iter: int = 30):
+        """Gauss-Newton from ``q``.
+
+        Returns
+        -------
+        q : (n,) array
+        converged : bool
+        jac, dres_ds : arrays
+            Jacobian and d(residual)/ds at the returned ``q`` (reused by the continuation).
+        """
         q = q.copy()
+        tol = ASSEMBLY_TOLERANCE * self.scale
         for _ in range(max_iter):
-            res, jac, _ = self.jacobian(q, s)
-            err = float(np.max(np.abs(res))) if res.size else 0.0
-            if err < ASSEMBLY_TOLERANCE * self.scale:
-                return q, True
-            step = np.linalg.lstsq(jac, -res, rcond=None)[0]
+            res, jac, ds = self.jacobian(q, s)
+            if res.size == 0 or float(np.max(np.abs(res))) < tol:
+                return q, True, jac, ds
+            step = np.linalg.lstsq(jac, -res, rcond=None)[0] if jac.shape[0] != jac.shape[1] \
+                else _solve_square(jac, -res)
             if not np.all(np.isfinite(step)):
-                return q, False
+                return q, False, jac, ds
             q = q + step
-        res = self.residual(q, s)
-        return q, bool(np.max(np.abs(res)) < ASSEMBLY_TOLERANCE * self.scale)
+        res, jac, ds = self.jacobian(q, s)
+        return q, bool(np.max(np.abs(res)) < tol), jac, ds
 
     def assemble(self, s: float) -> np.ndarray:
         guess = []
@@ -448,7 +484,7 @@ class _System:
             if name not in self.mech.assembly:
                 raise SpecError(f"mechanism.assembly.{name}", "missing assembly guess for body")
             guess.extend(np.asarray(self.mech.assembly[name], dtype=np.float64))
-        q, ok = self.newton(np.asarray(guess), s)
+        q, ok, _, _ = self.newton(np.asarray(guess), s)
         if not ok:
             raise LockupError(s, f"{self.mech.name}: cannot assemble the first pose")
         return q
@@ -459,8 +495,8 @@ class _System:
         d = (q_new - q_old).reshape(-1, 3)
         return bool(np.all(np.abs(d[:, 2]) < 0.3) and np.all(np.hypot(d[:, 0], d[:, 1]) < 0.3 * self.scale))
 
-    def _orientation(self, q: np.ndarray, s: float) -> float:
-        _, jac, _ = self.jacobian(q, s)
+    @staticmethod
+    def _orientation(jac: np.ndarray) -> float:
         if jac.shape[0] != jac.shape[1]:
             return 0.0
         return float(np.sign(np.linalg.det(jac)))
@@ -469,23 +505,24 @@ class _System:
                     s1: float) -> tuple[np.ndarray, tuple[np.ndarray, float]]:
         """Follow the branch from (q at s0) to s1 with an adaptive step; raise at lock-up."""
         s = s0
-        sign0 = self._orientation(q, s)
+        _, jac, ds = self.jacobian(q, s)
+        sign0 = self._orientation(jac)
         direction = 1.0 if s1 >= s0 else -1.0
         h_mag = abs(s1 - s0)
         min_h = abs(s1 - s0) * 1e-6 + 1e-12
         while direction * (s1 - s) > 1e-15:
             h = direction * min(h_mag, abs(s1 - s))
             # first-order (tangent) predictor keeps the corrector on this branch
-            _, jac, ds = self.jacobian(q, s)
-            tangent = np.linalg.lstsq(jac, -ds, rcond=None)[0]
-            q_new, ok = self.newton(q + tangent * h, s + h)
+            tangent = _solve_square(jac, -ds) if jac.shape[0] == jac.shape[1] \
+                else np.linalg.lstsq(jac, -ds, rcond=None)[0]
+            q_new, ok, jac_new, ds_new = self.newton(q + tangent * h, s + h)
             if ok and self._step_ok(q, q_new, s + h):
-                sign = self._orientation(q_new, s + h)
+                sign = self._orientation(jac_new)
                 if sign0 != 0.0 and sign != 0.0 and sign != sign0:
                     raise LockupError(s + h, f"{self.mech.name}: the motion passes a singular pose "
                                              "(branch change)")
                 previous = (q, s)
-                q, s = q_new, s + h
+                q, s, jac, ds = q_new, s + h, jac_new, ds_new
                 h_mag *= 1.5
                 continue
             h_mag *= 0.5
@@ -493,3 +530,11 @@ class _System:
                 raise LockupError(s, f"{self.mech.name}: lock-up, no assembly beyond this input")
         return q, previous if previous is not None else (q, s)
 
+
+
+def _solve_square(jac: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Solve a square system; a singular Jacobian gives a non-finite step (treated as failure)."""
+    try:
+        return np.linalg.solve(jac, rhs)
+    except np.linalg.LinAlgError:
+        return np.full_like(rhs, np.nan)

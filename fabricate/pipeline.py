@@ -1,0 +1,215 @@
+"""The whole pipeline: template → spec → synthesis → mechanism → gears → parts → exports and checks.
+
+Everything is computed in memory into ``{relative path: bytes}``; only :func:`write_atomically` touches
+the file system, into a temporary sibling directory renamed into place when every file is written, so a
+failed run never leaves half a result.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fabricate import __version__
+from fabricate.errors import LockupError
+from fabricate.mechanism import Mechanism, Motion
+from fabricate.report import report_json, report_markdown
+from fabricate.spec import TEMPLATE_DIR, DesignSpec
+from fabricate.synthesis import KINDS
+from fabricate.synthesis.base import SynthesisResult
+
+Progress = Callable[[str], None]
+
+
+@dataclass
+class BuildOutcome:
+    """What a pipeline run produced.
+
+    Attributes
+    ----------
+    exit_code : int
+        0 all checks pass, 1 the design fails a check (files are still produced).
+    report : dict
+        The report.json content.
+    files : dict
+        ``{relative path: bytes}`` including report.json and report.md.
+    """
+
+    exit_code: int
+    report: dict[str, Any]
+    files: dict[str, bytes] = field(default_factory=dict)
+    synthesis: SynthesisResult | None = None
+    motion: Motion | None = None
+    partset: Any = None
+    gear_pairs: list[Any] = field(default_factory=list)
+    checks: Any = None
+
+
+def _quiet(_: str) -> None:
+    pass
+
+
+def template_label(path: Path) -> str:
+    """How the report names a template: relative to the shipped folder or the working directory."""
+    path = path.resolve()
+    for base in (TEMPLATE_DIR.parent, Path.cwd()):
+        try:
+            return path.relative_to(base.resolve()).as_posix()
+        except ValueError:
+            continue
+    return path.as_posix()
+
+
+def design_section(design: DesignSpec) -> dict[str, Any]:
+    return {"name": design.name, "kind": design.kind, "template": template_label(design.template),
+            "fabricate_version": __version__, "description": design.description,
+            "process": design.process.name}
+
+
+def mechanism_section(mechanism: Mechanism, motion: Motion) -> dict[str, Any]:
+    """DESIGN.md ``mechanism`` keys: every named point at the first pose, bodies with their points."""
+    joints = {}
+    for body in mechanism.bodies:
+        for name in body.points:
+            if name not in joints:
+                joints[name] = motion.point(name, body.name)[0]
+    return {
+        "joints": {k: [float(v[0]), float(v[1])] for k, v in joints.items()},
+        "bodies": {b.name: list(b.points) for b in mechanism.bodies},
+        "input_range_deg": [float(mechanism.input_range[0]), float(mechanism.input_range[1])],
+        "input_unit": mechanism.input_unit,
+        "ground": mechanism.ground,
+        "degrees_of_freedom": mechanism.degrees_of_freedom(),
+        "drivers": len(mechanism.drivers),
+    }
+
+
+def synthesise(design: DesignSpec, progress: Progress = _quiet) -> SynthesisResult:
+    progress(f"synthesis ({design.kind})")
+    return KINDS[design.kind].synthesise(design)
+
+
+def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
+    """Synthesis only: report.json with design, mechanism and synthesis, plus the method's plots."""
+    result = synthesise(design, progress)
+    report: dict[str, Any] = {"design": design_section(design)}
+    files: dict[str, bytes] = {}
+    motion = None
+    failures: list[str] = []
+    if result.mechanism is not None:
+        progress("sweep")
+        try:
+            motion = result.mechanism.sweep(design.checks.sweep_poses + 1)
+            report["mechanism"] = mechanism_section(result.mechanism, motion)
+        except LockupError as exc:
+            failures.append(f"motion: {exc}")
+    report["synthesis"] = result.report
+    progress("plots")
+    for name, data in sorted(result.figures().items()):
+        files[f"plots/{name}"] = data
+    report["checks"] = {"passed": not failures, "failures": failures}
+    return _finish(report, files, exit_code=1 if failures else 0, synthesis=result, motion=motion)
+
+
+def run_build(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
+    """The whole pipeline in memory.
+
+    Raises
+    ------
+    SpecError, SynthesisError
+        Invalid input or nothing feasible (the CLI exits 2 and writes nothing).
+    """
+    from fabricate.checks import run_checks
+    from fabricate.export import export_all
+    from fabricate.gears import build_gear_pairs
+    from fabricate.parts.build import build_parts
+
+    result = synthesise(design, progress)
+    report: dict[str, Any] = {"design": design_section(design)}
+    files: dict[str, bytes] = {}
+    mechanism = result.mechanism
+    progress("sweep")
+    try:
+        motion = mechanism.sweep(design.checks.sweep_poses + 1)
+    except LockupError as exc:
+        report["synthesis"] = result.report
+        report["checks"] = {"passed": False, "failures": [f"motion: {exc}"]}
+        return _finish(report, files, exit_code=1, synthesis=result)
+    report["mechanism"] = mechanism_section(mechanism, motion)
+    report["synthesis"] = result.report
+    progress("gears")
+    gear_pairs = build_gear_pairs(mechanism, design.gears, design.process.chord_tolerance_mm)
+    report["gears"] = [pair.report() for pair in gear_pairs]
+    progress("parts")
+    partset = build_parts(design, mechanism, motion, gear_pairs, result.parts)
+    progress("exports")
+    exported, parts_report = export_all(design, partset, mechanism, motion)
+    files.update(exported)
+    report["parts"] = parts_report
+    report["bom"] = list(getattr(partset, "bom", []))
+    progress("checks")
+    checks = run_checks(design, partset, mechanism, motion, gear_pairs)
+    report["interference"] = checks.interference
+    failures = list(checks.failures)
+    for pair in gear_pairs:
+        failures += [f"gear {pair.name}: {text}" for text in pair.failures()]
+    report["checks"] = {"passed": not failures, "failures": failures}
+    progress("plots")
+    for name, data in sorted(result.figures().items()):
+        files[f"plots/{name}"] = data
+    for name, data in sorted(checks.figures().items()):
+        files[f"plots/{name}"] = data
+    if gear_pairs:
+        from fabricate.export.gear_plots import pair_gif, pair_png
+
+        for pair in gear_pairs:
+            x_mid = 0.5 * (pair.working_range[0] + pair.working_range[1])
+            files[f"gears/{pair.name}_mesh.png"] = pair_png(pair, x_mid)
+            files[f"gears/{pair.name}_turning.gif"] = pair_gif(pair, 36)
+    return _finish(report, files, exit_code=0 if not failures else 1, synthesis=result, motion=motion,
+                   partset=partset, gear_pairs=gear_pairs, checks=checks)
+
+
+def _finish(report: dict[str, Any], files: dict[str, bytes], **kw: Any) -> BuildOutcome:
+    """Add report.json / report.md and the file list (every path relative to the output directory)."""
+    images = [p for p in sorted(files) if p.endswith((".png", ".gif"))]
+    report["files"] = sorted(set(files) | {"report.json", "report.md"})
+    files["report.md"] = report_markdown(report, images).encode("utf-8")
+    files["report.json"] = report_json(report)
+    return BuildOutcome(report=report, files=files, **kw)
+
+
+def write_atomically(files: dict[str, bytes], out_dir: Path) -> None:
+    """Write every file into a temporary sibling of ``out_dir`` and rename it into place.
+
+    An existing ``out_dir`` is replaced only after the new one is complete.
+    """
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".tmp", dir=out_dir.parent))
+    try:
+        for rel, data in sorted(files.items()):
+            target = tmp / rel
+            target.parent.mkdir(parents=True, exist_ok=True)
+            with open(target, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+        os.chmod(tmp, 0o755)
+        if out_dir.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".old", dir=out_dir.parent))
+            os.rmdir(old)
+            os.replace(out_dir, old)
+            os.replace(tmp, out_dir)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, out_dir)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
