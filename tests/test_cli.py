@@ -1,0 +1,123 @@
+"""The command-line contract: exit codes, nothing written on bad input, atomic output, determinism,
+and every shipped template built end to end."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from fabricate.cli import main
+from fabricate.pipeline import write_atomically
+from fabricate.spec import shipped_templates
+
+REPORT_KEYS = {"design", "mechanism", "synthesis", "gears", "parts", "interference", "checks", "files"}
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "design.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("[design]\nkind = 'five_bar_ncg'\n", "design.name: missing required field"),
+        ("[design]\nname = 'x'\nkind = 'teleporter'\n", "design.kind: expected one of"),
+        ("[design]\nname = 'x'\nkind = 'gear_pair'\n[process]\nprofile = 'sla'\nmin_wall_mm = -1\n",
+         "process.min_wall_mm: expected a positive number"),
+        ("[design]\nname = 'x'\nkind = 'gear_pair'\n[checks]\nsweep_poses = 'many'\n",
+         'checks.sweep_poses: expected a number, got "many"'),
+        ("[design\nname = 'x'\n", "invalid TOML"),
+        ("[design]\nname = '../escape'\nkind = 'gear_pair'\n", "design.name: expected a plain file name"),
+    ],
+)
+def test_bad_input_exits_2_names_the_field_and_writes_nothing(tmp_path, capsys, text, needle):
+    out = tmp_path / "out"
+    code = main(["build", str(_write(tmp_path, text)), "-o", str(out), "-q"])
+    assert code == 2
+    assert needle in capsys.readouterr().err
+    assert not out.exists()
+    assert [p.name for p in tmp_path.iterdir()] == ["design.toml"]
+
+
+def test_missing_template_exits_2(tmp_path, capsys):
+    assert main(["build", str(tmp_path / "nope.toml"), "-o", str(tmp_path / "o")]) == 2
+    assert "template not found" in capsys.readouterr().err
+
+
+def test_usage_error_exits_2(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["frobnicate"])
+    assert info.value.code == 2
+
+
+def test_write_atomically_replaces_only_when_complete(tmp_path):
+    out = tmp_path / "build"
+    write_atomically({"a.txt": b"1", "sub/b.txt": b"2"}, out)
+    assert (out / "sub" / "b.txt").read_bytes() == b"2"
+
+    files = {"a.txt": b"new", "z.txt": None}  # writing None fails half-way
+    with pytest.raises(TypeError):
+        write_atomically(files, out)  # type: ignore[arg-type]
+    assert (out / "a.txt").read_bytes() == b"1"  # the old result is untouched
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["build"]  # no temporary left behind
+    write_atomically({"c.txt": b"3"}, out)
+    assert sorted(p.name for p in out.iterdir()) == ["c.txt"]
+
+
+def test_list_names_every_template(capsys):
+    assert main(["list"]) == 0
+    printed = capsys.readouterr().out
+    for path in shipped_templates():
+        assert path.stem in printed
+
+
+TEMPLATES = [p.stem for p in shipped_templates()]
+
+
+@pytest.fixture(scope="module")
+def builds(tmp_path_factory):
+    """Each shipped template built twice (determinism) — cached for the module."""
+    cache: dict[str, tuple[int, Path, int, Path]] = {}
+
+    def get(name: str):
+        if name not in cache:
+            root = tmp_path_factory.mktemp(name)
+            code1 = main(["build", name, "-o", str(root / "one"), "-q"])
+            code2 = main(["build", name, "-o", str(root / "two"), "-q"])
+            cache[name] = (code1, root / "one", code2, root / "two")
+        return cache[name]
+
+    return get
+
+
+@pytest.mark.parametrize("name", TEMPLATES)
+def test_template_builds_and_passes(builds, name):
+    code, out, _, _ = builds(name)
+    report = json.loads((out / "report.json").read_text())
+    assert code == 0, report["checks"]["failures"]
+    assert REPORT_KEYS <= set(report)
+    assert report["checks"]["passed"] is True
+    assert report["design"]["name"] == name
+    for rel in report["files"]:
+        assert (out / rel).is_file(), rel
+    listed = set(report["files"])
+    on_disk = {p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()}
+    assert listed == on_disk
+    for part in report["parts"]:
+        assert part["volume_mm3"] > 0 and (out / part["stl"]).is_file() and (out / part["dxf"]).is_file()
+    inter = report["interference"]
+    assert inter["poses"] >= 360 and inter["collisions"] == []
+
+
+@pytest.mark.parametrize("name", TEMPLATES)
+def test_same_template_gives_byte_identical_files(builds, name):
+    _, one, _, two = builds(name)
+    files_one = sorted(p.relative_to(one).as_posix() for p in one.rglob("*") if p.is_file())
+    files_two = sorted(p.relative_to(two).as_posix() for p in two.rglob("*") if p.is_file())
+    assert files_one == files_two
+    differing = [rel for rel in files_one if (one / rel).read_bytes() != (two / rel).read_bytes()]
+    assert differing == []
