@@ -1,0 +1,161 @@
+"""Pins, spacers and the bill of materials.
+
+A pin at a joint passes through the layers of the two bodies it joins; its length is the stack from the
+bottom of the lower layer to the top of the upper one. Layers in between that the pin skips are filled
+by a spacer tube (so the bodies cannot slide along the pin); the axial gap between adjacent layers is a
+washer.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from fabricate.parts.layers import layer_z, skipped_gap, stack_span
+
+
+@dataclass(frozen=True)
+class Pin:
+    """A pin at a joint.
+
+    Attributes
+    ----------
+    joint : str
+    bodies : (str, str)
+    diameter_mm, length_mm : float
+        Nominal diameter; length of the stack it passes through.
+    z_mm : float
+        Bottom of the stack.
+    layers : (int, int)
+        Lowest and highest layer it passes through.
+    """
+
+    joint: str
+    bodies: tuple[str, str]
+    diameter_mm: float
+    length_mm: float
+    z_mm: float
+    layers: tuple[int, int]
+
+
+@dataclass(frozen=True)
+class Spacer:
+    """A tube on a pin between two non-adjacent layers (or a washer between adjacent ones).
+
+    Attributes
+    ----------
+    joint : str
+    body : str
+        Body whose coordinates ``centre`` is given in (the lower body at the joint).
+    centre : (2,) array
+    inner_diameter_mm, outer_diameter_mm, length_mm, z_mm : float
+    lower_layer : int
+    washer : bool
+        True when it only fills the gap between adjacent layers.
+    """
+
+    joint: str
+    body: str
+    centre: np.ndarray
+    inner_diameter_mm: float
+    outer_diameter_mm: float
+    length_mm: float
+    z_mm: float
+    lower_layer: int
+    washer: bool
+
+
+def pins_and_spacers(pin_joints: Sequence[tuple[str, str, str]], layers: Mapping[str, int], pin_mm: float,
+                     hole_mm: float, boss_mm: float, thickness_mm: float, gap_mm: float,
+                     centres: Mapping[tuple[str, str], np.ndarray] | None = None
+                     ) -> tuple[list[Pin], list[Spacer]]:
+    """Pins sized to their stacks and the spacers / washers between the layers they join.
+
+    Parameters
+    ----------
+    pin_joints : sequence of (pin name, body a, body b)
+    layers : Mapping[str, int]
+        Body -> layer.
+    pin_mm, hole_mm, boss_mm : float
+        Pin, hole and boss diameters (the spacer's bore and outer diameter).
+    thickness_mm, gap_mm : float
+        Layer thickness and axial gap.
+    centres : Mapping[(body, pin), (2,) array], optional
+        Pin positions in body coordinates; filled in by the caller for spacer parts.
+
+    Returns
+    -------
+    (list of Pin, list of Spacer)
+    """
+    pins: list[Pin] = []
+    spacers: list[Spacer] = []
+    for name, a, b in pin_joints:
+        la, lb = layers[a], layers[b]
+        lo, hi = min(la, lb), max(la, lb)
+        z0, z1 = stack_span([la, lb], thickness_mm, gap_mm)
+        pins.append(Pin(joint=name, bodies=(a, b), diameter_mm=pin_mm, length_mm=z1 - z0, z_mm=z0,
+                        layers=(lo, hi)))
+        length = skipped_gap(lo, hi, thickness_mm, gap_mm)
+        if length <= 0.0:
+            continue
+        lower = a if la <= lb else b
+        centre = (centres or {}).get((lower, name), np.zeros(2))
+        spacers.append(Spacer(joint=name, body=lower, centre=np.asarray(centre, dtype=np.float64),
+                              inner_diameter_mm=hole_mm, outer_diameter_mm=boss_mm, length_mm=length,
+                              z_mm=layer_z(lo, thickness_mm, gap_mm) + thickness_mm, lower_layer=lo,
+                              washer=hi - lo == 1))
+    return pins, spacers
+
+
+def _group(rows: list[dict[str, Any]], key: tuple[str, ...]) -> list[dict[str, Any]]:
+    """Merge rows with equal ``key`` fields, summing ``qty`` and collecting ``joints``."""
+    merged: dict[tuple, dict[str, Any]] = {}
+    for row in rows:
+        k = tuple(row[f] for f in key)
+        if k in merged:
+            merged[k]["qty"] += row["qty"]
+            merged[k]["joints"] = sorted(set(merged[k]["joints"]) | set(row.get("joints", [])))
+        else:
+            merged[k] = dict(row)
+    return list(merged.values())
+
+
+def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Mapping[str, Any], process: str,
+                      copies: int = 1, mounting: int = 0,
+                      mounting_mm: float = 3.0) -> list[dict[str, Any]]:
+    """Bill of materials rows (JSON-ready), quantities multiplied by ``copies``.
+
+    Rows have ``item``, ``kind`` (``pin``, ``spacer``, ``washer``, ``spring``, ``screw``, ``purchased``),
+    ``qty``, a human ``description`` and the sizes in mm where they apply.
+    """
+    rows: list[dict[str, Any]] = []
+    for pin in pins:
+        rows.append({"item": f"pin {pin.diameter_mm:g} x {pin.length_mm:.2f} mm", "kind": "pin",
+                     "diameter_mm": round(pin.diameter_mm, 4), "length_mm": round(pin.length_mm, 4),
+                     "qty": copies, "joints": [pin.joint],
+                     "description": "steel dowel pin, cut to the stack; retain with adhesive or clips"})
+    for sp in spacers:
+        kind = "washer" if sp.washer else "spacer"
+        made = "printed with the parts" if (not sp.washer and process == "sla") else "purchased"
+        rows.append({"item": f"{kind} {sp.inner_diameter_mm:g}/{sp.outer_diameter_mm:g} x {sp.length_mm:.2f} mm",
+                     "kind": kind, "inner_diameter_mm": round(sp.inner_diameter_mm, 4),
+                     "outer_diameter_mm": round(sp.outer_diameter_mm, 4), "length_mm": round(sp.length_mm, 4),
+                     "qty": copies, "joints": [sp.joint], "description": made})
+    rows = _group(rows, ("item", "kind"))
+    if mounting:
+        rows.append({"item": f"screw M{mounting_mm:g}", "kind": "screw", "qty": mounting * copies,
+                     "joints": [], "description": "mounting screw for the ground part"})
+    for spring in hints.get("springs", ()) or ():
+        rows.append({"item": f"torsion spring at {spring.get('joint', '?')}", "kind": "spring",
+                     "qty": copies, "joints": [str(spring.get("joint", ""))],
+                     "rate_Nmm_per_deg": spring.get("rate_Nmm_per_deg"),
+                     "preload_deg": spring.get("preload_deg"), "legs_mm": spring.get("legs_mm"),
+                     "description": str(spring.get("note", ""))})
+    for item in hints.get("purchased", ()) or ():
+        rows.append({"item": str(item.get("item", "item")), "kind": "purchased",
+                     "qty": int(item.get("qty", 1)) * copies, "joints": [],
+                     "description": str(item.get("note", ""))})
+    return rows

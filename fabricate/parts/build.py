@@ -1,0 +1,360 @@
+"""Every body of a solved mechanism becomes a part: outline, pin holes, fused gears, layer and height.
+
+Nothing here knows which paper a mechanism came from: the parts follow from the bodies' points, the
+joints, the gear pairs, the process profile (``[process]``), the ``[parts]`` table and the synthesis
+hints (pads, springs, purchased items, copies).
+
+Shapes
+------
+- A body's profile is the exact convex hull of circles of the boss radius around each of its points
+  (a rounded slot for a binary link; a single disc for a one-point body), plus the fingertip pad
+  circle where a hint asks for one.
+- Boss radius = hole radius + wall, wall = ``[parts] boss_wall_mm`` or max(process minimum wall, half the
+  pin diameter; for laser also at least the sheet thickness, the minimum web); a requested link width
+  widens it.
+- A gear is fused (polygon union) with a hub to the body that carries it; the body's pin hole at the gear
+  axis stays.
+- A slider (push rod) becomes a rounded bar along the slide axis with a slot that runs on two guide pins
+  fixed in the reference body (two pins so the rod cannot turn).
+- The ground part gets mounting holes on the side away from the moving parts.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from fabricate.errors import GeometryError
+from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
+from fabricate.parts.bom import Pin, Spacer, bill_of_materials, pins_and_spacers
+from fabricate.parts.layers import assign_layers, conflict_graph, layer_z
+from fabricate.parts.model import BulgePath, Hole, Part, circle_polygon
+from fabricate.parts.profiles import circle_hull, fuse_polygons
+from fabricate.parts.spec import PartsSpec
+from fabricate.planar import rotation
+from fabricate.spec import ProcessSpec
+
+#: Chord tolerance (mm) of the coarse outlines used only for the layer conflict test.
+CONFLICT_CHORD_MM = 0.05
+
+
+@dataclass(frozen=True)
+class SlottedPart(Part):
+    """A part with slots (stadium-shaped through cuts, e.g. the guide slot of a push rod) besides holes.
+
+    Attributes
+    ----------
+    slots : tuple of BulgePath
+        Counter-clockwise slot contours in body coordinates; cut through the plate.
+    """
+
+    slots: tuple[BulgePath, ...] = ()
+
+    def polygons(self, chord_tolerance_mm: float) -> list[np.ndarray]:
+        rings = super().polygons(chord_tolerance_mm)
+        for slot in self.slots:
+            ring = slot.polygon(chord_tolerance_mm)
+            rings.append(ring[::-1] if slot.area() > 0 else ring)
+        return rings
+
+    def area_mm2(self) -> float:
+        return super().area_mm2() - sum(abs(s.area()) for s in self.slots)
+
+
+@dataclass(frozen=True)
+class PartSet:
+    """All parts of one mechanism and how they go together.
+
+    Attributes
+    ----------
+    parts : tuple of Part
+        Body parts (one per body) then printed spacers.
+    bom : list of dict
+        Bill of materials rows (JSON-ready): pins, spacers, washers, springs, purchased items.
+    pins : tuple of Pin
+    spacers : tuple of Spacer
+    layers : dict[str, int]
+        Body name -> layer index.
+    process : str
+        ``"sla"`` or ``"laser"``.
+    chord_tolerance_mm : float
+        Polygonisation tolerance for meshes.
+    copies : int
+        Identical copies of the mechanism (BOM quantities already multiplied).
+    """
+
+    parts: tuple[Part, ...]
+    bom: list[dict[str, Any]]
+    pins: tuple[Pin, ...]
+    spacers: tuple[Spacer, ...]
+    layers: dict[str, int]
+    process: str
+    chord_tolerance_mm: float
+    thickness_mm: float
+    layer_gap_mm: float
+    kerf_mm: float
+    copies: int = 1
+    hints: Mapping[str, Any] = field(default_factory=dict)
+
+    def part(self, name: str) -> Part:
+        for p in self.parts:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def body_parts(self) -> tuple[Part, ...]:
+        """Parts that move with a body (spacers excluded)."""
+        return tuple(p for p in self.parts if p.role != "spacer")
+
+
+@dataclass(frozen=True)
+class Sizes:
+    """Derived sizes (mm) of holes and bosses for a process."""
+
+    pin_mm: float
+    hole_mm: float
+    boss_radius_mm: float
+    mount_hole_mm: float
+    mount_boss_radius_mm: float
+    hub_mm: float
+
+
+def derive_sizes(process: ProcessSpec, parts: PartsSpec, hints: Mapping[str, Any],
+                 gear_hub_mm: float | None = None) -> Sizes:
+    """Hole and boss sizes from the process and the ``[parts]`` table.
+
+    The modelled hole is the finished hole: pin + 2 × radial running clearance + the process's hole
+    compensation (SLA prints holes undersize). The laser kerf is applied only to the cut path (DXF).
+    """
+    pin = process.pin_diameter_mm
+    hole = pin + 2.0 * process.running_clearance_mm + process.hole_compensation_mm
+    wall = parts.boss_wall_mm if parts.boss_wall_mm is not None else max(process.min_wall_mm, 0.5 * pin)
+    if process.name == "laser":
+        wall = max(wall, process.thickness_mm)  # minimum web >= sheet thickness
+    radius = hole / 2.0 + wall
+    width = parts.link_width_mm if parts.link_width_mm is not None else hints.get("link_width_mm")
+    if width is not None:
+        radius = max(radius, 0.5 * float(width))
+    mount = parts.mounting_hole_mm + 2.0 * process.running_clearance_mm + process.hole_compensation_mm
+    hub = parts.hub_diameter_mm or gear_hub_mm or 2.0 * radius
+    return Sizes(pin_mm=pin, hole_mm=hole, boss_radius_mm=radius, mount_hole_mm=mount,
+                 mount_boss_radius_mm=mount / 2.0 + wall, hub_mm=max(hub, hole + 2.0 * process.min_wall_mm))
+
+
+def safe_name(name: str) -> str:
+    """A file-name-safe part name."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._") or "part"
+
+
+def gear_outline_in_body(mechanism: Mechanism, pair: Any, side: str) -> tuple[str, str, np.ndarray]:
+    """A gear outline mapped into the coordinates of the body that carries it.
+
+    Parameters
+    ----------
+    pair : GearPair
+        Needs ``name``, ``body_a``, ``body_b``, ``axis_a``, ``axis_b``, ``outline_a``, ``outline_b``.
+    side : str
+        ``"a"`` or ``"b"``.
+
+    Returns
+    -------
+    (body, axis joint, (n, 2) array)
+        u = u_axis + R(beta) g, beta = direction of JB - JA in the carrier (gear-frame convention).
+    """
+    coupling = next((g for g in mechanism.gears if g.name == pair.name), None)
+    carrier = mechanism.body(coupling.carrier) if coupling is not None else None
+    ja, jb = pair.axis_a, pair.axis_b
+    if carrier is not None and ja in carrier.points and jb in carrier.points:
+        d = carrier.point(jb) - carrier.point(ja)
+    else:  # no carrier record: the line of centres as seen in body a
+        d = mechanism.body(pair.body_a).point(jb) - mechanism.body(pair.body_a).point(ja)
+    beta = math.atan2(d[1], d[0])
+    body = pair.body_a if side == "a" else pair.body_b
+    axis = ja if side == "a" else jb
+    outline = np.asarray(pair.outline_a if side == "a" else pair.outline_b, dtype=np.float64)
+    u_axis = mechanism.body(body).point(axis)
+    return body, axis, outline @ rotation(beta).T + u_axis
+
+
+def _slider_geometry(mechanism: Mechanism, motion: Motion, joint: Slider, sizes: Sizes
+                     ) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """Guide pin spacing and slot ends for a slider.
+
+    Returns
+    -------
+    axis_a : (2,) unit axis in the reference body; axis_b : (2,) the same axis in the rod body;
+    s_min, s_max : float, travel of the rod point along the axis (mm) over the motion.
+    """
+    axis_a = np.asarray(joint.axis, dtype=np.float64)
+    axis_a = axis_a / np.hypot(*axis_a)
+    axis_b = rotation(-joint.angle) @ axis_a
+    pa = motion.point(joint.name, joint.body_a)
+    pb = motion.point(joint.name, joint.body_b)
+    theta_a = motion.pose(joint.body_a)[:, 2]
+    axis_world = np.einsum("nij,j->ni", rotation(theta_a), axis_a)
+    travel = np.einsum("ni,ni->n", pb - pa, axis_world)
+    return axis_a, axis_b, float(travel.min()), float(travel.max())
+
+
+def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: Sequence[Any],
+                hints: Mapping[str, Any] | None = None) -> PartSet:
+    """Turn a solved mechanism into parts.
+
+    Parameters
+    ----------
+    design : DesignSpec
+        Uses ``design.process``, ``design.parts`` and ``design.gears.hub_diameter_mm``.
+    mechanism : Mechanism
+    motion : Motion
+        A sweep of the mechanism (layers are chosen over this motion).
+    gear_pairs : sequence of GearPair
+        Built gears; each gear is fused to the body that carries it.
+    hints : Mapping, optional
+        ``SynthesisResult.parts`` (pads, springs, purchased, copies, link_width_mm).
+
+    Returns
+    -------
+    PartSet
+
+    Raises
+    ------
+    GeometryError
+        When a hint names a point a body does not have, or a gear does not join its body.
+    """
+    hints = dict(hints or {})
+    process: ProcessSpec = design.process
+    parts_spec: PartsSpec = design.parts
+    gear_hub = getattr(getattr(design, "gears", None), "hub_diameter_mm", None)
+    sizes = derive_sizes(process, parts_spec, hints, gear_hub)
+    tol = process.chord_tolerance_mm
+    radius = sizes.boss_radius_mm
+
+    holes: dict[str, list[Hole]] = {b.name: [] for b in mechanism.bodies}
+    circles: dict[str, list[tuple[np.ndarray, float]]] = {
+        b.name: [(b.point(p), radius) for p in b.points] for b in mechanism.bodies}
+    slots: dict[str, list[BulgePath]] = {b.name: [] for b in mechanism.bodies}
+    pin_joints: list[tuple[str, str, str]] = []  # (pin name, body a, body b)
+    for joint in mechanism.joints:
+        if isinstance(joint, Revolute):
+            for body in (joint.body_a, joint.body_b):
+                holes[body].append(Hole(joint.name, mechanism.body(body).point(joint.name), sizes.hole_mm,
+                                        sizes.pin_mm))
+            pin_joints.append((joint.name, joint.body_a, joint.body_b))
+        elif isinstance(joint, Slider):
+            axis_a, axis_b, s_min, s_max = _slider_geometry(mechanism, motion, joint, sizes)
+            spacing = 2.0 * radius + 2.0 * process.min_wall_mm  # between the two guide pins
+            ref_point = mechanism.body(joint.body_a).point(joint.name)
+            rod_point = mechanism.body(joint.body_b).point(joint.name)
+            for k, offset in enumerate((0.0, spacing)):
+                name = joint.name if k == 0 else f"{joint.name}_guide"
+                centre = ref_point + offset * axis_a
+                holes[joint.body_a].append(Hole(name, centre, sizes.hole_mm, sizes.pin_mm))
+                circles[joint.body_a].append((centre, radius))
+                pin_joints.append((name, joint.body_a, joint.body_b))
+            # a guide pin at ref + e*axis sits at rod_point - (s - e)*axis_b in the rod: one slot covers both
+            ends = np.array([rod_point - s_max * axis_b, rod_point - (s_min - spacing) * axis_b])
+            slots[joint.body_b].append(circle_hull(ends, sizes.hole_mm / 2.0))
+            circles[joint.body_b] += [(ends[0], radius), (ends[1], radius)]
+
+    for body, pad in dict(hints.get("pads", {})).items():
+        if body not in circles:
+            raise GeometryError(f"pad hint names unknown body {body!r}")
+        points = mechanism.body(body).points
+        if pad.get("point") not in points:
+            raise GeometryError(f"pad hint: body {body!r} has no point {pad.get('point')!r}")
+        r_pad = parts_spec.pad_radius_mm or float(pad.get("radius_mm", radius))
+        circles[body].append((mechanism.body(body).point(pad["point"]), max(r_pad, radius)))
+
+    gear_polys: dict[str, list[np.ndarray]] = {b.name: [] for b in mechanism.bodies}
+    gear_of: dict[str, list[str]] = {b.name: [] for b in mechanism.bodies}
+    for pair in gear_pairs:
+        for side in ("a", "b"):
+            body, axis, outline = gear_outline_in_body(mechanism, pair, side)
+            centre = mechanism.body(body).point(axis)
+            gear_polys[body] += [outline, circle_polygon(centre, sizes.hub_mm, tol)]
+            gear_of[body].append(pair.name)
+
+    ground = mechanism.ground
+    _add_mounting(mechanism, motion, ground, circles, holes, gear_polys, sizes, parts_spec)
+
+    outlines: dict[str, BulgePath] = {}
+    for b in mechanism.bodies:
+        centres = np.array([c for c, _ in circles[b.name]]) if circles[b.name] else np.zeros((1, 2))
+        radii = np.array([r for _, r in circles[b.name]]) if circles[b.name] else np.array([radius])
+        path = circle_hull(centres, radii)
+        if gear_polys[b.name]:
+            path = fuse_polygons(path, gear_polys[b.name], tol)
+        outlines[b.name] = path
+
+    coarse = {n: p.polygon(CONFLICT_CHORD_MM) for n, p in outlines.items()}
+    poses = {n: motion.pose(n) for n in mechanism.body_names}
+    graph = conflict_graph(coarse, poses, process.running_clearance_mm + CONFLICT_CHORD_MM,
+                           always=[(a, b) for _, a, b in pin_joints])
+    same = [(p.body_a, p.body_b) for p in gear_pairs]
+    layers = assign_layers(graph, list(mechanism.body_names), same)
+
+    thickness, gap = process.thickness_mm, process.layer_gap_mm
+    parts: list[Part] = []
+    for b in mechanism.bodies:
+        role = "ground" if b.name == ground else ("gear" if gear_of[b.name] else
+                                                  ("rod" if slots[b.name] else "link"))
+        common = dict(name=safe_name(b.name), body=b.name, outline=outlines[b.name],
+                      holes=tuple(holes[b.name]), thickness_mm=thickness,
+                      z_mm=layer_z(layers[b.name], thickness, gap), layer=layers[b.name],
+                      process=process.name, role=role, gear=",".join(gear_of[b.name]))
+        if slots[b.name]:
+            parts.append(SlottedPart(**common, slots=tuple(slots[b.name])))
+        else:
+            parts.append(Part(**common))
+    centres = {(body, h.joint): h.centre for body, hs in holes.items() for h in hs}
+    pins, spacers = pins_and_spacers(pin_joints, layers, sizes.pin_mm, sizes.hole_mm,
+                                     2.0 * radius, thickness, gap, centres)
+    if process.name == "sla":
+        for sp in spacers:
+            if sp.length_mm >= process.thickness_mm - 1e-9:  # thin gaps are washers, bought not printed
+                parts.append(Part(name=safe_name(f"spacer_{sp.joint}"), body=sp.body,
+                                  outline=circle_hull(sp.centre[None, :], sp.outer_diameter_mm / 2.0),
+                                  holes=(Hole(sp.joint, sp.centre, sp.inner_diameter_mm, sizes.pin_mm),),
+                                  thickness_mm=sp.length_mm, z_mm=sp.z_mm, layer=sp.lower_layer + 1,
+                                  process=process.name, role="spacer"))
+    names = [p.name for p in parts]
+    if len(set(names)) != len(names):
+        raise GeometryError(f"part names collide after sanitising: {sorted(names)}")
+    copies = int(hints.get("copies", 1) or 1)
+    mounting = sum(1 for h in holes[ground] if h.joint.startswith("mount_"))
+    bom = bill_of_materials(pins, spacers, hints, process.name, copies, mounting=mounting,
+                            mounting_mm=parts_spec.mounting_hole_mm)
+    return PartSet(parts=tuple(parts), bom=bom, pins=tuple(pins), spacers=tuple(spacers), layers=layers,
+                   process=process.name, chord_tolerance_mm=tol, thickness_mm=thickness, layer_gap_mm=gap,
+                   kerf_mm=process.kerf_mm, copies=copies, hints=hints)
+
+
+def _add_mounting(mechanism: Mechanism, motion: Motion, ground: str,
+                  circles: dict[str, list[tuple[np.ndarray, float]]], holes: dict[str, list[Hole]],
+                  gear_polys: dict[str, list[np.ndarray]], sizes: Sizes, parts_spec: PartsSpec) -> None:
+    """Mounting holes on the ground part, in a row on the side away from the moving bodies."""
+    count = parts_spec.mounting_holes
+    if count == 0:
+        return
+    own = np.array([c for c, _ in circles[ground]]) if circles[ground] else np.zeros((1, 2))
+    moving = [motion.point(p, b.name) for b in mechanism.bodies if b.name != ground for p in b.points]
+    swept = np.concatenate(moving).mean(axis=0) if moving else own.mean(axis=0) + np.array([0.0, 1.0])
+    away = own.mean(axis=0) - swept
+    norm = float(np.hypot(*away))
+    direction = away / norm if norm > 1e-6 else np.array([0.0, -1.0])
+    side = np.array([-direction[1], direction[0]])
+    reach = float(np.max(own @ direction)) + sizes.boss_radius_mm
+    for poly in gear_polys[ground]:
+        reach = max(reach, float(np.max(poly @ direction)))
+    r_mount = sizes.mount_boss_radius_mm
+    base = own.mean(axis=0) @ side * side + (reach + r_mount + 1.0) * direction
+    pitch = 2.0 * r_mount + 2.0
+    for k in range(count):
+        centre = base + (k - 0.5 * (count - 1)) * pitch * side
+        holes[ground].append(Hole(f"mount_{k + 1}", centre, sizes.mount_hole_mm, 0.0))
+        circles[ground].append((centre, r_mount))

@@ -1,0 +1,173 @@
+"""Layer assignment: bodies that come near each other anywhere over the motion go to different layers.
+
+The conflict test works in the plan view: for every pair of bodies the outline of one is moved into the
+frame of the other at every sampled pose (the relative swept plan view) and the smallest distance between
+the two outlines is compared with the clearance. Bodies joined by a pin always conflict (their bosses
+share the pin). Bodies carrying meshing gears are merged into one group first (their teeth must lie in
+one plane) and the groups are coloured greedily (DSATUR, ties broken by body order so it is
+deterministic).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import shapely
+
+from fabricate.planar import pose_matrix
+
+#: At most this many poses of the motion are used for the plan-view conflict test.
+MAX_CONFLICT_POSES = 180
+
+
+def relative_poses(pose_ref: np.ndarray, pose_body: np.ndarray) -> np.ndarray:
+    """Poses (n, 3) of a body in the frame of a reference body, from both world poses (n, 3)."""
+    m_ref = pose_matrix(pose_ref)
+    m_body = pose_matrix(pose_body)
+    rel = np.linalg.inv(m_ref) @ m_body
+    return np.column_stack([rel[:, 0, 2], rel[:, 1, 2], np.arctan2(rel[:, 1, 0], rel[:, 0, 0])])
+
+
+def min_distance_over_motion(outline_ref: np.ndarray, outline_body: np.ndarray, rel: np.ndarray) -> float:
+    """Smallest distance (mm) between a fixed outline and a moving one over relative poses.
+
+    Parameters
+    ----------
+    outline_ref, outline_body : (n, 2), (m, 2) arrays
+        Outlines in their own body coordinates, mm.
+    rel : (k, 3) array
+        Poses of the moving body in the reference body's frame.
+
+    Returns
+    -------
+    float
+        0 where they overlap; otherwise the gap, less a margin for the motion between samples.
+    """
+    c, s = np.cos(rel[:, 2]), np.sin(rel[:, 2])
+    x = outline_body[None, :, 0] * c[:, None] - outline_body[None, :, 1] * s[:, None] + rel[:, None, 0]
+    y = outline_body[None, :, 0] * s[:, None] + outline_body[None, :, 1] * c[:, None] + rel[:, None, 1]
+    rings = np.stack([x, y], -1)
+    rings = np.concatenate([rings, rings[:, :1]], axis=1)
+    moving = shapely.polygons(rings)
+    fixed = shapely.Polygon(outline_ref)
+    gaps = shapely.distance(moving, fixed)
+    # a point of the moving outline travels at most this far between consecutive samples
+    if len(rel) > 1:
+        reach = float(np.max(np.hypot(outline_body[:, 0], outline_body[:, 1])))
+        step = np.hypot(np.diff(rel[:, 0]), np.diff(rel[:, 1])) + np.abs(np.diff(rel[:, 2])) * reach
+        margin = 0.5 * float(np.max(step))
+    else:
+        margin = 0.0
+    return max(0.0, float(np.min(gaps)) - margin)
+
+
+def conflict_graph(outlines: Mapping[str, np.ndarray], world_poses: Mapping[str, np.ndarray],
+                   clearance_mm: float, always: Sequence[tuple[str, str]] = ()) -> dict[str, set[str]]:
+    """Which bodies must not share a layer.
+
+    Parameters
+    ----------
+    outlines : Mapping[str, (n, 2) array]
+        Each body's outline polygon in body coordinates (mm).
+    world_poses : Mapping[str, (k, 3) array]
+        Each body's world poses over the motion.
+    clearance_mm : float
+        Outlines closer than this anywhere over the motion conflict.
+    always : sequence of (str, str)
+        Pairs that conflict regardless (bodies sharing a pin).
+
+    Returns
+    -------
+    dict[str, set[str]]
+        Symmetric adjacency.
+    """
+    names = list(outlines)
+    graph: dict[str, set[str]] = {n: set() for n in names}
+    for a, b in always:
+        if a in graph and b in graph and a != b:
+            graph[a].add(b)
+            graph[b].add(a)
+    k = len(next(iter(world_poses.values()))) if world_poses else 0
+    pick = np.unique(np.linspace(0, max(k - 1, 0), min(k, MAX_CONFLICT_POSES)).round().astype(int))
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            if b in graph[a]:
+                continue
+            rel = relative_poses(world_poses[a][pick], world_poses[b][pick])
+            if min_distance_over_motion(outlines[a], outlines[b], rel) < clearance_mm:
+                graph[a].add(b)
+                graph[b].add(a)
+    return graph
+
+
+def assign_layers(graph: Mapping[str, set[str]], order: Sequence[str],
+                  same_layer: Sequence[tuple[str, str]] = ()) -> dict[str, int]:
+    """Colour the conflict graph: bodies -> layer index (0 at the bottom).
+
+    Parameters
+    ----------
+    graph : Mapping[str, set[str]]
+        Conflicts from :func:`conflict_graph`.
+    order : sequence of str
+        Body order for tie-breaks (the mechanism's order; the first body's group gets layer 0 when
+        it is among the most constrained).
+    same_layer : sequence of (str, str)
+        Pairs forced into one layer (meshing gears); their mutual conflict is ignored.
+
+    Returns
+    -------
+    dict[str, int]
+    """
+    parent = {n: n for n in order}
+
+    def find(n: str) -> str:
+        while parent[n] != n:
+            parent[n] = parent[parent[n]]
+            n = parent[n]
+        return n
+
+    for a, b in same_layer:
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            # the earlier body in the order names the group
+            if order.index(rb) < order.index(ra):
+                ra, rb = rb, ra
+            parent[rb] = ra
+    groups: dict[str, list[str]] = {}
+    for n in order:
+        groups.setdefault(find(n), []).append(n)
+    group_graph: dict[str, set[str]] = {g: set() for g in groups}
+    for a in order:
+        for b in graph.get(a, ()):
+            ga, gb = find(a), find(b)
+            if ga != gb:
+                group_graph[ga].add(gb)
+                group_graph[gb].add(ga)
+    colour: dict[str, int] = {}
+    rank = {g: order.index(g) for g in groups}
+    while len(colour) < len(groups):
+        def key(g: str) -> tuple[int, int, int]:
+            saturation = len({colour[h] for h in group_graph[g] if h in colour})
+            return (-saturation, -len(group_graph[g]), rank[g])
+        g = min((g for g in groups if g not in colour), key=key)
+        used = {colour[h] for h in group_graph[g] if h in colour}
+        colour[g] = next(c for c in range(len(groups) + 1) if c not in used)
+    return {n: colour[find(n)] for n in order}
+
+
+def layer_z(layer: int, thickness_mm: float, gap_mm: float) -> float:
+    """Height (mm) of the bottom face of ``layer``."""
+    return layer * (thickness_mm + gap_mm)
+
+
+def stack_span(layers: Sequence[int], thickness_mm: float, gap_mm: float) -> tuple[float, float]:
+    """Bottom and top z (mm) of the stack from the lowest to the highest of ``layers``."""
+    lo, hi = min(layers), max(layers)
+    return layer_z(lo, thickness_mm, gap_mm), layer_z(hi, thickness_mm, gap_mm) + thickness_mm
+
+
+def skipped_gap(lower: int, upper: int, thickness_mm: float, gap_mm: float) -> float:
+    """Axial length (mm) between the top of ``lower`` and the bottom of ``upper`` (a spacer's length)."""
+    return max(0.0, layer_z(upper, thickness_mm, gap_mm) - layer_z(lower, thickness_mm, gap_mm) - thickness_mm)
+
