@@ -1,0 +1,91 @@
+"""Gear law of the five-bar finger: cubic spline through the poses and pitch curves by rolling.
+
+The sun gear is fixed to the ground at O, the planet to link A-B at A; the carrier is the proximal body
+(arm O-A). With ``x_a`` the ground's and ``x_b`` the link's rotation relative to the arm, the law is
+``x_b = f(x_a)`` (a :class:`scipy.interpolate.CubicSpline` through the pose samples, eq 17). An external
+pair turns the two ways relative to the carrier, so ``f' < 0`` and the ratio is ``i = -f'`` (eq 18).
+
+Pitch radii (our derivation; the printed eq 19 does not roll without slip): equal rolled arcs
+``r_a dx_a = r_b |dx_b|`` and ``r_a + r_b = |OA|`` give ``r_a = |OA| i / (1 + i)``, ``r_b = |OA| / (1 + i)``.
+Angles in radians, lengths in mm.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+#: Samples of the gear law used for feasibility (ratio, curvature) and the report.
+LAW_SAMPLES = 241
+
+
+@dataclass(frozen=True)
+class GearLaw:
+    """The planet's rotation relative to the arm against the sun's (ground's), both rad.
+
+    Attributes
+    ----------
+    law : CubicSpline
+        ``x_b = law(x_a)`` through the pose samples (x_a increasing).
+    knots_a, knots_b : (n,) arrays
+        Pose samples in pose order.
+    centre_distance : float
+        |OA|, mm.
+    x : (k,) array
+        Dense samples of the working range.
+    ratio, r_a, r_b, rho_a, rho_b : (k,) arrays
+        Transmission ratio ``-law'``, pitch radii of sun (a) and planet (b), and the pitch curves'
+        signed radii of curvature (positive: convex), mm.
+    """
+
+    law: CubicSpline
+    knots_a: np.ndarray
+    knots_b: np.ndarray
+    centre_distance: float
+    x: np.ndarray
+    ratio: np.ndarray
+    r_a: np.ndarray
+    r_b: np.ndarray
+    rho_a: np.ndarray
+    rho_b: np.ndarray
+
+    @property
+    def working_range(self) -> tuple[float, float]:
+        return float(self.x[0]), float(self.x[-1])
+
+
+def _polar_curvature_radius(r: np.ndarray, r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
+    """Signed radius of curvature of a polar curve r(phi) from r, dr/dphi, d2r/dphi2."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return (r * r + r1 * r1) ** 1.5 / (r * r + 2.0 * r1 * r1 - r * r2)
+
+
+def gear_law(knots_a: np.ndarray, knots_b: np.ndarray, centre_distance: float) -> GearLaw:
+    """Spline the law through the poses and derive the pitch curves by rolling without slip.
+
+    Parameters
+    ----------
+    knots_a, knots_b : (n,) arrays
+        ``x_a`` (ground relative to the arm) and ``x_b`` (A-B relative to the arm) at the poses, rad.
+    centre_distance : float
+        |OA|, mm.
+    """
+    order = np.argsort(knots_a)
+    law = CubicSpline(knots_a[order], knots_b[order])
+    x = np.linspace(knots_a[order[0]], knots_a[order[-1]], LAW_SAMPLES)
+    i, di, ddi = -law(x, 1), -law(x, 2), -law(x, 3)
+    a = centre_distance
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r_a, r_b = a * i / (1.0 + i), a / (1.0 + i)
+        # sun: pitch point at polar angle -x_a in its gear frame, r_a(x_a)
+        ra_x = a * di / (1.0 + i) ** 2
+        ra_xx = a * (ddi * (1.0 + i) - 2.0 * di * di) / (1.0 + i) ** 3
+        rho_a = _polar_curvature_radius(r_a, -ra_x, ra_xx)
+        # planet: polar angle pi - x_b, d(angle)/dx_a = i
+        rb_x = -ra_x
+        rb_xx = a * (2.0 * di * di - ddi * (1.0 + i)) / (1.0 + i) ** 3
+        rho_b = _polar_curvature_radius(r_b, rb_x / i, (rb_xx * i - rb_x * di) / i ** 3)
+    return GearLaw(law=law, knots_a=knots_a, knots_b=knots_b, centre_distance=a, x=x, ratio=i,
+                   r_a=r_a, r_b=r_b, rho_a=rho_a, rho_b=rho_b)

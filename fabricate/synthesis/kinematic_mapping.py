@@ -1,0 +1,289 @@
+"""Planar kinematic mapping and the dyad-family synthesis of seed 000 (eqs 1-14).
+
+A planar displacement (rotation ``v``, translation ``(e, f)``) maps to homogeneous image coordinates
+``Z = (Z1, Z2, Z3, Z4)`` (eq 2). A point ``b`` fixed in the moving frame stays on a circle of the fixed
+frame (centre ``a``) over a set of displacements iff the 8-vector ``p`` of the circle (eq 6) satisfies
+``M p = 0`` with one row of ``M`` per displacement (eq 11), plus two quadratic conditions (eq 7) which
+say that ``p`` really comes from a circle point and a centre point.
+
+With ``n`` poses ``M^T M`` has ``8 - n`` vanishing eigenvalues. Following the paper (eq 13) the
+solution is spanned by the four eigenvectors of the smallest eigenvalues,
+``p = alpha v1 + beta v2 + gamma v3 + kappa v4``; ``p`` is homogeneous, so we fix its scale by
+``alpha``'s chart of the pencil: for each ``kappa = cot(omega)`` (eq 14) the coefficients
+``(alpha : beta : gamma)`` with ``w = (alpha, beta, gamma, kappa * alpha)`` must lie on two conics in
+the projective plane. Their (up to four) real intersections are found by the degenerate member of the
+conic pencil, so every point of the curve whose ``w4 / w1`` equals ``kappa`` is found, none is missed
+by a chart boundary except the single plane ``w1 = 0``.
+
+Everything here is pure numpy; lengths in mm, angles in radians.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Index pairs (0-based) and coefficients of the two quadratic side conditions of eq 7:
+#: ``p1 p6 + p2 p5 - p3 p4 = 0`` and ``2 p1 p7 - p2 p4 - p3 p5 = 0``.
+_SIDE_CONDITIONS = (
+    ((0, 5, 1.0), (1, 4, 1.0), (2, 3, -1.0)),
+    ((0, 6, 2.0), (1, 3, -1.0), (2, 4, -1.0)),
+)
+
+
+def image_coordinates(displacements: np.ndarray) -> np.ndarray:
+    """Kinematic image (eq 2) of planar displacements.
+
+    Parameters
+    ----------
+    displacements : (n, 3) array
+        Rows ``(e, f, v)``: translation (mm) and rotation (rad) of the moving frame in the fixed one,
+        i.e. a moving point ``x`` lands at ``R(v) x + (e, f)``.
+
+    Returns
+    -------
+    (n, 4) array
+        ``(Z1, Z2, Z3, Z4)`` normalised so that ``Z3**2 + Z4**2 = 1``.
+    """
+    d = np.atleast_2d(np.asarray(displacements, dtype=np.float64))
+    e, f, v = d[:, 0], d[:, 1], d[:, 2]
+    s, c = np.sin(0.5 * v), np.cos(0.5 * v)
+    return np.stack([0.5 * (e * s - f * c), 0.5 * (e * c + f * s), s, c], axis=-1)
+
+
+def displacement_from_image(z: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`image_coordinates` (any scale of ``Z``); returns (n, 3) rows ``(e, f, v)``.
+
+    The matrix of eq 3 gives ``e = 2 (Z1 Z3 + Z2 Z4)`` and ``f = 2 (Z2 Z3 - Z1 Z4)`` for
+    ``Z3**2 + Z4**2 = 1``; a general scale divides by ``Z3**2 + Z4**2``.
+    """
+    z = np.atleast_2d(np.asarray(z, dtype=np.float64))
+    z1, z2, z3, z4 = z.T
+    norm = z3 * z3 + z4 * z4
+    e = 2.0 * (z1 * z3 + z2 * z4) / norm
+    f = 2.0 * (z2 * z3 - z1 * z4) / norm
+    v = 2.0 * np.arctan2(z3, z4)
+    return np.stack([e, f, v], axis=-1)
+
+
+def map_points(z: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Apply the displacement with image ``z`` (4,) to moving-frame points (n, 2) by eq 3."""
+    z1, z2, z3, z4 = np.asarray(z, dtype=np.float64)
+    h = z3 * z3 + z4 * z4
+    mat = np.array([[z4 * z4 - z3 * z3, -2.0 * z4 * z3, 2.0 * (z1 * z3 + z2 * z4)],
+                    [2.0 * z4 * z3, z4 * z4 - z3 * z3, 2.0 * (z2 * z3 - z1 * z4)]]) / h
+    pts = np.atleast_2d(np.asarray(points, dtype=np.float64))
+    return pts @ mat[:, :2].T + mat[:, 2]
+
+
+def constraint_matrix(z: np.ndarray) -> np.ndarray:
+    """Matrix ``M`` of eq 11, one row per displacement image (n, 4) -> (n, 8)."""
+    z = np.atleast_2d(np.asarray(z, dtype=np.float64))
+    z1, z2, z3, z4 = z.T
+    return np.stack([z1 * z1 + z2 * z2, z1 * z3 - z2 * z4, z2 * z3 + z1 * z4, z1 * z3 + z2 * z4,
+                     z2 * z3 - z1 * z4, z3 * z4, z3 * z3 - z4 * z4, z3 * z3 + z4 * z4], axis=-1)
+
+
+def circle_vector(centre: np.ndarray, moving_point: np.ndarray, radius: float) -> np.ndarray:
+    """The 8-vector ``p`` (eq 6) of a dyad: ``moving_point`` (moving frame) on a circle about ``centre``.
+
+    Derivation (our own; the printed eq 9 has sign and index slips): with the circle
+    ``a0 (X^2 + Y^2) + 2 a1 X + 2 a2 Y + a3 = 0`` the centre is ``(-a1 / a0, -a2 / a0)``; we take
+    ``a0 = 1/2``, so ``a1 = -cx / 2``, ``a2 = -cy / 2`` and ``a3 = (|c|^2 - r^2) / 2``.
+    """
+    cx, cy = np.asarray(centre, dtype=np.float64)
+    x, y = np.asarray(moving_point, dtype=np.float64)
+    a0, a1, a2 = 0.5, -0.5 * cx, -0.5 * cy
+    a3 = 0.5 * (cx * cx + cy * cy - radius * radius)
+    return np.array([2 * a0, -2 * a0 * x, -2 * a0 * y, 2 * a1, 2 * a2, 2 * (a2 * x - a1 * y),
+                     -(a1 * x + a2 * y), 0.5 * (a3 + a0 * (x * x + y * y))])
+
+
+def dyad_from_vector(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Centre (fixed frame) and circle point (moving frame) of circle vector(s) ``p`` (..., 8).
+
+    From eq 6: ``p1 = 2 a0``, ``p2 = -2 a0 x``, ``p3 = -2 a0 y``, ``p4 = 2 a1``, ``p5 = 2 a2``, so
+    ``b = -(p2, p3) / p1`` and ``a = -(p4, p5) / p1`` (independent of the scale of ``p``).
+    """
+    p = np.asarray(p, dtype=np.float64)
+    centre = -p[..., 3:5] / p[..., :1]
+    point = -p[..., 1:3] / p[..., :1]
+    return centre, point
+
+
+def side_condition_forms() -> tuple[np.ndarray, np.ndarray]:
+    """Symmetric 8x8 matrices ``S`` with ``p^T S p`` equal to the two conditions of eq 7."""
+    forms = []
+    for terms in _SIDE_CONDITIONS:
+        s = np.zeros((8, 8))
+        for i, j, c in terms:
+            s[i, j] += 0.5 * c
+            s[j, i] += 0.5 * c
+        forms.append(s)
+    return forms[0], forms[1]
+
+
+def side_conditions(p: np.ndarray) -> np.ndarray:
+    """Values of the two conditions of eq 7 for vector(s) ``p`` (..., 8) -> (..., 2)."""
+    p = np.asarray(p, dtype=np.float64)
+    return np.stack([p[..., 0] * p[..., 5] + p[..., 1] * p[..., 4] - p[..., 2] * p[..., 3],
+                     2 * p[..., 0] * p[..., 6] - p[..., 1] * p[..., 3] - p[..., 2] * p[..., 4]], -1)
+
+
+def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
+    """Real intersection points of two conics ``x^T C x = 0`` in the projective plane.
+
+    Parameters
+    ----------
+    c1, c2 : (3, 3) symmetric arrays
+
+    Returns
+    -------
+    list of (3,) unit vectors
+        Homogeneous points (sign arbitrary), polished by Newton's method.
+
+    Notes
+    -----
+    A real root ``lam`` of ``det(c1 + lam c2) = 0`` gives a degenerate conic of the pencil; when it is
+    indefinite it is a pair of real lines through every real intersection point, and each line meets
+    ``c1`` in the roots of a quadratic.
+    """
+    scale = max(np.abs(c1).max(), np.abs(c2).max(), 1e-300)
+    c1, c2 = c1 / scale, c2 / scale
+    samples = np.array([-1.0, 0.0, 1.0, 2.0])
+    coefficients = np.polyfit(samples, [np.linalg.det(c1 + t * c2) for t in samples], 3)
+    if abs(coefficients[0]) < 1e-14:  # c2 itself degenerate: it is the member at infinity
+        lams = [np.inf]
+    else:
+        lams = []
+    lams += [r.real for r in np.roots(coefficients) if abs(r.imag) <= 1e-9 * max(1.0, abs(r))]
+    points: list[np.ndarray] = []
+    for lam in lams:
+        member = c2 if np.isinf(lam) else c1 + lam * c2
+        values, vectors = np.linalg.eigh(member)
+        order = np.argsort(np.abs(values))
+        values, vectors = values[order], vectors[:, order]
+        if values[1] * values[2] >= 0.0:
+            continue  # a definite (point) or double-line member: try another root
+        w1, w2 = np.sqrt(abs(values[1])), np.sqrt(abs(values[2]))
+        for line in (w1 * vectors[:, 1] + w2 * vectors[:, 2], w1 * vectors[:, 1] - w2 * vectors[:, 2]):
+            basis = np.linalg.svd(line[None, :])[2][1:]
+            a = basis[0] @ c1 @ basis[0]
+            b = basis[0] @ c1 @ basis[1]
+            c = basis[1] @ c1 @ basis[1]
+            disc = b * b - a * c
+            if disc < 0.0:
+                continue
+            root = np.sqrt(disc)
+            if abs(a) >= abs(c):
+                pairs = [((-b + root) / a, 1.0), ((-b - root) / a, 1.0)] if a != 0 else []
+            else:
+                pairs = [(1.0, (-b + root) / c), (1.0, (-b - root) / c)]
+            for s, t in pairs:
+                x = s * basis[0] + t * basis[1]
+                points.append(_polish(c1, c2, x / np.linalg.norm(x)))
+        break
+    return [x for x in points if abs(x @ c1 @ x) < 1e-8 and abs(x @ c2 @ x) < 1e-8]
+
+
+def _polish(c1: np.ndarray, c2: np.ndarray, x: np.ndarray, steps: int = 3) -> np.ndarray:
+    """A few minimum-norm Newton steps on ``x^T c1 x = x^T c2 x = 0`` staying on the unit sphere."""
+    for _ in range(steps):
+        res = np.array([x @ c1 @ x, x @ c2 @ x])
+        jac = np.vstack([2 * c1 @ x, 2 * c2 @ x, x])
+        step = np.linalg.lstsq(jac, -np.append(res, 0.0), rcond=None)[0]
+        x = x + step
+        x = x / np.linalg.norm(x)
+    return x
+
+
+@dataclass(frozen=True)
+class DyadFamily:
+    """Points of the one-parameter dyad family (eq 13-14), one row per solution.
+
+    Attributes
+    ----------
+    kappa : (m,) array
+        ``cot(omega)`` of the sample.
+    branch : (m,) int array
+        Branch id: consecutive samples of one branch are joined in plots and crossing searches.
+    p : (m, 8) array
+        Unit circle vectors.
+    centre : (m, 2) array
+        Centre (fixed frame), mm.
+    point : (m, 2) array
+        Circle point (moving frame), mm.
+    """
+
+    kappa: np.ndarray
+    branch: np.ndarray
+    p: np.ndarray
+    centre: np.ndarray
+    point: np.ndarray
+
+
+def family_basis(m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All eigenvalues (ascending, (8,)) and unit eigenvectors (8, 8 columns) of ``M^T M``."""
+    values, vectors = np.linalg.eigh(m.T @ m)
+    return values, vectors
+
+
+def solve_at_kappa(basis4: np.ndarray, kappa: float) -> list[np.ndarray]:
+    """Unit circle vectors ``p`` in span(basis4) with ``w4 = kappa * w1`` meeting eq 7.
+
+    Parameters
+    ----------
+    basis4 : (8, 4) array
+        The four eigenvectors of the smallest eigenvalues.
+    kappa : float
+    """
+    s1, s2 = side_condition_forms()
+    chart = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [kappa, 0.0, 0.0]])
+    lift = basis4 @ chart  # (8, 3): p = lift @ (alpha, beta, gamma)
+    out = []
+    for x in conic_intersections(lift.T @ s1 @ lift, lift.T @ s2 @ lift):
+        p = lift @ x
+        out.append(p / np.linalg.norm(p))
+    return out
+
+
+def trace_family(basis4: np.ndarray, samples: int, min_centre_weight: float = 1e-9) -> DyadFamily:
+    """Trace the dyad family over ``omega`` in (0, pi) with ``kappa = cot(omega)`` (eq 14).
+
+    Parameters
+    ----------
+    basis4 : (8, 4) array
+        Eigenvectors of the four smallest eigenvalues of ``M^T M``.
+    samples : int
+        Number of ``omega`` samples, evenly spaced in the open interval.
+    min_centre_weight : float
+        Solutions with ``|p1|`` below this (a circle of infinite radius: a slider) are dropped.
+    """
+    omegas = np.linspace(0.0, np.pi, samples + 2)[1:-1]
+    kappas, branches, ps = [], [], []
+    previous: list[tuple[np.ndarray, int]] = []
+    next_branch = 0
+    for omega in omegas:
+        kappa = float(np.cos(omega) / np.sin(omega))
+        current: list[tuple[np.ndarray, int]] = []
+        for p in solve_at_kappa(basis4, kappa):
+            if abs(p[0]) < min_centre_weight:
+                continue
+            # same branch when the (sign-free) direction of p barely moved since the last sample
+            best, best_dot = -1, 0.999
+            for q, b in previous:
+                dot = abs(float(p @ q))
+                if dot > best_dot and all(b != c for _, c in current):
+                    best, best_dot = b, dot
+            if best < 0:
+                best, next_branch = next_branch, next_branch + 1
+            current.append((p, best))
+            kappas.append(kappa)
+            branches.append(best)
+            ps.append(p)
+        previous = current
+    p_arr = np.array(ps).reshape(-1, 8)
+    centre, point = dyad_from_vector(p_arr)
+    return DyadFamily(kappa=np.asarray(kappas, dtype=np.float64), branch=np.asarray(branches, dtype=int),
+                      p=p_arr, centre=centre.reshape(-1, 2), point=point.reshape(-1, 2))
