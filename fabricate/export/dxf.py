@@ -1,0 +1,225 @@
+"""DXF for laser cutting and CAD (the only module that imports ezdxf).
+
+Every document is R2010 in millimetres ($INSUNITS = 4, $MEASUREMENT = 1). Cut geometry goes on layer
+``CUT`` (red): each outline is one closed LWPOLYLINE whose arcs are bulges, each hole a CIRCLE, each slot
+a closed LWPOLYLINE. Labels go on ``ENGRAVE`` (blue). The laser kerf is applied to the cut path only:
+outlines are offset out by kerf / 2 and holes in by kerf / 2 (a hole's CIRCLE is its finished diameter
+minus the kerf), so the finished part has the modelled size.
+
+Documents are written with ezdxf's fixed metadata (dates, GUIDs) so equal inputs give equal bytes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from collections.abc import Iterator, Mapping, Sequence
+from typing import Any
+
+import ezdxf
+import numpy as np
+import shapely
+from ezdxf import units
+from shapely.ops import polylabel
+
+from fabricate.export.layout import Placement, shelf_pack
+from fabricate.parts.model import BulgePath, Part
+from fabricate.parts.profiles import offset_path
+from fabricate.planar import transform_points
+
+#: ACI colours: red for cutting, blue for engraving, grey for the sheet border, others for CAD drawings.
+LAYERS = {"CUT": 1, "ENGRAVE": 5, "SHEET": 8, "LINKS": 7, "JOINTS": 3, "DIMENSIONS": 2, "LABELS": 4}
+
+
+@contextlib.contextmanager
+def _fixed_metadata() -> Iterator[None]:
+    """Write fixed dates and GUIDs (ezdxf's testing switch) for byte-identical output."""
+    previous = ezdxf.options.write_fixed_meta_data_for_testing
+    ezdxf.options.write_fixed_meta_data_for_testing = True
+    try:
+        yield
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = previous
+
+
+def new_document(layers: Sequence[str] = ("CUT", "ENGRAVE"), dimensions: bool = False) -> Any:
+    """An empty R2010 document in mm with the given layers (colours from :data:`LAYERS`).
+
+    ``dimensions`` adds ezdxf's dimension styles (needed by the kinematic drawing only; the cut files
+    stay small).
+    """
+    with _fixed_metadata():  # ezdxf stamps the creation time at new()
+        doc = ezdxf.new("R2010", setup=["styles", "dimstyles"] if dimensions else False)
+    doc.units = units.MM
+    doc.header["$MEASUREMENT"] = 1
+    doc.header["$LUNITS"] = 2
+    for name in layers:
+        layer = doc.layers.add(name, color=LAYERS[name])
+        if name == "SHEET":
+            layer.dxf.plot = 0  # the sheet border is a guide, not a cut
+    return doc
+
+
+def document_bytes(doc: Any) -> bytes:
+    """Encode a document as DXF bytes (fixed metadata, UTF-8 for R2007+)."""
+    stream = io.StringIO()
+    with _fixed_metadata():
+        doc.write(stream)
+    return stream.getvalue().encode("utf-8")
+
+
+def cut_geometry(part: Part, kerf_mm: float) -> tuple[BulgePath, list[tuple[np.ndarray, float]], list[BulgePath]]:
+    """The laser path of a part: outline offset out by kerf/2, holes (centre, diameter) shrunk by the kerf,
+    slots offset in by kerf/2. With no kerf this is the part's exact geometry."""
+    half = 0.5 * kerf_mm
+    outline = offset_path(part.outline, half)
+    holes = [(np.asarray(h.centre, dtype=np.float64), h.diameter_mm - kerf_mm) for h in part.holes]
+    slots = [offset_path(s, -half) for s in getattr(part, "slots", ())]
+    return outline, holes, slots
+
+
+def _label_spot(part: Part, text: str) -> tuple[np.ndarray, float]:
+    """A point inside the part far from its edges and holes, and a text height that fits there.
+
+    The point is the pole of inaccessibility of the plate (outline less holes); the height keeps the
+    text (about 0.65 h per character wide) inside the largest circle around it.
+    """
+    polygon = shapely.Polygon(part.outline.polygon(0.05))
+    for h in part.holes:
+        polygon = polygon.difference(shapely.Point(h.centre).buffer(h.diameter_mm / 2.0, 16))
+    for s in getattr(part, "slots", ()):
+        polygon = polygon.difference(shapely.Polygon(s.polygon(0.05)))
+    if polygon.is_empty:
+        return np.asarray(part.outline.vertices.mean(axis=0)), 1.0
+    if polygon.geom_type == "MultiPolygon":
+        polygon = max(polygon.geoms, key=lambda g: g.area)
+    spot = polylabel(polygon, tolerance=0.05)
+    room = float(polygon.exterior.distance(spot))
+    for ring in polygon.interiors:
+        room = min(room, float(ring.distance(spot)))
+    height = min(0.8 * room, 1.8 * room / (0.65 * max(1, len(text))))
+    return np.array([spot.x, spot.y]), float(np.clip(round(height, 3), 0.3, 5.0))
+
+
+def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None = None,
+             label: str | None = None) -> None:
+    """Draw a part's cut path (CUT) and its label (ENGRAVE) into a modelspace.
+
+    Parameters
+    ----------
+    placement : Placement, optional
+        Rotation and offset onto a sheet; None keeps the part's own coordinates.
+    label : str, optional
+        Text engraved at the roomiest inside point (default: the part name).
+    """
+    outline, holes, slots = cut_geometry(part, kerf_mm)
+
+    def place(points: np.ndarray) -> np.ndarray:
+        return placement.apply(points) if placement is not None else np.asarray(points, dtype=np.float64)
+
+    for path in [outline] + slots:
+        xy = place(path.vertices)
+        msp.add_lwpolyline([(float(x), float(y), float(b)) for (x, y), b in zip(xy, path.bulges, strict=True)],
+                           format="xyb", close=True, dxfattribs={"layer": "CUT"})
+    for centre, diameter in holes:
+        c = place(centre[None, :])[0]
+        msp.add_circle((float(c[0]), float(c[1])), float(diameter) / 2.0, dxfattribs={"layer": "CUT"})
+    label = label if label is not None else part.name
+    spot, height = _label_spot(part, label)
+    spot = place(spot[None, :])[0]
+    text = msp.add_text(label, height=height, dxfattribs={"layer": "ENGRAVE"})
+    text.set_placement((float(spot[0]), float(spot[1])), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
+
+
+def part_dxf(part: Part, kerf_mm: float) -> bytes:
+    """DXF of one part in its own (body) coordinates."""
+    doc = new_document()
+    add_part(doc.modelspace(), part, kerf_mm)
+    return document_bytes(doc)
+
+
+def sheet_layout(parts: Sequence[Part], kerf_mm: float, sheet_mm: tuple[float, float], margin_mm: float,
+                 spacing_mm: float) -> list[Placement]:
+    """Nest the parts' cut outlines on sheets of ``sheet_mm`` (bounding-rectangle shelves, no overlap)."""
+    outlines = [cut_geometry(p, kerf_mm)[0].polygon(0.05) for p in parts]
+    return shelf_pack(outlines, sheet_mm, margin_mm, spacing_mm + kerf_mm)
+
+
+def sheet_dxf(parts: Sequence[Part], kerf_mm: float, placements: Sequence[Placement],
+              sheet_mm: tuple[float, float]) -> bytes:
+    """All parts nested on sheets; every further sheet is drawn to the right of the previous one."""
+    doc = new_document(("CUT", "ENGRAVE", "SHEET"))
+    msp = doc.modelspace()
+    sheets = 1 + max((p.sheet for p in placements), default=0)
+    pitch = sheet_mm[0] + 20.0
+    for k in range(sheets):
+        x0 = k * pitch
+        msp.add_lwpolyline([(x0, 0.0), (x0 + sheet_mm[0], 0.0), (x0 + sheet_mm[0], sheet_mm[1]),
+                            (x0, sheet_mm[1])], format="xy", close=True, dxfattribs={"layer": "SHEET"})
+    for part, placement in zip(parts, placements, strict=True):
+        shifted = Placement(placement.angle, placement.offset + np.array([placement.sheet * pitch, 0.0]),
+                            placement.sheet, placement.size)
+        add_part(msp, part, kerf_mm, shifted)
+    return document_bytes(doc)
+
+
+def kinematic_dxf(mechanism: Any, poses: Mapping[str, np.ndarray]) -> bytes:
+    """Kinematic drawing at one pose: joints, link centre lines, link-length and joint-coordinate dimensions.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    poses : Mapping[str, (3,) array]
+        World pose of every body (the first pose of the motion).
+    """
+    doc = new_document(("LINKS", "JOINTS", "DIMENSIONS", "LABELS"), dimensions=True)
+    msp = doc.modelspace()
+    joint_names = {j.name for j in mechanism.joints}
+    world: dict[str, np.ndarray] = {}
+    for body in mechanism.bodies:
+        for name in body.points:
+            world.setdefault(name, transform_points(poses[body.name], body.point(name)))
+    span = max(1.0, float(np.ptp(np.array(list(world.values())), axis=0).max())) if world else 1.0
+    text_h = round(max(1.0, span / 60.0), 3)
+    drawn: set[tuple[str, str]] = set()
+    for body in mechanism.bodies:
+        names = [n for n in body.points if n in joint_names] or list(body.points)
+        for i, a in enumerate(names):
+            for b in names[i + 1:]:
+                key = tuple(sorted((a, b)))
+                pa = transform_points(poses[body.name], body.point(a))
+                pb = transform_points(poses[body.name], body.point(b))
+                length = float(np.hypot(*(pb - pa)))
+                if key in drawn or length < 1e-6:
+                    continue
+                drawn.add(key)
+                msp.add_line(tuple(pa), tuple(pb), dxfattribs={"layer": "LINKS"})
+                dim = msp.add_aligned_dim(p1=tuple(pa), p2=tuple(pb), distance=3.0 * text_h,
+                                          override={"dimtxt": text_h, "dimasz": text_h, "dimdec": 3, "dimlfac": 1.0},
+                                          dxfattribs={"layer": "DIMENSIONS"})
+                dim.render()
+    for name in sorted(world):
+        p = world[name]
+        is_joint = name in joint_names
+        msp.add_circle(tuple(p), 0.6 * text_h if is_joint else 0.3 * text_h,
+                       dxfattribs={"layer": "JOINTS" if is_joint else "LABELS"})
+        label = f"{name} ({p[0]:.3f}, {p[1]:.3f})"
+        text = msp.add_text(label, height=text_h, dxfattribs={"layer": "LABELS"})
+        text.set_placement((float(p[0] + text_h), float(p[1] + text_h)),
+                           align=ezdxf.enums.TextEntityAlignment.BOTTOM_LEFT)
+        if is_joint:
+            for add, offset in ((msp.add_ordinate_x_dim, (0.0, -4.0 * text_h)),
+                                (msp.add_ordinate_y_dim, (-4.0 * text_h, 0.0))):
+                dim = add(feature_location=tuple(p), offset=offset,
+                          override={"dimtxt": 0.7 * text_h, "dimasz": 0.7 * text_h, "dimdec": 3,
+                                    "dimlfac": 1.0},
+                          dxfattribs={"layer": "DIMENSIONS"})
+                dim.render()
+    return document_bytes(doc)
+
+
+def audit_problems(data: bytes) -> list[str]:
+    """Read DXF bytes back and list what ezdxf's auditor fixed or found (empty means clean)."""
+    doc = ezdxf.read(io.StringIO(data.decode("utf-8")))
+    auditor = doc.audit()
+    return [str(e.message) for e in auditor.errors] + [str(f.message) for f in auditor.fixes]

@@ -1,0 +1,172 @@
+"""Pictures of the assembly: a PNG at several poses (matplotlib) and a GIF of the motion (Pillow).
+
+Both are deterministic: the PNG carries no software/date metadata and the GIF frames are drawn with
+Pillow's rasteriser from fixed pixel maps. Parts are drawn bottom layer first, each layer in its own
+colour, holes as background discs.
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from fabricate.parts.model import Part
+from fabricate.planar import transform_points
+
+#: Layer colours (RGB 0-255), cycled.
+PALETTE = [(31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189),
+           (140, 86, 75), (227, 119, 194), (127, 127, 127), (188, 189, 34), (23, 190, 207)]
+
+#: Outline tolerance (mm) for pictures.
+PREVIEW_CHORD_MM = 0.05
+
+
+def pose_indices(count: int, poses: int) -> list[int]:
+    """``poses`` sweep indices spread evenly from the first to the last of ``count``."""
+    if count <= 1 or poses <= 1:
+        return [0]
+    return sorted({int(round(v)) for v in np.linspace(0, count - 1, poses)})
+
+
+def _shapes(parts: Sequence[Part]) -> list[tuple[Part, np.ndarray, list[tuple[np.ndarray, float]]]]:
+    """(part, outline polygon, holes) drawn bottom layer first."""
+    ordered = sorted(parts, key=lambda p: (p.z_mm, p.name))
+    return [(p, p.outline.polygon(PREVIEW_CHORD_MM),
+             [(np.asarray(h.centre, dtype=np.float64), h.diameter_mm / 2.0) for h in p.holes]
+             + [(s.vertices.mean(axis=0), 0.0) for s in getattr(p, "slots", ())]) for p in ordered]
+
+
+def _extent(shapes: list, motion: Any, indices: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
+    pts = []
+    for i in indices:
+        poses = motion.poses_at(i)
+        for part, outline, _ in shapes:
+            pts.append(transform_points(poses.get(part.body, np.zeros(3)), outline))
+    allpts = np.concatenate(pts)
+    lo, hi = allpts.min(axis=0), allpts.max(axis=0)
+    pad = 0.05 * float(max(hi - lo)) + 1.0
+    return lo - pad, hi + pad
+
+
+def assembly_png(parts: Sequence[Part], motion: Any, poses: int = 4, tip_point: str | None = None,
+                 title: str = "") -> bytes:
+    """PNG of the assembly at ``poses`` poses spread over the motion, one panel each.
+
+    Parameters
+    ----------
+    parts : sequence of Part
+    motion : Motion
+    poses : int
+        Number of panels.
+    tip_point : str, optional
+        A point whose whole trajectory is drawn in every panel.
+    title : str
+        Figure title.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, Polygon
+
+    shapes = _shapes(parts)
+    indices = pose_indices(len(motion.inputs), poses)
+    lo, hi = _extent(shapes, motion, indices)
+    fig, axes = plt.subplots(1, len(indices), figsize=(3.2 * len(indices), 3.4), squeeze=False,
+                             sharex=True, sharey=True)
+    unit = getattr(motion.mechanism, "input_unit", "deg")
+    trace = None
+    if tip_point:
+        try:
+            trace = motion.point(tip_point)
+        except KeyError:
+            trace = None
+    for ax, i in zip(axes[0], indices, strict=True):
+        body_poses = motion.poses_at(i)
+        for part, outline, holes in shapes:
+            pose = body_poses.get(part.body, np.zeros(3))
+            colour = np.array(PALETTE[part.layer % len(PALETTE)]) / 255.0
+            ax.add_patch(Polygon(transform_points(pose, outline), closed=True, facecolor=(*colour, 0.55),
+                                 edgecolor=colour * 0.6, linewidth=0.6))
+            for centre, radius in holes:
+                if radius > 0:
+                    c = transform_points(pose, centre)
+                    ax.add_patch(Circle(tuple(c), radius, facecolor="white", edgecolor=colour * 0.6,
+                                        linewidth=0.4))
+        if trace is not None:
+            ax.plot(trace[:, 0], trace[:, 1], color="black", linewidth=0.6, linestyle="--")
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
+        ax.set_aspect("equal")
+        ax.set_title(f"input {motion.inputs[i]:.1f} {unit}", fontsize=8)
+        ax.tick_params(labelsize=6)
+        ax.locator_params(nbins=4)
+    axes[0][0].set_ylabel("y (mm)", fontsize=7)
+    for ax in axes[0]:
+        ax.set_xlabel("x (mm)", fontsize=7)
+    if title:
+        fig.suptitle(title, fontsize=9)
+    # fixed margins: tight_layout costs more than the drawing itself
+    fig.subplots_adjust(left=0.06, right=0.99, bottom=0.14, top=0.86, wspace=0.08)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=110, metadata={"Software": None})
+    plt.close(fig)
+    return buffer.getvalue()
+
+
+def motion_gif(parts: Sequence[Part], motion: Any, frames: int = 24, size_px: int = 360,
+               frame_ms: int = 80) -> bytes:
+    """Animated GIF of the motion there and back, drawn with Pillow.
+
+    Parameters
+    ----------
+    parts : sequence of Part
+    motion : Motion
+    frames : int
+        Poses on the way out (the way back repeats them in reverse).
+    size_px : int
+        Longest image side in pixels.
+    frame_ms : int
+        Frame duration.
+    """
+    from PIL import Image, ImageDraw
+
+    shapes = _shapes(parts)
+    indices = pose_indices(len(motion.inputs), frames)
+    lo, hi = _extent(shapes, motion, indices)
+    scale = size_px / float(max(hi - lo))
+    width = max(16, int(round((hi[0] - lo[0]) * scale)))
+    height = max(16, int(round((hi[1] - lo[1]) * scale)))
+
+    def pixels(points: np.ndarray) -> list[tuple[float, float]]:
+        x = (points[:, 0] - lo[0]) * scale
+        y = height - (points[:, 1] - lo[1]) * scale  # image y points down
+        return [(round(float(a), 2), round(float(b), 2)) for a, b in zip(x, y, strict=True)]
+
+    # a fixed palette: index 0 white, 1 outline grey, 2.. the layer colours (no per-frame quantising)
+    palette = [255, 255, 255, 40, 40, 40] + [c for rgb in PALETTE for c in rgb]
+    palette += [0] * (768 - len(palette))
+    images = []
+    for i in indices:
+        image = Image.new("P", (width, height), 0)
+        image.putpalette(palette)
+        draw = ImageDraw.Draw(image)
+        body_poses = motion.poses_at(i)
+        for part, outline, holes in shapes:
+            pose = body_poses.get(part.body, np.zeros(3))
+            colour = 2 + part.layer % len(PALETTE)
+            draw.polygon(pixels(transform_points(pose, outline)), fill=colour, outline=1)
+            for centre, radius in holes:
+                if radius > 0:
+                    (cx, cy), = pixels(transform_points(pose, centre)[None, :])
+                    r = radius * scale
+                    draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=0)
+        images.append(image)
+    sequence = images + images[-2:0:-1]
+    buffer = io.BytesIO()
+    sequence[0].save(buffer, format="GIF", save_all=True, append_images=sequence[1:], duration=frame_ms,
+                     loop=0, optimize=False, disposal=1)
+    return buffer.getvalue()

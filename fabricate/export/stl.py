@@ -1,0 +1,180 @@
+"""Meshes for SLA printing: binary STL per part, the print plate, and a 3MF of the assembly.
+
+Solids come from the manifold3d adapter (:mod:`fabricate.parts.solids`); trimesh only encodes and
+validates. Every encoder returns bytes and is deterministic (no timestamps, no random ids): the 3MF
+container is written here with fixed zip dates and ids numbered in part order.
+"""
+
+from __future__ import annotations
+
+import io
+import zipfile
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import trimesh
+
+from fabricate.export.layout import Placement, shelf_pack
+from fabricate.parts.model import Part
+from fabricate.parts.solids import mesh_arrays, part_solid, posed
+
+#: Fixed zip entry date so the 3MF bytes do not depend on when they were written.
+_ZIP_DATE = (1980, 1, 1, 0, 0, 0)
+
+
+class SolidCache:
+    """Solids of parts, polygonised and extruded once per build.
+
+    Parameters
+    ----------
+    chord_tolerance_mm : float
+        Polygonisation tolerance of every profile.
+    """
+
+    def __init__(self, chord_tolerance_mm: float) -> None:
+        self.tol = chord_tolerance_mm
+        self._solids: dict[str, Any] = {}
+        self._flat: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+    def solid(self, part: Part) -> Any:
+        """The part's manifold solid at its assembly height."""
+        if part.name not in self._solids:
+            self._solids[part.name] = part_solid(part, self.tol)
+        return self._solids[part.name]
+
+    def flat_mesh(self, part: Part) -> tuple[np.ndarray, np.ndarray]:
+        """Vertices (n, 3) and triangles (m, 3) of the part lying on z = 0 in its own coordinates."""
+        if part.name not in self._flat:
+            vertices, faces = mesh_arrays(self.solid(part))
+            vertices = vertices.copy()
+            vertices[:, 2] -= part.z_mm
+            self._flat[part.name] = (vertices, faces)
+        return self._flat[part.name]
+
+
+def _mesh(vertices: np.ndarray, faces: np.ndarray) -> trimesh.Trimesh:
+    return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+
+
+def stl_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
+    """Binary STL of a triangle mesh (80-byte zero header, float32 normals and corners)."""
+    return trimesh.exchange.stl.export_stl(_mesh(vertices, faces))
+
+
+def part_stl(part: Part, cache: SolidCache) -> bytes:
+    """Binary STL of one part in its own coordinates, bottom face on z = 0 (its print orientation)."""
+    return stl_bytes(*cache.flat_mesh(part))
+
+
+def validate_stl(data: bytes, expected_volume_mm3: float | None = None,
+                 rel_tol: float = 1e-3) -> list[str]:
+    """Problems found by reading STL bytes back with trimesh (an empty list means a valid solid).
+
+    Parameters
+    ----------
+    data : bytes
+        Binary STL.
+    expected_volume_mm3 : float, optional
+        Also compare the volume with this value.
+    rel_tol : float
+        Relative volume tolerance.
+
+    Returns
+    -------
+    list of str
+        Human-readable problems: not watertight, inconsistent winding, non-positive volume, volume off.
+    """
+    try:
+        mesh = trimesh.load(io.BytesIO(data), file_type="stl", process=True)
+    except Exception as exc:  # noqa: BLE001 - any decoder failure is a finding
+        return [f"cannot be read back: {exc}"]
+    problems = []
+    if len(mesh.faces) == 0:
+        return ["no triangles"]
+    if not mesh.is_watertight:
+        problems.append("not watertight")
+    if not mesh.is_winding_consistent:
+        problems.append("inconsistent winding")
+    volume = float(mesh.volume)
+    if not volume > 0:
+        problems.append(f"volume {volume:.6g} mm^3 is not positive")
+    if expected_volume_mm3 is not None and abs(volume - expected_volume_mm3) > rel_tol * abs(expected_volume_mm3):
+        problems.append(f"volume {volume:.6g} mm^3 differs from {expected_volume_mm3:.6g} mm^3")
+    return problems
+
+
+def plate_layout(parts: Sequence[Part], cache: SolidCache, build_area_mm: tuple[float, float],
+                 spacing_mm: float) -> list[Placement]:
+    """Placements of parts on the SLA build plate (x, y of the build volume)."""
+    outlines = [p.outline.polygon(max(cache.tol, 0.05)) for p in parts]
+    return shelf_pack(outlines, build_area_mm, margin_mm=spacing_mm, spacing_mm=spacing_mm)
+
+
+def print_plate_stl(parts: Sequence[Part], cache: SolidCache, placements: Sequence[Placement],
+                    build_area_mm: tuple[float, float]) -> bytes:
+    """One STL with every part lying flat on the plate; further plates continue to the right.
+
+    Each part keeps its own closed shells, so the plate is watertight when each part is.
+    """
+    vertices_all, faces_all, base = [], [], 0
+    for part, place in zip(parts, placements, strict=True):
+        vertices, faces = cache.flat_mesh(part)
+        xy = place.apply(vertices[:, :2])
+        xy[:, 0] += place.sheet * (build_area_mm[0] + 10.0)
+        vertices_all.append(np.column_stack([xy, vertices[:, 2]]))
+        faces_all.append(faces + base)
+        base += len(vertices)
+    return stl_bytes(np.concatenate(vertices_all), np.concatenate(faces_all))
+
+
+def assembly_3mf(parts: Sequence[Part], cache: SolidCache, poses: Mapping[str, np.ndarray],
+                 title: str = "assembly") -> bytes:
+    """3MF (core spec) of the assembly at the given body poses: one object per part, in mm.
+
+    Parameters
+    ----------
+    parts : sequence of Part
+    cache : SolidCache
+    poses : Mapping[str, (3,) array]
+        World pose of each body (x mm, y mm, theta rad); spacers move with their body.
+    title : str
+        Model title metadata.
+    """
+    objects, items = [], []
+    for k, part in enumerate(parts, start=1):
+        solid = posed(cache.solid(part), np.asarray(poses.get(part.body, np.zeros(3)), dtype=np.float64))
+        vertices, faces = mesh_arrays(solid)
+        vert_xml = "".join(f'<vertex x="{x:.6f}" y="{y:.6f}" z="{z:.6f}"/>' for x, y, z in vertices)
+        tri_xml = "".join(f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in faces)
+        objects.append(f'<object id="{k}" name="{_xml_escape(part.name)}" type="model"><mesh>'
+                       f"<vertices>{vert_xml}</vertices><triangles>{tri_xml}</triangles></mesh></object>")
+        items.append(f'<item objectid="{k}"/>')
+    model = ('<?xml version="1.0" encoding="UTF-8"?>\n'
+             '<model unit="millimeter" xml:lang="en-US" '
+             'xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02">'
+             f'<metadata name="Title">{_xml_escape(title)}</metadata>'
+             f'<resources>{"".join(objects)}</resources><build>{"".join(items)}</build></model>')
+    content_types = ('<?xml version="1.0" encoding="UTF-8"?>\n'
+                     '<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">'
+                     '<Default Extension="rels" '
+                     'ContentType="application/vnd.openxmlformats-package.relationships+xml"/>'
+                     '<Default Extension="model" '
+                     'ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/></Types>')
+    rels = ('<?xml version="1.0" encoding="UTF-8"?>\n'
+            '<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">'
+            '<Relationship Target="/3D/3dmodel.model" Id="rel0" '
+            'Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>')
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as archive:
+        for name, text in (("[Content_Types].xml", content_types), ("_rels/.rels", rels),
+                           ("3D/3dmodel.model", model)):
+            info = zipfile.ZipInfo(name, date_time=_ZIP_DATE)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            archive.writestr(info, text.encode("utf-8"))
+    return buffer.getvalue()
+
+
+def _xml_escape(text: str) -> str:
+    return (text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+            .replace('"', "&quot;"))
