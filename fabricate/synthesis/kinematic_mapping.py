@@ -131,6 +131,11 @@ def side_conditions(p: np.ndarray) -> np.ndarray:
                      2 * p[..., 0] * p[..., 6] - p[..., 1] * p[..., 3] - p[..., 2] * p[..., 4]], -1)
 
 
+_CUBIC_SAMPLES = np.array([-1.0, 0.0, 1.0, 2.0])
+#: Maps det(c1 + t c2) at the four samples to the cubic's coefficients (highest power first).
+_CUBIC_FIT = np.linalg.inv(np.vander(_CUBIC_SAMPLES, 4))
+
+
 def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
     """Real intersection points of two conics ``x^T C x = 0`` in the projective plane.
 
@@ -151,8 +156,8 @@ def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
     """
     scale = max(np.abs(c1).max(), np.abs(c2).max(), 1e-300)
     c1, c2 = c1 / scale, c2 / scale
-    samples = np.array([-1.0, 0.0, 1.0, 2.0])
-    coefficients = np.polyfit(samples, [np.linalg.det(c1 + t * c2) for t in samples], 3)
+    # the cubic through four exact samples of det(c1 + lam c2)
+    coefficients = _CUBIC_FIT @ np.linalg.det(c1[None] + _CUBIC_SAMPLES[:, None, None] * c2[None])
     if abs(coefficients[0]) < 1e-14:  # c2 itself degenerate: it is the member at infinity
         lams = [np.inf]
     else:
@@ -187,12 +192,15 @@ def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
     return [x for x in points if abs(x @ c1 @ x) < 1e-8 and abs(x @ c2 @ x) < 1e-8]
 
 
-def _polish(c1: np.ndarray, c2: np.ndarray, x: np.ndarray, steps: int = 3) -> np.ndarray:
-    """A few minimum-norm Newton steps on ``x^T c1 x = x^T c2 x = 0`` staying on the unit sphere."""
+def _polish(c1: np.ndarray, c2: np.ndarray, x: np.ndarray, steps: int = 2) -> np.ndarray:
+    """Newton steps on ``x^T c1 x = x^T c2 x = 0`` with the step orthogonal to ``x`` (unit sphere)."""
     for _ in range(steps):
-        res = np.array([x @ c1 @ x, x @ c2 @ x])
-        jac = np.vstack([2 * c1 @ x, 2 * c2 @ x, x])
-        step = np.linalg.lstsq(jac, -np.append(res, 0.0), rcond=None)[0]
+        g1, g2 = c1 @ x, c2 @ x
+        jac = np.array([2.0 * g1, 2.0 * g2, x])
+        try:
+            step = np.linalg.solve(jac, [-(x @ g1), -(x @ g2), 0.0])
+        except np.linalg.LinAlgError:  # tangential intersection: keep the unpolished point
+            return x
         x = x + step
         x = x / np.linalg.norm(x)
     return x
