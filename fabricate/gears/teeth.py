@@ -1,0 +1,188 @@
+"""Tooth outlines of one gear: rack envelope (exact) or osculating-circle involute teeth (approx),
+clipped by the tip curve, closed as a full gear or as a sector with a hub, cleaned and decimated.
+
+Outlines are (n, 2) float64 in the gear frame (mm), counter-clockwise, no repeated closing vertex,
+valid simple polygons (shapely) with a chord error below the requested tolerance: the dense outline's
+vertices are exact envelope points spaced so that its own chord error is below 0.1 um, and the
+Douglas-Peucker decimation keeps a subset of those vertices within 0.9 x tolerance of it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+from shapely.geometry.polygon import orient
+
+from fabricate.gears.pitch import PitchCurves
+from fabricate.gears.rack import FLANK, RackProfile, contact_abscissa, envelope, offset_profile, osculating_frames
+
+
+@dataclass(frozen=True)
+class GearTeeth:
+    """One cut gear.
+
+    Attributes
+    ----------
+    outline : (n, 2) array
+        Decimated outline, CCW, mm (gear frame).
+    dense : (m, 2) array
+        The outline before decimation, CCW.
+    flanks : dict[int, (k, 2) array]
+        Involute-flank points (inside the tip curve) by rack flank index ``j`` (even: left flank of a
+        gear-a tooth, odd: right), for the mesh check.
+    tooth_centres : (z,) array
+        Rack abscissae (mm) of this gear's tooth centres.
+    tip_land_min_mm : float
+        Shortest tip land (length of outline on the tip curve per tooth), mm.
+    self_intersecting : bool
+        The raw envelope crossed itself (undercut: the fillet trochoid cut into the flank).
+    root_radius_min_mm : float
+        Smallest distance of the outline from the axis over the teeth, mm.
+    """
+
+    outline: np.ndarray
+    dense: np.ndarray
+    flanks: dict[int, np.ndarray]
+    tooth_centres: np.ndarray
+    tip_land_min_mm: float
+    self_intersecting: bool
+    root_radius_min_mm: float
+
+
+def flank_index(flank_u: np.ndarray, pitch: float, origin: float) -> np.ndarray:
+    """Rack flank index of pitch-line abscissae ``flank_u`` (left flank of the a-tooth at ``origin``
+    is 0, its right flank 1, the next tooth's left flank 2, ...)."""
+    index = np.rint((flank_u - origin + pitch / 4) / (pitch / 2))
+    return np.where(np.isfinite(index), index, -(2**62)).astype(np.int64)
+
+
+def _largest_polygon(geom: shapely.Geometry) -> Polygon:
+    if geom.geom_type == "Polygon":
+        return geom
+    parts = [g for g in getattr(geom, "geoms", []) if g.geom_type == "Polygon"]
+    parts += [p for g in getattr(geom, "geoms", []) if g.geom_type == "MultiPolygon" for p in g.geoms]
+    if not parts:
+        raise ValueError("no polygon")
+    return max(parts, key=lambda g: g.area)
+
+
+def _clean_ring(coords: np.ndarray) -> np.ndarray:
+    """Drop the closing vertex and consecutive duplicates."""
+    ring = np.asarray(coords, dtype=np.float64)
+    if len(ring) > 1 and np.allclose(ring[0], ring[-1]):
+        ring = ring[:-1]
+    keep = np.ones(len(ring), dtype=bool)
+    keep[1:] = np.hypot(*(np.diff(ring, axis=0).T)) > 1e-9
+    ring = ring[keep]
+    if np.hypot(*(ring[0] - ring[-1])) <= 1e-9:
+        ring = ring[:-1]
+    return ring
+
+
+def circle_points(radius: float, chord_tolerance: float, start: float = 0.0) -> np.ndarray:
+    """A CCW circle polygon whose chord error is at most ``chord_tolerance``."""
+    n = max(16, int(np.ceil(np.pi / np.arccos(max(-1.0, 1.0 - chord_tolerance / radius)))))
+    ang = start + np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    return radius * np.stack([np.cos(ang), np.sin(ang)], -1)
+
+
+def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np.ndarray, *,
+             method: str, delta: float, addendum_mm: float, closed: bool, rack_origin: float,
+             hub_radius_mm: float, chord_tolerance_mm: float) -> GearTeeth:
+    """Cut one gear by the rack.
+
+    Parameters
+    ----------
+    pitch : PitchCurves
+    gear : {"a", "b"}
+    rack : RackProfile
+        Gear a's cutter (gear b's is its reflection).
+    tooth_centres : (z,) array
+        Rack abscissae of this gear's tooth centres, mm, increasing.
+    method : {"exact", "approx"}
+    delta : float
+        Normal offset of the flanks into the gear (half the backlash share), mm.
+    addendum_mm : float
+        Tip height over the pitch curve, mm.
+    closed : bool
+        Full gear (``tooth_centres`` cover one perimeter) or sector.
+    rack_origin : float
+        Abscissa of gear-a tooth 0 (flank numbering).
+    hub_radius_mm : float
+        Radius of the hub disk that closes a sector.
+    chord_tolerance_mm : float
+        Allowed chord error of the decimated outline.
+    """
+    profile = rack if gear == "a" else rack.for_gear_b()
+    z = len(tooth_centres)
+    base = offset_profile(profile.points, profile.normals, delta, gear)
+    k = len(base)
+    pts = np.tile(base, (z, 1))
+    pts[:, 0] += np.repeat(tooth_centres, k)
+    normals = np.tile(profile.normals, (z, 1))
+    element = np.tile(profile.element, z)
+    flank_u = np.tile(profile.flank_u, z) + np.repeat(tooth_centres, k)
+    s = contact_abscissa(pts, normals)
+    if method == "exact":
+        frames = pitch.frames(s, gear)
+    else:
+        centre_frames = pitch.frames(np.asarray(tooth_centres, dtype=np.float64), gear)
+
+        def at_centres(_: np.ndarray) -> object:
+            return type(centre_frames)(np.repeat(centre_frames.point, k, 0), np.repeat(centre_frames.tangent, k, 0),
+                                       np.repeat(centre_frames.normal, k, 0), np.repeat(centre_frames.curvature, k))
+
+        frames = osculating_frames(s, np.repeat(tooth_centres, k), at_centres)
+    chain = envelope(pts, s, frames, gear)
+    p = rack.pitch
+    # tip curve: pitch curve offset outwards by the addendum
+    if closed:
+        perimeter = pitch.perimeter_a if gear == "a" else pitch.perimeter_b
+        s_tip = np.linspace(0.0, perimeter, max(200, int(perimeter / p * 60)), endpoint=False)
+    else:
+        lo, hi = tooth_centres[0] - 1.5 * p, tooth_centres[-1] + 1.5 * p
+        s_tip = np.linspace(lo, hi, max(100, int((hi - lo) / p * 60)))
+    tf = pitch.frames(s_tip, gear)
+    tip = tf.point + addendum_mm * tf.normal
+    origin = np.zeros((1, 2))
+    if closed:
+        chain_poly, tip_poly = Polygon(chain), Polygon(tip)
+    else:
+        chain_poly, tip_poly = Polygon(np.vstack([chain, origin])), Polygon(np.vstack([tip, origin]))
+    self_intersecting = not chain_poly.is_valid
+    if self_intersecting:
+        chain_poly = _largest_polygon(shapely.make_valid(chain_poly))
+    if not tip_poly.is_valid:
+        tip_poly = _largest_polygon(shapely.make_valid(tip_poly))
+    teeth = chain_poly.intersection(tip_poly)
+    root_min = float(np.min(np.hypot(chain[:, 0], chain[:, 1])))
+    if not closed:
+        hub = Polygon(circle_points(min(hub_radius_mm, 0.95 * root_min), 0.2 * chord_tolerance_mm))
+        teeth = teeth.union(hub)
+    poly = orient(_largest_polygon(teeth), 1.0)
+    dense = _clean_ring(np.asarray(poly.exterior.coords))
+    dense_poly = Polygon(dense)
+    simple = shapely.simplify(dense_poly, 0.9 * chord_tolerance_mm, preserve_topology=True)
+    outline = _clean_ring(np.asarray(orient(_largest_polygon(simple), 1.0).exterior.coords))
+    # tip lands: pieces of the outline lying on the tip curve
+    on_tip = dense_poly.exterior.intersection(tip_poly.exterior.buffer(1e-6))
+    pieces = [g.length for g in getattr(on_tip, "geoms", [on_tip]) if g.geom_type == "LineString"]
+    pieces = sorted(pieces)
+    # the two end pieces of a sector may be split (the tip clip meets the hub); ignore tiny slivers
+    tip_land = float(pieces[0]) if pieces else 0.0
+    # involute flanks for the mesh check
+    is_flank = element == FLANK
+    inside = shapely.contains_xy(tip_poly, chain[:, 0], chain[:, 1])
+    keys = flank_index(flank_u, p, rack_origin)
+    flanks: dict[int, np.ndarray] = {}
+    count = 2 * z if closed else None
+    for j in np.unique(keys[is_flank]):
+        sel = is_flank & inside & (keys == j)
+        if np.count_nonzero(sel) >= 2:
+            flanks[int(j % count) if count else int(j)] = chain[sel]
+    return GearTeeth(outline=outline, dense=dense, flanks=flanks,
+                     tooth_centres=np.asarray(tooth_centres, dtype=np.float64), tip_land_min_mm=tip_land,
+                     self_intersecting=self_intersecting, root_radius_min_mm=root_min)
