@@ -1,0 +1,150 @@
+"""Approximate refinement of region points that suffer a circuit defect (extension to seed 004).
+
+Every point of the solution region passes the four positions *exactly* on some assembly of each loop,
+but not necessarily on one continuous branch: when a loop must switch branch between two positions
+(a circuit defect) the built finger misses the later positions by centimetres. With the paper's
+printed Table 2 (angles rounded to whole degrees) every non-trivial dyad d-e of C_d has such a
+defect in the loop proximal-middle-distal-coupler; the paper's mechanism 1 sits next to a change-point
+four-bar (|ad| + |ab| ~ |be| + |de|) where rounding the input moves the curves by millimetres.
+
+So, when asked, we look for mechanisms that pass the positions within a fingertip tolerance on one
+continuous branch: a damped Gauss-Newton (Levenberg-Marquardt) run, vectorised over many seeds (the
+region points themselves), on the eight coordinates of d, e, f, d0 inside their boxes, minimising the
+fingertip errors at positions 2..4 (position 1 is exact by construction) plus a weak pull towards
+the seed so each run stays near its region point. Results are candidates, not region points: they
+are reported as such with their fingertip error, their distance to the exact curves and K.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fabricate.synthesis.watt_six_bar_statics import SixBarBatch, assemble, fingertip_errors, force_index
+
+#: Residual (mm) standing in for a position where a loop cannot close: large, so the step is refused.
+_NO_ASSEMBLY = 1.0e3
+
+
+@dataclass(frozen=True)
+class RefinedCandidates:
+    """Approximate mechanisms found from region seeds; arrays over M candidates.
+
+    Attributes
+    ----------
+    d, e, f, d0 : (M, 2) arrays
+        Joints at position 1, mm.
+    seed : (M,) int array
+        Index of the region point each run started from.
+    tip_error : (M,) array
+        Largest fingertip error at the four positions, mm.
+    K : (M,) array
+        Force index.
+    accepted : (M,) bool
+        Within the tip tolerance, K limit and the boxes.
+    """
+
+    d: np.ndarray
+    e: np.ndarray
+    f: np.ndarray
+    d0: np.ndarray
+    seed: np.ndarray
+    tip_error: np.ndarray
+    K: np.ndarray
+    accepted: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.d)
+
+
+def _residuals(params: np.ndarray, seeds: np.ndarray, template: SixBarBatch, theta_positions: np.ndarray,
+               tips: np.ndarray, pull: np.ndarray) -> np.ndarray:
+    """(N, 6 + 8) residuals: fingertip misses at positions 2..4, then pull * (params - anchor)."""
+    batch = SixBarBatch(template.a, template.b, template.c, params[:, 0:2], params[:, 2:4],
+                        params[:, 4:6], params[:, 6:8], template.theta1_start)
+    poses = assemble(batch, theta_positions[1:])
+    miss = (poses.c - tips[None, 1:]).reshape(len(params), -1)
+    bad = np.repeat(poses.margin < 0.0, 2, axis=1) | ~np.isfinite(miss)
+    miss = np.where(bad, _NO_ASSEMBLY, miss)
+    return np.concatenate([miss, pull * (params - seeds)], axis=1)
+
+
+def refine(seeds: np.ndarray, template: SixBarBatch, theta_positions: np.ndarray, tips: np.ndarray,
+           lower: np.ndarray, upper: np.ndarray, iterations: int = 60, pull: np.ndarray | float = 0.01,
+           anchor: np.ndarray | None = None) -> np.ndarray:
+    """Levenberg-Marquardt on every seed at once, kept inside ``lower``/``upper`` by clipping.
+
+    Parameters
+    ----------
+    seeds : (N, 8) array
+        Starting (d, e, f, d0), mm.
+    template : SixBarBatch
+        Supplies a, b, c at position 1 and theta1 there (its d, e, f, d0 are ignored).
+    theta_positions : (4,) array
+        theta1 at the positions, rad.
+    tips : (4, 2) array
+        Fingertip targets, mm.
+    lower, upper : (8,) arrays
+        Box bounds of (d, e, f, d0).
+    pull : float or (8,) array
+        Weight (mm per mm) of the pull towards ``anchor`` (default: the seeds) per coordinate.
+
+    Returns
+    -------
+    (N, 8) array of refined parameters.
+    """
+    p = np.clip(seeds, lower, upper)
+    damping = np.full(len(p), 1e-2)
+    anchor = seeds if anchor is None else anchor
+    args = (anchor, template, theta_positions, tips, np.broadcast_to(np.asarray(pull, dtype=np.float64), (8,)))
+    r = _residuals(p, *args)
+    cost = np.einsum("ij,ij->i", r, r)
+    h = 1e-5
+    eye = np.eye(p.shape[1])
+    for _ in range(iterations):
+        jac = np.empty(r.shape + (p.shape[1],))
+        for k in range(p.shape[1]):
+            jac[:, :, k] = (_residuals(p + h * eye[k], *args) - r) / h
+        jtj = np.einsum("nik,nil->nkl", jac, jac)
+        jtr = np.einsum("nik,ni->nk", jac, r)
+        diag = np.einsum("nkk->nk", jtj)
+        system = jtj + damping[:, None, None] * (np.eye(p.shape[1]) * (diag[:, None, :] + 1e-9))
+        step = np.linalg.solve(system, -jtr[..., None])[..., 0]
+        trial = np.clip(p + step, lower, upper)
+        r_trial = _residuals(trial, *args)
+        cost_trial = np.einsum("ij,ij->i", r_trial, r_trial)
+        better = cost_trial < cost
+        p = np.where(better[:, None], trial, p)
+        r = np.where(better[:, None], r_trial, r)
+        cost = np.where(better, cost_trial, cost)
+        damping = np.where(better, damping * 0.3, damping * 4.0)
+        damping = np.clip(damping, 1e-9, 1e9)
+    return p
+
+
+def refine_region(seed_points: np.ndarray, seed_index: np.ndarray, template: SixBarBatch,
+                  theta_positions: np.ndarray, tips: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                  theta_statics: np.ndarray, force: float, tip_tolerance: float, k_max: float,
+                  iterations: int = 60, pull: np.ndarray | float = 0.01,
+                  anchor: np.ndarray | None = None) -> RefinedCandidates:
+    """Refine seeds, then score them like region points (fingertip error, K); duplicates removed."""
+    params = refine(seed_points, template, theta_positions, tips, lower, upper, iterations, pull, anchor)
+    # runs that converge to the same mechanism: keep the first (0.01 mm grid)
+    _, first = np.unique(np.round(params, 2), axis=0, return_index=True)
+    first = np.sort(first)
+    params, seed_index = params[first], seed_index[first]
+    batch = SixBarBatch(template.a, template.b, template.c, params[:, 0:2], params[:, 2:4], params[:, 4:6],
+                        params[:, 6:8], template.theta1_start)
+    tip = np.nan_to_num(fingertip_errors(batch, theta_positions, tips).max(axis=1), nan=np.inf)
+    k = force_index(batch, theta_statics, force)
+    inside = np.all((params >= lower - 1e-9) & (params <= upper + 1e-9), axis=1)
+    return RefinedCandidates(d=params[:, 0:2], e=params[:, 2:4], f=params[:, 4:6], d0=params[:, 6:8],
+                             seed=seed_index, tip_error=tip, K=k,
+                             accepted=inside & (tip <= tip_tolerance) & (k <= k_max))
+
+
+def merge(first: RefinedCandidates, second: RefinedCandidates) -> RefinedCandidates:
+    """Both sets of candidates in one (first's order, then second's)."""
+    return RefinedCandidates(*(np.concatenate([getattr(first, name), getattr(second, name)])
+                               for name in ("d", "e", "f", "d0", "seed", "tip_error", "K", "accepted")))
