@@ -1,0 +1,454 @@
+"""Interference of every pair of parts (and pins) over the whole motion.
+
+Every part is a prism (a planar outline extruded from ``z_mm`` by ``thickness_mm``) moving with its
+body; pins are cylinders fixed in one body. For two prisms the 3D problem is exactly planar:
+
+- z ranges overlap by ``t > 0``: the solids collide iff the posed outlines overlap, the overlap volume
+  is the planar overlap area × ``t``, and the clearance is the planar distance of the outlines;
+- z ranges are disjoint with gap ``g``: no collision; the clearance is ``hypot(g, planar distance)``
+  (``g`` itself wherever the outlines overlap in plan view, e.g. two links stacked on one pin).
+
+The sweep is therefore (1) a broad phase per pair over all poses at once: z ranges (layers) and the
+distance of bounding circles; (2) the exact planar clearance of the poses left, computed for all of
+them in one vectorised pass (:mod:`fabricate.checks.distance`); (3) manifold3d on the few poses that
+decide the verdict: ``min_gap`` at each pair's closest pose (searching just beyond the planar value)
+and the boolean intersection volume at each colliding pair's worst pose. The kernel's numbers are
+the ones reported, the planar engine only chooses where to ask.
+
+Pairs of one body are rigid (no relative motion) and are not swept. Joined pairs (two parts on one
+pin, a pin in the hole of a part of another body) are swept like any other: their clearances are the
+layer gap and the radial pin clearance, and they must meet the minimum like every moving pair. Gear
+parts meshing with each other (same ``gear`` name, different bodies) run with the backlash, far below
+the process clearance: for them only an overlap fails here, the backlash is judged by the gear mesh
+check.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fabricate.checks.distance import Outline, RelativePoses, overlap_areas, planar_clearance
+from fabricate.mechanism import Motion
+from fabricate.parts.model import Part, circle_polygon
+
+#: Planar clearances beyond this (mm) are not resolved exactly (curves show a lower bound there).
+DEFAULT_SEARCH_MM = 2.0
+#: Overlap volumes below this (mm^3) are rounding, not a collision.
+VOLUME_EPS_MM3 = 1e-6
+
+
+@dataclass(frozen=True)
+class PinSolid:
+    """A pin: a cylinder fixed in ``body`` through the holes of joint ``joint``.
+
+    Attributes
+    ----------
+    name, joint, body : str
+    centre : (2,) array
+        Axis position in the body's coordinates, mm.
+    diameter_mm, z_mm, length_mm : float
+        Diameter, height of its lower end and length, mm.
+    """
+
+    name: str
+    joint: str
+    body: str
+    centre: np.ndarray
+    diameter_mm: float
+    z_mm: float
+    length_mm: float
+
+
+@dataclass(frozen=True)
+class SweepItem:
+    """One solid of the sweep in its body's frame: a part or a pin."""
+
+    name: str
+    body: str
+    kind: str                       # "part" or "pin"
+    rings: tuple[np.ndarray, ...]   # outer CCW then holes CW, mm, body frame
+    z0: float
+    z1: float
+    joints: frozenset[str]          # joints of its holes (parts) or its own joint (pins)
+    gear: str = ""
+    source: object = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class PairResult:
+    """Clearance and collisions of one pair over the motion.
+
+    Attributes
+    ----------
+    a, b : str
+        Item names.
+    relation : str
+        ``"moving"``, ``"joined"`` (share a pin), ``"pin"`` (a pin in another body's hole) or
+        ``"meshing"`` (gear parts in mesh).
+    z_gap_mm : float
+        Gap between the z ranges (negative: the overlap thickness).
+    required_mm : float
+        Clearance the pair must keep (0 for meshing gears: only an overlap fails).
+    clearance : (n,) array
+        Clearance per pose, mm: exact up to the search length, a lower bound beyond it
+        (``exact`` says which); 0 where the solids overlap.
+    exact : (n,) bool array
+    min_clearance_mm : float
+        Smallest clearance over the motion (manifold ``min_gap`` at that pose when it resolves it).
+    min_index : int
+        Pose index of the smallest clearance.
+    kernel_gap_mm : float or None
+        manifold3d ``min_gap`` at ``min_index`` (None when not asked).
+    collision_indices : (k,) int array
+        Poses where the solids overlap.
+    overlap_mm3 : (k,) array
+        Planar overlap area × z overlap at those poses.
+    max_overlap_mm3 : float
+        Largest overlap volume, from manifold3d's boolean intersection at the worst pose.
+    max_overlap_index : int
+    """
+
+    a: str
+    b: str
+    relation: str
+    z_gap_mm: float
+    required_mm: float
+    clearance: np.ndarray
+    exact: np.ndarray
+    min_clearance_mm: float
+    min_index: int
+    kernel_gap_mm: float | None
+    collision_indices: np.ndarray
+    overlap_mm3: np.ndarray
+    max_overlap_mm3: float
+    max_overlap_index: int
+
+    @property
+    def collides(self) -> bool:
+        return len(self.collision_indices) > 0
+
+
+@dataclass(frozen=True)
+class InterferenceResult:
+    """Outcome of :func:`sweep_interference`.
+
+    Attributes
+    ----------
+    inputs : (n,) array
+        Input values of the poses (``input_unit``).
+    input_unit : str
+    pairs : tuple of PairResult
+        Every non-rigid pair, in item order.
+    rigid_pairs : int
+        Pairs on one body (no relative motion), not swept.
+    min_clearance_required_mm : float
+    tolerance_mm : float
+        Slack of the clearance verdict: the chord tolerance of the polygonised solids.
+    search_length_mm : float
+    """
+
+    inputs: np.ndarray
+    input_unit: str
+    pairs: tuple[PairResult, ...]
+    rigid_pairs: int
+    min_clearance_required_mm: float
+    tolerance_mm: float
+    search_length_mm: float
+
+    @property
+    def collisions(self) -> list[PairResult]:
+        return [p for p in self.pairs if p.collides]
+
+    def too_close(self) -> list[PairResult]:
+        """Pairs that do not collide but come closer than they must."""
+        return [p for p in self.pairs if not p.collides
+                and p.min_clearance_mm < p.required_mm - self.tolerance_mm]
+
+    @property
+    def min_clearance_mm(self) -> float:
+        """Smallest clearance over all pairs that must keep the process clearance (mm)."""
+        values = [p.min_clearance_mm for p in self.pairs if p.relation != "meshing"]
+        return float(min(values)) if values else math.inf
+
+    def failures(self) -> list[str]:
+        """Human-readable reasons the sweep fails (empty when it passes)."""
+        out = []
+        unit = self.input_unit
+        for p in self.collisions:
+            ranges = ", ".join(f"{lo:g}..{hi:g}" for lo, hi in self.input_ranges(p.collision_indices))
+            out.append(f"interference: {p.a} collides with {p.b} at input {ranges} {unit} "
+                       f"(largest overlap {p.max_overlap_mm3:.3f} mm^3 at "
+                       f"{self.inputs[p.max_overlap_index]:g} {unit})")
+        for p in self.too_close():
+            out.append(f"clearance: {p.a} and {p.b} come within {p.min_clearance_mm:.3f} mm at input "
+                       f"{self.inputs[p.min_index]:g} {unit}; the process needs {p.required_mm:.3f} mm")
+        return out
+
+    @property
+    def passed(self) -> bool:
+        return not self.failures()
+
+    def input_ranges(self, indices: np.ndarray) -> list[tuple[float, float]]:
+        """Contiguous runs of pose indices as (first, last) input values."""
+        if len(indices) == 0:
+            return []
+        idx = np.asarray(indices)
+        breaks = np.nonzero(np.diff(idx) > 1)[0]
+        starts = np.concatenate([[idx[0]], idx[breaks + 1]])
+        ends = np.concatenate([idx[breaks], [idx[-1]]])
+        return [(float(self.inputs[s]), float(self.inputs[e])) for s, e in zip(starts, ends)]
+
+    def report(self) -> dict:
+        """The ``interference`` section of report.json (DESIGN.md keys plus extras)."""
+        collisions = []
+        for p in self.collisions:
+            collisions.append({
+                "a": p.a, "b": p.b,
+                "input_deg": float(self.inputs[p.max_overlap_index]),
+                "volume_mm3": round(float(p.max_overlap_mm3), 6),
+                "input_ranges": [[lo, hi] for lo, hi in self.input_ranges(p.collision_indices)],
+                "poses_colliding": int(len(p.collision_indices)),
+            })
+        return {
+            "poses": int(len(self.inputs)),
+            "pairs_checked": len(self.pairs),
+            "collisions": collisions,
+            "min_clearance_mm": _finite(self.min_clearance_mm),
+            "input_unit": self.input_unit,
+            "required_clearance_mm": self.min_clearance_required_mm,
+            "tolerance_mm": self.tolerance_mm,
+            "rigid_pairs_skipped": self.rigid_pairs,
+            "pairs": [self.pair_row(p) for p in self.pairs],
+        }
+
+    def pair_row(self, p: PairResult) -> dict:
+        """One row of the per-pair table."""
+        return {
+            "a": p.a, "b": p.b, "relation": p.relation,
+            "min_clearance_mm": _finite(p.min_clearance_mm),
+            "input_deg": float(self.inputs[p.min_index]),
+            "required_mm": p.required_mm,
+            "z_gap_mm": round(p.z_gap_mm, 6),
+            "kernel_gap_mm": None if p.kernel_gap_mm is None else round(p.kernel_gap_mm, 6),
+            "collides": p.collides,
+            "ok": not p.collides and p.min_clearance_mm >= p.required_mm - self.tolerance_mm,
+        }
+
+
+def _finite(value: float) -> float | None:
+    return round(float(value), 6) if math.isfinite(value) else None
+
+
+# -- items -----------------------------------------------------------------------------------------
+def part_items(parts: Sequence[Part], chord_tolerance_mm: float) -> list[SweepItem]:
+    """Sweep items of parts (their polygons at the chord tolerance)."""
+    return [SweepItem(p.name, p.body, "part", tuple(p.polygons(chord_tolerance_mm)), float(p.z_mm),
+                      float(p.z_mm + p.thickness_mm), frozenset(h.joint for h in p.holes), p.gear, p)
+            for p in parts]
+
+
+def pins_from_holes(parts: Sequence[Part]) -> list[PinSolid]:
+    """One pin per joint whose holes take a pin: through every part with that joint's hole, fixed in
+    the body of the lowest of them, diameter the holes' nominal pin diameter."""
+    by_joint: dict[str, list[tuple[Part, object]]] = {}
+    for p in parts:
+        for h in p.holes:
+            if h.pin_diameter_mm > 0:
+                by_joint.setdefault(h.joint, []).append((p, h))
+    pins = []
+    for joint, members in by_joint.items():
+        if len({p.body for p, _ in members}) < 2:
+            continue  # a hole with no partner on another body is a mounting hole
+        members.sort(key=lambda m: (m[0].z_mm, m[0].name))
+        base, hole = members[0]
+        z0 = min(p.z_mm for p, _ in members)
+        z1 = max(p.z_mm + p.thickness_mm for p, _ in members)
+        pins.append(PinSolid(f"pin_{joint}", joint, base.body, np.asarray(hole.centre, dtype=np.float64),
+                             float(hole.pin_diameter_mm), float(z0), float(z1 - z0)))
+    return pins
+
+
+def pin_items(pins: Sequence[PinSolid], chord_tolerance_mm: float) -> list[SweepItem]:
+    return [SweepItem(p.name, p.body, "pin",
+                      (circle_polygon(p.centre, p.diameter_mm, chord_tolerance_mm),),
+                      float(p.z_mm), float(p.z_mm + p.length_mm), frozenset([p.joint]), "", p)
+            for p in pins]
+
+
+def _relation(a: SweepItem, b: SweepItem) -> str:
+    if a.body == b.body:
+        return "rigid"
+    if a.kind == "part" and b.kind == "part" and a.gear and a.gear == b.gear:
+        return "meshing"
+    if a.joints & b.joints:
+        return "pin" if "pin" in (a.kind, b.kind) else "joined"
+    return "moving"
+
+
+# -- the sweep -------------------------------------------------------------------------------------
+def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance_mm: float,
+                       min_clearance_mm: float, pins: Sequence[PinSolid] | None = None,
+                       search_length_mm: float | None = None, use_kernel: bool = True) -> InterferenceResult:
+    """Check every pair of parts and pins for collision and clearance at every pose of ``motion``.
+
+    Parameters
+    ----------
+    parts : sequence of Part
+    motion : Motion
+        Poses of every body; each of its inputs is one pose of the check.
+    chord_tolerance_mm : float
+        Polygonisation of the solids (also the slack of the clearance verdict).
+    min_clearance_mm : float
+        Clearance every moving pair must keep (mm).
+    pins : sequence of PinSolid, optional
+        Default: :func:`pins_from_holes`.
+    search_length_mm : float, optional
+        Planar distances up to this are resolved exactly (default max(2 mm, 4 × the minimum)).
+    use_kernel : bool
+        Confirm with manifold3d (``min_gap`` / intersection volume) at the deciding poses.
+
+    Returns
+    -------
+    InterferenceResult
+    """
+    if pins is None:
+        pins = pins_from_holes(parts)
+    search = float(search_length_mm or max(DEFAULT_SEARCH_MM, 4.0 * min_clearance_mm))
+    items = part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
+    outlines: dict[str, Outline] = {}
+    solids: dict[str, object] = {}
+    poses = {name: motion.pose(name) for name in motion.body_names}
+    results = []
+    rigid = 0
+    for i in range(len(items)):
+        for j in range(i + 1, len(items)):
+            a, b = items[i], items[j]
+            relation = _relation(a, b)
+            if relation == "rigid":
+                rigid += 1
+                continue
+            for it in (a, b):
+                if it.name not in outlines:
+                    outlines[it.name] = Outline(list(it.rings))
+            required = 0.0 if relation == "meshing" else float(min_clearance_mm)
+            results.append(_sweep_pair(a, b, outlines[a.name], outlines[b.name], poses[a.body], poses[b.body],
+                                       relation, required, search, solids if use_kernel else None,
+                                       chord_tolerance_mm))
+    return InterferenceResult(np.asarray(motion.inputs, dtype=np.float64), motion.mechanism.input_unit,
+                              tuple(results), rigid, float(min_clearance_mm), float(chord_tolerance_mm), search)
+
+
+def _sweep_pair(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, pose_a: np.ndarray, pose_b: np.ndarray,
+                relation: str, required: float, search: float, solids: dict | None,
+                tol: float) -> PairResult:
+    n = len(pose_a)
+    z_gap = max(a.z0, b.z0) - min(a.z1, b.z1)
+    stacked = z_gap >= 0.0
+    rel = RelativePoses.between(pose_a, pose_b)
+    # broad phase: bounding circles; a pose whose circles are farther apart than the search length
+    # keeps that distance as a lower bound of its clearance
+    centre_b = rel.apply(ob.centre[None, :])[:, 0]
+    lower = np.hypot(*(centre_b - oa.centre).T) - oa.radius - ob.radius
+    planar = np.maximum(lower, search)
+    exact = np.zeros(n, dtype=bool)
+    near = np.nonzero(lower < search)[0]
+    shortcut = _shortcut(a, b, oa, ob, rel, lower, z_gap, required, tol, search)
+    if shortcut is not None:
+        k, value = shortcut
+        if value > 0.0:  # a pin in its hole: the same clearance at every pose
+            planar[:] = value
+            exact[:] = True
+        else:  # stacked, overlapping in plan at pose k: elsewhere 0 is a safe lower bound
+            planar = np.maximum(lower, 0.0)
+            planar[k], exact[k] = value, True
+        near = near[:0]
+    if len(near):
+        d = planar_clearance(oa, ob, RelativePoses(rel.q[near]), search)
+        resolved = np.isfinite(d) | (d < 0)
+        planar[near] = np.where(resolved, d, search)
+        exact[near] = resolved
+    overlap_2d = planar <= 0.0
+    if stacked:
+        clearance = np.hypot(z_gap, np.maximum(planar, 0.0))
+        collide_idx = np.zeros(0, dtype=int)
+    else:
+        clearance = np.maximum(planar, 0.0)
+        collide_idx = np.nonzero(planar < 0.0)[0]
+    exact = exact | overlap_2d
+    overlap = np.zeros(0)
+    max_overlap = 0.0
+    max_idx = 0
+    if len(collide_idx):
+        overlap = overlap_areas(oa, ob, RelativePoses(rel.q[collide_idx])) * (-z_gap)
+        real = overlap > VOLUME_EPS_MM3
+        collide_idx, overlap = collide_idx[real], overlap[real]
+        clearance[np.setdiff1d(np.nonzero(planar < 0.0)[0], collide_idx)] = 0.0  # touching, not overlapping
+    if len(collide_idx):
+        k = int(np.argmax(overlap))
+        max_idx = int(collide_idx[k])
+        max_overlap = float(overlap[k])
+        if solids is not None:
+            sa, sb = _posed_pair(a, b, pose_a[max_idx], pose_b[max_idx], solids, tol)
+            max_overlap = float((sa ^ sb).volume())
+    min_idx = int(np.argmin(clearance))
+    min_clear = float(clearance[min_idx])
+    kernel_gap = None
+    if solids is not None and not len(collide_idx) and exact[min_idx] and min_clear < search:
+        sa, sb = _posed_pair(a, b, pose_a[min_idx], pose_b[min_idx], solids, tol)
+        # search just beyond the planar value: manifold's min_gap is fast when the search is short
+        reach = min_clear + 4.0 * tol + 1e-3
+        kernel_gap = float(sa.min_gap(sb, reach))
+        if kernel_gap < reach:
+            min_clear = min(min_clear, kernel_gap)
+    return PairResult(a.name, b.name, relation, float(z_gap), required, clearance, exact, min_clear, min_idx,
+                      kernel_gap, collide_idx, overlap, max_overlap, max_idx)
+
+
+def _shortcut(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, rel: RelativePoses, lower: np.ndarray,
+              z_gap: float, required: float, tol: float, search: float) -> tuple[int, float] | None:
+    """Pairs whose sweep one pose settles: (pose index, planar value) or None.
+
+    - A pin in another body's hole whose axis stays on the hole's centre (a revolute joint): the pin
+      lies inside the hole's disc at every pose, so the nearest material of the part is that hole's
+      wall and the clearance is the same at every pose; one pose gives it exactly.
+    - Parts on disjoint z ranges whose gap alone meets the requirement: the clearance is at least the
+      gap at every pose and equals it wherever the outlines overlap in plan view (parts on one pin
+      always do); one pose that shows the overlap gives the exact minimum.
+    """
+    if a.kind == "pin" or b.kind == "pin":
+        pin, part, flip = (a, b, False) if a.kind == "pin" else (b, a, True)
+        if part.kind != "part":
+            return None
+        hole = next((h for h in part.source.holes if h.joint in pin.joints), None)
+        if hole is None:
+            return None
+        # pin axis in the part's frame at every pose
+        q = rel.inverse() if not flip else rel
+        axis = q.apply(np.asarray(pin.source.centre, dtype=np.float64)[None, :])[:, 0]
+        if np.max(np.hypot(*(axis - np.asarray(hole.centre)).T)) > 1e-6:
+            return None
+        value = float(planar_clearance(oa, ob, RelativePoses(rel.q[:1]), search)[0])
+        return (0, value) if value > 0.0 else None
+    if z_gap >= 0.0 and z_gap >= required - tol:
+        k = int(np.argmin(lower))
+        value = float(overlap_areas(oa, ob, RelativePoses(rel.q[k:k + 1]))[0])
+        if value > 0.0:
+            return k, -math.inf
+    return None
+
+
+def _posed_pair(a: SweepItem, b: SweepItem, pose_a: np.ndarray, pose_b: np.ndarray, cache: dict,
+                tol: float):
+    # manifold3d is imported here and in the parts adapter only (kernel isolation)
+    from fabricate.parts.solids import extrude_polygons, posed
+
+    out = []
+    for it, pose in ((a, pose_a), (b, pose_b)):
+        if it.name not in cache:
+            cache[it.name] = extrude_polygons(list(it.rings), it.z1 - it.z0, it.z0, what=it.name)
+        out.append(posed(cache[it.name], pose))
+    return out
