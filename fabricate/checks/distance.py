@@ -101,7 +101,7 @@ class Outline:
     def __init__(self, rings: list[np.ndarray], max_edge_mm: float = 0.05) -> None:
         verts: list[np.ndarray] = []
         nxt: list[np.ndarray] = []
-        chunk_members: list[np.ndarray] = []
+        runs: list[np.ndarray] = []  # per chunk: first vertex, vertex count, ring start, ring length
         start = 0
         oriented = []
         for k, ring in enumerate(rings):
@@ -118,13 +118,12 @@ class Outline:
             # chunks: runs of at most CHUNK vertices spanning at most CHUNK_SPAN_MM of boundary; each
             # also holds the first vertex of the next run so that it covers its edges
             step = np.hypot(*(np.roll(dense, -1, axis=0) - dense).T)
-            c0 = 0
-            while c0 < n:
-                span = np.cumsum(step[c0:min(c0 + CHUNK, n)])
-                c1 = c0 + max(1, int(np.searchsorted(span, CHUNK_SPAN_MM, side="right")))
-                c1 = min(c1, n)
-                chunk_members.append(idx[np.arange(c0, c1 + 1) % n])
-                c0 = c1
+            arc = np.concatenate([[0.0], np.cumsum(step)[:-1]])
+            key = (arc // CHUNK_SPAN_MM).astype(np.int64) * (n + 1) + np.arange(n) // CHUNK
+            starts = np.concatenate([[0], np.nonzero(np.diff(key))[0] + 1])
+            ends = np.concatenate([starts[1:], [n]])  # the next run's first vertex, wrapping
+            runs.append(np.column_stack([starts + start, ends - starts, np.full(len(starts), start),
+                                         np.full(len(starts), n)]))
             start += n
         self.rings = oriented
         self.vertices = np.concatenate(verts)
@@ -137,15 +136,15 @@ class Outline:
         # longest edge at each vertex: a vertex whose edge crosses another boundary is this close to it
         self.vertex_edge = np.maximum(length, length[self.prev])
         self.tree = cKDTree(self.vertices)
-        width = max(len(m) for m in chunk_members)
-        # padded with each chunk's last vertex (repeats do not change a minimum)
-        self.chunk_table = np.array([np.concatenate([m, np.full(width - len(m), m[-1])])
-                                     for m in chunk_members])
-        self.chunk_members = chunk_members
-        self.chunk_edge = np.array([self.vertex_edge[m].max() for m in chunk_members])
-        self.chunk_centres = np.array([self.vertices[m].mean(axis=0) for m in chunk_members])
-        self.chunk_radii = np.array([np.max(np.hypot(*(self.vertices[m] - c).T))
-                                     for m, c in zip(chunk_members, self.chunk_centres)])
+        # padded table of chunk vertices: repeats of a chunk's last vertex do not change a minimum
+        first, count, ring_start, ring_len = np.concatenate(runs).T
+        width = int(count.max()) + 1
+        offset = np.minimum(np.arange(width)[None, :], count[:, None])
+        self.chunk_table = ring_start[:, None] + (first[:, None] - ring_start[:, None] + offset) % ring_len[:, None]
+        members = self.vertices[self.chunk_table]
+        self.chunk_centres = 0.5 * (members.min(axis=1) + members.max(axis=1))
+        self.chunk_radii = np.max(np.hypot(*(members - self.chunk_centres[:, None, :]).transpose(2, 0, 1)), axis=1)
+        self.chunk_edge = self.vertex_edge[self.chunk_table].max(axis=1)
         self.centre = 0.5 * (self.vertices.min(axis=0) + self.vertices.max(axis=0))
         self.radius = float(np.max(np.hypot(*(self.vertices - self.centre).T)))
         self.polygon = shapely.Polygon(oriented[0], oriented[1:])
@@ -214,10 +213,9 @@ def _subdivide(ring: np.ndarray, max_edge: float) -> np.ndarray:
     pieces = np.maximum(1, np.ceil(length / max_edge).astype(int))
     if np.all(pieces == 1):
         return ring
-    out = []
-    for p, q, m in zip(ring, nxt, pieces):
-        out.append(p + np.outer(np.arange(m) / m, q - p))
-    return np.concatenate(out)
+    first = np.repeat(np.cumsum(pieces) - pieces, pieces)
+    t = (np.arange(int(pieces.sum())) - first) / np.repeat(pieces, pieces)
+    return np.repeat(ring, pieces, axis=0) + t[:, None] * np.repeat(nxt - ring, pieces, axis=0)
 
 
 def _one_way(target: Outline, mover: Outline, rel: RelativePoses, search_mm: float) -> np.ndarray:
@@ -280,16 +278,32 @@ def planar_clearance(a: Outline, b: Outline, rel: RelativePoses, search_mm: floa
         Distance (mm) between the regions where ≤ ``search_mm``; ``+inf`` where farther; negative
         (a penetration depth along the boundary) where they overlap.
     """
-    d = np.minimum(_one_way(a, b, rel, search_mm), _one_way(b, a, rel.inverse(), search_mm))
+    n = len(rel.q)
+    d = np.full(n, np.inf)
+    # cheap probe first: a sample of vertices inside the other's material proves an overlap, and the
+    # exact pass (which would only refine a penetration depth) is skipped for those poses
+    overlapping = _probe_overlap(a, b, rel) | _probe_overlap(b, a, rel.inverse())
+    d[overlapping] = -math.inf
+    rest = np.nonzero(~overlapping)[0]
+    if len(rest) == 0:
+        return d
+    sub = RelativePoses(rel.q[rest])
+    d[rest] = np.minimum(_one_way(a, b, sub, search_mm), _one_way(b, a, sub.inverse(), search_mm))
     # wholly inside the other's material with no boundary near: one vertex per pose tells
-    far = ~(d <= 0.0)
-    if np.any(far):
-        idx = np.nonzero(far)[0]
-        b_in_a = a.contains(rel.apply(np.repeat(b.vertices[:1], len(idx), axis=0), idx))
-        a_in_b = b.contains(rel.inverse().apply(np.repeat(a.vertices[:1], len(idx), axis=0), idx))
-        inside = b_in_a | a_in_b
-        d[idx[inside]] = -math.inf
+    far = rest[~(d[rest] <= 0.0)]
+    if len(far):
+        b_in_a = a.contains(rel.apply(np.repeat(b.vertices[:1], len(far), axis=0), far))
+        a_in_b = b.contains(rel.inverse().apply(np.repeat(a.vertices[:1], len(far), axis=0), far))
+        d[far[b_in_a | a_in_b]] = -math.inf
     return d
+
+
+def _probe_overlap(target: Outline, mover: Outline, rel: RelativePoses, samples: int = 64) -> np.ndarray:
+    """Poses (n,) where one of ~``samples`` evenly spread vertices of ``mover`` lies in ``target``."""
+    step = max(1, len(mover.vertices) // samples)
+    pts = rel.apply(mover.vertices[::step])  # (n, k, 2)
+    inside = target.contains(pts.reshape(-1, 2)).reshape(pts.shape[:2])
+    return inside.any(axis=1)
 
 
 def overlap_areas(a: Outline, b: Outline, rel: RelativePoses) -> np.ndarray:

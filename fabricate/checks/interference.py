@@ -37,8 +37,10 @@ from fabricate.parts.model import Part, circle_polygon
 
 #: Planar clearances beyond this (mm) are not resolved exactly (curves show a lower bound there).
 DEFAULT_SEARCH_MM = 2.0
-#: Overlap volumes below this (mm^3) are rounding, not a collision.
-VOLUME_EPS_MM3 = 1e-6
+#: Planar penetration (mm) below which two outlines touch rather than overlap.
+TOUCH_MM = 1e-9
+#: Colliding poses at which the overlap volume is computed before refining around the worst.
+OVERLAP_SAMPLES = 24
 
 
 @dataclass(frozen=True)
@@ -105,7 +107,10 @@ class PairResult:
         manifold3d ``min_gap`` at ``min_index`` (None when not asked).
     collision_indices : (k,) int array
         Poses where the solids overlap.
-    overlap_mm3 : (k,) array
+    overlap_indices : (j,) int array
+        Colliding poses whose overlap volume was computed (all of them, or a spread sample refined
+        around the worst).
+    overlap_mm3 : (j,) array
         Planar overlap area × z overlap at those poses.
     max_overlap_mm3 : float
         Largest overlap volume, from manifold3d's boolean intersection at the worst pose.
@@ -123,6 +128,7 @@ class PairResult:
     min_index: int
     kernel_gap_mm: float | None
     collision_indices: np.ndarray
+    overlap_indices: np.ndarray
     overlap_mm3: np.ndarray
     max_overlap_mm3: float
     max_overlap_index: int
@@ -200,7 +206,7 @@ class InterferenceResult:
         breaks = np.nonzero(np.diff(idx) > 1)[0]
         starts = np.concatenate([[idx[0]], idx[breaks + 1]])
         ends = np.concatenate([idx[breaks], [idx[-1]]])
-        return [(float(self.inputs[s]), float(self.inputs[e])) for s, e in zip(starts, ends)]
+        return [(float(self.inputs[s]), float(self.inputs[e])) for s, e in zip(starts, ends, strict=True)]
 
     def report(self) -> dict:
         """The ``interference`` section of report.json (DESIGN.md keys plus extras)."""
@@ -372,24 +378,22 @@ def _sweep_pair(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, pose_a: np
         planar[near] = np.where(resolved, d, search)
         exact[near] = resolved
     overlap_2d = planar <= 0.0
+    exact = exact | overlap_2d
     if stacked:
         clearance = np.hypot(z_gap, np.maximum(planar, 0.0))
         collide_idx = np.zeros(0, dtype=int)
     else:
         clearance = np.maximum(planar, 0.0)
-        collide_idx = np.nonzero(planar < 0.0)[0]
-    exact = exact | overlap_2d
+        # a negative value within rounding is touching (clearance 0), not an overlap
+        collide_idx = np.nonzero(planar < -TOUCH_MM)[0]
+    sampled = np.zeros(0, dtype=int)
     overlap = np.zeros(0)
     max_overlap = 0.0
     max_idx = 0
     if len(collide_idx):
-        overlap = overlap_areas(oa, ob, RelativePoses(rel.q[collide_idx])) * (-z_gap)
-        real = overlap > VOLUME_EPS_MM3
-        collide_idx, overlap = collide_idx[real], overlap[real]
-        clearance[np.setdiff1d(np.nonzero(planar < 0.0)[0], collide_idx)] = 0.0  # touching, not overlapping
-    if len(collide_idx):
+        sampled, overlap = _overlap_volumes(oa, ob, rel, collide_idx, -z_gap)
         k = int(np.argmax(overlap))
-        max_idx = int(collide_idx[k])
+        max_idx = int(sampled[k])
         max_overlap = float(overlap[k])
         if solids is not None:
             sa, sb = _posed_pair(a, b, pose_a[max_idx], pose_b[max_idx], solids, tol)
@@ -405,7 +409,30 @@ def _sweep_pair(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, pose_a: np
         if kernel_gap < reach:
             min_clear = min(min_clear, kernel_gap)
     return PairResult(a.name, b.name, relation, float(z_gap), required, clearance, exact, min_clear, min_idx,
-                      kernel_gap, collide_idx, overlap, max_overlap, max_idx)
+                      kernel_gap, collide_idx, sampled, overlap, max_overlap, max_idx)
+
+
+def _overlap_volumes(oa: Outline, ob: Outline, rel: RelativePoses, colliding: np.ndarray,
+                     thickness: float) -> tuple[np.ndarray, np.ndarray]:
+    """Overlap volumes (planar overlap area × z overlap) at up to :data:`OVERLAP_SAMPLES` colliding
+    poses spread over the run, then at every colliding pose next to the worst sample (the volume is
+    continuous in the pose, so its maximum lies there); returns (pose indices, volumes)."""
+    if len(colliding) <= OVERLAP_SAMPLES:
+        picks = colliding
+    else:
+        picks = colliding[np.unique(np.linspace(0, len(colliding) - 1, OVERLAP_SAMPLES).round().astype(int))]
+    volumes = overlap_areas(oa, ob, RelativePoses(rel.q[picks])) * thickness
+    if len(picks) < len(colliding):
+        k = int(np.argmax(volumes))
+        lo = picks[k - 1] if k > 0 else picks[0]
+        hi = picks[k + 1] if k + 1 < len(picks) else picks[-1]
+        extra = np.setdiff1d(colliding[(colliding > lo) & (colliding < hi)], picks)
+        if len(extra):
+            picks = np.concatenate([picks, extra])
+            volumes = np.concatenate([volumes, overlap_areas(oa, ob, RelativePoses(rel.q[extra])) * thickness])
+            order = np.argsort(picks)
+            picks, volumes = picks[order], volumes[order]
+    return picks, volumes
 
 
 def _shortcut(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, rel: RelativePoses, lower: np.ndarray,
@@ -451,4 +478,33 @@ def _posed_pair(a: SweepItem, b: SweepItem, pose_a: np.ndarray, pose_b: np.ndarr
         if it.name not in cache:
             cache[it.name] = extrude_polygons(list(it.rings), it.z1 - it.z0, it.z0, what=it.name)
         out.append(posed(cache[it.name], pose))
+    return out
+
+
+def naive_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance_mm: float,
+                       pins: Sequence[PinSolid] | None = None) -> dict[tuple[str, str], np.ndarray]:
+    """Reference: the boolean intersection of every non-rigid pair at every pose (manifold3d only).
+
+    Returns
+    -------
+    dict
+        ``(a, b) -> (n,) overlap volumes (mm^3)`` for the same pairs :func:`sweep_interference` checks.
+        For benchmarks and tests; far slower than the sweep.
+    """
+    if pins is None:
+        pins = pins_from_holes(parts)
+    items = part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
+    cache: dict[str, object] = {}
+    poses = {name: motion.pose(name) for name in motion.body_names}
+    out = {}
+    for i in range(len(items)):
+        for j in range(i + 1, len(items)):
+            a, b = items[i], items[j]
+            if _relation(a, b) == "rigid":
+                continue
+            volumes = np.zeros(len(motion.inputs))
+            for k in range(len(motion.inputs)):
+                sa, sb = _posed_pair(a, b, poses[a.body][k], poses[b.body][k], cache, chord_tolerance_mm)
+                volumes[k] = (sa ^ sb).volume()
+            out[(a.name, b.name)] = volumes
     return out
