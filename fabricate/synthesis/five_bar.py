@@ -61,6 +61,8 @@ class FiveBarSpec:
         Fingertip pad radius (a parts hint).
     kappa_samples : int
         Samples of ``omega`` in (0, pi) for tracing the hinge curves.
+    curve_step_mm : float
+        Largest step of A or B between samples inside the A box (more samples are inserted there).
     a_x_mm, a_y_mm : (float, float)
         Box for hinge A at the first pose.
     ab_length_mm, bc_length_mm : (float, float)
@@ -82,6 +84,7 @@ class FiveBarSpec:
     poses_deg: tuple[tuple[float, float, float], ...]
     pad_radius_mm: float
     kappa_samples: int
+    curve_step_mm: float
     a_x_mm: tuple[float, float]
     a_y_mm: tuple[float, float]
     ab_length_mm: tuple[float, float]
@@ -128,6 +131,7 @@ def parse_spec(root: Table) -> FiveBarSpec:
         poses_deg=tuple(tuple(float(v) for v in row) for row in poses),
         pad_radius_mm=pad,
         kappa_samples=syn.integer("kappa_samples", 2001, min=50, max=200000),
+        curve_step_mm=syn.number("curve_step_mm", 0.25, positive=True),
         a_x_mm=_interval(syn, "a_x_mm"),
         a_y_mm=_interval(syn, "a_y_mm"),
         ab_length_mm=_interval(syn, "ab_length_mm", positive=True),
@@ -578,6 +582,16 @@ def synthesise(design: Any) -> SynthesisResult:
     eigenvalues, eigenvectors = km.family_basis(matrix)
     basis4 = eigenvectors[:, :4]
     family = km.trace_family(basis4, spec.kappa_samples)
+
+    def hinges(p: np.ndarray) -> np.ndarray:  # A and B at the first pose, (k, 4) mm
+        centre, point = km.dyad_from_vector(p)
+        return np.hstack([targets.origin + centre @ rotation(targets.angles[0, 0]).T,
+                          targets.p[0] + point @ rotation(targets.angles[0, 2]).T])
+
+    first = hinges(family.p)
+    in_box = ((first[:, 0] >= spec.a_x_mm[0]) & (first[:, 0] <= spec.a_x_mm[1])
+              & (first[:, 1] >= spec.a_y_mm[0]) & (first[:, 1] <= spec.a_y_mm[1]))
+    family = km.refine_family(basis4, family, hinges, in_box, spec.curve_step_mm)
     domain = hinge_domain(spec, targets, family)
     dyad = select_dyad(spec, targets, domain, basis4, design.name)
     mech = build_mechanism(design.name, targets, dyad)

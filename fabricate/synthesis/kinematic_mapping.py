@@ -256,6 +256,22 @@ def solve_at_kappa(basis4: np.ndarray, kappa: float) -> list[np.ndarray]:
     return out
 
 
+def _match_branches(found: list[np.ndarray], previous: list[tuple[np.ndarray, int]],
+                    min_dot: float = 0.9) -> list[int]:
+    """Branch label of each new solution: greedy by the largest (sign-free) cosine to the previous
+    sample's solutions, each previous branch used once; -1 for a new branch."""
+    labels = [-1] * len(found)
+    pairs = sorted(((abs(float(p @ q)), i, b) for i, p in enumerate(found) for q, b in previous), reverse=True)
+    used: set[int] = set()
+    for dot, i, b in pairs:
+        if dot < min_dot:
+            break
+        if labels[i] < 0 and b not in used:
+            labels[i] = b
+            used.add(b)
+    return labels
+
+
 def trace_family(basis4: np.ndarray, samples: int, min_centre_weight: float = 1e-9) -> DyadFamily:
     """Trace the dyad family over ``omega`` in (0, pi) with ``kappa = cot(omega)`` (eq 14).
 
@@ -274,24 +290,81 @@ def trace_family(basis4: np.ndarray, samples: int, min_centre_weight: float = 1e
     next_branch = 0
     for omega in omegas:
         kappa = float(np.cos(omega) / np.sin(omega))
-        current: list[tuple[np.ndarray, int]] = []
-        for p in solve_at_kappa(basis4, kappa):
-            if abs(p[0]) < min_centre_weight:
-                continue
-            # same branch when the (sign-free) direction of p barely moved since the last sample
-            best, best_dot = -1, 0.999
-            for q, b in previous:
-                dot = abs(float(p @ q))
-                if dot > best_dot and all(b != c for _, c in current):
-                    best, best_dot = b, dot
-            if best < 0:
-                best, next_branch = next_branch, next_branch + 1
-            current.append((p, best))
+        found = [p for p in solve_at_kappa(basis4, kappa) if abs(p[0]) >= min_centre_weight]
+        labels = _match_branches(found, previous)
+        current = []
+        for p, label in zip(found, labels, strict=True):
+            if label < 0:
+                label, next_branch = next_branch, next_branch + 1
+            current.append((p, label))
             kappas.append(kappa)
-            branches.append(best)
+            branches.append(label)
             ps.append(p)
         previous = current
     p_arr = np.array(ps).reshape(-1, 8)
     centre, point = dyad_from_vector(p_arr)
     return DyadFamily(kappa=np.asarray(kappas, dtype=np.float64), branch=np.asarray(branches, dtype=int),
                       p=p_arr, centre=centre.reshape(-1, 2), point=point.reshape(-1, 2))
+
+
+def refine_family(basis4: np.ndarray, family: DyadFamily, measure, keep: np.ndarray, max_step: float,
+                  max_inserts: int = 200) -> DyadFamily:
+    """Insert kappa samples where a branch jumps by more than ``max_step`` between two samples.
+
+    ``kappa = cot(omega)`` sampled evenly in ``omega`` is coarse where the hinges move fast; only the
+    gaps with an end in ``keep`` (e.g. inside the limits box) are refined, so the far, unbounded parts
+    of the curves do not cost anything.
+
+    Parameters
+    ----------
+    basis4 : (8, 4) array
+    family : DyadFamily
+    measure : callable
+        Maps circle vectors (k, 8) to positions (k, d) whose distance is compared with ``max_step``
+        (e.g. A and B at the first pose, mm).
+    keep : (m,) bool array
+        Samples whose gaps to their branch neighbours may be refined.
+    max_step : float
+    max_inserts : int
+        Largest number of samples inserted into one gap.
+    """
+    order = np.argsort(np.arctan2(1.0, family.kappa), kind="stable")  # omega order
+    fam = _take(family, order)
+    keep = np.asarray(keep)[order]
+    pos = measure(fam.p)
+    new_k, new_b, new_p = [], [], []
+    for branch in np.unique(fam.branch):
+        idx = np.flatnonzero(fam.branch == branch)
+        for j, k in zip(idx[:-1], idx[1:], strict=True):
+            gap = float(np.linalg.norm(pos[k] - pos[j]))
+            if not (keep[j] or keep[k]) or gap <= max_step:
+                continue
+            count = min(max_inserts, int(np.ceil(gap / max_step)) - 1)
+            reference = fam.p[j]
+            for t in np.linspace(0.0, 1.0, count + 2)[1:-1]:
+                kappa = (1.0 - t) * fam.kappa[j] + t * fam.kappa[k]
+                solutions = solve_at_kappa(basis4, kappa)
+                if not solutions:
+                    break
+                p = max(solutions, key=lambda q: abs(float(q @ reference)))
+                if abs(float(p @ reference)) < 0.99 or abs(p[0]) < 1e-9:
+                    break  # lost the branch (a turning point between the samples)
+                p = p if float(p @ reference) > 0 else -p
+                new_k.append(kappa)
+                new_b.append(branch)
+                new_p.append(p)
+                reference = p
+    if not new_k:
+        return fam
+    p_all = np.vstack([fam.p, np.array(new_p)])
+    kappa_all = np.concatenate([fam.kappa, new_k])
+    branch_all = np.concatenate([fam.branch, new_b]).astype(int)
+    order = np.argsort(np.arctan2(1.0, kappa_all), kind="stable")
+    centre, point = dyad_from_vector(p_all[order])
+    return DyadFamily(kappa=kappa_all[order], branch=branch_all[order], p=p_all[order], centre=centre,
+                      point=point)
+
+
+def _take(family: DyadFamily, index: np.ndarray) -> DyadFamily:
+    return DyadFamily(kappa=family.kappa[index], branch=family.branch[index], p=family.p[index],
+                      centre=family.centre[index], point=family.point[index])
