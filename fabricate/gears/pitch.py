@@ -18,6 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.interpolate import CubicHermiteSpline
 
 from fabricate.gears.law import check_ratio, law_derivative
 
@@ -74,6 +75,9 @@ class PitchCurves:
         cumulative = np.concatenate([[0.0], np.cumsum(pieces)])
         self.s_nodes = cumulative
         self.s_nodes = cumulative - self.s_of_x(np.array([self.x_ref]))[0]
+        # x(s) as a cubic Hermite spline with the exact slope 1/speed at the nodes: interpolation
+        # error ~ h^4 max|x''''| / 384, about 1e-13 rad for the default grid (no Newton steps needed)
+        self._x_of_s = CubicHermiteSpline(self.s_nodes, self.nodes, 1.0 / self.speed(self.nodes))
         if periods is not None:
             self.perimeter_a = float(self.s_of_x(np.array([self.x_ref + periods[0]]))[0])
             self.perimeter_b = float(self.s_of_x(np.array([self.x_ref + periods[1]]))[0])
@@ -122,12 +126,8 @@ class PitchCurves:
         return self.s_nodes[k] + (self.speed(xq) * _GL_W).sum(axis=-1) * h
 
     def x_of_s(self, s: np.ndarray) -> np.ndarray:
-        """Inverse of :meth:`s_of_x` by interpolation and two Newton steps."""
-        s = np.asarray(s, dtype=np.float64)
-        x = np.interp(s, self.s_nodes, self.nodes)
-        for _ in range(3):
-            x = x - (self.s_of_x(x) - s) / self.speed(x)
-        return x
+        """Inverse of :meth:`s_of_x` (Hermite interpolation, see ``__init__``)."""
+        return self._x_of_s(np.asarray(s, dtype=np.float64))
 
     def wrap(self, s: np.ndarray, gear: str) -> np.ndarray:
         """Arc length reduced to one perimeter (closed gears); unchanged for sectors."""

@@ -1,0 +1,91 @@
+"""Geometric checks of a gear pair that need no booleans: curvature, undercut, contact ratio,
+working pressure angle, and the feasibility limits that make a request an error.
+
+Limits used
+-----------
+- Undercut (a flag): the rack's straight flank reaches ``h_l = h_f - rho_f (1 - sin alpha)`` below the
+  pitch line (1.0 m for the standard 1.25 m / 0.38 m rack); a pitch curve whose radius of curvature
+  ``rho`` is below ``h_l / sin^2 alpha`` is undercut locally (the classical ``z_min = 2 h_l / (m sin^2
+  alpha)`` = 17 applied to the osculating circle).
+- Infeasible (an error): an osculating circle holding fewer than ``min_teeth`` teeth
+  (``2 rho / m < min_teeth``), or a concave stretch whose radius is within ``2 h_f`` (the tip or root
+  curve would fold).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from fabricate.errors import SpecError
+from fabricate.gears.pitch import PitchCurves
+
+
+def curvature_summary(pitch: PitchCurves, x: np.ndarray) -> dict[str, float]:
+    """Smallest radius of curvature of the convex parts and smallest curvature of each pitch curve."""
+    out: dict[str, float] = {}
+    for gear in ("a", "b"):
+        k = pitch.frames_at_x(x, gear).curvature
+        kmax = float(np.max(k))
+        out[f"min_radius_of_curvature_{gear}_mm"] = float(1.0 / kmax) if kmax > 0 else float("inf")
+        out[f"min_curvature_{gear}_per_mm"] = float(np.min(k))
+        concave = k < 0
+        out[f"min_concave_radius_{gear}_mm"] = float(1.0 / np.max(-k[concave])) if np.any(concave) \
+            else float("inf")
+    return out
+
+
+def undercut_limit_mm(module: float, spec: Any) -> float:
+    """Smallest pitch radius of curvature free of undercut, mm."""
+    straight = spec.dedendum - spec.root_fillet * (1.0 - np.sin(spec.pressure_angle))
+    return float(straight * module / np.sin(spec.pressure_angle) ** 2)
+
+
+def check_feasible(curv: dict[str, float], module: float, spec: Any, path: str = "gears.module_mm") -> None:
+    """Raise :class:`SpecError` naming the quantity and the fix when the module cannot be cut."""
+    rho = min(curv["min_radius_of_curvature_a_mm"], curv["min_radius_of_curvature_b_mm"])
+    needed = 2.0 * rho / spec.min_teeth
+    if module > needed:
+        raise SpecError(path, f"module {module:g} mm too large: min pitch radius of curvature {rho:.3g} mm "
+                              f"holds {2 * rho / module:.1f} teeth (min_teeth = {spec.min_teeth}); "
+                              f"needs module <= {needed:.3g} mm (or a gentler ratio law)")
+    concave = min(curv["min_concave_radius_a_mm"], curv["min_concave_radius_b_mm"])
+    limit = 2.0 * spec.dedendum * module
+    if concave < limit:
+        raise SpecError(path, f"module {module:g} mm too large: the pitch curve is concave with radius "
+                              f"{concave:.3g} mm; needs module <= {concave / (2 * spec.dedendum):.3g} mm")
+
+
+def local_contact_ratio(pitch: PitchCurves, x: np.ndarray, module: float, spec: Any) -> np.ndarray:
+    """Contact ratio of the osculating spur pair at each ``x`` (rack limit where a curve is flat or
+    concave): ``(L_a + L_b) / (p cos alpha)`` with ``L = sqrt((rho + h_a)^2 - (rho cos alpha)^2) -
+    rho sin alpha``."""
+    alpha = spec.pressure_angle
+    ha = spec.addendum * module
+    total = np.zeros_like(x)
+    for gear in ("a", "b"):
+        k = pitch.frames_at_x(x, gear).curvature
+        rack = ha / np.sin(alpha)
+        rho = np.where(k > 1e-9, 1.0 / np.maximum(k, 1e-9), np.inf)
+        finite = np.isfinite(rho)
+        part = np.full_like(x, rack)
+        r = rho[finite]
+        part[finite] = np.sqrt((r + ha) ** 2 - (r * np.cos(alpha)) ** 2) - r * np.sin(alpha)
+        total += part
+    return total / (np.pi * module * np.cos(alpha))
+
+
+def pressure_angle_range_deg(pitch: PitchCurves, x: np.ndarray, spec: Any) -> dict[str, list[float]]:
+    """Working pressure angle against the line of centres on each flank (deg, [min, max]).
+
+    The rack flank makes ``alpha`` with the pitch normal; the pitch tangent of a non-circular gear is
+    tilted by ``mu = atan(dr / (r dtheta))`` from the perpendicular of the line of centres, so the two
+    flanks work at ``alpha + mu`` and ``alpha - mu``.
+    """
+    r, dr, _, _, _ = pitch.radii(x, "a")
+    mu = np.arctan2(dr, r)
+    alpha = spec.pressure_angle
+    drive, coast = np.degrees(alpha + mu), np.degrees(alpha - mu)
+    return {"alpha_plus_mu_deg": [float(drive.min()), float(drive.max())],
+            "alpha_minus_mu_deg": [float(coast.min()), float(coast.max())]}

@@ -1,0 +1,398 @@
+"""Gear pairs: from a ratio law and a centre distance to two cut, checked gears.
+
+:func:`make_gear_pair` does the work for one law; :func:`build_gear_pairs` makes one pair for each
+:class:`~fabricate.mechanism.GearCoupling` of a mechanism (the pipeline's entry point).
+
+Sectors (open working range): teeth are placed at multiples of the circular pitch along the rolled
+arc length, with tooth 0 of gear a centred on the pitch point of the working range's start; every
+tooth that engages within the range is cut plus ``spare_teeth`` more at each end. Closed gears: the
+perimeters must hold whole numbers of teeth, ``z_a / z_b`` equal to the law's turns of b per turn of a;
+with the centre distance fixed the module follows (``m = perimeter_a / (pi z_a)``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from fabricate.errors import SpecError
+from fabricate.gears.checks import (
+    check_feasible,
+    curvature_summary,
+    local_contact_ratio,
+    pressure_angle_range_deg,
+    undercut_limit_mm,
+)
+from fabricate.gears.law import check_ratio
+from fabricate.gears.mesh import MeshResult, mesh_check
+from fabricate.gears.pitch import PitchCurves
+from fabricate.gears.rack import basic_rack
+from fabricate.gears.spec import GearSpec
+from fabricate.gears.teeth import GearTeeth, cut_gear
+
+#: Default module of a sector when the template leaves it open (SLA-sized), mm.
+DEFAULT_SECTOR_MODULE_MM = 0.5
+#: Default bore when neither the template nor the caller gives one (the SLA pin), mm.
+DEFAULT_BORE_MM = 2.0
+#: Shortest acceptable tip land, multiples of the module.
+MIN_TIP_LAND = 0.2
+TWO_PI = 2.0 * np.pi
+
+
+@dataclass(frozen=True, eq=False)
+class GearPair:
+    """Two cut gears and everything measured about them.
+
+    Outlines and pitch curves are in each gear's frame (origin at its axis, x along the line of
+    centres at relative angle 0, see :mod:`fabricate.gears.pitch`), mm, CCW, (n, 2).
+
+    Attributes
+    ----------
+    name : str
+        The coupling's name (the pair is named after it).
+    coupling, carrier, body_a, body_b, axis_a, axis_b : str
+        Where the pair sits in the mechanism.
+    center_distance_mm, module : float
+    teeth : (int, int)
+        Teeth cut on gear a and gear b (for sectors, the count on the sector).
+    method : str
+        ``"exact"`` or ``"approx"``.
+    closed : bool
+    working_range : (float, float)
+        Range of ``x_a`` (rad).
+    law : callable
+        ``x_b = law(x_a)``.
+    outline_a, outline_b : (n, 2) arrays
+    pitch_a, pitch_b : (n, 2) arrays
+    bore_a_mm, bore_b_mm, hub_diameter_mm : float
+    checks : dict
+        Numbers of the boolean-free checks.
+    mesh : MeshResult or None
+    """
+
+    name: str
+    coupling: str
+    carrier: str
+    body_a: str
+    body_b: str
+    axis_a: str
+    axis_b: str
+    center_distance_mm: float
+    teeth: tuple[int, int]
+    module: float
+    method: str
+    closed: bool
+    working_range: tuple[float, float]
+    law: Callable
+    outline_a: np.ndarray
+    outline_b: np.ndarray
+    pitch_a: np.ndarray
+    pitch_b: np.ndarray
+    bore_a_mm: float
+    bore_b_mm: float
+    hub_diameter_mm: float
+    spec: GearSpec
+    pitch_model: PitchCurves = field(repr=False)
+    cut_a: GearTeeth = field(repr=False)
+    cut_b: GearTeeth = field(repr=False)
+    rack_origin: float = 0.0
+    checks: dict[str, Any] = field(default_factory=dict)
+    mesh: MeshResult | None = None
+
+    @property
+    def module_mm(self) -> float:
+        return self.module
+
+    def report(self) -> dict[str, Any]:
+        """JSON-ready entry of report.json's ``gears`` list (DESIGN.md keys first)."""
+        c = self.checks
+        mesh = self.mesh.summary() if self.mesh is not None else {}
+        out: dict[str, Any] = {
+            "name": self.name,
+            "teeth": [int(self.teeth[0]), int(self.teeth[1])],
+            "module_mm": float(self.module),
+            "method": self.method,
+            "center_distance_mm": float(self.center_distance_mm),
+            "transmission_error_deg": mesh.get("transmission_error_deg"),
+            "backlash_mm": mesh.get("backlash_mm", [None, None]),
+            "interference_area_mm2": mesh.get("interference_area_mm2"),
+            "undercut": bool(c["undercut"]),
+            "min_pitch_radius_of_curvature_mm": _finite(c["min_pitch_radius_of_curvature_mm"]),
+        }
+        out.update({
+            "closed": self.closed,
+            "coupling": self.coupling,
+            "bodies": [self.body_a, self.body_b],
+            "working_range_deg": [float(np.degrees(v)) for v in self.working_range],
+            "pressure_angle_deg": float(self.spec.pressure_angle_deg),
+            "backlash_design_mm": float(self.spec.backlash_mm),
+            "transmission_ratio": c["transmission_ratio"],
+            "pitch_radius_a_mm": c["pitch_radius_a_mm"],
+            "pitch_radius_b_mm": c["pitch_radius_b_mm"],
+            "convex": bool(c["convex"]),
+            "undercut_limit_radius_mm": c["undercut_limit_radius_mm"],
+            "contact_ratio": c["contact_ratio"],
+            "working_pressure_angle_deg": c["working_pressure_angle_deg"],
+            "tip_land_min_mm": c["tip_land_min_mm"],
+            "exact_vs_approx_max_deviation_um": c.get("exact_vs_approx_max_deviation_um"),
+            "contact_lag_deg": mesh.get("contact_lag_deg"),
+            "mesh_steps": mesh.get("steps"),
+            "bore_mm": [float(self.bore_a_mm), float(self.bore_b_mm)],
+            "outline_vertices": [int(len(self.outline_a)), int(len(self.outline_b))],
+        })
+        return out
+
+    def failures(self) -> list[str]:
+        """Human-readable failed checks (empty when the pair is fine)."""
+        c, out = self.checks, []
+        m = self.module
+        if c["undercut"]:
+            out.append(f"undercut: min pitch radius of curvature {c['min_pitch_radius_of_curvature_mm']:.3g} mm "
+                       f"< {c['undercut_limit_radius_mm']:.3g} mm; use module <= "
+                       f"{m * c['min_pitch_radius_of_curvature_mm'] / c['undercut_limit_radius_mm']:.3g} mm")
+        if c["tip_land_min_mm"] < MIN_TIP_LAND * m:
+            out.append(f"pointed teeth: tip land {c['tip_land_min_mm']:.3g} mm < {MIN_TIP_LAND * m:.3g} mm; "
+                       "use a smaller addendum or a larger module")
+        if c["contact_ratio"]["min"] < 1.0:
+            out.append(f"contact ratio {c['contact_ratio']['min']:.3f} < 1: the teeth lose contact; "
+                       "use a smaller module or a larger addendum")
+        if self.mesh is not None:
+            s = self.mesh.summary()
+            if s["interference_area_mm2"] > 1e-6:
+                out.append(f"interference: {s['interference_area_mm2']:.3g} mm^2 of tooth overlap in mesh")
+            lo = s["backlash_mm"][0]
+            if lo is None or s["steps_without_contact_pair"]:
+                out.append(f"mesh: {s['steps_without_contact_pair']} step(s) without a flank pair in mesh "
+                           "(add spare teeth)")
+            elif lo <= 0:
+                out.append(f"backlash {lo:.3g} mm <= 0: the teeth jam; increase backlash_mm")
+        return out
+
+
+def _finite(value: float) -> float | None:
+    return float(value) if np.isfinite(value) else None
+
+
+def _range(values: np.ndarray) -> list[float]:
+    return [float(np.min(values)), float(np.max(values))]
+
+
+def _closed_teeth(law: Callable, x0: float, spec: GearSpec, center_distance: float) -> tuple[int, int]:
+    """Tooth counts of a closed pair from the template (teeth or module) and the law's closure."""
+    turns = -(float(law(x0 + TWO_PI)) - float(law(x0))) / TWO_PI
+    if not np.isfinite(turns) or turns <= 0:
+        raise SpecError("gears.closed", f"the law turns gear b {turns:.4g} times per turn of gear a; "
+                                        "a closed external pair needs a positive number")
+    if spec.teeth is not None:
+        z_a, z_b = spec.teeth
+        if abs(z_a / z_b - turns) > 1e-6 * turns:
+            raise SpecError("gears.teeth", f"teeth {z_a}:{z_b} give {z_a / z_b:.6g} turns of b per turn of a "
+                                           f"but the law gives {turns:.6g}; use teeth "
+                                           f"[{z_a}, {z_a / turns:.6g}] or a law that closes")
+        return z_a, z_b
+    if spec.module_mm is None:
+        raise SpecError("gears.teeth", "a closed pair needs teeth = [z_a, z_b] or module_mm")
+    pitch = PitchCurves(law, center_distance, (x0, x0 + TWO_PI), x0)
+    ideal = float(pitch.s_of_x(np.array([x0 + TWO_PI]))[0]) / (np.pi * spec.module_mm)
+    for dz in sorted(range(-60, 61), key=abs):
+        z_a = int(round(ideal)) + dz
+        if z_a < 3:
+            continue
+        z_b = z_a / turns
+        if abs(z_b - round(z_b)) < 1e-6 * z_b:
+            return z_a, int(round(z_b))
+    raise SpecError("gears.teeth", f"no whole tooth counts near {ideal:.1f} close the law "
+                                   f"({turns:.6g} turns of b per turn of a); give teeth = [z_a, z_b]")
+
+
+def _deviation_um(main: GearTeeth, other: GearTeeth) -> float:
+    """Largest distance (um) from the other method's dense outline to this one's (point to segment)."""
+    ring = main.dense
+    seg_a, seg_b = ring, np.roll(ring, -1, axis=0)
+    tree = cKDTree(ring)
+    _, idx = tree.query(other.dense, k=2)
+    best = np.full(len(other.dense), np.inf)
+    for column in range(idx.shape[1]):
+        for start in (idx[:, column], (idx[:, column] - 1) % len(ring)):
+            a, b = seg_a[start], seg_b[start]
+            d = b - a
+            t = np.clip(np.einsum("ij,ij->i", other.dense - a, d) / np.maximum(np.einsum("ij,ij->i", d, d),
+                                                                           1e-30), 0.0, 1.0)
+            dist = np.hypot(*(a + t[:, None] * d - other.dense).T)
+            best = np.minimum(best, dist)
+    return float(np.max(best) * 1000.0)
+
+
+def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tuple[float, float],
+                   spec: GearSpec, *, closed: bool, name: str = "gears", chord_tolerance_mm: float = 0.005,
+                   coupling: str = "", carrier: str = "", body_a: str = "gear_a", body_b: str = "gear_b",
+                   axis_a: str = "", axis_b: str = "", run_mesh_check: bool = True) -> GearPair:
+    """Cut and check one gear pair.
+
+    Parameters
+    ----------
+    law : callable
+        ``x_b = law(x_a)`` (rad, relative to the carrier), ``law(x, nu)`` for derivatives, ``law' < 0``.
+    center_distance_mm : float
+    working_range : (float, float)
+        Range of ``x_a`` (rad); a full turn for closed gears.
+    spec : GearSpec
+    closed : bool
+    name : str
+    chord_tolerance_mm : float
+        Chord error allowed in the outlines.
+    run_mesh_check : bool
+        Run :func:`~fabricate.gears.mesh.mesh_check` over the working range (``spec.mesh_steps``).
+
+    Raises
+    ------
+    SpecError
+        Infeasible request, naming the quantity and the fix (nothing is built).
+    """
+    lo, hi = (float(v) for v in working_range)
+    a = float(center_distance_mm)
+    if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
+        raise SpecError(f"gears.{name}.working_range", f"expected a finite range lo < hi, got {working_range}")
+    if not (np.isfinite(a) and a > 0):
+        raise SpecError(f"gears.{name}.center_distance_mm", f"expected a positive distance, got {a}")
+    check_ratio(law, np.linspace(lo, hi, 1025), f"gears.{name}.law")
+    alpha = spec.pressure_angle
+    if closed:
+        z_a, z_b = _closed_teeth(law, lo, spec, a)
+        periods = (TWO_PI, TWO_PI * z_b / z_a)
+        span = max(periods)
+        ratio_grid = np.linspace(lo, lo + TWO_PI, 721)
+        i0, i1 = -law(ratio_grid, 1), -law(ratio_grid + periods[1], 1)
+        if np.max(np.abs(i0 - i1)) > 1e-7 * np.max(np.abs(i0)):
+            raise SpecError(f"gears.{name}.law", f"the law does not close gear b: its ratio does not repeat "
+                                                 f"after gear b's turn ({np.degrees(periods[1]):.2f} deg of a); "
+                                                 "use a law periodic over that angle")
+        pitch = PitchCurves(law, a, (lo, lo + span), lo, periods)
+        module = pitch.perimeter_a / (np.pi * z_a)
+        if min(z_a, z_b) < spec.min_teeth:
+            largest = pitch.perimeter_a / (np.pi * spec.min_teeth * max(1.0, z_a / min(z_a, z_b)))
+            raise SpecError("gears.teeth", f"{min(z_a, z_b)} teeth is below min_teeth = {spec.min_teeth}: "
+                                           f"use at least {spec.min_teeth} teeth (module <= {largest:.3g} mm)")
+        p = np.pi * module
+        centres_a = np.arange(z_a) * p
+        centres_b = np.arange(z_b) * p + 0.5 * p
+        x_cover = np.linspace(lo, lo + span, 2049)
+    else:
+        module = spec.module_or(DEFAULT_SECTOR_MODULE_MM)
+        p = np.pi * module
+        margin = (1.25 + spec.spare_teeth + 2.5) * p + 5 * module
+        r_min = float(np.min(_Bare(law, a).radii(np.linspace(lo, hi, 257), "a")[0]))
+        grow = 1.3 * margin / max(r_min, 1e-6)
+        for _ in range(8):
+            try:
+                pitch = PitchCurves(law, a, (lo - grow, hi + grow), lo)
+            except SpecError as exc:
+                raise SpecError(f"gears.{name}.law", f"{exc.message} (the law is extended "
+                                f"{np.degrees(grow):.1f} deg beyond the working range for the spare teeth; "
+                                "widen the law's range or use fewer spare_teeth)") from exc
+            s_lo, s_hi = 0.0, float(pitch.s_of_x(np.array([hi]))[0])
+            if pitch.s_nodes[0] < s_lo - margin and pitch.s_nodes[-1] > s_hi + margin:
+                break
+            grow *= 1.5
+        reach = (1.25 + spec.spare_teeth) * p
+        k_a = np.arange(np.ceil((s_lo - reach) / p), np.floor((s_hi + reach) / p) + 1)
+        k_b = np.arange(np.ceil((s_lo - reach) / p - 0.5), np.floor((s_hi + reach) / p - 0.5) + 1)
+        centres_a, centres_b = k_a * p, (k_b + 0.5) * p
+        z_a, z_b = len(centres_a), len(centres_b)
+        s_ends = np.array([min(centres_a[0], centres_b[0]) - p, max(centres_a[-1], centres_b[-1]) + p])
+        x_ends = pitch.x_of_s(s_ends)
+        x_cover = np.linspace(x_ends[0], x_ends[1], 2049)
+        sweep_b = abs(float(law(x_ends[1]) - law(x_ends[0])))
+        if x_ends[1] - x_ends[0] >= TWO_PI or sweep_b >= TWO_PI:
+            raise SpecError(f"gears.{name}.closed", "the sector with its spare teeth spans a full turn; "
+                                                    "use closed = true")
+    curv = curvature_summary(pitch, x_cover)
+    check_feasible(curv, module, spec)
+    delta = spec.backlash_mm * np.cos(alpha) / 4.0
+    if spec.backlash_mm > 0.25 * p:
+        raise SpecError("gears.backlash_mm", f"backlash {spec.backlash_mm:g} mm is too large for module "
+                                             f"{module:.3g} mm; use backlash_mm <= {0.25 * p:.3g}")
+    rack = basic_rack(module, alpha, spec.dedendum, spec.root_fillet, spec.addendum)
+    bore = spec.bore_mm if spec.bore_mm is not None else DEFAULT_BORE_MM
+    hub = spec.hub_diameter_mm if spec.hub_diameter_mm is not None else max(bore + 2.0, bore + 4 * module)
+    common = dict(delta=delta, addendum_mm=spec.addendum * module, closed=closed, rack_origin=0.0,
+                  hub_radius_mm=0.5 * hub, chord_tolerance_mm=chord_tolerance_mm)
+    cut_a = cut_gear(pitch, "a", rack, centres_a, method=spec.method, **common)
+    cut_b = cut_gear(pitch, "b", rack, centres_b, method=spec.method, **common)
+    for gear, cut in (("a", cut_a), ("b", cut_b)):
+        if cut.root_radius_min_mm <= 0.5 * bore:
+            raise SpecError("gears.bore_mm", f"bore {bore:g} mm cuts into the root of gear {gear} (root radius "
+                                             f"{cut.root_radius_min_mm:.3g} mm); use a smaller bore or module")
+    deviation = None
+    if spec.compare_methods:
+        other = "approx" if spec.method == "exact" else "exact"
+        dev = [_deviation_um(main, cut_gear(pitch, g, rack, c, method=other, **common))
+               for g, main, c in (("a", cut_a, centres_a), ("b", cut_b, centres_b))]
+        deviation = float(max(dev))
+    x_work = np.linspace(lo, hi, 721)
+    ratio = -law(x_work, 1)
+    limit = undercut_limit_mm(module, spec)
+    rho_min = min(curv["min_radius_of_curvature_a_mm"], curv["min_radius_of_curvature_b_mm"])
+    eps = local_contact_ratio(pitch, x_work, module, spec)
+    checks: dict[str, Any] = {
+        "transmission_ratio": _range(ratio),
+        "pitch_radius_a_mm": _range(pitch.radii(x_work, "a")[0]),
+        "pitch_radius_b_mm": _range(pitch.radii(x_work, "b")[0]),
+        "min_pitch_radius_of_curvature_mm": rho_min,
+        "convex": bool(min(curv["min_curvature_a_per_mm"], curv["min_curvature_b_per_mm"]) > 0),
+        "undercut_limit_radius_mm": limit,
+        "undercut": bool(rho_min < limit),
+        "self_intersecting_envelope": bool(cut_a.self_intersecting or cut_b.self_intersecting),
+        "contact_ratio": {"min": float(eps.min()), "mean": float(eps.mean())},
+        "working_pressure_angle_deg": pressure_angle_range_deg(pitch, x_work, spec),
+        "tip_land_min_mm": float(min(cut_a.tip_land_min_mm, cut_b.tip_land_min_mm)),
+        "exact_vs_approx_max_deviation_um": deviation,
+    }
+    pitch_a = pitch.curve(x_cover if not closed else np.linspace(lo, lo + TWO_PI, 721)[:-1], "a")
+    pitch_b = pitch.curve(x_cover if not closed else np.linspace(lo, lo + periods[1], 721)[:-1], "b")
+    if not closed:
+        pitch_a, pitch_b = pitch_a[::-1].copy(), pitch_b  # CCW like the outlines
+    pair = GearPair(name=name, coupling=coupling or name, carrier=carrier, body_a=body_a, body_b=body_b,
+                    axis_a=axis_a, axis_b=axis_b, center_distance_mm=a, teeth=(int(z_a), int(z_b)),
+                    module=float(module), method=spec.method, closed=closed, working_range=(lo, hi), law=law,
+                    outline_a=cut_a.outline, outline_b=cut_b.outline, pitch_a=pitch_a, pitch_b=pitch_b,
+                    bore_a_mm=float(bore), bore_b_mm=float(bore), hub_diameter_mm=float(hub), spec=spec,
+                    pitch_model=pitch, cut_a=cut_a, cut_b=cut_b, rack_origin=0.0, checks=checks)
+    if run_mesh_check:
+        pair = replace(pair, mesh=mesh_check(pair))
+    return pair
+
+
+class _Bare(PitchCurves):
+    """Radii only (no arc-length table), for sizing the extended domain."""
+
+    def __init__(self, law: Callable, center_distance: float) -> None:  # noqa: D107
+        self.law = law
+        self.a = float(center_distance)
+
+
+def build_gear_pairs(mechanism: Any, spec: GearSpec, chord_tolerance_mm: float) -> list[GearPair]:
+    """One checked :class:`GearPair` per gear coupling of ``mechanism``.
+
+    The centre distance is the distance between the coupling's axis points in the carrier; a
+    coupling whose working range covers a full turn makes closed gears unless ``spec.closed`` says
+    otherwise.
+    """
+    pairs = []
+    for g in mechanism.gears:
+        carrier = mechanism.body(g.carrier)
+        if g.axis_a in carrier.points and g.axis_b in carrier.points:
+            d = carrier.point(g.axis_b) - carrier.point(g.axis_a)
+        else:
+            body = mechanism.body(g.gear_a)
+            d = body.point(g.axis_b) - body.point(g.axis_a)
+        lo, hi = g.working_range
+        closed = spec.closed if spec.closed is not None else bool(hi - lo >= TWO_PI - 1e-9)
+        pairs.append(make_gear_pair(g.law, float(np.hypot(*d)), (lo, hi), spec, closed=closed, name=g.name,
+                                    chord_tolerance_mm=chord_tolerance_mm, coupling=g.name, carrier=g.carrier,
+                                    body_a=g.gear_a, body_b=g.gear_b, axis_a=g.axis_a, axis_b=g.axis_b))
+    return pairs
