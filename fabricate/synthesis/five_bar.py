@@ -19,6 +19,11 @@ Departures from the printed formulas (OCR slips, checked by reconstruction in th
 - eq 19: rolling without slip, ``r_a dx_a = r_b dx_b`` with ``r_a + r_b = |OA|`` and ratio
   ``i = -f'(x_a)``, gives ``r_a = |OA| i / (1 + i)`` and ``r_b = |OA| / (1 + i)``; the printed
   ``r1 = a / (1 + i12)`` with ``|OA| = 2a`` is neither.
+- order defect (section 2.3): the paper asks for phi1 "from small to large"; which sense is right
+  depends on the frame's orientation, so we require A-B to turn strictly monotonically relative to
+  O-D and let the gear check decide the sense (an external pair needs ``f' < 0``).
+- eq 15-16: the pose error is not estimated from the dyad directions but measured on the solved
+  mechanism (A-B's angle at each pose is eq 10's direction of A->B_i, which the spline interpolates).
 """
 
 from __future__ import annotations
@@ -28,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from fabricate.errors import FabricateError, SpecError, SynthesisError
+from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, GearCoupling, Mechanism, Motion, Revolute
 from fabricate.planar import rotation, unit, wrap_angle
 from fabricate.spec import Table
@@ -356,31 +361,6 @@ def _evaluate(spec: FiveBarSpec, targets: FingerTargets, p: np.ndarray, kappa: f
                            length_error=float(one.length_error[0]))
 
 
-def _x_a_of(targets: FingerTargets, p: np.ndarray) -> float:
-    centre, _ = km.dyad_from_vector(p)
-    return float(targets.proximal_to_world(centre)[0, 0])
-
-
-def _refine_crossing(basis4: np.ndarray, targets: FingerTargets, goal: float, k0: float, p0: np.ndarray,
-                     k1: float, p1: np.ndarray, iterations: int = 48) -> tuple[float, np.ndarray]:
-    """Bisect kappa between two samples of one branch so that A's x equals ``goal``."""
-    f0 = _x_a_of(targets, p0) - goal
-    reference = p0
-    for _ in range(iterations):
-        km_mid = 0.5 * (k0 + k1)
-        solutions = km.solve_at_kappa(basis4, km_mid)
-        if not solutions:
-            break
-        p_mid = max(solutions, key=lambda q: abs(float(q @ reference)))
-        f_mid = _x_a_of(targets, p_mid) - goal
-        if np.sign(f_mid) == np.sign(f0):
-            k0, p0, f0 = km_mid, p_mid, f_mid
-        else:
-            k1, p1 = km_mid, p_mid
-        reference = p_mid
-    return (k0, p0) if abs(f0) <= abs(_x_a_of(targets, p1) - goal) else (k1, p1)
-
-
 def select_dyad(spec: FiveBarSpec, targets: FingerTargets, domain: HingeDomain, basis4: np.ndarray,
                 name: str) -> SelectedDyad:
     """Apply the template's selection rule to the feasible domain.
@@ -394,6 +374,10 @@ def select_dyad(spec: FiveBarSpec, targets: FingerTargets, domain: HingeDomain, 
     if feasible.size == 0:
         raise SynthesisError(_empty_domain_message(domain))
     fam = domain.family
+
+    def x_a_of(p: np.ndarray) -> float:
+        return float(targets.proximal_to_world(km.dyad_from_vector(p)[0])[0, 0])
+
     if spec.select == "x_A":
         goal = float(spec.x_A_mm)
         found: list[SelectedDyad] = []
@@ -407,7 +391,8 @@ def select_dyad(spec: FiveBarSpec, targets: FingerTargets, domain: HingeDomain, 
                 k = j + 1 + int(later[0])
             if not domain.feasible[k] or (domain.a[j, 0] - goal) * (domain.a[k, 0] - goal) > 0:
                 continue
-            kappa, p = _refine_crossing(basis4, targets, goal, fam.kappa[j], fam.p[j], fam.kappa[k], fam.p[k])
+            kappa, p = km.bisect_on_branch(basis4, lambda q: x_a_of(q) - goal, fam.kappa[j], fam.p[j],
+                                           fam.kappa[k], fam.p[k])
             status, dyad = _evaluate(spec, targets, p, kappa)
             if dyad is not None:
                 found.append(dyad)
@@ -508,6 +493,11 @@ class FiveBarData:
     motion: Motion
 
 
+def _floats(values: np.ndarray) -> list[float]:
+    """Plain floats for JSON (adding 0.0 turns -0.0 into 0.0)."""
+    return [float(v) + 0.0 for v in np.ravel(values)]
+
+
 def _xy(v: np.ndarray) -> list[float]:
     return [float(v[0]), float(v[1])]
 
@@ -527,7 +517,7 @@ def build_report(data: FiveBarData) -> dict[str, Any]:
     return {
         "method": "kinematic mapping + eigenvectors of M^T M, cubic-spline non-circular gear law",
         "poses": int(len(t.p)),
-        "eigenvalues": [float(v) for v in data.eigenvalues],
+        "eigenvalues": _floats(data.eigenvalues),
         "kappa": float(dyad.kappa),
         "selection": {"rule": data.spec.select, "x_A_mm": data.spec.x_A_mm},
         "A_mm": _xy(a),
@@ -539,18 +529,18 @@ def build_report(data: FiveBarData) -> dict[str, Any]:
         },
         "dyad_length_error_mm": float(dyad.length_error),
         "pose_error_mm": {"max": float(np.max(data.position_error)), "mean": float(np.mean(data.position_error)),
-                          "per_pose": [float(v) for v in data.position_error]},
+                          "per_pose": _floats(data.position_error)},
         "orientation_error_deg": {"max": float(np.degrees(np.max(np.abs(data.orientation_error)))),
                                   "mean": float(np.degrees(np.mean(np.abs(data.orientation_error)))),
-                                  "per_pose": [float(v) for v in np.degrees(data.orientation_error)]},
+                                  "per_pose": _floats(np.degrees(data.orientation_error))},
         "target_tip_mm": [_xy(p) for p in t.p],
         "gear_law": {
             "note": "x_a = ground minus arm O-A rotation, x_b = link A-B minus arm rotation; x_b = f(x_a)",
-            "poses_x_a_deg": [float(v) for v in np.degrees(law.knots_a)],
-            "poses_x_b_deg": [float(v) for v in np.degrees(law.knots_b)],
-            "x_a_deg": [float(v) for v in np.degrees(samples)],
-            "x_b_deg": [float(v) for v in np.degrees(law.law(samples))],
-            "working_range_deg": [float(v) for v in np.degrees(law.working_range)],
+            "poses_x_a_deg": _floats(np.degrees(law.knots_a)),
+            "poses_x_b_deg": _floats(np.degrees(law.knots_b)),
+            "x_a_deg": _floats(np.degrees(samples)),
+            "x_b_deg": _floats(np.degrees(law.law(samples))),
+            "working_range_deg": _floats(np.degrees(law.working_range)),
         },
         "center_distance_mm": float(law.centre_distance),
         "transmission_ratio": _range(law.ratio),
@@ -595,9 +585,13 @@ def synthesise(design: Any) -> SynthesisResult:
     domain = hinge_domain(spec, targets, family)
     dyad = select_dyad(spec, targets, domain, basis4, design.name)
     mech = build_mechanism(design.name, targets, dyad)
-    position, orientation, _ = pose_errors(mech, targets)
     sweep_poses = int(getattr(getattr(design, "checks", None), "sweep_poses", 360))
-    motion = mech.sweep(max(sweep_poses, 2))
+    try:
+        position, orientation, _ = pose_errors(mech, targets)
+        motion = mech.sweep(max(sweep_poses, 2))
+    except LockupError as exc:
+        raise SynthesisError(f"the selected dyad (A = {_xy(mech.body(LINK_AB).point('A'))} mm) gives a "
+                             f"mechanism that cannot move through the poses: {exc}") from exc
     data = FiveBarData(spec=spec, targets=targets, matrix=matrix, eigenvalues=eigenvalues,
                        eigenvectors=eigenvectors, domain=domain, dyad=dyad, mechanism=mech,
                        position_error=position, orientation_error=orientation, motion=motion)

@@ -368,3 +368,30 @@ def refine_family(basis4: np.ndarray, family: DyadFamily, measure, keep: np.ndar
 def _take(family: DyadFamily, index: np.ndarray) -> DyadFamily:
     return DyadFamily(kappa=family.kappa[index], branch=family.branch[index], p=family.p[index],
                       centre=family.centre[index], point=family.point[index])
+
+
+def bisect_on_branch(basis4: np.ndarray, func, k0: float, p0: np.ndarray, k1: float, p1: np.ndarray,
+                     iterations: int = 48) -> tuple[float, np.ndarray]:
+    """Root of ``func(p)`` between two samples ``(k0, p0)``, ``(k1, p1)`` of one branch, by bisection
+    in kappa; at each step the solution nearest (in direction) to the last one keeps the branch.
+
+    Returns
+    -------
+    (kappa, p) : float, (8,) array
+        The end of the final bracket with the smaller ``|func|``.
+    """
+    f0, f1 = func(p0), func(p1)
+    reference = p0
+    for _ in range(iterations):
+        k_mid = 0.5 * (k0 + k1)
+        solutions = solve_at_kappa(basis4, k_mid)
+        if not solutions:
+            break
+        p_mid = max(solutions, key=lambda q: abs(float(q @ reference)))
+        f_mid = func(p_mid)
+        if np.sign(f_mid) == np.sign(f0):
+            k0, p0, f0 = k_mid, p_mid, f_mid
+        else:
+            k1, p1, f1 = k_mid, p_mid, f_mid
+        reference = p_mid
+    return (k0, p0) if abs(f0) <= abs(f1) else (k1, p1)
