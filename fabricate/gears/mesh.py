@@ -9,10 +9,15 @@ the carrier frame (axis A at the origin, axis B at ``(a, 0)``). Three things are
   touches (``free_plus`` towards the flank gear a drives with, ``free_minus`` the other way). It is
   measured on the dense involute flanks: each pair of flanks enveloped by the same rack line is put
   in polar coordinates about axis B and the angular gap is taken at every radius both cover;
-- transmission error: the driven angle at the middle of its free play against the law,
-  ``(free_plus - free_minus) / 2``. With a driving forward, b lags by ``free_plus`` (the driven angle
-  at contact is ``law + free_plus``); for non-circular gears that lag follows the pitch radius, so the
-  mid-play angle is the one that measures the tooth geometry.
+- transmission error: the driven angle at contact against the law, beyond the designed backlash.
+  Backlash is a normal offset ``delta`` of both gears' flanks, so on each flank the pair is the
+  zero-backlash conjugate pair with gear b's flank moved ``2 delta`` along the common normal; gear b
+  closes that by turning ``2 delta / d_B``, where ``d_B`` is the distance from axis B to the line of
+  action (through the pitch point, at the rack pressure angle to the pitch normal). For
+  non-circular gears ``d_B`` differs between the two flanks and along the motion (``r_b cos(alpha
+  +- mu)``), so the raw lag is not a constant; the transmission error is
+  ``free_plus - 2 delta / d_B`` (driving flank) and likewise on the coast flank, and the report gives
+  the largest magnitude of both. The raw lag (driven angle at contact minus the law) is kept too.
 
 Backlash is the circumferential free play at the pitch curve, ``(free_plus + free_minus) r_b``.
 """
@@ -39,7 +44,8 @@ class MeshResult:
     backlash_mm : (n,) array
         Circumferential backlash at the pitch curve.
     transmission_error : (n,) array
-        Mid-play driven angle minus the law.
+        Driven angle at contact minus the law minus the designed backlash lag, on whichever flank
+        deviates more (signed).
     contact_lag : (n,) array
         Driven angle at contact (a driving forward) minus the law, ``= free_plus``.
     interference_area_mm2 : (n,) array
@@ -208,6 +214,26 @@ def mesh_check(pair: Any, x_a_values: np.ndarray | None = None, steps: int | Non
     x = np.asarray(x_a_values, dtype=np.float64)
     plus, minus = free_play(pair, x)
     r_b = pair.pitch_model.radii(x, "b")[0]
+    lag_plus, lag_minus = designed_lag(pair, x)
+    err_plus, err_minus = plus - lag_plus, minus - lag_minus
+    te = np.where(np.abs(err_plus) >= np.abs(err_minus), err_plus, err_minus)
     area = interference_areas(pair, x)
     return MeshResult(x_a=x, free_plus=plus, free_minus=minus, backlash_mm=(plus + minus) * r_b,
-                      transmission_error=0.5 * (plus - minus), contact_lag=plus, interference_area_mm2=area)
+                      transmission_error=te, contact_lag=plus, interference_area_mm2=area)
+
+
+def designed_lag(pair: Any, x_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Free rotation of gear b the designed backlash alone allows on each flank (rad): ``2 delta /
+    d_B`` with ``d_B`` the distance from axis B to that flank's line of action (module docstring)."""
+    alpha = pair.spec.pressure_angle
+    delta = pair.spec.backlash_mm * np.cos(alpha) / 4.0
+    frames = pair.pitch_model.frames_at_x(x_a, "a")
+    c, s = np.cos(x_a), np.sin(x_a)
+    # world y-components of the pitch tangent and outward normal of gear a at the pitch point
+    t_y = s * frames.tangent[:, 0] + c * frames.tangent[:, 1]
+    n_y = s * frames.normal[:, 0] + c * frames.normal[:, 1]
+    r_b = pair.pitch_model.radii(x_a, "b")[0]
+    # lines of action through the pitch point (r_a, 0); their distance from B = (a, 0) is r_b |nu_y|
+    arm_left = r_b * np.abs(-np.cos(alpha) * t_y + np.sin(alpha) * n_y)
+    arm_right = r_b * np.abs(np.cos(alpha) * t_y + np.sin(alpha) * n_y)
+    return 2 * delta / arm_left, 2 * delta / arm_right

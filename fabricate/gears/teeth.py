@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
-from shapely.geometry import Polygon
+from shapely.geometry import LinearRing, LineString, Polygon
 from shapely.geometry.polygon import orient
 
 from fabricate.gears.pitch import PitchCurves
@@ -167,12 +167,11 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     dense_poly = Polygon(dense)
     simple = shapely.simplify(dense_poly, 0.9 * chord_tolerance_mm, preserve_topology=True)
     outline = _clean_ring(np.asarray(orient(_largest_polygon(simple), 1.0).exterior.coords))
-    # tip lands: pieces of the outline lying on the tip curve
-    on_tip = dense_poly.exterior.intersection(tip_poly.exterior.buffer(1e-6))
-    pieces = [g.length for g in getattr(on_tip, "geoms", [on_tip]) if g.geom_type == "LineString"]
-    pieces = sorted(pieces)
-    # the two end pieces of a sector may be split (the tip clip meets the hub); ignore tiny slivers
-    tip_land = float(pieces[0]) if pieces else 0.0
+    # tip lands: pieces of the outline lying on the tip curve (a pointed tooth has none)
+    tip_curve = LinearRing(tip) if closed else LineString(tip)
+    on_tip = dense_poly.exterior.intersection(tip_curve.buffer(1e-6))
+    pieces = sorted(g.length for g in getattr(on_tip, "geoms", [on_tip]) if g.geom_type == "LineString")
+    tip_land = float(pieces[0]) if len(pieces) >= z else 0.0
     # involute flanks for the mesh check
     is_flank = element == FLANK
     inside = shapely.contains_xy(tip_poly, chain[:, 0], chain[:, 1])

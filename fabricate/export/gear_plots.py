@@ -1,0 +1,127 @@
+"""Pictures of gear pairs: the pair in mesh (PNG), the pair turning (GIF), the ratio law (PNG).
+
+Encoders return bytes (deterministic: no timestamps, fixed sizes); only the pipeline writes files.
+Gears are drawn in the carrier frame: axis A at the origin, axis B at ``(a, 0)``.
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+
+def _figure(size: tuple[float, float] = (6.0, 4.0), dpi: int = 100) -> tuple[Any, Any]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=size, dpi=dpi)
+    FigureCanvasAgg(fig)
+    return fig, fig.add_subplot(1, 1, 1)
+
+
+def _png(fig: Any) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    return buf.getvalue()
+
+
+def _placed(pair: Any, x_a: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Outlines and pitch curves of both gears at driving angle ``x_a`` in the carrier frame."""
+    from fabricate.planar import rotation
+
+    theta_b = float(pair.law(x_a))
+    centre_b = np.array([pair.center_distance_mm, 0.0])
+    ra, rb = rotation(x_a), rotation(theta_b)
+    return (pair.outline_a @ ra.T, pair.outline_b @ rb.T + centre_b,
+            pair.pitch_a @ ra.T, pair.pitch_b @ rb.T + centre_b)
+
+
+def _draw_pair(ax: Any, pair: Any, x_a: float, zoom: bool) -> None:
+    out_a, out_b, pitch_a, pitch_b = _placed(pair, x_a)
+    ax.fill(out_a[:, 0], out_a[:, 1], color="#4c72b0", alpha=0.55, lw=0.6, ec="#1f3b63")
+    ax.fill(out_b[:, 0], out_b[:, 1], color="#dd8452", alpha=0.55, lw=0.6, ec="#7a3d17")
+    ax.plot(pitch_a[:, 0], pitch_a[:, 1], "--", color="#1f3b63", lw=0.5)
+    ax.plot(pitch_b[:, 0], pitch_b[:, 1], "--", color="#7a3d17", lw=0.5)
+    for centre, bore in (((0.0, 0.0), pair.bore_a_mm), ((pair.center_distance_mm, 0.0), pair.bore_b_mm)):
+        t = np.linspace(0, 2 * np.pi, 60)
+        ax.plot(centre[0] + 0.5 * bore * np.cos(t), centre[1] + 0.5 * bore * np.sin(t), color="k", lw=0.6)
+        ax.plot(*centre, "k+", ms=5)
+    ax.set_aspect("equal")
+    if zoom:
+        r_a = float(pair.pitch_model.radii(np.array([x_a]), "a")[0][0])
+        w = 6.0 * np.pi * pair.module
+        ax.set_xlim(r_a - 0.6 * w, r_a + 0.6 * w)
+        ax.set_ylim(-0.45 * w, 0.45 * w)
+
+
+def pair_png(pair: Any, x_a: float) -> bytes:
+    """The pair in mesh at driving angle ``x_a`` (rad): whole pair and a zoom on the pitch point."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(10.0, 4.6), dpi=110)
+    FigureCanvasAgg(fig)
+    ax1, ax2 = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
+    _draw_pair(ax1, pair, x_a, zoom=False)
+    _draw_pair(ax2, pair, x_a, zoom=True)
+    rep = pair.report()
+    ax1.set_title(f"{pair.name}: z = {rep['teeth'][0]}/{rep['teeth'][1]}, m = {pair.module:.4g} mm, "
+                  f"{pair.method}", fontsize=9)
+    te = rep.get("transmission_error_deg")
+    bl = rep.get("backlash_mm") or [None, None]
+    ax2.set_title(f"x_a = {np.degrees(x_a):.1f} deg; TE = {te if te is None else f'{te:.2g}'} deg; "
+                  f"backlash {bl[0] if bl[0] is None else f'{bl[0]:.3f}'} mm", fontsize=9)
+    for ax in (ax1, ax2):
+        ax.set_xlabel("x (mm)")
+        ax.tick_params(labelsize=7)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def pair_gif(pair: Any, frames: int) -> bytes:
+    """The pair turning through its working range, ``frames`` frames, as an animated GIF."""
+    from PIL import Image
+
+    lo, hi = pair.working_range
+    xs = np.linspace(lo, hi, int(frames), endpoint=not pair.closed)
+    out_a0, out_b0, _, _ = _placed(pair, lo)
+    reach = max(np.abs(out_a0).max(), np.abs(out_b0 - [pair.center_distance_mm, 0]).max())
+    images = []
+    for x in xs:
+        fig, ax = _figure((4.8, 3.2), 80)
+        _draw_pair(ax, pair, float(x), zoom=False)
+        ax.set_xlim(-reach * 1.05, pair.center_distance_mm + reach * 1.05)
+        ax.set_ylim(-reach * 1.05, reach * 1.05)
+        ax.set_axis_off()
+        fig.tight_layout()
+        fig.canvas.draw()
+        rgba = np.asarray(fig.canvas.buffer_rgba())
+        images.append(Image.fromarray(rgba[..., :3].copy()).convert("P", palette=Image.ADAPTIVE, colors=64))
+    buf = io.BytesIO()
+    images[0].save(buf, format="GIF", save_all=True, append_images=images[1:], duration=80, loop=0)
+    return buf.getvalue()
+
+
+def law_png(law: Callable, working_range: tuple[float, float], center_distance_mm: float) -> bytes:
+    """The ratio law: driven against driving angle, and the transmission ratio."""
+    lo, hi = working_range
+    x = np.linspace(lo, hi, 400)
+    fig, ax = _figure((6.0, 3.6), 100)
+    ax.plot(np.degrees(x), -np.degrees(np.asarray(law(x))), color="#4c72b0", label="driven angle (deg)")
+    ax.set_xlabel("driving angle x_a (deg)")
+    ax.set_ylabel("driven angle (deg)")
+    ax2 = ax.twinx()
+    ax2.plot(np.degrees(x), -np.asarray(law(x, 1)), color="#dd8452", label="ratio i")
+    ax2.set_ylabel("transmission ratio i = -law'")
+    ax.set_title(f"gear law, centre distance {center_distance_mm:.3f} mm", fontsize=9)
+    fig.tight_layout()
+    return _png(fig)
