@@ -1,30 +1,22 @@
-"""Fast exact planar clearance between two moving polygonal outlines (the narrow phase of the sweep).
+"""Exact planar clearance between two moving polygonal outlines (the narrow phase of the sweep).
 
 Every part in this project is a prism: a planar outline (outer contour CCW, holes CW) extruded along z.
 Two prisms whose z ranges overlap collide exactly when their outlines overlap in the plane, and their
 3D clearance is the planar distance of the outlines; on disjoint z ranges the clearance is
-``hypot(z gap, planar distance)``. So the whole sweep reduces to planar distances of posed outlines,
-which this module computes for many poses at once, with numpy and a k-d tree, without building a
-posed geometry per pose.
+``hypot(z gap, planar distance)``. So the sweep reduces to planar distances of posed outlines.
 
 Method
 ------
-The distance between two disjoint polygonal regions is attained between a vertex of one and an edge of
-the other. So the signed distance of every vertex of B to the boundary of A (negative inside A's
-material) and of every vertex of A to B's boundary, minimised, is the clearance; a negative value
-means the outlines overlap. Two levels keep it cheap:
-
-1. *Chunks*: each outline's vertices are grouped in runs of :data:`CHUNK` consecutive vertices with a
-   bounding circle. A chunk whose centre is farther than ``search + radius + h/2`` from every vertex of
-   the other outline (``h`` = longest edge after subdivision) cannot hold a vertex within ``search``
-   of the other boundary, and is skipped.
-2. *Vertices* of the surviving chunks: the ``k`` nearest vertices of the other outline give the
-   candidate edges (the two edges at each); the exact point-to-segment distance and the side of the
-   nearest edge give the signed distance. Edges are subdivided to at most ``h`` so a nearest edge always
-   has an endpoint near the query point.
-
-An outline lying wholly inside the other's material with no boundary nearby (a pin sunk into a plate)
-has no vertex near the other boundary; a point-in-polygon test of one vertex per pose catches it.
+All posed copies of outline B (in A's frame) are built in one vectorised shapely call. The overlap
+test runs against A's prepared geometry for all poses at once. The distance of the poses that do not
+overlap is taken on *clipped* outlines: when the distance ``d`` is at most ``search``, the closest
+points lie in the window ``(bbox(A) ⊕ search) ∩ (bbox(B) ⊕ search)`` (a closest point of A is within
+``d`` of B, hence in ``bbox(B) ⊕ d``, and in ``bbox(A)``), so clipping both outlines to that window
+keeps the closest pair and the distance exactly, while GEOS only sees the few edges near the contact.
+A window that is empty proves the distance exceeds ``search``. Successive poses differ little, so
+the previous pose's distance plus the largest point displacement since then is tried first as the
+search length (windows of a few edges, e.g. at the teeth in mesh), and the full search length only
+when that guess proves too short.
 """
 
 from __future__ import annotations
@@ -34,16 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
-from scipy.spatial import cKDTree
 
 from fabricate.planar import polygon_area
-
-#: Vertices per chunk of the outline hierarchy.
-CHUNK = 24
-#: Longest run of boundary (mm) in one chunk, so that a chunk's circle stays small.
-CHUNK_SPAN_MM = 0.6
-#: Nearest vertices whose edges are examined for each query point.
-NEIGHBOURS = 8
 
 
 @dataclass(frozen=True)
@@ -68,6 +52,9 @@ class RelativePoses:
         c, s = np.cos(th), np.sin(th)
         return RelativePoses(np.column_stack([-(c * x + s * y), s * x - c * y, -th]))
 
+    def subset(self, index: np.ndarray) -> RelativePoses:
+        return RelativePoses(self.q[index])
+
     def apply(self, points: np.ndarray, index: np.ndarray | None = None) -> np.ndarray:
         """Map points of frame B into frame A.
 
@@ -88,114 +75,42 @@ class RelativePoses:
 
 
 class Outline:
-    """A planar region (outer contour CCW, holes CW) prepared for fast signed-distance queries.
+    """A planar region (outer contour CCW, holes CW) in its body frame, ready for posed queries.
 
     Parameters
     ----------
     rings : list of (k, 2) arrays
-        Outer contour first, then holes, mm, in the body frame.
-    max_edge_mm : float
-        Edges longer than this are split into equal collinear pieces (the geometry is unchanged).
+        Outer contour first, then holes, mm.
     """
 
-    def __init__(self, rings: list[np.ndarray], max_edge_mm: float = 0.05) -> None:
-        verts: list[np.ndarray] = []
-        nxt: list[np.ndarray] = []
-        runs: list[np.ndarray] = []  # per chunk: first vertex, vertex count, ring start, ring length
-        start = 0
+    def __init__(self, rings: list[np.ndarray]) -> None:
         oriented = []
         for k, ring in enumerate(rings):
             ring = _clean_ring(np.asarray(ring, dtype=np.float64))
-            # outer CCW, holes CW: the material is on the left of every directed edge
             if (polygon_area(ring) > 0) != (k == 0):
                 ring = ring[::-1]
             oriented.append(ring)
-            dense = _subdivide(ring, max_edge_mm)
-            n = len(dense)
-            idx = np.arange(start, start + n)
-            verts.append(dense)
-            nxt.append(np.roll(idx, -1))
-            # chunks: runs of at most CHUNK vertices spanning at most CHUNK_SPAN_MM of boundary; each
-            # also holds the first vertex of the next run so that it covers its edges
-            step = np.hypot(*(np.roll(dense, -1, axis=0) - dense).T)
-            arc = np.concatenate([[0.0], np.cumsum(step)[:-1]])
-            key = (arc // CHUNK_SPAN_MM).astype(np.int64) * (n + 1) + np.arange(n) // CHUNK
-            starts = np.concatenate([[0], np.nonzero(np.diff(key))[0] + 1])
-            ends = np.concatenate([starts[1:], [n]])  # the next run's first vertex, wrapping
-            runs.append(np.column_stack([starts + start, ends - starts, np.full(len(starts), start),
-                                         np.full(len(starts), n)]))
-            start += n
         self.rings = oriented
-        self.vertices = np.concatenate(verts)
-        self.next = np.concatenate(nxt)
-        self.prev = np.empty_like(self.next)
-        self.prev[self.next] = np.arange(len(self.next))
-        edges = self.vertices[self.next] - self.vertices
-        length = np.hypot(edges[:, 0], edges[:, 1])
-        self.max_edge = float(np.max(length))
-        # longest edge at each vertex: a vertex whose edge crosses another boundary is this close to it
-        self.vertex_edge = np.maximum(length, length[self.prev])
-        self.tree = cKDTree(self.vertices)
-        # padded table of chunk vertices: repeats of a chunk's last vertex do not change a minimum
-        first, count, ring_start, ring_len = np.concatenate(runs).T
-        width = int(count.max()) + 1
-        offset = np.minimum(np.arange(width)[None, :], count[:, None])
-        self.chunk_table = ring_start[:, None] + (first[:, None] - ring_start[:, None] + offset) % ring_len[:, None]
-        members = self.vertices[self.chunk_table]
-        self.chunk_centres = 0.5 * (members.min(axis=1) + members.max(axis=1))
-        self.chunk_radii = np.max(np.hypot(*(members - self.chunk_centres[:, None, :]).transpose(2, 0, 1)), axis=1)
-        self.chunk_edge = self.vertex_edge[self.chunk_table].max(axis=1)
+        self.vertices = np.concatenate(oriented)
         self.centre = 0.5 * (self.vertices.min(axis=0) + self.vertices.max(axis=0))
         self.radius = float(np.max(np.hypot(*(self.vertices - self.centre).T)))
         self.polygon = shapely.Polygon(oriented[0], oriented[1:])
         shapely.prepare(self.polygon)
+        self.bounds = np.asarray(self.polygon.bounds)
 
-    # -- queries -------------------------------------------------------------------------------
-    def signed_distance(self, points: np.ndarray) -> np.ndarray:
-        """Signed distance (mm) of points (m, 2) in this outline's frame to its boundary;
-        negative inside the material. Exact when a nearest edge has an endpoint among the
-        :data:`NEIGHBOURS` nearest vertices (always, unless edges are much longer than the vertex
-        spacing nearby); otherwise within ``max_edge / 2``."""
-        points = np.asarray(points, dtype=np.float64)
-        if len(points) == 0:
-            return np.empty(0)
-        k = min(NEIGHBOURS, len(self.vertices))
-        _, near = self.tree.query(points, k=k)
-        near = near.reshape(len(points), k)
-        seg = np.concatenate([near, self.prev[near]], axis=1)  # edges starting at these vertices
-        p0 = self.vertices[seg]
-        e = self.vertices[self.next[seg]] - p0
-        rel = points[:, None, :] - p0
-        t = np.clip(np.einsum("mkj,mkj->mk", rel, e) / np.einsum("mkj,mkj->mk", e, e), 0.0, 1.0)
-        diff = rel - t[..., None] * e
-        dist = np.hypot(diff[..., 0], diff[..., 1])
-        best = np.argmin(dist, axis=1)
-        rows = np.arange(len(points))
-        d = dist[rows, best]
-        s = seg[rows, best]
-        tb = t[rows, best]
-        # the nearest point is interior to an edge: inside iff left of it; at a vertex use both edges
-        # (convex corner: left of both; reflex corner: left of either)
-        vertex = np.where(tb >= 1.0, self.next[s], s)
-        at_vertex = (tb <= 0.0) | (tb >= 1.0)
-        v = self.vertices[vertex]
-        e_in = v - self.vertices[self.prev[vertex]]
-        e_out = self.vertices[self.next[vertex]] - v
-        left_in = _cross(e_in, points - self.vertices[self.prev[vertex]]) > 0.0
-        left_out = _cross(e_out, points - v) > 0.0
-        convex = _cross(e_in, e_out) > 0.0
-        inside_vertex = np.where(convex, left_in & left_out, left_in | left_out)
-        inside_edge = _cross(e[rows, best], rel[rows, best]) > 0.0
-        inside = np.where(at_vertex, inside_vertex, inside_edge)
-        return np.where(inside, -d, d)
+    def posed(self, rel: RelativePoses) -> np.ndarray:
+        """This outline moved by every pose of ``rel``: an (n,) array of shapely Polygons."""
+        counts = np.array([len(r) for r in self.rings])
+        n = len(rel.q)
+        coords = rel.apply(self.vertices).reshape(-1, 2)
+        ring_id = np.repeat(np.arange(len(self.rings)), counts)
+        rings = shapely.linearrings(coords, indices=(np.arange(n)[:, None] * len(self.rings)
+                                                     + ring_id[None, :]).ravel())
+        return shapely.polygons(rings, indices=np.repeat(np.arange(n), len(self.rings)))
 
     def contains(self, points: np.ndarray) -> np.ndarray:
         """Whether points (m, 2) lie in the material (boundary excluded)."""
         return shapely.contains_xy(self.polygon, points[:, 0], points[:, 1])
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
 def _clean_ring(ring: np.ndarray) -> np.ndarray:
@@ -204,61 +119,6 @@ def _clean_ring(ring: np.ndarray) -> np.ndarray:
         ring = ring[:-1]
     step = np.hypot(*(np.roll(ring, -1, axis=0) - ring).T)
     return ring[step > 1e-12]
-
-
-def _subdivide(ring: np.ndarray, max_edge: float) -> np.ndarray:
-    """Insert collinear points so that no edge is longer than ``max_edge``."""
-    nxt = np.roll(ring, -1, axis=0)
-    length = np.hypot(*(nxt - ring).T)
-    pieces = np.maximum(1, np.ceil(length / max_edge).astype(int))
-    if np.all(pieces == 1):
-        return ring
-    first = np.repeat(np.cumsum(pieces) - pieces, pieces)
-    t = (np.arange(int(pieces.sum())) - first) / np.repeat(pieces, pieces)
-    return np.repeat(ring, pieces, axis=0) + t[:, None] * np.repeat(nxt - ring, pieces, axis=0)
-
-
-def _one_way(target: Outline, mover: Outline, rel: RelativePoses, search_mm: float) -> np.ndarray:
-    """Smallest signed distance of ``mover``'s vertices to ``target``'s boundary per pose (n,),
-    ``+inf`` where no vertex comes within ``search_mm``; ``rel`` maps mover frame → target frame.
-
-    Only vertices that can beat the pose's best so far are evaluated exactly. A vertex that proves an
-    overlap lies within one of its own edges of the target boundary (that edge crosses it), so a vertex
-    that close is always kept and an overlap is never pruned away.
-    """
-    n = len(rel.q)
-    out = np.full(n, np.inf)
-    centres = rel.apply(mover.chunk_centres)  # (n, c, 2)
-    half_edge = 0.5 * target.max_edge
-    # level 0: chunk circle against the target's bounding circle
-    gap0 = (np.hypot(*(centres - target.centre).transpose(2, 0, 1)) - target.radius
-            - mover.chunk_radii[None, :])
-    pose_idx, chunk_idx = np.nonzero(gap0 < search_mm)
-    if len(pose_idx) == 0:
-        return out
-    # level 1: chunk circle against the nearest target vertex; the boundary is within half an edge
-    # of a vertex, so [d - r - h/2, d + r] brackets the chunk's distances to the boundary
-    d_centre, _ = target.tree.query(centres[pose_idx, chunk_idx])
-    radius = mover.chunk_radii[chunk_idx]
-    best = np.full(n, search_mm)
-    np.minimum.at(best, pose_idx, d_centre + radius)
-    keep = d_centre - radius - half_edge <= np.maximum(best[pose_idx], mover.chunk_edge[chunk_idx])
-    pose_idx, chunk_idx = pose_idx[keep], chunk_idx[keep]
-    if len(pose_idx) == 0:
-        return out
-    # level 2: the vertices of the surviving chunks, first against the nearest target vertex
-    members = mover.chunk_table[chunk_idx].ravel()
-    owner = np.repeat(pose_idx, mover.chunk_table.shape[1])
-    pts = rel.apply(mover.vertices[members], owner)
-    d_vertex, _ = target.tree.query(pts)
-    best = np.full(n, search_mm)
-    np.minimum.at(best, owner, d_vertex)
-    keep = d_vertex - half_edge <= np.maximum(best[owner], mover.vertex_edge[members])
-    pts, owner = pts[keep], owner[keep]
-    sd = target.signed_distance(pts)
-    np.minimum.at(out, owner, sd)
-    out[out > search_mm] = np.inf
-    return out
 
 
 def planar_clearance(a: Outline, b: Outline, rel: RelativePoses, search_mm: float) -> np.ndarray:
@@ -275,46 +135,61 @@ def planar_clearance(a: Outline, b: Outline, rel: RelativePoses, search_mm: floa
     Returns
     -------
     (n,) float64 array
-        Distance (mm) between the regions where ≤ ``search_mm``; ``+inf`` where farther; negative
-        (a penetration depth along the boundary) where they overlap.
+        Distance (mm) between the regions where ≤ ``search_mm``; ``+inf`` where farther; 0 where
+        the boundaries touch; ``-inf`` where the interiors overlap.
     """
     n = len(rel.q)
-    d = np.full(n, np.inf)
-    # cheap probe first: a sample of vertices inside the other's material proves an overlap, and the
-    # exact pass (which would only refine a penetration depth) is skipped for those poses
-    overlapping = _probe_overlap(a, b, rel) | _probe_overlap(b, a, rel.inverse())
-    d[overlapping] = -math.inf
-    rest = np.nonzero(~overlapping)[0]
+    out = np.full(n, np.inf)
+    if n == 0:
+        return out
+    polys = b.posed(rel)
+    meets = shapely.intersects(a.polygon, polys)
+    if np.any(meets):
+        idx = np.nonzero(meets)[0]
+        touching = shapely.touches(a.polygon, polys[idx])
+        out[idx] = np.where(touching, 0.0, -math.inf)
+    rest = np.nonzero(~meets)[0]
     if len(rest) == 0:
-        return d
-    sub = RelativePoses(rel.q[rest])
-    d[rest] = np.minimum(_one_way(a, b, sub, search_mm), _one_way(b, a, sub.inverse(), search_mm))
-    # wholly inside the other's material with no boundary near: one vertex per pose tells
-    far = rest[~(d[rest] <= 0.0)]
-    if len(far):
-        b_in_a = a.contains(rel.apply(np.repeat(b.vertices[:1], len(far), axis=0), far))
-        a_in_b = b.contains(rel.inverse().apply(np.repeat(a.vertices[:1], len(far), axis=0), far))
-        d[far[b_in_a | a_in_b]] = -math.inf
-    return d
+        return out
+    # poses follow each other closely: the previous distance plus the largest point displacement
+    # since then bounds this one, and a window that small is much cheaper (retried at full size
+    # when the guess proves too small)
+    centre = rel.apply(b.centre[None, :])[:, 0]
+    step = np.hypot(*np.diff(centre, axis=0).T) + np.abs(np.diff(rel.q[:, 2])) * b.radius
+    moved = np.concatenate([[math.inf], step])
+    bb = shapely.bounds(polys)
+    previous, previous_index = math.inf, -2
+    for i in rest:
+        guess = previous + moved[i] + 1e-9 if previous_index == i - 1 else math.inf
+        d = math.inf
+        if guess < search_mm:
+            d = _clipped_distance(a, polys[i], bb[i], guess)
+        if not d <= guess:
+            d = _clipped_distance(a, polys[i], bb[i], search_mm)
+        if d <= search_mm:
+            out[i] = d
+        previous, previous_index = d, i
+    return out
 
 
-def _probe_overlap(target: Outline, mover: Outline, rel: RelativePoses, samples: int = 64) -> np.ndarray:
-    """Poses (n,) where one of ~``samples`` evenly spread vertices of ``mover`` lies in ``target``."""
-    step = max(1, len(mover.vertices) // samples)
-    pts = rel.apply(mover.vertices[::step])  # (n, k, 2)
-    inside = target.contains(pts.reshape(-1, 2)).reshape(pts.shape[:2])
-    return inside.any(axis=1)
+def _clipped_distance(a: Outline, poly_b: shapely.Polygon, bounds_b: np.ndarray, search: float) -> float:
+    """Distance of ``a`` and ``poly_b`` if at most ``search`` (exact), else a value > ``search``."""
+    lo = np.maximum(a.bounds[:2], bounds_b[:2]) - search
+    hi = np.minimum(a.bounds[2:], bounds_b[2:]) + search
+    if np.any(lo > hi):
+        return math.inf
+    clip_a = shapely.clip_by_rect(a.polygon, lo[0], lo[1], hi[0], hi[1])
+    if clip_a.is_empty:
+        return math.inf
+    # B's closest point is within ``search`` of the clipped A (which holds A's closest point)
+    ca = clip_a.bounds
+    clip_b = shapely.clip_by_rect(poly_b, max(lo[0], ca[0] - search), max(lo[1], ca[1] - search),
+                                  min(hi[0], ca[2] + search), min(hi[1], ca[3] + search))
+    if clip_b.is_empty:
+        return math.inf
+    return float(shapely.distance(clip_a, clip_b))
 
 
 def overlap_areas(a: Outline, b: Outline, rel: RelativePoses) -> np.ndarray:
-    """Area (mm^2) of the overlap of ``a`` and ``b`` posed by each of ``rel`` (n,), via shapely."""
-    rings = b.rings
-    counts = np.array([len(r) for r in rings])
-    coords = np.concatenate(rings)
-    n = len(rel.q)
-    posed = rel.apply(coords)  # (n, m, 2)
-    ring_id = np.repeat(np.arange(len(rings)), counts)
-    ring_index = (np.arange(n)[:, None] * len(rings) + ring_id[None, :]).ravel()
-    lr = shapely.linearrings(posed.reshape(-1, 2), indices=ring_index)
-    polys = shapely.polygons(lr, indices=np.repeat(np.arange(n), len(rings)))
-    return shapely.area(shapely.intersection(a.polygon, polys))
+    """Area (mm^2) of the overlap of ``a`` and ``b`` posed by each of ``rel`` (n,)."""
+    return np.asarray(shapely.area(shapely.intersection(a.polygon, b.posed(rel))), dtype=np.float64)

@@ -89,7 +89,8 @@ class PairResult:
     a, b : str
         Item names.
     relation : str
-        ``"moving"``, ``"joined"`` (share a pin), ``"pin"`` (a pin in another body's hole) or
+        ``"moving"``, ``"joined"`` (share a pin), ``"pin"`` (a pin in another body's hole),
+        ``"bearing"`` (a spacer against a part of its joint: may touch, must not overlap) or
         ``"meshing"`` (gear parts in mesh).
     z_gap_mm : float
         Gap between the z ranges (negative: the overlap thickness).
@@ -177,7 +178,7 @@ class InterferenceResult:
     @property
     def min_clearance_mm(self) -> float:
         """Smallest clearance over all pairs that must keep the process clearance (mm)."""
-        values = [p.min_clearance_mm for p in self.pairs if p.relation != "meshing"]
+        values = [p.min_clearance_mm for p in self.pairs if p.relation not in ("meshing", "bearing")]
         return float(min(values)) if values else math.inf
 
     def failures(self) -> list[str]:
@@ -278,6 +279,24 @@ def pins_from_holes(parts: Sequence[Part]) -> list[PinSolid]:
     return pins
 
 
+def pins_from_parts_layer(pins: Sequence[object], parts: Sequence[Part]) -> list[PinSolid]:
+    """PinSolids from the parts layer's pins (``joint``, ``bodies``, ``diameter_mm``, ``length_mm``,
+    ``z_mm``): each fixed in the first of its bodies, on the axis of that body's hole for the joint.
+    Objects that already are :class:`PinSolid` pass through."""
+    out = []
+    for pin in pins:
+        if isinstance(pin, PinSolid):
+            out.append(pin)
+            continue
+        body = pin.bodies[0]
+        hole = next((h for p in parts if p.body == body for h in p.holes if h.joint == pin.joint), None)
+        if hole is None:
+            continue
+        out.append(PinSolid(f"pin_{pin.joint}", pin.joint, body, np.asarray(hole.centre, dtype=np.float64),
+                            float(pin.diameter_mm), float(pin.z_mm), float(pin.length_mm)))
+    return out
+
+
 def pin_items(pins: Sequence[PinSolid], chord_tolerance_mm: float) -> list[SweepItem]:
     return [SweepItem(p.name, p.body, "pin",
                       (circle_polygon(p.centre, p.diameter_mm, chord_tolerance_mm),),
@@ -291,7 +310,11 @@ def _relation(a: SweepItem, b: SweepItem) -> str:
     if a.kind == "part" and b.kind == "part" and a.gear and a.gear == b.gear:
         return "meshing"
     if a.joints & b.joints:
-        return "pin" if "pin" in (a.kind, b.kind) else "joined"
+        if "pin" in (a.kind, b.kind):
+            return "pin"
+        # a spacer on a pin bears on the parts of that joint: touching is its job
+        roles = {getattr(a.source, "role", ""), getattr(b.source, "role", "")}
+        return "bearing" if "spacer" in roles else "joined"
     return "moving"
 
 
@@ -321,8 +344,7 @@ def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
     -------
     InterferenceResult
     """
-    if pins is None:
-        pins = pins_from_holes(parts)
+    pins = pins_from_holes(parts) if pins is None else pins_from_parts_layer(pins, parts)
     search = float(search_length_mm or max(DEFAULT_SEARCH_MM, 4.0 * min_clearance_mm))
     items = part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
     outlines: dict[str, Outline] = {}
@@ -340,7 +362,7 @@ def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
             for it in (a, b):
                 if it.name not in outlines:
                     outlines[it.name] = Outline(list(it.rings))
-            required = 0.0 if relation == "meshing" else float(min_clearance_mm)
+            required = 0.0 if relation in ("meshing", "bearing") else float(min_clearance_mm)
             results.append(_sweep_pair(a, b, outlines[a.name], outlines[b.name], poses[a.body], poses[b.body],
                                        relation, required, search, solids if use_kernel else None,
                                        chord_tolerance_mm))
@@ -398,7 +420,9 @@ def _sweep_pair(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, pose_a: np
         if solids is not None:
             sa, sb = _posed_pair(a, b, pose_a[max_idx], pose_b[max_idx], solids, tol)
             max_overlap = float((sa ^ sb).volume())
-    min_idx = int(np.argmin(clearance))
+    # smallest clearance, an exactly known pose first among equal values (stacked parts show the
+    # z gap as a lower bound everywhere and exactly where they overlap in plan)
+    min_idx = int(np.lexsort((~exact, clearance))[0])
     min_clear = float(clearance[min_idx])
     kernel_gap = None
     if solids is not None and not len(collide_idx) and exact[min_idx] and min_clear < search:
@@ -491,8 +515,7 @@ def naive_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
         ``(a, b) -> (n,) overlap volumes (mm^3)`` for the same pairs :func:`sweep_interference` checks.
         For benchmarks and tests; far slower than the sweep.
     """
-    if pins is None:
-        pins = pins_from_holes(parts)
+    pins = pins_from_holes(parts) if pins is None else pins_from_parts_layer(pins, parts)
     items = part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
     cache: dict[str, object] = {}
     poses = {name: motion.pose(name) for name in motion.body_names}
