@@ -159,10 +159,12 @@ def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
     # the cubic through four exact samples of det(c1 + lam c2)
     coefficients = _CUBIC_FIT @ np.linalg.det(c1[None] + _CUBIC_SAMPLES[:, None, None] * c2[None])
     if abs(coefficients[0]) < 1e-14:  # c2 itself degenerate: it is the member at infinity
-        lams = [np.inf]
-    else:
-        lams = []
-    lams += [r.real for r in np.roots(coefficients) if abs(r.imag) <= 1e-9 * max(1.0, abs(r))]
+        roots = np.concatenate([[np.inf], np.roots(coefficients)])
+    else:  # eigenvalues of the companion matrix (np.roots without its overhead)
+        lead = coefficients[0]
+        roots = np.linalg.eigvals(np.array([[-coefficients[1] / lead, -coefficients[2] / lead,
+                                             -coefficients[3] / lead], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]))
+    lams = [r.real for r in roots if np.isinf(r) or abs(r.imag) <= 1e-9 * max(1.0, abs(r))]
     points: list[np.ndarray] = []
     for lam in lams:
         member = c2 if np.isinf(lam) else c1 + lam * c2
@@ -173,7 +175,7 @@ def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
             continue  # a definite (point) or double-line member: try another root
         w1, w2 = np.sqrt(abs(values[1])), np.sqrt(abs(values[2]))
         for line in (w1 * vectors[:, 1] + w2 * vectors[:, 2], w1 * vectors[:, 1] - w2 * vectors[:, 2]):
-            basis = np.linalg.svd(line[None, :])[2][1:]
+            basis = _line_basis(line)
             a = basis[0] @ c1 @ basis[0]
             b = basis[0] @ c1 @ basis[1]
             c = basis[1] @ c1 @ basis[1]
@@ -190,6 +192,16 @@ def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
                 points.append(_polish(c1, c2, x / np.linalg.norm(x)))
         break
     return [x for x in points if abs(x @ c1 @ x) < 1e-8 and abs(x @ c2 @ x) < 1e-8]
+
+
+def _line_basis(line: np.ndarray) -> np.ndarray:
+    """Two orthonormal homogeneous points (2, 3) spanning the projective line ``line . x = 0``."""
+    axis = np.zeros(3)
+    axis[int(np.argmin(np.abs(line)))] = 1.0
+    e = np.cross(line, axis)
+    e = e / np.linalg.norm(e)
+    f = np.cross(line, e)
+    return np.array([e, f / np.linalg.norm(f)])
 
 
 def _polish(c1: np.ndarray, c2: np.ndarray, x: np.ndarray, steps: int = 2) -> np.ndarray:
