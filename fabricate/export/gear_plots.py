@@ -83,7 +83,7 @@ def pair_png(pair: Any, x_a: float) -> bytes:
     for ax in (ax1, ax2):
         ax.set_xlabel("x (mm)")
         ax.tick_params(labelsize=7)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.06, right=0.98, bottom=0.12, top=0.92, wspace=0.15)
     return _png(fig)
 
 
@@ -102,7 +102,7 @@ def pair_gif(pair: Any, frames: int) -> bytes:
         ax.set_xlim(-reach * 1.05, pair.center_distance_mm + reach * 1.05)
         ax.set_ylim(-reach * 1.05, reach * 1.05)
         ax.set_axis_off()
-        fig.tight_layout()
+        fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.99)
         fig.canvas.draw()
         rgba = np.asarray(fig.canvas.buffer_rgba())
         images.append(Image.fromarray(rgba[..., :3].copy()).convert("P", palette=Image.ADAPTIVE, colors=64))
@@ -123,5 +123,5 @@ def law_png(law: Callable, working_range: tuple[float, float], center_distance_m
     ax2.plot(np.degrees(x), -np.asarray(law(x, 1)), color="#dd8452", label="ratio i")
     ax2.set_ylabel("transmission ratio i = -law'")
     ax.set_title(f"gear law, centre distance {center_distance_mm:.3f} mm", fontsize=9)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.12, right=0.86, bottom=0.14, top=0.9)
     return _png(fig)

@@ -181,10 +181,11 @@ def check_ratio(law: Callable, x: np.ndarray, path: str = "law") -> np.ndarray:
         Naming the angle where the ratio fails and the fix.
     """
     ratio = -law_derivative(law, x, 1)
-    bad = ~np.isfinite(ratio)
+    # the law itself too: the complex step can give a finite slope where the real value is NaN
+    bad = ~np.isfinite(ratio) | ~np.isfinite(np.asarray(law(x), dtype=np.float64))
     if np.any(bad):
         at = float(np.degrees(x[np.argmax(bad)]))
-        raise SpecError(path, f"transmission ratio is not finite at x_a = {at:.3f} deg; "
+        raise SpecError(path, f"the law or its ratio is not finite at x_a = {at:.3f} deg; "
                               "give a law that is smooth over the working range")
     if np.any(ratio <= 0):
         k = int(np.argmin(ratio))

@@ -228,7 +228,7 @@ def _deviation_um(main: GearTeeth, other: GearTeeth) -> float:
 
 
 def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tuple[float, float],
-                   spec: GearSpec, *, closed: bool, name: str = "gears", chord_tolerance_mm: float = 0.005,
+                   spec: GearSpec, *, closed: bool, name: str = "pair", chord_tolerance_mm: float = 0.005,
                    coupling: str = "", carrier: str = "", body_a: str = "gear_a", body_b: str = "gear_b",
                    axis_a: str = "", axis_b: str = "", run_mesh_check: bool = True) -> GearPair:
     """Cut and check one gear pair.
@@ -261,6 +261,9 @@ def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tupl
         raise SpecError(f"gears.{name}.center_distance_mm", f"expected a positive distance, got {a}")
     check_ratio(law, np.linspace(lo, hi, 1025), f"gears.{name}.law")
     alpha = spec.pressure_angle
+    if spec.module_mm is not None:
+        # the module against the curvature of the working range first: the clearest message
+        check_feasible(curvature_summary(_Bare(law, a), np.linspace(lo, hi, 721)), spec.module_mm, spec)
     if closed:
         z_a, z_b = _closed_teeth(law, lo, spec, a)
         periods = (TWO_PI, TWO_PI * z_b / z_a)
