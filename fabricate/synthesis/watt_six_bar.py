@@ -64,6 +64,7 @@ class WattSixBarSpec:
     force_N: float = 1.0
     statics_samples: int = 41
     tip_tolerance_mm: float = 0.5
+    min_pin_to_middle_mm: float = 0.0
     rule: str = "nearest"
     target: tuple[float, float] | None = None
     branches: tuple[int, int] | None = None
@@ -79,7 +80,8 @@ class WattSixBarSpec:
                             angles=np.radians(np.asarray(self.angles_deg, dtype=np.float64)),
                             box_d=self.box("d"), box_e=self.box("e"), box_f=self.box("f"),
                             box_d0=self.box("d0"), step=self.step_mm, force=self.force_N,
-                            statics_samples=self.statics_samples, tip_tolerance=self.tip_tolerance_mm)
+                            statics_samples=self.statics_samples, tip_tolerance=self.tip_tolerance_mm,
+                            min_clearance=self.min_pin_to_middle_mm)
 
 
 def parse_spec(root: Table) -> WattSixBarSpec:
@@ -95,6 +97,12 @@ def parse_spec(root: Table) -> WattSixBarSpec:
                                                     "positions (it drives the finger)")
     if np.max(np.abs(angles[0][-1] - angles[0][0])) >= 180.0:
         raise SpecError(finger.field("theta1_deg"), "the input must turn less than 180 degrees")
+    # the distal phalanx must move relative to the proximal one between every two positions, or the
+    # dyad condition is empty (every point would be a "solution")
+    distal_rel = np.diff(angles[2] - angles[0])
+    if np.any(np.abs(distal_rel) < 0.1):
+        raise SpecError(finger.field("theta3_deg"), "the distal phalanx must turn relative to the proximal "
+                                                    "one between consecutive positions")
 
     boxes_t = root.table("boxes")
     boxes = []
@@ -111,6 +119,7 @@ def parse_spec(root: Table) -> WattSixBarSpec:
     force = region.number("force_N", 1.0, positive=True)
     samples = region.integer("statics_samples", 41, min=3, max=2001)
     tol = region.number("tip_tolerance_mm", 0.5, positive=True, max=50.0)
+    clearance = region.number("min_pin_to_middle_mm", 0.0, min=0.0, max=100.0)
     region.finish()
     box_d = dict(boxes)["d"]
     box_d0 = dict(boxes)["d0"]
@@ -149,7 +158,8 @@ def parse_spec(root: Table) -> WattSixBarSpec:
         phalanx_lengths_mm=tuple(float(v) for v in lengths),
         angles_deg=tuple(tuple(float(v) for v in row) for row in angles),
         boxes=tuple(boxes), tip_pad_radius_mm=pad, step_mm=step, k_max=k_max, force_N=force,
-        statics_samples=samples, tip_tolerance_mm=tol, rule=rule, target=target, branches=branches,
+        statics_samples=samples, tip_tolerance_mm=tol, min_pin_to_middle_mm=clearance, rule=rule, target=target,
+        branches=branches,
         refine=refine, refine_seeds=seeds, reference=tuple(reference))
 
 
@@ -164,6 +174,7 @@ class Choice:
     f: np.ndarray
     d0: np.ndarray
     K: float
+    clearance: float
     branch_pair: tuple[int, int]
     exact: bool  # a region point (on the curves) rather than a refined candidate
     region_index: int  # the region point, or the refinement's seed
@@ -172,11 +183,11 @@ class Choice:
 def _candidate_pool(region: SolutionRegion, refined: RefinedCandidates | None):
     """Accepted region points and refined candidates as parallel arrays (+ whether exact, source index)."""
     idx = np.flatnonzero(region.accepted)
-    cols = [region.d[idx], region.e[idx], region.f[idx], region.d0[idx], region.K[idx],
+    cols = [region.d[idx], region.e[idx], region.f[idx], region.d0[idx], region.K[idx], region.clearance[idx],
             np.ones(len(idx), bool), idx]
     if refined is not None:
         r = np.flatnonzero(refined.accepted)
-        extra = [refined.d[r], refined.e[r], refined.f[r], refined.d0[r], refined.K[r],
+        extra = [refined.d[r], refined.e[r], refined.f[r], refined.d0[r], refined.K[r], refined.clearance[r],
                  np.zeros(len(r), bool), refined.seed[r]]
         cols = [np.concatenate([a, b]) for a, b in zip(cols, extra, strict=True)]
     return cols
@@ -184,7 +195,7 @@ def _candidate_pool(region: SolutionRegion, refined: RefinedCandidates | None):
 
 def choose(spec: WattSixBarSpec, region: SolutionRegion, refined: RefinedCandidates | None) -> Choice:
     """Apply the template's rule to the accepted region points and refined candidates."""
-    d, e, f, d0, k, exact, source = _candidate_pool(region, refined)
+    d, e, f, d0, k, clearance, exact, source = _candidate_pool(region, refined)
     mask = np.ones(len(d), bool)
     if spec.branches is not None:
         m, n = spec.branches
@@ -202,7 +213,7 @@ def choose(spec: WattSixBarSpec, region: SolutionRegion, refined: RefinedCandida
         order = np.lexsort((k[pick], ~exact[pick], dist))
     j = int(pick[order[0]])
     src = int(source[j])
-    return Choice(d=d[j], e=e[j], f=f[j], d0=d0[j], K=float(k[j]),
+    return Choice(d=d[j], e=e[j], f=f[j], d0=d0[j], K=float(k[j]), clearance=float(clearance[j]),
                   branch_pair=(int(region.branch_d[src]), int(region.branch_d0[src])),
                   exact=bool(exact[j]), region_index=src)
 
@@ -361,18 +372,21 @@ def synthesise_spec(spec: WattSixBarSpec, name: str = "finger_watt_six_bar") -> 
                                                                       - torque))),
         "joint_forces_max_N": {j: float(loads.forces[j].max()) for j in JOINTS},
         "pose_error_mm": {"max": float(tip.max()), "mean": float(tip.mean())},
+        "pin_to_middle_link_mm": _clearance_of(finger, choice, theta),
+        "pin_to_middle_link_limit_mm": spec.min_pin_to_middle_mm,
         "region": {
             "step_mm": spec.step_mm,
             "points": len(region),
             "points_without_circuit_defect": int(region.passes.sum()),
             "points_K_ok": int(np.sum(region.K <= spec.k_max)),
             "points_accepted": int(region.accepted.sum()),
+            "points_clear_of_middle_link": int(np.sum(region.clearance >= spec.min_pin_to_middle_mm)),
             "branch_pairs": region.branch_pair_counts(),
             "branch_pairs_K_ok": region.branch_pair_counts(region.K <= spec.k_max),
             "curve_d_feasible_x_mm": {str(k): list(v) for k, v in one.feasible_ranges().items()},
         },
         "refined": None if refined is None else {
-            "seeds": len(refined), "accepted": int(refined.accepted.sum()),
+            "candidates": len(refined), "accepted": int(refined.accepted.sum()),
         },
         "selection": {"rule": spec.rule, "target_dx_d0x_mm": None if spec.target is None else list(spec.target),
                       "exact_region_point": choice.exact},
@@ -400,6 +414,15 @@ def synthesise_spec(spec: WattSixBarSpec, name: str = "finger_watt_six_bar") -> 
     data = {"region": region, "refined": refined, "choice": choice, "finger": finger, "inputs": inputs}
     parts = {"pads": {"distal": {"point": "c", "radius_mm": spec.tip_pad_radius_mm}}, "tip_point": "c"}
     return SynthesisResult(mechanism=mech, report=report, figures=figures, data=data, parts=parts)
+
+
+def _clearance_of(finger: FingerPositions, choice: Choice, theta: np.ndarray) -> float:
+    """Smallest distance of d and e from the middle link over the motion (mm) of the chosen design."""
+    from fabricate.synthesis.watt_six_bar_statics import middle_link_clearance
+
+    batch = SixBarBatch(finger.a[0], finger.b[0], finger.c[0], choice.d[None], choice.e[None], choice.f[None],
+                        choice.d0[None], float(theta[0]))
+    return float(middle_link_clearance(batch, theta)[0])
 
 
 def _selected_distances(finger: FingerPositions, choice: Choice) -> dict[str, float]:
@@ -433,17 +456,19 @@ def _refine(spec: WattSixBarSpec, region: SolutionRegion, finger: FingerPosition
     template = SixBarBatch(finger.a[0], finger.b[0], finger.c[0], region.d[:0], region.e[:0], region.f[:0],
                            region.d0[:0], float(inputs.angles[0, 0]))
     args = (template, inputs.angles[0], finger.c, lower, upper, theta, inputs.force, inputs.tip_tolerance,
-            spec.k_max)
-    first = refine_region(seeds, seeds_idx, *args)
-    if spec.rule != "nearest" or not np.any(first.accepted):
+            spec.k_max, spec.min_pin_to_middle_mm)
+    first = refine_region(seeds, seeds_idx, *args, penalise_clearance=False)
+    fits = np.flatnonzero((first.tip_error <= inputs.tip_tolerance) & (first.K <= spec.k_max))
+    if not len(fits) or (spec.rule != "nearest" and spec.min_pin_to_middle_mm <= 0.0):
         return first
-    # second pass: slide the accepted candidates along their (approximate) family towards the target
-    # (d_x, d0_x), the other coordinates only loosely held, and score them again
-    ok = np.flatnonzero(first.accepted)
+    # second pass: slide the candidates that fit along their (approximate) family towards the target
+    # (d_x, d0_x), the other coordinates only loosely held, now also pushed clear of the middle link
+    ok = fits
     start = np.concatenate([first.d[ok], first.e[ok], first.f[ok], first.d0[ok]], axis=1)
     anchor = start.copy()
-    anchor[:, 0], anchor[:, 6] = spec.target
     pull = np.full(8, 0.002)
-    pull[[0, 6]] = 0.05
+    if spec.rule == "nearest":
+        anchor[:, 0], anchor[:, 6] = spec.target
+        pull[[0, 6]] = 0.05
     second = refine_region(start, first.seed[ok], *args, iterations=100, pull=pull, anchor=anchor)
     return merge(first, second)

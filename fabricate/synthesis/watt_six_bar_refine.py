@@ -21,10 +21,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fabricate.synthesis.watt_six_bar_statics import SixBarBatch, assemble, fingertip_errors, force_index
+from fabricate.synthesis.watt_six_bar_statics import (
+    SixBarBatch,
+    assemble,
+    fingertip_errors,
+    force_index,
+    middle_link_clearance,
+    segment_distance,
+)
 
 #: Residual (mm) standing in for a position where a loop cannot close: large, so the step is refused.
 _NO_ASSEMBLY = 1.0e3
+#: Extra clearance (mm) the minimisation aims for beyond the template's limit.
+_CLEARANCE_MARGIN = 0.1
 
 
 @dataclass(frozen=True)
@@ -41,8 +50,10 @@ class RefinedCandidates:
         Largest fingertip error at the four positions, mm.
     K : (M,) array
         Force index.
+    clearance : (M,) array
+        Smallest distance of d and e from the middle link a-b over the motion, mm.
     accepted : (M,) bool
-        Within the tip tolerance, K limit and the boxes.
+        Within the tip tolerance, K limit, clearance and the boxes.
     """
 
     d: np.ndarray
@@ -52,6 +63,7 @@ class RefinedCandidates:
     seed: np.ndarray
     tip_error: np.ndarray
     K: np.ndarray
+    clearance: np.ndarray
     accepted: np.ndarray
 
     def __len__(self) -> int:
@@ -59,20 +71,32 @@ class RefinedCandidates:
 
 
 def _residuals(params: np.ndarray, seeds: np.ndarray, template: SixBarBatch, theta_positions: np.ndarray,
-               tips: np.ndarray, pull: np.ndarray) -> np.ndarray:
-    """(N, 6 + 8) residuals: fingertip misses at positions 2..4, then pull * (params - anchor)."""
+               tips: np.ndarray, pull: np.ndarray, theta_check: np.ndarray, min_clearance: float) -> np.ndarray:
+    """(N, 6 + 1 + 8) residuals: fingertip misses at positions 2..4, the clearance shortfall of d and e
+    from the middle link over ``theta_check`` (zero when clear), then pull * (params - anchor)."""
     batch = SixBarBatch(template.a, template.b, template.c, params[:, 0:2], params[:, 2:4],
                         params[:, 4:6], params[:, 6:8], template.theta1_start)
-    poses = assemble(batch, theta_positions[1:])
-    miss = (poses.c - tips[None, 1:]).reshape(len(params), -1)
-    bad = np.repeat(poses.margin < 0.0, 2, axis=1) | ~np.isfinite(miss)
+    n_pos = len(theta_positions) - 1
+    checking = min_clearance > 0.0 and len(theta_check) > 0
+    poses = assemble(batch, np.concatenate([theta_positions[1:], theta_check]) if checking
+                     else theta_positions[1:])
+    miss = (poses.c[:, :n_pos] - tips[None, 1:]).reshape(len(params), -1)
+    bad = np.repeat(poses.margin[:, :n_pos] < 0.0, 2, axis=1) | ~np.isfinite(miss)
     miss = np.where(bad, _NO_ASSEMBLY, miss)
-    return np.concatenate([miss, pull * (params - seeds)], axis=1)
+    shortfall = np.zeros((len(params), 1))
+    if checking:
+        gap = np.minimum(segment_distance(poses.e[:, n_pos:], poses.a[:, n_pos:], poses.b[:, n_pos:]),
+                         segment_distance(poses.d[:, n_pos:], poses.a[:, n_pos:], poses.b[:, n_pos:]))
+        gap = np.where(poses.margin[:, n_pos:] >= 0.0, gap, 0.0)
+        # aim a little beyond the limit: the scoring samples the motion more finely than this check
+        shortfall[:, 0] = np.maximum(0.0, min_clearance + _CLEARANCE_MARGIN - np.min(gap, axis=1))
+    return np.concatenate([miss, shortfall, pull * (params - seeds)], axis=1)
 
 
 def refine(seeds: np.ndarray, template: SixBarBatch, theta_positions: np.ndarray, tips: np.ndarray,
            lower: np.ndarray, upper: np.ndarray, iterations: int = 60, pull: np.ndarray | float = 0.01,
-           anchor: np.ndarray | None = None) -> np.ndarray:
+           anchor: np.ndarray | None = None, theta_check: np.ndarray | None = None,
+           min_clearance: float = 0.0) -> np.ndarray:
     """Levenberg-Marquardt on every seed at once, kept inside ``lower``/``upper`` by clipping.
 
     Parameters
@@ -89,6 +113,8 @@ def refine(seeds: np.ndarray, template: SixBarBatch, theta_positions: np.ndarray
         Box bounds of (d, e, f, d0).
     pull : float or (8,) array
         Weight (mm per mm) of the pull towards ``anchor`` (default: the seeds) per coordinate.
+    theta_check : (S,) array, optional
+        Inputs (rad) at which d and e must keep ``min_clearance`` (mm) from the middle link a-b.
 
     Returns
     -------
@@ -97,7 +123,9 @@ def refine(seeds: np.ndarray, template: SixBarBatch, theta_positions: np.ndarray
     p = np.clip(seeds, lower, upper)
     damping = np.full(len(p), 1e-2)
     anchor = seeds if anchor is None else anchor
-    args = (anchor, template, theta_positions, tips, np.broadcast_to(np.asarray(pull, dtype=np.float64), (8,)))
+    theta_check = np.zeros(0) if theta_check is None else np.asarray(theta_check, dtype=np.float64)
+    args = (anchor, template, theta_positions, tips, np.broadcast_to(np.asarray(pull, dtype=np.float64), (8,)),
+            theta_check, float(min_clearance))
     r = _residuals(p, *args)
     cost = np.einsum("ij,ij->i", r, r)
     h = 1e-5
@@ -126,10 +154,16 @@ def refine(seeds: np.ndarray, template: SixBarBatch, theta_positions: np.ndarray
 def refine_region(seed_points: np.ndarray, seed_index: np.ndarray, template: SixBarBatch,
                   theta_positions: np.ndarray, tips: np.ndarray, lower: np.ndarray, upper: np.ndarray,
                   theta_statics: np.ndarray, force: float, tip_tolerance: float, k_max: float,
-                  iterations: int = 60, pull: np.ndarray | float = 0.01,
-                  anchor: np.ndarray | None = None) -> RefinedCandidates:
-    """Refine seeds, then score them like region points (fingertip error, K); duplicates removed."""
-    params = refine(seed_points, template, theta_positions, tips, lower, upper, iterations, pull, anchor)
+                  min_clearance: float = 0.0, iterations: int = 60, pull: np.ndarray | float = 0.01,
+                  anchor: np.ndarray | None = None, penalise_clearance: bool = True) -> RefinedCandidates:
+    """Refine seeds, then score them like region points (fingertip error, K, clearance); duplicates removed.
+
+    ``penalise_clearance=False`` leaves the clearance out of the minimisation (a faster first pass);
+    it is still scored.
+    """
+    check = theta_statics[np.unique(np.linspace(0, len(theta_statics) - 1, 11).astype(int))]
+    params = refine(seed_points, template, theta_positions, tips, lower, upper, iterations, pull, anchor,
+                    check, min_clearance if penalise_clearance else 0.0)
     # runs that converge to the same mechanism: keep the first (0.01 mm grid)
     _, first = np.unique(np.round(params, 2), axis=0, return_index=True)
     first = np.sort(first)
@@ -138,13 +172,16 @@ def refine_region(seed_points: np.ndarray, seed_index: np.ndarray, template: Six
                         params[:, 6:8], template.theta1_start)
     tip = np.nan_to_num(fingertip_errors(batch, theta_positions, tips).max(axis=1), nan=np.inf)
     k = force_index(batch, theta_statics, force)
+    clearance = np.nan_to_num(middle_link_clearance(batch, theta_statics), nan=-np.inf)
     inside = np.all((params >= lower - 1e-9) & (params <= upper + 1e-9), axis=1)
     return RefinedCandidates(d=params[:, 0:2], e=params[:, 2:4], f=params[:, 4:6], d0=params[:, 6:8],
-                             seed=seed_index, tip_error=tip, K=k,
-                             accepted=inside & (tip <= tip_tolerance) & (k <= k_max))
+                             seed=seed_index, tip_error=tip, K=k, clearance=clearance,
+                             accepted=inside & (tip <= tip_tolerance) & (k <= k_max)
+                             & (clearance >= min_clearance))
 
 
 def merge(first: RefinedCandidates, second: RefinedCandidates) -> RefinedCandidates:
     """Both sets of candidates in one (first's order, then second's)."""
     return RefinedCandidates(*(np.concatenate([getattr(first, name), getattr(second, name)])
-                               for name in ("d", "e", "f", "d0", "seed", "tip_error", "K", "accepted")))
+                               for name in ("d", "e", "f", "d0", "seed", "tip_error", "K", "clearance",
+                                            "accepted")))

@@ -30,7 +30,12 @@ from fabricate.synthesis.watt_six_bar_burmester import (
     plane_motion,
     sample_curve,
 )
-from fabricate.synthesis.watt_six_bar_statics import SixBarBatch, fingertip_errors, force_index
+from fabricate.synthesis.watt_six_bar_statics import (
+    SixBarBatch,
+    fingertip_errors,
+    force_index,
+    middle_link_clearance,
+)
 
 
 @dataclass(frozen=True)
@@ -53,6 +58,8 @@ class RegionInputs:
         Number of theta1 values from position 1 to position 4 for the statics.
     tip_tolerance : float
         Largest fingertip error at the positions (mm) for a point to count as passing them.
+    min_clearance : float
+        Smallest distance (mm) the pins d and e must keep from the middle link a-b over the motion.
     """
 
     lengths: np.ndarray
@@ -65,6 +72,7 @@ class RegionInputs:
     force: float = 1.0
     statics_samples: int = 41
     tip_tolerance: float = 0.5
+    min_clearance: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -151,8 +159,10 @@ class SolutionRegion:
         Largest fingertip error at the four positions on the branch of position 1, mm.
     passes : (N,) bool
         tip_error within the tolerance (no circuit defect).
+    clearance : (N,) array
+        Smallest distance of d and e from the middle link a-b over the motion, mm.
     accepted : (N,) bool
-        passes and K <= the limit.
+        passes, K <= the limit and the clearance kept.
     stage_one : StageOne
     """
 
@@ -165,6 +175,7 @@ class SolutionRegion:
     K: np.ndarray
     tip_error: np.ndarray
     passes: np.ndarray
+    clearance: np.ndarray
     accepted: np.ndarray
     stage_one: StageOne
 
@@ -205,8 +216,13 @@ def solution_region(inputs: RegionInputs, k_max: float) -> SolutionRegion:
     k = force_index(batch, theta, inputs.force) if len(batch) else np.zeros(0)
     tip = fingertip_errors(batch, inputs.angles[0], finger.c).max(axis=1) if len(batch) else np.zeros(0)
     passes = np.nan_to_num(tip, nan=np.inf) <= inputs.tip_tolerance
+    if inputs.min_clearance > 0.0 and len(batch):
+        clearance = np.nan_to_num(middle_link_clearance(batch, theta), nan=-np.inf)
+    else:
+        clearance = np.full(len(batch), np.inf)
     return SolutionRegion(d=d_sel, e=e_sel, d0=d0, f=f, branch_d=cols[i_d] + 1, branch_d0=i_b + 1, K=k,
-                          tip_error=tip, passes=passes, accepted=passes & (k <= k_max), stage_one=one)
+                          tip_error=tip, passes=passes, clearance=clearance,
+                          accepted=passes & (k <= k_max) & (clearance >= inputs.min_clearance), stage_one=one)
 
 
 def select_point(region: SolutionRegion, rule: str, target: tuple[float, float] | None = None,

@@ -287,3 +287,27 @@ def virtual_work_torque(mechanism, motion, point_local: np.ndarray, body: str, l
     dtheta = vel[driver.body][2] - vel[driver.reference][2]
     _, load = load_of_pose(poses)
     return float(-np.dot(load, v_point) / dtheta)
+
+
+def segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance (...,) of points p from segments a-b, all (..., 2)."""
+    ab = b - a
+    t = np.einsum("...a,...a->...", p - a, ab) / np.einsum("...a,...a->...", ab, ab)
+    foot = a + np.clip(t, 0.0, 1.0)[..., None] * ab
+    return np.hypot(*(p - foot).transpose(-1, *range(p.ndim - 1)))
+
+
+def middle_link_clearance(batch: SixBarBatch, theta1: np.ndarray, chunk: int = 4096) -> np.ndarray:
+    """Smallest distance (N,) of the joints d and e from the middle link's centreline a-b, mm.
+
+    The pins at d (proximal-coupler) and e (coupler-distal) join links on both sides of the middle
+    phalanx's layer, so the middle link must pass them with room for its own width and the pins'
+    spacers; NaN where the motion cannot be assembled.
+    """
+    out = np.empty(len(batch))
+    for start in range(0, len(batch), chunk):
+        poses = assemble(batch.take(slice(start, start + chunk)), theta1)
+        gap = np.minimum(segment_distance(poses.e, poses.a, poses.b), segment_distance(poses.d, poses.a, poses.b))
+        gap = np.where(poses.margin >= 0.0, gap, np.nan)
+        out[start:start + chunk] = np.min(gap, axis=1)
+    return out

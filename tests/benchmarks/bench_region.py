@@ -48,7 +48,7 @@ def main() -> None:
     rows.append(("whole region + K (41 angles) + defects", t, len(region)))
     rows.append((f"  of which K <= {spec.k_max:g}", float("nan"), int(np.sum(region.K <= spec.k_max))))
     t, result = _best_of(lambda: wsb.synthesise_spec(spec), repeat=1)
-    rows.append(("synthesise (region, refinement, mechanism, checks)", t, result.report["refined"]["seeds"]))
+    rows.append(("synthesise (region, refinement, mechanism, checks)", t, result.report["refined"]["candidates"]))
     print(f"{'stage':<54}{'time (s)':>10}{'points':>10}")
     for name, seconds, count in rows:
         time_text = "" if np.isnan(seconds) else f"{seconds:10.3f}"
