@@ -331,3 +331,19 @@ def test_parse_spec_names_the_bad_field(edit, path):
     with pytest.raises(SpecError) as err:
         wsb.parse_spec(_template_root(edit=edit))
     assert err.value.path == path
+
+
+def test_selected_finger_keeps_its_pins_clear_and_does_not_collide(paper_result):
+    rep = paper_result.report
+    assert rep["pin_to_middle_link_mm"] >= rep["pin_to_middle_link_limit_mm"] == 5.0
+    build = pytest.importorskip("fabricate.parts.build")
+    interference = pytest.importorskip("fabricate.checks.interference")
+    from fabricate.spec import load_design
+
+    design = load_design(TEMPLATE)
+    mech = paper_result.mechanism
+    motion = mech.sweep(91)
+    partset = build.build_parts(design, mech, motion, [], paper_result.parts)
+    result = interference.sweep_interference(partset.parts, motion, chord_tolerance_mm=0.05,
+                                             min_clearance_mm=0.25)
+    assert [(p.a, p.b) for p in result.collisions] == []

@@ -5,7 +5,9 @@ Template tables read here (see ``templates/finger_watt_six_bar.toml``):
 ``[finger]``     phalanx_lengths_mm (L1, L2, L3), theta1_deg / theta2_deg / theta3_deg (absolute angles
                  of a0-a, a-b, b-c from +x at the four positions), tip_pad_radius_mm.
 ``[boxes]``      d0, d, e, f: ``[x_min, x_max, y_min, y_max]`` at position 1, a0 at the origin (Table 3).
-``[region]``     step_mm (x sampling of both curves), k_max, force_N, statics_samples, tip_tolerance_mm.
+``[region]``     step_mm (x sampling of both curves), k_max, force_N, statics_samples, tip_tolerance_mm,
+                 min_pin_to_middle_mm (pins d and e cross the middle link's layer: smallest distance
+                 from its centreline a-b over the motion; 0 switches the check off).
 ``[selection]``  rule ("nearest" to ``target = [d_x, d0_x]`` or "least_k"), optional branches = [m, n],
                  refine (look for approximate defect-free mechanisms from the region points, see
                  :mod:`.watt_six_bar_refine`), refine_seeds.
@@ -69,7 +71,7 @@ class WattSixBarSpec:
     target: tuple[float, float] | None = None
     branches: tuple[int, int] | None = None
     refine: bool = True
-    refine_seeds: int = 1000
+    refine_seeds: int = 600
     reference: tuple[tuple[str, tuple[float, float]], ...] = ()
 
     def box(self, name: str) -> np.ndarray:
@@ -142,7 +144,7 @@ def parse_spec(root: Table) -> WattSixBarSpec:
             raise SpecError(sel.field("branches"), "expected two whole numbers 1..3")
         branches = (int(b[0]), int(b[1]))
     refine = sel.boolean("refine", True)
-    seeds = sel.integer("refine_seeds", 1000, min=1, max=100000)
+    seeds = sel.integer("refine_seeds", 600, min=1, max=100000)
     sel.finish()
 
     reference: list[tuple[str, tuple[float, float]]] = []
