@@ -161,10 +161,9 @@ def planar_clearance(a: Outline, b: Outline, rel: RelativePoses, search_mm: floa
     previous, previous_index = math.inf, -2
     for i in rest:
         guess = previous + moved[i] + 1e-9 if previous_index == i - 1 else math.inf
-        d = math.inf
-        if guess < search_mm:
-            d = _clipped_distance(a, polys[i], bb[i], guess)
-        if not d <= guess:
+        tried = guess < search_mm
+        d = _clipped_distance(a, polys[i], bb[i], guess) if tried else math.inf
+        if not (tried and d <= guess):  # no guess, or the guess was too short
             d = _clipped_distance(a, polys[i], bb[i], search_mm)
         if d <= search_mm:
             out[i] = d

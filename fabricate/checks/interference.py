@@ -237,6 +237,8 @@ class InterferenceResult:
         return {
             "a": p.a, "b": p.b, "relation": p.relation,
             "min_clearance_mm": _finite(p.min_clearance_mm),
+            # False: the parts never came within the search length, the value is a lower bound
+            "exact": bool(p.exact[p.min_index]),
             "input_deg": float(self.inputs[p.min_index]),
             "required_mm": p.required_mm,
             "z_gap_mm": round(p.z_gap_mm, 6),
