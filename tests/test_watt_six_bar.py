@@ -347,3 +347,12 @@ def test_selected_finger_keeps_its_pins_clear_and_does_not_collide(paper_result)
     result = interference.sweep_interference(partset.parts, motion, chord_tolerance_mm=0.05,
                                              min_clearance_mm=0.25)
     assert [(p.a, p.b) for p in result.collisions] == []
+
+
+def test_boxes_that_no_joint_can_reach_raise_synthesis_error():
+    from fabricate.errors import SynthesisError
+
+    spec = _paper_spec()
+    boxes = tuple((name, (200.0, 210.0, -20.0, 20.0)) if name == "d" else (name, box) for name, box in spec.boxes)
+    with pytest.raises(SynthesisError, match="region: 0 points"):
+        wsb.synthesise_spec(replace(spec, boxes=boxes))

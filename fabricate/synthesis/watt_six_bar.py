@@ -436,7 +436,7 @@ def _selected_distances(finger: FingerPositions, choice: Choice) -> dict[str, fl
 
 
 def _refine(spec: WattSixBarSpec, region: SolutionRegion, finger: FingerPositions, inputs: RegionInputs,
-            theta: np.ndarray) -> RefinedCandidates:
+            theta: np.ndarray) -> RefinedCandidates | None:
     """Seeds: region points that assemble over the motion, nearest the target (or lowest K) first."""
     usable = np.flatnonzero(np.isfinite(region.K) & ~region.passes)
     if spec.rule == "nearest":
@@ -451,6 +451,8 @@ def _refine(spec: WattSixBarSpec, region: SolutionRegion, finger: FingerPosition
     spread = rest[np.unique(np.linspace(0, len(rest) - 1, spec.refine_seeds - len(near)).astype(int))] \
         if len(rest) else rest
     seeds_idx = np.sort(np.concatenate([near, spread]))
+    if not len(seeds_idx):
+        return None
     seeds = np.concatenate([region.d[seeds_idx], region.e[seeds_idx], region.f[seeds_idx],
                             region.d0[seeds_idx]], axis=1)
     lower = np.array([spec.box(n)[[0, 2]] for n in ("d", "e", "f", "d0")]).ravel()
