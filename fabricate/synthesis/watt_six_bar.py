@@ -405,6 +405,15 @@ def synthesise_spec(spec: WattSixBarSpec, name: str = "finger_watt_six_bar") -> 
         },
         "degrees_of_freedom": mech.degrees_of_freedom(),
     }
+    notes = []
+    if not region.passes.any():
+        notes.append("every region point has a circuit defect (a loop must change assembly branch between "
+                     "two positions), so the selection comes from the approximate refinement: it passes the "
+                     f"positions within {spec.tip_tolerance_mm:g} mm at the fingertip but lies off the exact curves")
+    if not choice.exact:
+        notes.append("selected design is a refined candidate (see distance_to_curve_mm), seeded by region point "
+                     f"{choice.region_index}")
+    report["notes"] = notes
     if spec.reference:
         report["reference"] = _reference_report(spec, finger, inputs)
 

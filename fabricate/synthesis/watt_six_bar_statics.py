@@ -149,8 +149,8 @@ class JointLoads:
 def external_force(poses: SixBarPoses, force: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """Point of application (midpoint of e-c) and force vector normal to e-c, both (N, S, 2).
 
-    The normal is e->c turned +90 degrees (towards the palm side when the finger flexes clockwise);
-    K does not depend on the sign.
+    The normal is e->c turned +90 degrees: with the finger flexing clockwise (negative angles) that is
+    the push of a grasped object on the palm side of the distal phalanx. K does not depend on the sign.
     """
     ec = poses.c - poses.e
     n = perp(ec) / np.hypot(ec[..., 0], ec[..., 1])[..., None]
