@@ -356,3 +356,9 @@ def test_boxes_that_no_joint_can_reach_raise_synthesis_error():
     boxes = tuple((name, (200.0, 210.0, -20.0, 20.0)) if name == "d" else (name, box) for name, box in spec.boxes)
     with pytest.raises(SynthesisError, match="region: 0 points"):
         wsb.synthesise_spec(replace(spec, boxes=boxes))
+
+
+def test_grid_starts_at_the_box_edge_and_stays_inside():
+    assert np.allclose(grid_in_range(30.1, 31.0, 0.2), [30.1, 30.3, 30.5, 30.7, 30.9], atol=1e-12)
+    grid = grid_in_range(-10.0, 10.0, 0.2)
+    assert len(grid) == 101 and np.allclose(grid[[0, -1]], [-10.0, 10.0])

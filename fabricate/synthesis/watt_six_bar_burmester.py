@@ -297,20 +297,21 @@ def in_box(points: np.ndarray, box: np.ndarray) -> np.ndarray:
 
 
 def grid_in_range(lo: float, hi: float, step: float) -> np.ndarray:
-    """``lo, lo + step, ...`` up to ``hi`` inclusive (rounded to the step so 0.2 mm grids are exact)."""
+    """``lo, lo + step, ...`` up to ``hi`` inclusive (rounded to 1e-9 mm so 0.2 mm grids print exactly)."""
     n = int(np.floor((hi - lo) / step + 1e-9)) + 1
-    return np.round((lo + step * np.arange(n)) / step) * step
+    return np.round(lo + step * np.arange(n), 9)
 
 
-def distance_to_curve(curve: CubicCurve, point: np.ndarray, iterations: int = 50) -> tuple[float, np.ndarray]:
+def distance_to_curve(curve: CubicCurve, point: np.ndarray, iterations: int = 50,
+                      span: float = 40.0) -> tuple[float, np.ndarray]:
     """Euclidean distance from ``point`` (2,) to a single (unbatched) curve and the foot point.
 
-    Sampled search on a fine grid of x and y lines around the point (robust where the curve has
-    vertical tangents), refined by projecting with Newton steps along the gradient.
+    Sampled search on a fine grid of x and y lines within ``span`` mm of the point (robust where the
+    curve has vertical tangents), refined by projecting with Newton steps along the gradient. Returns
+    ``(inf, point)`` when no branch comes within ``span``.
     """
     point = np.asarray(point, dtype=np.float64)
     best = (np.inf, point)
-    span = 40.0
     for axis in (0, 1):
         grid = point[axis] + np.linspace(-span, span, 4001)
         if axis == 0:
