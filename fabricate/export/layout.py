@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import ConvexHull
 
 from fabricate.planar import rotation
 
@@ -48,17 +49,15 @@ def best_angle(points: np.ndarray, steps: int = 180) -> float:
     Ties go to the smaller angle, and a wider-than-tall box is preferred (shelves fill better).
     """
     pts = np.asarray(points, dtype=np.float64)
-    best = (math.inf, 0.0)
-    for k in range(steps):
-        angle = math.pi * k / steps
-        q = pts @ rotation(angle).T
-        w, h = np.ptp(q[:, 0]), np.ptp(q[:, 1])
-        area = round(float(w * h), 6)
-        if w + 1e-9 < h:
-            area += 1e-3  # prefer lying down
-        if area < best[0]:
-            best = (area, angle)
-    return best[1]
+    if len(pts) > 3:
+        pts = pts[ConvexHull(pts).vertices]  # the box of the hull is the box of the part
+    angles = math.pi * np.arange(steps) / steps
+    c, s = np.cos(angles), np.sin(angles)
+    x = pts[None, :, 0] * c[:, None] - pts[None, :, 1] * s[:, None]
+    y = pts[None, :, 0] * s[:, None] + pts[None, :, 1] * c[:, None]
+    w, h = np.ptp(x, axis=1), np.ptp(y, axis=1)
+    area = np.round(w * h, 6) + np.where(w + 1e-9 < h, 1e-3, 0.0)  # prefer lying down
+    return float(angles[int(np.argmin(area))])  # first minimum: ties go to the smaller angle
 
 
 def shelf_pack(outlines: Sequence[np.ndarray], area_mm: tuple[float, float], margin_mm: float,

@@ -90,7 +90,7 @@ def validate_stl(data: bytes, expected_volume_mm3: float | None = None,
     except Exception as exc:  # noqa: BLE001 - any decoder failure is a finding
         return [f"cannot be read back: {exc}"]
     problems = []
-    if len(mesh.faces) == 0:
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         return ["no triangles"]
     if not mesh.is_watertight:
         problems.append("not watertight")

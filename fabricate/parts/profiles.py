@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import shapely
+from scipy.spatial import ConvexHull
 from shapely.geometry import Polygon
 
 from fabricate.errors import GeometryError
@@ -106,24 +107,8 @@ def circle_hull(centres: np.ndarray, radii: np.ndarray | float) -> BulgePath:
 
 
 def _convex_hull_indices(points: np.ndarray) -> np.ndarray:
-    """Indices of the convex hull of ``points`` (n, 2), counter-clockwise (monotone chain)."""
-    idx = np.lexsort((points[:, 1], points[:, 0]))
-
-    def cross(o: int, a: int, b: int) -> float:
-        return ((points[a, 0] - points[o, 0]) * (points[b, 1] - points[o, 1])
-                - (points[a, 1] - points[o, 1]) * (points[b, 0] - points[o, 0]))
-
-    lower: list[int] = []
-    for p in idx:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(int(p))
-    upper: list[int] = []
-    for p in idx[::-1]:
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(int(p))
-    return np.array(lower[:-1] + upper[:-1])
+    """Indices of the convex hull vertices of ``points`` (n, 2), counter-clockwise (qhull)."""
+    return np.asarray(ConvexHull(points).vertices, dtype=np.int64)
 
 
 def fuse_polygons(path: BulgePath, extra: list[np.ndarray], chord_tolerance_mm: float) -> BulgePath:

@@ -1,0 +1,435 @@
+"""Exporters, read back by independent readers: STL (trimesh), DXF (ezdxf), 3MF (zip + XML), pictures (Pillow).
+
+Every case (fixture mechanisms and every shipped template, each with the SLA and the laser profile) goes
+through every exporter. Real tools (OpenSCAD, PrusaSlicer) are run when installed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import math
+import re
+import shutil
+import subprocess
+import xml.etree.ElementTree as ET
+import zipfile
+from functools import cache
+from types import SimpleNamespace
+
+import ezdxf
+import numpy as np
+import pytest
+import shapely
+import trimesh
+from conftest import make_four_bar
+from ezdxf import path as dxf_path
+from ezdxf.math import bulge_to_arc
+from PIL import Image
+from test_parts import slider_crank, spur_like, sun_planet_four_bar
+
+from fabricate.export import export_all
+from fabricate.export.dxf import audit_problems, kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
+from fabricate.export.stl import (
+    SolidCache,
+    assembly_3mf,
+    part_stl,
+    plate_layout,
+    print_plate_stl,
+    validate_stl,
+)
+from fabricate.parts.build import build_parts
+from fabricate.parts.profiles import offset_path
+from fabricate.parts.spec import PartsSpec
+from fabricate.spec import ProcessSpec, load_design, shipped_templates
+from fabricate.synthesis import KINDS
+
+SLA = ProcessSpec(name="sla", running_clearance_mm=0.25, hole_compensation_mm=0.2, min_wall_mm=0.8,
+                  min_pin_mm=1.5, layer_gap_mm=0.3, thickness_mm=3.0, kerf_mm=0.0, min_feature_mm=0.3,
+                  build_volume_mm=(130.0, 80.0, 160.0), pin_diameter_mm=2.0, chord_tolerance_mm=0.005)
+LASER = ProcessSpec(name="laser", running_clearance_mm=0.1, hole_compensation_mm=0.0, min_wall_mm=3.0,
+                    min_pin_mm=2.0, layer_gap_mm=0.5, thickness_mm=3.0, kerf_mm=0.2, min_feature_mm=0.5,
+                    build_volume_mm=(600.0, 400.0, 3.0), pin_diameter_mm=3.0, chord_tolerance_mm=0.005)
+PROCESSES = {"sla": SLA, "laser": LASER}
+FIXTURES = ("four_bar", "slider_crank", "geared_four_bar")
+TEMPLATES = tuple(p.stem for p in shipped_templates())
+CASES = [f"{m}-{p}" for m in FIXTURES + TEMPLATES for p in PROCESSES]
+
+
+@cache
+def _synthesised(template: str):
+    design = load_design(template)
+    result = KINDS[design.kind].synthesise(design)
+    try:
+        from fabricate.gears import build_gear_pairs
+    except ImportError:  # the gears layer is not there yet
+        gear_pairs = []
+    else:
+        gear_pairs = build_gear_pairs(result.mechanism, design.gears, design.process.chord_tolerance_mm)
+    return design, result, gear_pairs
+
+
+@cache
+def case(name: str) -> SimpleNamespace:
+    """Design, mechanism, motion, part set and exported files of one case (built once per session)."""
+    mech_name, process_name = name.rsplit("-", 1)
+    process = PROCESSES[process_name]
+    hints: dict = {}
+    gear_pairs: list = []
+    if mech_name in TEMPLATES:
+        base, result, gear_pairs = _synthesised(mech_name)
+        design = dataclasses.replace(base, process=dataclasses.replace(
+            process, chord_tolerance_mm=base.process.chord_tolerance_mm))
+        mechanism, hints = result.mechanism, dict(result.parts)
+        motion = mechanism.sweep(design.checks.sweep_poses + 1)
+    else:
+        design = SimpleNamespace(name=mech_name, process=process, parts=PartsSpec(gif_frames=8),
+                                 gears=SimpleNamespace(hub_diameter_mm=None))
+        if mech_name == "slider_crank":
+            mechanism = slider_crank()
+        else:
+            mechanism = make_four_bar()
+        motion = mechanism.sweep(121)
+        if mech_name == "geared_four_bar":
+            mechanism = sun_planet_four_bar(mechanism)
+            gear_pairs = [SimpleNamespace(name="sun_planet", body_a="ground", body_b="coupler", axis_a="O",
+                                          axis_b="A", outline_a=spur_like(9.0, 12, 0.4),
+                                          outline_b=spur_like(6.0, 8, 0.4))]
+            hints = {"pads": {"rocker": {"point": "B", "radius_mm": 4.0}}}
+    partset = build_parts(design, mechanism, motion, gear_pairs, hints)
+    files, entries = export_all(design, partset, mechanism, motion)
+    return SimpleNamespace(design=design, process=process, mechanism=mechanism, motion=motion,
+                           partset=partset, files=files, entries=entries, gear_pairs=gear_pairs, hints=hints)
+
+
+def perimeter_mm(part) -> float:
+    """Outline, hole and slot perimeters (mm): with the chord tolerance it bounds the area error."""
+    rings = part.polygons(1e-3)
+    return float(sum(shapely.LinearRing(r).length for r in rings))
+
+
+def expected_cut_diameter(part, hole, process) -> float:
+    """Finished hole minus the kerf: pin + 2 x radial clearance (+ SLA compensation) - kerf."""
+    if hole.joint.startswith("mount_"):
+        return hole.diameter_mm - process.kerf_mm
+    return (process.pin_diameter_mm + 2 * process.running_clearance_mm + process.hole_compensation_mm
+            - process.kerf_mm)
+
+
+# -- STL ----------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("name", CASES)
+def test_stl_round_trip(name):
+    c = case(name)
+    tol = c.partset.chord_tolerance_mm
+    for part in c.partset.parts:
+        data = c.files[f"parts/{part.name}.stl"]
+        assert validate_stl(data) == []
+        mesh = trimesh.load(io.BytesIO(data), file_type="stl")
+        assert mesh.is_watertight and mesh.is_winding_consistent
+        # volume = exact plate area x thickness, within the chord bound (inscribed polygons lose at most
+        # tolerance x perimeter of area) plus float32 rounding of the STL
+        bound = tol * perimeter_mm(part) * part.thickness_mm + 1e-5 * part.volume_mm3()
+        assert abs(mesh.volume - part.volume_mm3()) <= bound, (part.name, mesh.volume, part.volume_mm3(), bound)
+        genus = (2 - mesh.euler_number) // 2
+        assert genus == len(part.holes) + len(getattr(part, "slots", ())), part.name
+        assert mesh.bounds[0][2] == pytest.approx(0.0, abs=1e-6)
+        assert mesh.bounds[1][2] == pytest.approx(part.thickness_mm, abs=1e-5)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_print_plate(name):
+    c = case(name)
+    data = c.files["print_plate.stl"]
+    assert validate_stl(data) == []
+    mesh = trimesh.load(io.BytesIO(data), file_type="stl")
+    total = sum(p.volume_mm3() for p in c.partset.parts)
+    bound = sum(c.partset.chord_tolerance_mm * perimeter_mm(p) * p.thickness_mm for p in c.partset.parts)
+    assert abs(mesh.volume - total) <= bound + 1e-5 * total
+    assert len(mesh.split(only_watertight=True)) == len(c.partset.parts)
+    width, depth = c.process.build_volume_mm[:2]
+    if all(e["plate"]["fits"] and e["plate"]["index"] == 0 for e in c.entries):
+        assert mesh.bounds[0][0] >= -1e-6 and mesh.bounds[0][1] >= -1e-6
+        assert mesh.bounds[1][0] <= width + 1e-6 and mesh.bounds[1][1] <= depth + 1e-6
+    # no two parts overlap on the plate
+    footprints = [shapely.MultiPoint(b.vertices[:, :2]).convex_hull for b in mesh.split(only_watertight=True)]
+    assert sum(f.area for f in footprints) == pytest.approx(shapely.union_all(footprints).area, rel=1e-9)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_assembly_3mf(name):
+    c = case(name)
+    with zipfile.ZipFile(io.BytesIO(c.files["assembly.3mf"])) as archive:
+        assert {"[Content_Types].xml", "_rels/.rels", "3D/3dmodel.model"} <= set(archive.namelist())
+        root = ET.fromstring(archive.read("3D/3dmodel.model"))
+    ns = {"m": "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"}
+    assert root.get("unit") == "millimeter"
+    objects = root.findall("m:resources/m:object", ns)
+    assert [o.get("name") for o in objects] == [p.name for p in c.partset.parts]
+    first = c.motion.poses_at(0)
+    for obj, part in zip(objects, c.partset.parts, strict=True):
+        verts = np.array([[float(v.get(k)) for k in "xyz"] for v in obj.findall("m:mesh/m:vertices/m:vertex", ns)])
+        tris = np.array([[int(t.get(k)) for k in ("v1", "v2", "v3")]
+                         for t in obj.findall("m:mesh/m:triangles/m:triangle", ns)])
+        mesh = trimesh.Trimesh(verts, tris)
+        assert mesh.is_watertight
+        bound = c.partset.chord_tolerance_mm * perimeter_mm(part) * part.thickness_mm + 1e-4 * part.volume_mm3()
+        assert abs(mesh.volume - part.volume_mm3()) <= bound
+        # posed at the first pose: the first hole's centre is where the body puts it
+        if part.holes:
+            pose = first[part.body]
+            centre = part.holes[0].centre @ np.array([[math.cos(pose[2]), math.sin(pose[2])],
+                                                      [-math.sin(pose[2]), math.cos(pose[2])]]) + pose[:2]
+            ring = verts[np.abs(np.hypot(*(verts[:, :2] - centre).T) - part.holes[0].diameter_mm / 2) < 1e-3]
+            assert len(ring) >= 8
+            assert verts[:, 2].min() == pytest.approx(part.z_mm, abs=1e-5)
+
+
+# -- DXF ----------------------------------------------------------------------------------------
+
+def read_dxf(data: bytes):
+    doc = ezdxf.read(io.StringIO(data.decode("utf-8")))
+    assert doc.dxfversion == "AC1024"  # R2010
+    assert doc.header["$INSUNITS"] == 4 and doc.header["$MEASUREMENT"] == 1  # mm, metric
+    return doc
+
+
+def contour_polygons(msp, layer: str = "CUT", flatten_mm: float = 1e-4) -> list[shapely.Polygon]:
+    """Closed contours on ``layer`` as polygons, read through ezdxf's own path flattening."""
+    polys = []
+    for e in msp.query(f'LWPOLYLINE[layer=="{layer}"]'):
+        assert e.closed, "open contour"
+        pts = [(v.x, v.y) for v in dxf_path.make_path(e).flattening(flatten_mm)]
+        polys.append(shapely.Polygon(pts))
+    for e in msp.query(f'CIRCLE[layer=="{layer}"]'):
+        polys.append(shapely.Point(e.dxf.center.x, e.dxf.center.y).buffer(e.dxf.radius, 4096))
+    return polys
+
+
+def lwpolyline_area(entity) -> float:
+    """Exact area of a closed LWPOLYLINE: its vertex polygon plus the circular segments of its arcs,
+    the arcs taken from ezdxf's own bulge conversion."""
+    pts = np.array(entity.get_points("xyb"))
+    xy = pts[:, :2]
+    area = 0.5 * float(np.dot(xy[:, 0], np.roll(xy[:, 1], -1)) - np.dot(np.roll(xy[:, 0], -1), xy[:, 1]))
+    for i, bulge in enumerate(pts[:, 2]):
+        if bulge == 0:
+            continue
+        _, start, end, radius = bulge_to_arc(xy[i], xy[(i + 1) % len(xy)], bulge)
+        sweep = (end - start) % (2 * math.pi)
+        area += math.copysign(0.5 * radius * radius * (sweep - math.sin(sweep)), bulge)
+    return area
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_part_dxf_round_trip(name):
+    c = case(name)
+    kerf = c.process.kerf_mm
+    for part in c.partset.parts:
+        data = c.files[f"parts/{part.name}.dxf"]
+        doc = read_dxf(data)
+        assert doc.layers.get("CUT").color == 1
+        assert audit_problems(data) == []
+        msp = doc.modelspace()
+        outlines = msp.query('LWPOLYLINE[layer=="CUT"]')
+        assert len(outlines) == 1 + len(getattr(part, "slots", ()))
+        assert all(e.closed for e in outlines)
+        circles = msp.query('CIRCLE[layer=="CUT"]')
+        assert len(circles) == len(part.holes)
+        for circle, hole in zip(circles, part.holes, strict=True):
+            assert 2 * circle.dxf.radius == pytest.approx(expected_cut_diameter(part, hole, c.process), abs=1e-6)
+            np.testing.assert_allclose([circle.dxf.center.x, circle.dxf.center.y], hole.centre, atol=1e-6)
+        # the outline read back through ezdxf's bulge-to-arc conversion has the exact kerf-offset area
+        expected = offset_path(part.outline, kerf / 2).area()
+        assert lwpolyline_area(outlines[0]) == pytest.approx(expected, rel=1e-9)
+        # no duplicate contours
+        keys = [tuple(np.round(np.array(e.get_points("xyb")).ravel(), 6)) for e in outlines]
+        keys += [(round(e.dxf.center.x, 6), round(e.dxf.center.y, 6), round(e.dxf.radius, 6)) for e in circles]
+        assert len(set(keys)) == len(keys)
+        assert len(msp.query('TEXT[layer=="ENGRAVE"]')) == 1
+
+
+def test_binary_link_dxf_is_exact_rounded_slot():
+    """Closed form: a 15 mm crank cut on the laser is a stadium of radius boss + kerf / 2."""
+    c = case("four_bar-laser")
+    crank = c.partset.part("crank")
+    doc = read_dxf(c.files["parts/crank.dxf"])
+    (outline,) = doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')
+    r = 0.5 * (3.0 + 0.2) + 3.0 + 0.1  # hole/2 + web (= sheet thickness) + kerf/2
+    bulges = sorted(b for *_, b in outline.get_points("xyb"))
+    np.testing.assert_allclose(bulges, [0.0, 0.0, 1.0, 1.0], atol=1e-12)
+    pts = np.array(outline.get_points("xy"))
+    assert np.ptp(pts[:, 1]) == pytest.approx(2 * r, abs=1e-9)
+    assert lwpolyline_area(outline) == pytest.approx(2 * r * 15.0 + math.pi * r * r, rel=1e-12)
+    assert crank.outline.area() == pytest.approx(2 * (r - 0.1) * 15.0 + math.pi * (r - 0.1) ** 2, rel=1e-12)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_sheet_dxf_nests_without_overlap(name):
+    c = case(name)
+    data = c.files["sheet.dxf"]
+    assert audit_problems(data) == []
+    msp = read_dxf(data).modelspace()
+    contours = contour_polygons(msp, flatten_mm=1e-3)
+    # outer contours are those not inside another one
+    outers = [p for p in contours if not any(q is not p and q.contains(p) for q in contours)]
+    assert len(outers) == len(c.partset.parts)
+    for i, a in enumerate(outers):
+        for b in outers[i + 1:]:
+            assert not a.intersects(b)
+    sheets = [shapely.Polygon(np.array(e.get_points("xy"))) for e in msp.query('LWPOLYLINE[layer=="SHEET"]')]
+    for outer in outers:
+        assert any(s.contains(outer) for s in sheets)
+    assert len(msp.query('TEXT[layer=="ENGRAVE"]')) == len(c.partset.parts)
+    assert sorted(t.dxf.text for t in msp.query("TEXT")) == sorted(p.name for p in c.partset.parts)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_kinematic_dxf(name):
+    c = case(name)
+    data = c.files["kinematic.dxf"]
+    assert audit_problems(data) == []
+    msp = read_dxf(data).modelspace()
+    first = c.motion.poses_at(0)
+    lengths = []
+    for dim in msp.query("DIMENSION"):
+        if dim.dimtype == 0:  # linear along the link (ezdxf writes aligned as rotated linear)
+            lengths.append(dim.get_measurement())
+    joint_names = {j.name for j in c.mechanism.joints}
+    expected = set()
+    for body in c.mechanism.bodies:
+        names = [n for n in body.points if n in joint_names] or list(body.points)
+        for i, a in enumerate(names):
+            for b in names[i + 1:]:
+                length = float(np.hypot(*(body.point(a) - body.point(b))))
+                if length > 1e-6:
+                    expected.add(round(length, 6))
+    assert {round(v, 6) for v in lengths} == expected
+    labels = " ".join(t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]'))
+    for body in c.mechanism.bodies:
+        for n in body.points:
+            assert re.search(rf"\b{re.escape(n)} \(", labels)
+    # the ordinate dimensions locate every joint at the first pose
+    located = [d.get_measurement() for d in msp.query("DIMENSION") if d.dimtype == 6]
+    for joint in joint_names:
+        owner = c.mechanism.point_owner(joint)
+        pose = first[owner]
+        rot = np.array([[math.cos(pose[2]), -math.sin(pose[2])], [math.sin(pose[2]), math.cos(pose[2])]])
+        xy = pose[:2] + rot @ c.mechanism.body(owner).point(joint)
+        assert sum(abs(v.x - xy[0]) < 1e-6 and abs(v.y - xy[1]) < 1e-6 for v in located) == 2, joint
+
+
+# -- pictures, report, determinism ------------------------------------------------------------------
+
+@pytest.mark.parametrize("name", CASES)
+def test_previews_and_report_entries(name):
+    c = case(name)
+    png = Image.open(io.BytesIO(c.files["previews/assembly.png"]))
+    assert png.format == "PNG" and png.size[0] > png.size[1]
+    gif = Image.open(io.BytesIO(c.files["previews/motion.gif"]))
+    assert gif.format == "GIF" and gif.n_frames == 2 * c.design.parts.gif_frames - 2
+    assert [e["name"] for e in c.entries] == [p.name for p in c.partset.parts]
+    for entry, part in zip(c.entries, c.partset.parts, strict=True):
+        assert entry["stl"] in c.files and entry["dxf"] in c.files
+        assert entry["volume_mm3"] == pytest.approx(part.volume_mm3(), abs=1e-4)
+        assert entry["layer"] == part.layer and entry["process"] == c.process.name
+        assert [h["joint"] for h in entry["holes"]] == [h.joint for h in part.holes]
+    assert c.files["bom.csv"].startswith(b"item,kind,qty")
+
+
+@pytest.mark.parametrize("name", [CASES[0], CASES[-1]])
+def test_same_input_gives_identical_bytes(name):
+    c = case(name)
+    again = build_parts(c.design, c.mechanism, c.motion, c.gear_pairs, c.hints)
+    files, entries = export_all(c.design, again, c.mechanism, c.motion)
+    assert sorted(files) == sorted(c.files)
+    assert [k for k in files if files[k] != c.files[k]] == []
+    assert entries == c.entries
+
+
+def test_encoders_are_pure_functions_of_their_input():
+    c = case("geared_four_bar-laser")
+    parts = list(c.partset.parts)
+    cache = SolidCache(c.partset.chord_tolerance_mm)
+    assert part_stl(parts[0], cache) == c.files[f"parts/{parts[0].name}.stl"]
+    assert part_dxf(parts[0], c.process.kerf_mm) == c.files[f"parts/{parts[0].name}.dxf"]
+    layout = sheet_layout(parts, c.process.kerf_mm, c.process.build_volume_mm[:2], 5.0, 3.0)
+    assert sheet_dxf(parts, c.process.kerf_mm, layout, c.process.build_volume_mm[:2]) == c.files["sheet.dxf"]
+    plate = plate_layout(parts, cache, c.process.build_volume_mm[:2], 4.0)
+    assert print_plate_stl(parts, cache, plate, c.process.build_volume_mm[:2]) == c.files["print_plate.stl"]
+    assert assembly_3mf(parts, cache, c.motion.poses_at(0), c.design.name) == c.files["assembly.3mf"]
+    assert kinematic_dxf(c.mechanism, c.motion.poses_at(0)) == c.files["kinematic.dxf"]
+
+
+def test_validate_stl_finds_problems():
+    c = case("four_bar-sla")
+    good = c.files["parts/crank.stl"]
+    assert validate_stl(good) == []
+    # drop the last triangle: the surface is open
+    count = int.from_bytes(good[80:84], "little")
+    broken = good[:80] + (count - 1).to_bytes(4, "little") + good[84:-50]
+    assert "not watertight" in validate_stl(broken)
+    assert validate_stl(b"garbage")
+
+
+# -- real tools ---------------------------------------------------------------------------------------
+
+TOOL_CASES = ["four_bar-laser", "slider_crank-sla", "geared_four_bar-sla"] + [
+    f"{t}-sla" for t in TEMPLATES]
+
+
+@pytest.mark.skipif(shutil.which("openscad") is None, reason="OpenSCAD not installed")
+@pytest.mark.parametrize("name", TOOL_CASES)
+def test_openscad_imports_every_dxf(name, tmp_path):
+    """OpenSCAD imports each DXF's CUT layer (and the kinematic drawing's joints) without an error.
+
+    OpenSCAD 2021.01 reads LWPOLYLINE vertices but ignores bulges (it draws arcs as chords), so only
+    the import itself and the outline's extent along straight edges are checked here; the exact arcs
+    are checked through ezdxf above.
+    """
+    c = case(name)
+    dxfs = {k: v for k, v in c.files.items() if k.endswith(".dxf")}
+    for k, (rel, data) in enumerate(sorted(dxfs.items())):
+        target = tmp_path / f"f{k}.dxf"
+        target.write_bytes(data)
+        layer = "JOINTS" if rel == "kinematic.dxf" else "CUT"
+        scad = tmp_path / f"f{k}.scad"
+        scad.write_text(f'linear_extrude(1) import("{target}", layer="{layer}");\n')
+        out = tmp_path / f"f{k}.stl"
+        run = subprocess.run(["openscad", "-o", str(out), str(scad)], capture_output=True, text=True,
+                             timeout=120)
+        assert run.returncode == 0, (rel, run.stderr)
+        assert "ERROR" not in run.stderr, (rel, run.stderr)
+        warnings = [w for w in run.stderr.splitlines() if "WARNING" in w]
+        if rel == "kinematic.dxf":  # OpenSCAD cannot draw dimensions and texts: it says so and skips them
+            warnings = [w for w in warnings if "Unsupported DXF Entity" not in w]
+        assert warnings == [], (rel, warnings)
+        assert out.stat().st_size > 0
+        mesh = trimesh.load(out)
+        assert len(mesh.faces) > 0, rel
+
+
+@pytest.mark.skipif(shutil.which("prusa-slicer") is None, reason="PrusaSlicer not installed")
+@pytest.mark.parametrize("name", TOOL_CASES)
+def test_prusaslicer_reports_manifold_without_repair(name, tmp_path):
+    c = case(name)
+    stls = {k: v for k, v in c.files.items() if k.endswith(".stl")}
+    paths = []
+    for k, (rel, data) in enumerate(sorted(stls.items())):
+        target = tmp_path / f"s{k}.stl"
+        target.write_bytes(data)
+        paths.append((rel, target))
+    run = subprocess.run(["prusa-slicer", "--info"] + [str(p) for _, p in paths], capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    blocks = re.split(r"^\[(.+?)\]\s*$", run.stdout, flags=re.M)
+    info = {blocks[i]: blocks[i + 1] for i in range(1, len(blocks) - 1, 2)}
+    assert len(info) == len(paths)
+    repairs = ("open_edges", "edges_fixed", "degenerate_facets", "facets_removed", "facets_added",
+               "facets_reversed", "backwards_edges")
+    for rel, target in paths:
+        text = info[target.name]
+        assert "manifold = yes" in text, (rel, text)
+        for key in repairs:
+            m = re.search(rf"{key}\s*=\s*(\d+)", text)
+            assert m is None or int(m.group(1)) == 0, (rel, key, text)
