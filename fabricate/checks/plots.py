@@ -1,0 +1,54 @@
+"""Plot of clearance against input for the interference sweep (matplotlib only here)."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+from fabricate.checks.interference import InterferenceResult
+
+#: Pairs drawn: the closest ones (the others are in the report's table).
+MAX_PAIRS = 12
+
+
+def clearance_png(result: InterferenceResult, max_pairs: int = MAX_PAIRS) -> bytes:
+    """PNG of the clearance of the closest pairs over the motion, with the required minimum.
+
+    Exact values are drawn as solid lines, lower bounds (beyond the search length, or stacked parts
+    away from their closest pose) dotted. Colliding poses are marked on the zero line.
+    Deterministic bytes (no timestamps in the metadata).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    # spacers bearing on their joint touch by design: leave them to the table
+    shown = [p for p in result.pairs if p.relation != "bearing"]
+    pairs = sorted(shown, key=lambda p: (p.min_clearance_mm, p.a, p.b))[:max_pairs]
+    fig, ax = plt.subplots(figsize=(10.0, 4.5), dpi=100)
+    x = result.inputs
+    top = result.search_length_mm
+    for p in pairs:
+        line, = ax.plot(x, np.where(p.exact, p.clearance, np.nan), lw=1.4,
+                        label=f"{p.a} – {p.b} ({p.relation})")
+        # where only a lower bound is known (beyond the search length, or parts on other layers
+        # away from their closest pose) draw it dotted
+        ax.plot(x, np.where(p.exact, np.nan, p.clearance), lw=0.8, ls=":", color=line.get_color())
+        if p.collides:
+            ax.plot(x[p.collision_indices], np.zeros(len(p.collision_indices)), "x", color=line.get_color(),
+                    ms=4)
+    ax.axhline(result.min_clearance_required_mm, color="red", ls="--", lw=1.0,
+               label=f"required {result.min_clearance_required_mm:g} mm")
+    ax.set_xlabel(f"input ({result.input_unit})")
+    ax.set_ylabel("clearance (mm)")
+    ax.set_ylim(-0.05 * top, 1.05 * top)
+    ax.set_title(f"Clearance over the motion ({len(x)} poses, {len(result.pairs)} pairs)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    plt.close(fig)
+    return buf.getvalue()
