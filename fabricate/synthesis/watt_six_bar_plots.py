@@ -122,12 +122,15 @@ def plot_region(spec, region, refined, choice) -> bytes:
     over = finite & (region.K > spec.k_max)
     ax.plot(region.d[over, 0], region.d0[over, 0], ",", color="0.75", label=f"K > {spec.k_max:g}")
     ok = finite & (region.K <= spec.k_max)
-    sc = ax.scatter(region.d[ok, 0], region.d0[ok, 0], c=region.K[ok], s=4, cmap="viridis",
-                    vmin=0.0, vmax=spec.k_max, label=f"K <= {spec.k_max:g}")
+    clean = ok & region.passes
     defect = ok & ~region.passes
+    # defect-free points as discs, points with a circuit defect as crosses, both coloured by K
+    sc = ax.scatter(region.d[clean, 0], region.d0[clean, 0], c=region.K[clean], s=6, cmap="viridis",
+                    vmin=0.0, vmax=spec.k_max, label=f"K <= {spec.k_max:g}")
     if np.any(defect):
-        ax.scatter(region.d[defect, 0], region.d0[defect, 0], s=14, facecolors="none", edgecolors="r",
-                   linewidths=0.3, label="circuit defect")
+        sc = ax.scatter(region.d[defect, 0], region.d0[defect, 0], c=region.K[defect], s=6, marker="x",
+                        linewidths=0.5, cmap="viridis", vmin=0.0, vmax=spec.k_max,
+                        label=f"K <= {spec.k_max:g}, circuit defect")
     if refined is not None and np.any(refined.accepted):
         acc = refined.accepted
         ax.scatter(refined.d[acc, 0], refined.d0[acc, 0], c=refined.K[acc], s=30, marker="D", cmap="viridis",
