@@ -82,7 +82,7 @@ def _label_spot(part: Part, text: str) -> tuple[np.ndarray, float]:
     """A point inside the part far from its edges and holes, and a text height that fits there.
 
     The point is the pole of inaccessibility of the plate (outline less holes); the height keeps the
-    text (about 0.65 h per character wide) inside the largest circle around it.
+    text (at most about 0.9 h per character wide) inside the largest circle around it.
     """
     polygon = shapely.Polygon(part.outline.polygon(0.05))
     for h in part.holes:
@@ -97,7 +97,7 @@ def _label_spot(part: Part, text: str) -> tuple[np.ndarray, float]:
     room = float(polygon.exterior.distance(spot))
     for ring in polygon.interiors:
         room = min(room, float(ring.distance(spot)))
-    height = min(0.8 * room, 1.8 * room / (0.65 * max(1, len(text))))
+    height = min(0.8 * room, 1.6 * room / (0.9 * max(1, len(text))))
     return np.array([spot.x, spot.y]), float(np.clip(round(height, 3), 0.3, 5.0))
 
 
