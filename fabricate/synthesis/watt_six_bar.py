@@ -9,8 +9,8 @@ Template tables read here (see ``templates/finger_watt_six_bar.toml``):
                  min_pin_to_middle_mm (pins d and e cross the middle link's layer: smallest distance
                  from its centreline a-b over the motion; 0 switches the check off).
 ``[selection]``  rule ("nearest" to ``target = [d_x, d0_x]`` or "least_k"), optional branches = [m, n],
-                 refine (look for approximate defect-free mechanisms from the region points, see
-                 :mod:`.watt_six_bar_refine`), refine_seeds.
+                 refine (when no exact region point qualifies, look for approximate defect-free
+                 mechanisms from the region points, see :mod:`.watt_six_bar_refine`), refine_seeds.
 ``[reference]``  optional published design (d, e, f, d0) to compare with; report only.
 
 The pipeline: curves and region (:mod:`.watt_six_bar_region`), force index K (:mod:`.watt_six_bar_statics`),
@@ -202,12 +202,20 @@ def choose(spec: WattSixBarSpec, region: SolutionRegion, refined: RefinedCandida
     if spec.branches is not None:
         m, n = spec.branches
         mask &= (region.branch_d[source] == m) & (region.branch_d0[source] == n)
+    # exact region points first: refined candidates only stand in when no region point qualifies
+    if np.any(mask & exact):
+        mask &= exact
     pick = np.flatnonzero(mask)
     if not len(pick):
+        k_ok = region.K <= spec.k_max
+        clear = region.clearance >= spec.min_pin_to_middle_mm
         raise SynthesisError(
-            f"no six-bar in the solution region passes the {len(spec.angles_deg[0])} positions within "
-            f"{spec.tip_tolerance_mm:g} mm with K <= {spec.k_max:g} (region: {len(region)} points, "
-            f"{int(region.passes.sum())} without a circuit defect)")
+            f"no six-bar passes the {len(spec.angles_deg[0])} positions within {spec.tip_tolerance_mm:g} mm "
+            f"with K <= {spec.k_max:g} and pins {spec.min_pin_to_middle_mm:g} mm clear of the middle link "
+            f"(region: {len(region)} points; without a circuit defect {int(region.passes.sum())}, "
+            f"K ok {int(k_ok.sum())}, clear {int(clear.sum())}, defect-free and K ok "
+            f"{int((region.passes & k_ok).sum())}; refined candidates accepted "
+            f"{0 if refined is None else int(refined.accepted.sum())})")
     if spec.rule == "least_k":
         order = np.lexsort((~exact[pick], k[pick]))
     else:
@@ -342,7 +350,7 @@ def synthesise_spec(spec: WattSixBarSpec, name: str = "finger_watt_six_bar") -> 
     region = solution_region(inputs, spec.k_max)
     theta = np.linspace(inputs.angles[0, 0], inputs.angles[0, -1], inputs.statics_samples)
     refined = None
-    if spec.refine:
+    if spec.refine and not _region_qualifies(spec, region):
         refined = _refine(spec, region, finger, inputs, theta)
     choice = choose(spec, region, refined)
 
@@ -425,6 +433,14 @@ def synthesise_spec(spec: WattSixBarSpec, name: str = "finger_watt_six_bar") -> 
     data = {"region": region, "refined": refined, "choice": choice, "finger": finger, "inputs": inputs}
     parts = {"pads": {"distal": {"point": "c", "radius_mm": spec.tip_pad_radius_mm}}, "tip_point": "c"}
     return SynthesisResult(mechanism=mech, report=report, figures=figures, data=data, parts=parts)
+
+
+def _region_qualifies(spec: WattSixBarSpec, region: SolutionRegion) -> bool:
+    """Whether an exact region point can be selected (then no refinement is needed)."""
+    mask = region.accepted
+    if spec.branches is not None:
+        mask = mask & (region.branch_d == spec.branches[0]) & (region.branch_d0 == spec.branches[1])
+    return bool(np.any(mask))
 
 
 def _clearance_of(finger: FingerPositions, choice: Choice, theta: np.ndarray) -> float:
