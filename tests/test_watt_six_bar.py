@@ -290,10 +290,11 @@ def test_another_finger_gets_an_exact_defect_free_region_point():
     spec = replace(base, phalanx_lengths_mm=tuple(case["phalanx_lengths_mm"]),
                    angles_deg=tuple(tuple(r) for r in case["theta_deg"]),
                    boxes=tuple((k, tuple(v)) for k, v in case["boxes"].items()), rule="least_k", target=None,
-                   refine=False, reference=())
+                   reference=())
     res = wsb.synthesise_spec(spec, "other")
     rep = res.report
     assert rep["selection"]["exact_region_point"] is True
+    assert rep["refined"] is None  # exact points qualify: no approximate refinement
     assert rep["region"]["points_accepted"] > 100
     assert rep["pose_error_mm"]["max"] < 1e-6  # exact synthesis, one branch
     assert rep["K"] <= 20.0 and rep["K"] == pytest.approx(rep["K_virtual_work"], rel=1e-9)
