@@ -237,3 +237,72 @@ def designed_lag(pair: Any, x_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     arm_left = r_b * np.abs(-np.cos(alpha) * t_y + np.sin(alpha) * n_y)
     arm_right = r_b * np.abs(np.cos(alpha) * t_y + np.sin(alpha) * n_y)
     return 2 * delta / arm_left, 2 * delta / arm_right
+
+
+def _window_chains(outline: np.ndarray, centre_angles: np.ndarray, half_angle: float) -> np.ndarray:
+    """Per step, the contiguous run of outline vertices whose polar angle lies within
+    ``half_angle`` of ``centre_angles[k]``, padded to one length, closed through the axis: (n, K, 2)."""
+    phi = np.arctan2(outline[:, 1], outline[:, 0])
+    chains = []
+    for centre in centre_angles:
+        inside = np.abs((phi - centre + np.pi) % (2 * np.pi) - np.pi) <= half_angle
+        idx = np.flatnonzero(inside)
+        if len(idx) == 0:
+            chains.append(np.zeros((1, 2)))
+            continue
+        # a run that wraps past the ring's end starts after the largest gap in the indices
+        gaps = np.diff(idx)
+        if len(idx) > 1 and gaps.max() > 1:
+            cut = int(np.argmax(gaps)) + 1
+            idx = np.concatenate([idx[cut:], idx[:cut]])
+        run = np.arange(idx[0], idx[0] + ((idx[-1] - idx[0]) % len(outline)) + 1) % len(outline)
+        chains.append(np.vstack([outline[run], [[0.0, 0.0]]]))
+    width = max(len(c) for c in chains)
+    return np.stack([np.vstack([c, np.repeat(c[-1:], width - len(c), 0)]) for c in chains])
+
+
+def free_play_outlines(outline_a: np.ndarray, outline_b: np.ndarray, law: Any, center_distance: float,
+                       x_a: np.ndarray, module: float, max_angle: float = 0.02,
+                       tolerance: float = 1e-9) -> tuple[np.ndarray, np.ndarray]:
+    """Free rotation of gear b both ways (rad) from outlines alone, by bisection on 2D booleans.
+
+    Independent of how the outlines were made (used to measure other generators' gears the same
+    way as ours, e.g. in ``tests/benchmarks/bench_gears.py``). Each gear is reduced to a pie-shaped
+    window around the mesh (a contiguous run of its outline closed through its axis); gear b is
+    turned about its axis until the windows touch. NaN where the pair already overlaps at the law.
+    """
+    from fabricate.gears.law import law_derivative
+
+    x_a = np.asarray(x_a, dtype=np.float64)
+    theta_b = np.asarray(law(x_a), dtype=np.float64)
+    ratio = -law_derivative(law, x_a, 1)
+    r_a = center_distance * ratio / (1 + ratio)
+    half_a = 3.0 * np.pi * module / r_a.min()
+    half_b = 3.0 * np.pi * module / (center_distance - r_a).max()
+    win_a = _window_chains(outline_a, -x_a, half_a)
+    win_b = _window_chains(outline_b, np.pi - theta_b, half_b)
+    world_a = np.stack([np.cos(x_a)[:, None] * win_a[..., 0] - np.sin(x_a)[:, None] * win_a[..., 1],
+                        np.sin(x_a)[:, None] * win_a[..., 0] + np.cos(x_a)[:, None] * win_a[..., 1]], -1)
+    polys_a = shapely.polygons(np.concatenate([world_a, world_a[:, :1]], 1))
+    shapely.prepare(polys_a)
+
+    def touching(extra: np.ndarray) -> np.ndarray:
+        ang = (theta_b + extra)[:, None]
+        wx = np.cos(ang) * win_b[..., 0] - np.sin(ang) * win_b[..., 1] + center_distance
+        wy = np.sin(ang) * win_b[..., 0] + np.cos(ang) * win_b[..., 1]
+        ring = np.stack([wx, wy], -1)
+        polys_b = shapely.polygons(np.concatenate([ring, ring[:, :1]], 1))
+        # a positive overlap area, not just touching: exact contact of polylines is measure zero
+        return np.asarray(shapely.area(shapely.intersection(polys_a, polys_b)) > 1e-12)
+
+    overlap = touching(np.zeros_like(x_a))
+    result = []
+    for sign in (1.0, -1.0):
+        lo, hi = np.zeros_like(x_a), np.full_like(x_a, max_angle)
+        while np.max(hi - lo) > tolerance:
+            mid = 0.5 * (lo + hi)
+            hit = touching(sign * mid)
+            hi = np.where(hit, mid, hi)
+            lo = np.where(hit, lo, mid)
+        result.append(np.where(overlap, np.nan, 0.5 * (lo + hi)))
+    return result[0], result[1]

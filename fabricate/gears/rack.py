@@ -73,7 +73,7 @@ class RackProfile:
 
 
 def basic_rack(module: float, pressure_angle: float, dedendum: float, root_fillet: float,
-               addendum: float = 1.0, flank_points: int = 121, round_points: int = 25,
+               addendum: float = 1.0, flank_points: int = 241, round_points: int = 25,
                flat_points: int = 5) -> RackProfile:
     """Sample gear a's cutter over one period (gear b's: :meth:`RackProfile.for_gear_b`).
 
