@@ -82,6 +82,42 @@ def _clean_ring(coords: np.ndarray) -> np.ndarray:
     return ring
 
 
+def _douglas_peucker(points: np.ndarray, tolerance: float) -> np.ndarray:
+    """Indices kept by Douglas-Peucker on an open polyline (both ends kept)."""
+    keep = np.zeros(len(points), dtype=bool)
+    keep[0] = keep[-1] = True
+    stack = [(0, len(points) - 1)]
+    while stack:
+        i, j = stack.pop()
+        if j <= i + 1:
+            continue
+        a, b = points[i], points[j]
+        d = b - a
+        length = np.hypot(*d)
+        rel = points[i + 1:j] - a
+        if length < 1e-15:
+            dist = np.hypot(rel[:, 0], rel[:, 1])
+        else:
+            # distance to the segment (not the infinite line), so the bound holds everywhere
+            t = np.clip((rel @ d) / length**2, 0.0, 1.0)
+            dist = np.hypot(*(rel - t[:, None] * d).T)
+        k = int(np.argmax(dist))
+        if dist[k] > tolerance:
+            keep[i + 1 + k] = True
+            stack.extend([(i, i + 1 + k), (i + 1 + k, j)])
+    return np.flatnonzero(keep)
+
+
+def simplify_ring(ring: np.ndarray, tolerance: float) -> np.ndarray:
+    """Douglas-Peucker on a closed ring: every dropped vertex lies within ``tolerance`` of the result
+    (split at vertex 0 and the vertex farthest from it)."""
+    far = int(np.argmax(np.hypot(*(ring - ring[0]).T)))
+    first = _douglas_peucker(ring[:far + 1], tolerance)
+    second = _douglas_peucker(np.vstack([ring[far:], ring[:1]]), tolerance) + far
+    idx = np.concatenate([first, second[1:-1]])
+    return ring[idx]
+
+
 def circle_points(radius: float, chord_tolerance: float, start: float = 0.0) -> np.ndarray:
     """A CCW circle polygon whose chord error is at most ``chord_tolerance``."""
     n = max(16, int(np.ceil(np.pi / np.arccos(max(-1.0, 1.0 - chord_tolerance / radius)))))
@@ -165,8 +201,10 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     poly = orient(_largest_polygon(teeth), 1.0)
     dense = _clean_ring(np.asarray(poly.exterior.coords))
     dense_poly = Polygon(dense)
-    simple = shapely.simplify(dense_poly, 0.9 * chord_tolerance_mm, preserve_topology=True)
-    outline = _clean_ring(np.asarray(orient(_largest_polygon(simple), 1.0).exterior.coords))
+    outline = simplify_ring(dense, 0.9 * chord_tolerance_mm)
+    if not Polygon(outline).is_valid:  # pragma: no cover - tolerance far below tooth features
+        simple = shapely.simplify(dense_poly, 0.5 * chord_tolerance_mm, preserve_topology=True)
+        outline = _clean_ring(np.asarray(orient(_largest_polygon(simple), 1.0).exterior.coords))
     # tip lands: pieces of the outline lying on the tip curve (a pointed tooth has none)
     tip_curve = LinearRing(tip) if closed else LineString(tip)
     on_tip = dense_poly.exterior.intersection(tip_curve.buffer(1e-6))
