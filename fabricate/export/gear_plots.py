@@ -88,21 +88,35 @@ def pair_png(pair: Any, x_a: float) -> bytes:
 
 
 def pair_gif(pair: Any, frames: int) -> bytes:
-    """The pair turning through its working range, ``frames`` frames, as an animated GIF."""
+    """The pair turning through its working range, ``frames`` frames, as an animated GIF.
+
+    One figure is drawn once; each frame only moves the two gear patches (fast and deterministic).
+    """
+    from matplotlib.patches import Polygon as PolygonPatch
     from PIL import Image
 
     lo, hi = pair.working_range
     xs = np.linspace(lo, hi, int(frames), endpoint=not pair.closed)
     out_a0, out_b0, _, _ = _placed(pair, lo)
-    reach = max(np.abs(out_a0).max(), np.abs(out_b0 - [pair.center_distance_mm, 0]).max())
+    centre_b = np.array([pair.center_distance_mm, 0.0])
+    reach = max(np.abs(out_a0).max(), np.abs(out_b0 - centre_b).max())
+    fig, ax = _figure((4.8, 3.2), 80)
+    patch_a = PolygonPatch(out_a0, closed=True, fc="#4c72b0", ec="#1f3b63", alpha=0.6, lw=0.6)
+    patch_b = PolygonPatch(out_b0, closed=True, fc="#dd8452", ec="#7a3d17", alpha=0.6, lw=0.6)
+    ax.add_patch(patch_a)
+    ax.add_patch(patch_b)
+    for centre in ((0.0, 0.0), tuple(centre_b)):
+        ax.plot(*centre, "k+", ms=5)
+    ax.set_aspect("equal")
+    ax.set_xlim(-reach * 1.05, pair.center_distance_mm + reach * 1.05)
+    ax.set_ylim(-reach * 1.05, reach * 1.05)
+    ax.set_axis_off()
+    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.99)
     images = []
     for x in xs:
-        fig, ax = _figure((4.8, 3.2), 80)
-        _draw_pair(ax, pair, float(x), zoom=False)
-        ax.set_xlim(-reach * 1.05, pair.center_distance_mm + reach * 1.05)
-        ax.set_ylim(-reach * 1.05, reach * 1.05)
-        ax.set_axis_off()
-        fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.99)
+        out_a, out_b, _, _ = _placed(pair, float(x))
+        patch_a.set_xy(out_a)
+        patch_b.set_xy(out_b)
         fig.canvas.draw()
         rgba = np.asarray(fig.canvas.buffer_rgba())
         images.append(Image.fromarray(rgba[..., :3].copy()).convert("P", palette=Image.ADAPTIVE, colors=64))
