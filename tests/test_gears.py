@@ -147,7 +147,7 @@ def _assert_valid_outline(outline, dense, tolerance):
     assert np.max(shapely.distance(shapely.points(dense), ring)) <= tolerance
 
 
-@settings(max_examples=6, deadline=None)
+@settings(max_examples=4, deadline=None)
 @given(e=st.floats(0.0, 0.3), z=st.integers(20, 36))
 def test_elliptic_pairs_have_valid_outlines(e, z):
     spec = GearSpec(teeth=(z, z), backlash_mm=0.05, compare_methods=False)
@@ -176,3 +176,24 @@ def test_sector_outline_contains_its_axis_and_pitch_curve():
     # the sector covers the working range plus a spare tooth each side: more teeth than the arc needs
     arc = pair.pitch_model.s_of_x(np.array([0.9]))[0]
     assert min(pair.teeth) >= arc / (np.pi * pair.module) + 2 * spec.spare_teeth
+
+
+def test_approx_method_is_the_same_involute_for_a_constant_ratio():
+    # the osculating circle of a circle is the circle: the approximation is exact there
+    z, module = 24, 1.0
+    spec = GearSpec(teeth=(z, z), method="approx", backlash_mm=0.03, compare_methods=True)
+    pair = make_gear_pair(FormulaLaw("x"), z * module, (0.0, TWO_PI), spec, closed=True, run_mesh_check=False)
+    delta = 0.03 * np.cos(spec.pressure_angle) / 4
+    count, err = _involute_error_um(pair.cut_a.dense, z * module / 2, z, module, spec.pressure_angle, delta, 0.0,
+                                    spec)
+    assert count > 10 * z and err < DATA["involute_tolerance_um"]
+    assert pair.checks["exact_vs_approx_max_deviation_um"] < 0.01
+
+
+def test_small_gear_is_flagged_as_undercut():
+    spec = GearSpec(teeth=(12, 12), compare_methods=False, min_teeth=8)
+    pair = make_gear_pair(FormulaLaw("x"), 12.0, (0.0, TWO_PI), spec, closed=True, run_mesh_check=False)
+    assert pair.report()["undercut"]
+    # radius of curvature 6 mm < h_l / sin^2(alpha) = 1.0 m / sin^2(20 deg) = 8.55 mm
+    assert pair.checks["undercut_limit_radius_mm"] == pytest.approx(1.0 / np.sin(np.radians(20)) ** 2, rel=1e-3)
+    assert any(text.startswith("undercut") for text in pair.failures())

@@ -148,3 +148,22 @@ def test_plots_are_images_and_deterministic(elliptic_pair):
     gif = pair_gif(pair, 2)
     assert gif.startswith(b"GIF89a") and gif == pair_gif(pair, 2)
     assert law_png(pair.law, (0.0, 2 * np.pi), pair.center_distance_mm).startswith(b"\x89PNG")
+
+
+def test_gear_pair_kind_sector_from_a_formula(tmp_path):
+    f = tmp_path / "sector.toml"
+    f.write_text('[design]\nname = "sector"\nkind = "gear_pair"\n'
+                 '[gear_pair]\nlaw = "1.5*x + 0.1*sin(x)"\nclosed = false\nworking_range_deg = [-20, 40]\n'
+                 'center_distance_mm = 24.0\n[gears]\nmodule_mm = 0.6\nmethod = "approx"\n')
+    design = load_design(f)
+    result = KINDS["gear_pair"].synthesise(design)
+    motion = result.mechanism.sweep(31)
+    x_a = motion.relative_angle("gear_a", "carrier")
+    x_b = motion.relative_angle("gear_b", "carrier")
+    assert np.allclose(x_b, -(1.5 * x_a + 0.1 * np.sin(x_a)), atol=1e-9)
+    (pair,) = build_gear_pairs(result.mechanism, design.gears, 0.005)
+    assert not pair.closed and pair.method == "approx"
+    assert pair.center_distance_mm == pytest.approx(24.0)
+    checked = mesh_check(pair, x_a)  # at the assembly's actual angles
+    assert checked.steps == 31 and np.all(checked.interference_area_mm2 == 0.0)
+    assert np.all(checked.backlash_mm > 0)
