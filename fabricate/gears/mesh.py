@@ -205,11 +205,15 @@ def mesh_check(pair: Any, x_a_values: np.ndarray | None = None, steps: int | Non
     x_a_values : (n,) array, optional
         Driving angles relative to the carrier (e.g. the assembly's actual angles).
     steps : int, optional
-        Number of evenly spaced steps over the working range (default: the spec's ``mesh_steps``).
+        Number of evenly spaced steps over the working range (default: the spec's ``mesh_steps``); for
+        closed pairs over as many turns of gear a as gear b needs to turn once.
     """
     if x_a_values is None:
         n = int(steps or pair.spec.mesh_steps)
         lo, hi = pair.working_range
+        if pair.closed:
+            # until gear b has turned once too (z_b / z_a turns of a when b has more teeth)
+            hi = lo + 2 * np.pi * max(1.0, pair.teeth[1] / pair.teeth[0])
         x_a_values = np.linspace(lo, hi, n, endpoint=not pair.closed)
     x = np.asarray(x_a_values, dtype=np.float64)
     plus, minus = free_play(pair, x)

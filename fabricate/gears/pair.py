@@ -285,6 +285,9 @@ def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tupl
         centres_b = np.arange(z_b) * p + 0.5 * p
         x_cover = np.linspace(lo, lo + span, 2049)
     else:
+        if spec.teeth is not None:
+            raise SpecError("gears.teeth", "tooth counts apply to closed pairs; a sector's teeth follow from "
+                                           "its working range and module (leave teeth out or set closed = true)")
         module = spec.module_or(DEFAULT_SECTOR_MODULE_MM)
         p = np.pi * module
         margin = (1.25 + spec.spare_teeth + 2.5) * p + 5 * module
