@@ -20,7 +20,6 @@ material, a true normal offset of lines and arcs (arcs change radius by ``delta`
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -147,15 +146,20 @@ def envelope(points: np.ndarray, s: np.ndarray, frames: PitchFrames, gear: str) 
     return frames.point + (points[:, 0] - s)[:, None] * frames.tangent + v[:, None] * frames.normal
 
 
-def osculating_frames(s: np.ndarray, centre_s: np.ndarray, frames_at: Callable[[np.ndarray], PitchFrames]
-                      ) -> PitchFrames:
-    """Frames of the osculating circle of the pitch curve at ``centre_s`` (one per point), at ``s``.
+def osculating_frames(s: np.ndarray, centre_s: np.ndarray, centre: PitchFrames) -> PitchFrames:
+    """Frames at ``s`` of the osculating circles of the pitch curve at ``centre_s`` (one per point).
 
     The involute-approximated method: the tooth around ``centre_s`` is the rack-cut tooth of that
     circle, which is an exact involute tooth of the circle, placed along the curve's normal.
+
+    Parameters
+    ----------
+    s, centre_s : (n,) arrays
+        Rack abscissae of the points and of their tooth centres, mm.
+    centre : PitchFrames
+        The pitch curve's frames at ``centre_s`` (n rows).
     """
-    f0 = frames_at(centre_s)
-    k = f0.curvature
+    k = centre.curvature
     sigma = s - centre_s
     ks = k * sigma
     small = np.abs(ks) < 1e-6
@@ -164,7 +168,7 @@ def osculating_frames(s: np.ndarray, centre_s: np.ndarray, frames_at: Callable[[
     sin_k = np.where(small, sigma - k**2 * sigma**3 / 6, np.sin(ks) / safe_k)
     vers_k = np.where(small, k * sigma**2 / 2, (1 - np.cos(ks)) / safe_k)
     c, sn = np.cos(ks), np.sin(ks)
-    point = f0.point + sin_k[:, None] * f0.tangent - vers_k[:, None] * f0.normal
-    tangent = c[:, None] * f0.tangent - sn[:, None] * f0.normal
-    normal = c[:, None] * f0.normal + sn[:, None] * f0.tangent
+    point = centre.point + sin_k[:, None] * centre.tangent - vers_k[:, None] * centre.normal
+    tangent = c[:, None] * centre.tangent - sn[:, None] * centre.normal
+    normal = c[:, None] * centre.normal + sn[:, None] * centre.tangent
     return PitchFrames(point, tangent, normal, k)

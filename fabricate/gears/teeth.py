@@ -16,7 +16,7 @@ import shapely
 from shapely.geometry import LinearRing, LineString, Polygon
 from shapely.geometry.polygon import orient
 
-from fabricate.gears.pitch import PitchCurves
+from fabricate.gears.pitch import PitchCurves, PitchFrames
 from fabricate.gears.rack import FLANK, RackProfile, contact_abscissa, envelope, offset_profile, osculating_frames
 
 
@@ -165,13 +165,10 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     if method == "exact":
         frames = pitch.frames(s, gear)
     else:
-        centre_frames = pitch.frames(np.asarray(tooth_centres, dtype=np.float64), gear)
-
-        def at_centres(_: np.ndarray) -> object:
-            return type(centre_frames)(np.repeat(centre_frames.point, k, 0), np.repeat(centre_frames.tangent, k, 0),
-                                       np.repeat(centre_frames.normal, k, 0), np.repeat(centre_frames.curvature, k))
-
-        frames = osculating_frames(s, np.repeat(tooth_centres, k), at_centres)
+        cf = pitch.frames(np.asarray(tooth_centres, dtype=np.float64), gear)
+        per_point = PitchFrames(np.repeat(cf.point, k, 0), np.repeat(cf.tangent, k, 0),
+                                np.repeat(cf.normal, k, 0), np.repeat(cf.curvature, k))
+        frames = osculating_frames(s, np.repeat(tooth_centres, k), per_point)
     chain = envelope(pts, s, frames, gear)
     p = rack.pitch
     # tip curve: pitch curve offset outwards by the addendum
