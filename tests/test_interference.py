@@ -195,3 +195,23 @@ def test_clearance_under_minimum_fails_without_collision(four_bar_motion):
     assert not result.collisions
     assert {p.relation for p in result.too_close()} == {"pin"}
     assert any(f.startswith("clearance:") for f in result.failures())
+
+
+def test_tube_on_a_pin_bears_and_keeps_pin_clearance(four_bar_motion):
+    """A tube on pin A filling the skipped layer between crank (layer 1) and coupler (layer 3): it
+    touches the crank's face by design (bearing, clearance 0 allowed), the pin runs in it with the
+    radial clearance (2.5 - 2) / 2 mm, and the build passes."""
+    mech, motion = four_bar_motion
+    parts = four_bar_parts(mech, layers={"ground": 0, "crank": 1, "rocker": 1, "coupler": 3})
+    crank, coupler = parts[1], parts[2]
+    top = crank.z_mm + crank.thickness_mm
+    tube = SimpleNamespace(joint="A", body="coupler", centre=np.zeros(2), inner_diameter_mm=2.5,
+                           outer_diameter_mm=4.7, z_mm=top, length_mm=coupler.z_mm - top, washer=False)
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25, spacers=[tube])
+    assert result.passed, result.failures()
+    rows = {(p.a, p.b): p for p in result.pairs}
+    assert rows[("crank", "tube_A")].relation == "bearing"
+    assert rows[("crank", "tube_A")].min_clearance_mm == 0.0
+    assert not rows[("crank", "tube_A")].collides
+    assert rows[("pin_A", "tube_A")].relation == "pin"
+    assert 0.25 - TOL <= rows[("pin_A", "tube_A")].min_clearance_mm <= 0.25

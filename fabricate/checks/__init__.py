@@ -112,7 +112,8 @@ def run_checks(design: Any, partset: Any, mechanism: Mechanism, motion: Motion,
     parts = tuple(partset.parts)
     pins = tuple(getattr(partset, "pins", ()) or ())
     sweep = sweep_interference(parts, motion, chord_tolerance_mm=process.chord_tolerance_mm,
-                               min_clearance_mm=float(required), pins=pins or None)
+                               min_clearance_mm=float(required), pins=pins or None,
+                               spacers=tuple(getattr(partset, "spacers", ()) or ()))
     meshes = tuple(check_gear_meshes(gear_pairs, motion))
     printable = check_printability(parts, process, gear_pairs, pins)
     failures = sweep.failures()

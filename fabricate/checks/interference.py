@@ -71,7 +71,7 @@ class SweepItem:
 
     name: str
     body: str
-    kind: str                       # "part" or "pin"
+    kind: str                       # "part", "pin" or "spacer" (a tube or washer on a pin)
     rings: tuple[np.ndarray, ...]   # outer CCW then holes CW, mm, body frame
     z0: float
     z1: float
@@ -90,7 +90,8 @@ class PairResult:
         Item names.
     relation : str
         ``"moving"``, ``"joined"`` (share a pin), ``"pin"`` (a pin in another body's hole),
-        ``"bearing"`` (a spacer against a part of its joint: may touch, must not overlap) or
+        ``"bearing"`` (a spacer against a part of its joint, or anything flush with a spacer's end
+        face: may touch, must not overlap) or
         ``"meshing"`` (gear parts in mesh).
     z_gap_mm : float
         Gap between the z ranges (negative: the overlap thickness).
@@ -306,6 +307,26 @@ def pin_items(pins: Sequence[PinSolid], chord_tolerance_mm: float) -> list[Sweep
             for p in pins]
 
 
+def spacer_items(spacers: Sequence[object], parts: Sequence[Part], chord_tolerance_mm: float) -> list[SweepItem]:
+    """Tubes and washers of the parts layer (``joint``, ``body``, ``centre``, ``inner_diameter_mm``,
+    ``outer_diameter_mm``, ``z_mm``, ``length_mm``) as rings; those already modelled as spacer parts
+    (a part of role ``"spacer"`` on that body with a hole for the joint) are not repeated."""
+    modelled = {(p.body, h.joint) for p in parts if p.role == "spacer" for h in p.holes}
+    out = []
+    for k, sp in enumerate(spacers):
+        if (sp.body, sp.joint) in modelled or sp.length_mm <= 0.0:
+            continue
+        centre = np.asarray(sp.centre, dtype=np.float64)
+        rings = (circle_polygon(centre, sp.outer_diameter_mm, chord_tolerance_mm),
+                 circle_polygon(centre, sp.inner_diameter_mm, chord_tolerance_mm, clockwise=True))
+        name = f"{'washer' if getattr(sp, 'washer', False) else 'tube'}_{sp.joint}"
+        if any(it.name == name for it in out):
+            name = f"{name}_{k}"
+        out.append(SweepItem(name, sp.body, "spacer", rings, float(sp.z_mm), float(sp.z_mm + sp.length_mm),
+                             frozenset([sp.joint]), "", sp))
+    return out
+
+
 def _relation(a: SweepItem, b: SweepItem) -> str:
     if a.body == b.body:
         return "rigid"
@@ -315,15 +336,24 @@ def _relation(a: SweepItem, b: SweepItem) -> str:
         if "pin" in (a.kind, b.kind):
             return "pin"
         # a spacer on a pin bears on the parts of that joint: touching is its job
-        roles = {getattr(a.source, "role", ""), getattr(b.source, "role", "")}
-        return "bearing" if "spacer" in roles else "joined"
+        return "bearing" if _is_spacer(a) or _is_spacer(b) else "joined"
+    # a spacer's end faces sit flush on the layer faces around it: whatever else is flush there
+    # slides on the end face (touching), it does not cut into it
+    z_gap = max(a.z0, b.z0) - min(a.z1, b.z1)
+    if (_is_spacer(a) or _is_spacer(b)) and abs(z_gap) < 1e-9:
+        return "bearing"
     return "moving"
+
+
+def _is_spacer(item: SweepItem) -> bool:
+    return item.kind == "spacer" or getattr(item.source, "role", "") == "spacer"
 
 
 # -- the sweep -------------------------------------------------------------------------------------
 def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance_mm: float,
                        min_clearance_mm: float, pins: Sequence[PinSolid] | None = None,
-                       search_length_mm: float | None = None, use_kernel: bool = True) -> InterferenceResult:
+                       spacers: Sequence[object] = (), search_length_mm: float | None = None,
+                       use_kernel: bool = True) -> InterferenceResult:
     """Check every pair of parts and pins for collision and clearance at every pose of ``motion``.
 
     Parameters
@@ -335,8 +365,10 @@ def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
         Polygonisation of the solids (also the slack of the clearance verdict).
     min_clearance_mm : float
         Clearance every moving pair must keep (mm).
-    pins : sequence of PinSolid, optional
+    pins : sequence of PinSolid or parts-layer pins, optional
         Default: :func:`pins_from_holes`.
+    spacers : sequence of parts-layer spacers
+        Tubes and washers on the pins (see :func:`spacer_items`).
     search_length_mm : float, optional
         Planar distances up to this are resolved exactly (default max(2 mm, 4 × the minimum)).
     use_kernel : bool
@@ -348,7 +380,8 @@ def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
     """
     pins = pins_from_holes(parts) if pins is None else pins_from_parts_layer(pins, parts)
     search = float(search_length_mm or max(DEFAULT_SEARCH_MM, 4.0 * min_clearance_mm))
-    items = part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
+    items = (part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
+             + spacer_items(spacers, parts, chord_tolerance_mm))
     outlines: dict[str, Outline] = {}
     solids: dict[str, object] = {}
     poses = {name: motion.pose(name) for name in motion.body_names}
@@ -474,15 +507,19 @@ def _shortcut(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, rel: Relativ
     """
     if a.kind == "pin" or b.kind == "pin":
         pin, part, flip = (a, b, False) if a.kind == "pin" else (b, a, True)
-        if part.kind != "part":
-            return None
-        hole = next((h for h in part.source.holes if h.joint in pin.joints), None)
-        if hole is None:
+        if part.kind == "spacer":
+            hole_centre = np.asarray(part.source.centre, dtype=np.float64)
+        elif part.kind == "part":
+            hole = next((h for h in part.source.holes if h.joint in pin.joints), None)
+            if hole is None:
+                return None
+            hole_centre = np.asarray(hole.centre, dtype=np.float64)
+        else:
             return None
         # pin axis in the part's frame at every pose
         q = rel.inverse() if not flip else rel
         axis = q.apply(np.asarray(pin.source.centre, dtype=np.float64)[None, :])[:, 0]
-        if np.max(np.hypot(*(axis - np.asarray(hole.centre)).T)) > 1e-6:
+        if np.max(np.hypot(*(axis - hole_centre).T)) > 1e-6:
             return None
         value = float(planar_clearance(oa, ob, RelativePoses(rel.q[:1]), search)[0])
         return (0, value) if value > 0.0 else None
@@ -508,7 +545,8 @@ def _posed_pair(a: SweepItem, b: SweepItem, pose_a: np.ndarray, pose_b: np.ndarr
 
 
 def naive_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance_mm: float,
-                       pins: Sequence[PinSolid] | None = None) -> dict[tuple[str, str], np.ndarray]:
+                       pins: Sequence[PinSolid] | None = None,
+                       spacers: Sequence[object] = ()) -> dict[tuple[str, str], np.ndarray]:
     """Reference: the boolean intersection of every non-rigid pair at every pose (manifold3d only).
 
     Returns
@@ -518,7 +556,8 @@ def naive_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
         For benchmarks and tests; far slower than the sweep.
     """
     pins = pins_from_holes(parts) if pins is None else pins_from_parts_layer(pins, parts)
-    items = part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
+    items = (part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
+             + spacer_items(spacers, parts, chord_tolerance_mm))
     cache: dict[str, object] = {}
     poses = {name: motion.pose(name) for name in motion.body_names}
     out = {}
