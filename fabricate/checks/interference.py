@@ -246,6 +246,9 @@ class InterferenceResult:
             "kernel_gap_mm": None if p.kernel_gap_mm is None else round(p.kernel_gap_mm, 6),
             "collides": p.collides,
             "ok": not p.collides and p.min_clearance_mm >= p.required_mm - self.tolerance_mm,
+            # the names report.md's table reads
+            "at_input": float(self.inputs[p.min_index]),
+            "kind": p.relation,
         }
 
 
