@@ -167,3 +167,23 @@ def test_gear_pair_kind_sector_from_a_formula(tmp_path):
     checked = mesh_check(pair, x_a)  # at the assembly's actual angles
     assert checked.steps == 31 and np.all(checked.interference_area_mm2 == 0.0)
     assert np.all(checked.backlash_mm > 0)
+
+
+def test_working_pressure_angle_and_contact_ratio(elliptic_pair):
+    _, pair = elliptic_pair
+    e = ELLIPTIC["eccentricity"]
+    # the pitch tangent of an ellipse about its focus tilts by at most asin(e) from the radius normal
+    mu = np.degrees(np.arcsin(e))
+    for flank in ("drive_flank_deg", "coast_flank_deg"):
+        lo, hi = pair.report()["working_pressure_angle_deg"][flank]
+        assert lo == pytest.approx(20.0 - mu, abs=1e-3) and hi == pytest.approx(20.0 + mu, abs=1e-3)
+    # a circular 30:30 pair: measured teeth in contact against the textbook contact ratio
+    z, m = 30, 1.0
+    spur = make_gear_pair(FormulaLaw("x"), z * m, (0.0, 2 * np.pi), GearSpec(teeth=(z, z), compare_methods=False,
+                                                                              mesh_steps=1440), closed=True)
+    r_tip, r_base = z * m / 2 + m, z * m / 2 * np.cos(np.radians(20))
+    theory = (2 * np.sqrt(r_tip**2 - r_base**2) - z * m * np.sin(np.radians(20))) / (np.pi * m * np.cos(np.radians(20)))
+    report = spur.report()
+    assert report["contact_ratio"]["min"] == pytest.approx(theory, rel=1e-6)
+    assert report["contact_ratio_measured"] == pytest.approx(theory, rel=0.02)
+    assert report["teeth_in_contact"] == [1, 2]

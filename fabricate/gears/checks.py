@@ -77,15 +77,21 @@ def local_contact_ratio(pitch: PitchCurves, x: np.ndarray, module: float, spec: 
 
 
 def pressure_angle_range_deg(pitch: PitchCurves, x: np.ndarray, spec: Any) -> dict[str, list[float]]:
-    """Working pressure angle against the line of centres on each flank (deg, [min, max]).
+    """Working pressure angle of each flank over ``x`` (deg, [min, max]): the angle between its line
+    of action and the perpendicular to the line of centres.
 
     The rack flank makes ``alpha`` with the pitch normal; the pitch tangent of a non-circular gear is
-    tilted by ``mu = atan(dr / (r dtheta))`` from the perpendicular of the line of centres, so the two
-    flanks work at ``alpha + mu`` and ``alpha - mu``.
+    tilted by ``mu = atan(dr / (r dtheta))`` from that perpendicular, so the flanks work at about
+    ``alpha + mu`` and ``alpha - mu``. The driving flank is the one in contact when gear a drives with
+    ``x_a`` increasing (gear b lagging).
     """
-    r, dr, _, _, _ = pitch.radii(x, "a")
-    mu = np.arctan2(dr, r)
     alpha = spec.pressure_angle
-    drive, coast = np.degrees(alpha + mu), np.degrees(alpha - mu)
-    return {"alpha_plus_mu_deg": [float(drive.min()), float(drive.max())],
-            "alpha_minus_mu_deg": [float(coast.min()), float(coast.max())]}
+    frames = pitch.frames_at_x(x, "a")
+    c, s = np.cos(x), np.sin(x)
+    # world y-components (along the perpendicular to the line of centres) of tangent and normal
+    t_y = s * frames.tangent[:, 0] + c * frames.tangent[:, 1]
+    n_y = s * frames.normal[:, 0] + c * frames.normal[:, 1]
+    drive = np.degrees(np.arccos(np.clip(np.abs(-np.cos(alpha) * t_y + np.sin(alpha) * n_y), 0.0, 1.0)))
+    coast = np.degrees(np.arccos(np.clip(np.abs(np.cos(alpha) * t_y + np.sin(alpha) * n_y), 0.0, 1.0)))
+    return {"drive_flank_deg": [float(drive.min()), float(drive.max())],
+            "coast_flank_deg": [float(coast.min()), float(coast.max())]}

@@ -30,6 +30,9 @@ from typing import Any
 import numpy as np
 import shapely
 
+#: Driving flank pairs whose gap is within this of the smallest count as touching together (rad).
+CONTACT_TOLERANCE_RAD = 2e-6
+
 
 @dataclass(frozen=True)
 class MeshResult:
@@ -50,6 +53,9 @@ class MeshResult:
         Driven angle at contact (a driving forward) minus the law, ``= free_plus``.
     interference_area_mm2 : (n,) array
         Overlap area of the two outlines.
+    teeth_in_contact : (n,) int array
+        Driving flank pairs touching at once (conjugate flanks touch together; the mean over a
+        cycle is the measured contact ratio).
     """
 
     x_a: np.ndarray
@@ -59,6 +65,7 @@ class MeshResult:
     transmission_error: np.ndarray
     contact_lag: np.ndarray
     interference_area_mm2: np.ndarray
+    teeth_in_contact: np.ndarray | None = None
 
     @property
     def steps(self) -> int:
@@ -77,6 +84,10 @@ class MeshResult:
             "contact_lag_deg": [float(np.degrees(np.min(self.contact_lag[ok]))),
                                 float(np.degrees(np.max(self.contact_lag[ok])))] if np.any(ok) else [None, None],
             "steps_without_contact_pair": int(np.count_nonzero(~ok)),
+            "teeth_in_contact": [int(self.teeth_in_contact.min()), int(self.teeth_in_contact.max())]
+            if self.teeth_in_contact is not None else None,
+            "contact_ratio_measured": float(np.mean(self.teeth_in_contact))
+            if self.teeth_in_contact is not None else None,
         }
 
 
@@ -110,12 +121,13 @@ def _polar_tables(table: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
     return key.ravel(), phi.ravel(), ranges
 
 
-def free_play(pair: Any, x_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def free_play(pair: Any, x_a: np.ndarray, return_contacts: bool = False) -> tuple[np.ndarray, ...]:
     """Free rotation of gear b (rad) both ways at each ``x_a``; see the module docstring.
 
     Vectorised over steps: gear a's flanks near the pitch point are mapped into gear b's frame and
     compared, at each of their points' radii about axis B, with the angle of gear b's flank of the
-    same rack line (linear interpolation in a radius-sorted table).
+    same rack line (linear interpolation in a radius-sorted table). With ``return_contacts`` also
+    the number of driving flank pairs in contact at each step (their mean is the contact ratio).
     """
     pitch = pair.pitch_model
     p = np.pi * pair.module
@@ -163,8 +175,12 @@ def free_play(pair: Any, x_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     even = (j % 2 == 0)
     plus = np.where(even, per_flank, np.inf).min(axis=1)
     minus = np.where(~even, per_flank, np.inf).min(axis=1)
+    # driving flank pairs touching together (within CONTACT_TOLERANCE_RAD of the closest): the teeth in contact
+    in_contact = np.count_nonzero(even & (per_flank <= plus[:, None] + CONTACT_TOLERANCE_RAD), axis=1)
     plus[~np.isfinite(plus)] = np.nan
     minus[~np.isfinite(minus)] = np.nan
+    if return_contacts:
+        return plus, minus, in_contact
     return plus, minus
 
 
@@ -216,14 +232,15 @@ def mesh_check(pair: Any, x_a_values: np.ndarray | None = None, steps: int | Non
             hi = lo + 2 * np.pi * max(1.0, pair.teeth[1] / pair.teeth[0])
         x_a_values = np.linspace(lo, hi, n, endpoint=not pair.closed)
     x = np.asarray(x_a_values, dtype=np.float64)
-    plus, minus = free_play(pair, x)
+    plus, minus, contacts = free_play(pair, x, return_contacts=True)
     r_b = pair.pitch_model.radii(x, "b")[0]
     lag_plus, lag_minus = designed_lag(pair, x)
     err_plus, err_minus = plus - lag_plus, minus - lag_minus
     te = np.where(np.abs(err_plus) >= np.abs(err_minus), err_plus, err_minus)
     area = interference_areas(pair, x)
     return MeshResult(x_a=x, free_plus=plus, free_minus=minus, backlash_mm=(plus + minus) * r_b,
-                      transmission_error=te, contact_lag=plus, interference_area_mm2=area)
+                      transmission_error=te, contact_lag=plus, interference_area_mm2=area,
+                      teeth_in_contact=contacts)
 
 
 def designed_lag(pair: Any, x_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

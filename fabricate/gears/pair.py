@@ -140,6 +140,8 @@ class GearPair:
             "tip_land_min_mm": c["tip_land_min_mm"],
             "exact_vs_approx_max_deviation_um": c.get("exact_vs_approx_max_deviation_um"),
             "contact_lag_deg": mesh.get("contact_lag_deg"),
+            "teeth_in_contact": mesh.get("teeth_in_contact"),
+            "contact_ratio_measured": mesh.get("contact_ratio_measured"),
             "mesh_steps": mesh.get("steps"),
             "bore_mm": [float(self.bore_a_mm), float(self.bore_b_mm)],
             "outline_vertices": [int(len(self.outline_a)), int(len(self.outline_b))],
