@@ -172,3 +172,33 @@ def test_gear_mesh_check_fails_when_the_assembly_leaves_the_law(seed000):
                                min_clearance_mm=0.25, pins=partset.pins)
     (gears,) = [p for p in sweep.pairs if p.relation == "meshing"]
     assert gears.collides and len(gears.collision_indices) > len(motion.inputs) // 2
+
+
+def test_colliding_build_exits_1_with_files_and_reason(tmp_path, monkeypatch):
+    """``fabricate build`` of the default finger with the middle phalanx forced onto the gear layer
+    (the parts layer patched): exit code 1, every file written, report.json names the pair, the
+    inputs and the volume, and the checks section says why."""
+    import json
+
+    import fabricate.parts.build as parts_build
+    from fabricate.cli import main
+
+    original = parts_build.build_parts
+
+    def forced(*args, **kwargs):
+        partset = original(*args, **kwargs)
+        link = partset.part("link_AB")
+        parts = tuple(dataclasses.replace(p, z_mm=link.z_mm, layer=link.layer) if p.name == "middle" else p
+                      for p in partset.parts)
+        return dataclasses.replace(partset, parts=parts)
+
+    monkeypatch.setattr(parts_build, "build_parts", forced)
+    out = tmp_path / "broken"
+    assert main(["build", "-o", str(out), "--quiet"]) == 1
+    report = json.loads((out / "report.json").read_text())
+    assert report["checks"]["passed"] is False
+    hit = [c for c in report["interference"]["collisions"] if {c["a"], c["b"]} == {"link_AB", "middle"}]
+    assert len(hit) == 1 and hit[0]["volume_mm3"] > 0.0 and "input_deg" in hit[0]
+    assert any("collides with" in f and "middle" in f for f in report["checks"]["failures"])
+    assert all((out / f).is_file() for f in report["files"])
+    assert (out / "plots" / "clearance.png").is_file()
