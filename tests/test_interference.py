@@ -3,7 +3,9 @@ and the naive all-pairs boolean reference."""
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -21,6 +23,7 @@ from tests.conftest import make_four_bar
 from tests.interference_fixtures import four_bar_parts
 
 TOL = 0.005  # chord tolerance of the solids, mm
+EXPECTED = json.loads((Path(__file__).parent / "data" / "interference_four_bar.json").read_text())
 
 
 def box_part(name: str, body: str, size: tuple[float, float], z: float, thickness: float) -> Part:
@@ -128,20 +131,23 @@ def test_four_bar_passes_with_pin_and_layer_clearances(four_bar_motion):
     """The layered four-bar: no collision; joined links keep the layer gap (0.3 mm), pins keep the
     radial hole clearance 0.25 mm within the chord tolerance; every pair is reported."""
     mech, motion = four_bar_motion
+    expected = EXPECTED["layered"]
     result = sweep_interference(four_bar_parts(mech), motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25)
     assert result.passed, result.failures()
     rows = {(p.a, p.b): p for p in result.pairs}
+    gap = expected["joined_layer_gap_mm"]
     assert rows[("crank", "coupler")].relation == "joined"
-    assert rows[("crank", "coupler")].min_clearance_mm == pytest.approx(0.3, abs=1e-9)
-    assert rows[("crank", "coupler")].kernel_gap_mm == pytest.approx(0.3, abs=1e-6)
+    assert rows[("crank", "coupler")].min_clearance_mm == pytest.approx(gap, abs=1e-9)
+    assert rows[("crank", "coupler")].kernel_gap_mm == pytest.approx(gap, abs=1e-6)
     pin_rows = [p for p in result.pairs if p.relation == "pin"]
-    assert len(pin_rows) == 4
+    assert len(pin_rows) == expected["pin_pairs"]
     for p in pin_rows:
-        assert 0.25 - TOL <= p.min_clearance_mm <= 0.25 + 1e-9
+        assert expected["pin_clearance_mm"] - TOL <= p.min_clearance_mm <= expected["pin_clearance_mm"] + 1e-9
         assert p.kernel_gap_mm == pytest.approx(p.min_clearance_mm, abs=1e-6)
     report = result.report()
     assert report["poses"] == 360 and report["collisions"] == []
-    assert report["pairs_checked"] == len(result.pairs) == 23
+    assert report["pairs_checked"] == len(result.pairs) == expected["pairs_checked"]
+    assert report["rigid_pairs_skipped"] == expected["rigid_pairs_skipped"]
     assert report["min_clearance_mm"] == pytest.approx(min(p.min_clearance_mm for p in pin_rows), abs=1e-6)
 
 
@@ -150,13 +156,13 @@ def test_forced_layer_collision_caught_with_pair_and_inputs(four_bar_motion):
     turn. The colliding inputs must be exactly those where shapely finds a positive overlap, the
     volume the largest shapely area × thickness (1e-6 relative), and the failure must say so."""
     mech, motion = four_bar_motion
-    parts = four_bar_parts(mech, layers={"ground": 0, "crank": 1, "rocker": 2, "coupler": 0})
+    expected_case = EXPECTED["coupler_on_ground_layer"]
+    parts = four_bar_parts(mech, layers=expected_case["layers"])
     result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25)
     assert not result.passed
     # the coupler hits the ground link and the pin at O; the pin at A (fixed in the coupler) hits
     # the ground link
-    assert {(p.a, p.b) for p in result.collisions} == {("ground", "coupler"), ("ground", "pin_A"),
-                                                       ("coupler", "pin_O")}
+    assert {(p.a, p.b) for p in result.collisions} == {tuple(p) for p in expected_case["colliding_pairs"]}
     pair = next(p for p in result.collisions if (p.a, p.b) == ("ground", "coupler"))
     ground, coupler = Outline(parts[0].polygons(TOL)), Outline(parts[2].polygons(TOL))
     rel = RelativePoses.between(motion.pose("ground"), motion.pose("coupler"))
