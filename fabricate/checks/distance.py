@@ -52,9 +52,6 @@ class RelativePoses:
         c, s = np.cos(th), np.sin(th)
         return RelativePoses(np.column_stack([-(c * x + s * y), s * x - c * y, -th]))
 
-    def subset(self, index: np.ndarray) -> RelativePoses:
-        return RelativePoses(self.q[index])
-
     def apply(self, points: np.ndarray, index: np.ndarray | None = None) -> np.ndarray:
         """Map points of frame B into frame A.
 
@@ -107,10 +104,6 @@ class Outline:
         rings = shapely.linearrings(coords, indices=(np.arange(n)[:, None] * len(self.rings)
                                                      + ring_id[None, :]).ravel())
         return shapely.polygons(rings, indices=np.repeat(np.arange(n), len(self.rings)))
-
-    def contains(self, points: np.ndarray) -> np.ndarray:
-        """Whether points (m, 2) lie in the material (boundary excluded)."""
-        return shapely.contains_xy(self.polygon, points[:, 0], points[:, 1])
 
 
 def _clean_ring(ring: np.ndarray) -> np.ndarray:

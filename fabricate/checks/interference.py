@@ -437,8 +437,6 @@ def _sweep_pair(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, pose_a: np
         resolved = np.isfinite(d) | (d < 0)
         planar[near] = np.where(resolved, d, search)
         exact[near] = resolved
-    overlap_2d = planar <= 0.0
-    exact = exact | overlap_2d
     if stacked:
         clearance = np.hypot(z_gap, np.maximum(planar, 0.0))
         collide_idx = np.zeros(0, dtype=int)
