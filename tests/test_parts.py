@@ -314,3 +314,36 @@ def test_same_input_same_parts(four_bar, sla_process):
     for p, q in zip(a.parts, b.parts, strict=True):
         np.testing.assert_array_equal(p.outline.vertices, q.outline.vertices)
     assert a.layers == b.layers and a.bom == b.bom
+
+
+def test_no_body_sweeps_over_a_spacer_between_its_layers(four_bar, sla_process):
+    """Independent check over 181 poses: a body in a layer skipped by a pin keeps clear of its spacer.
+
+    (The plain colouring of this four-bar puts the coupler, which sweeps over pin O, between the layers
+    of the ground and the crank; the layer ordering must move it out.)"""
+    motion = four_bar.sweep(181)
+    partset = build_parts(design_for(sla_process), four_bar, motion, [], {})
+    sizes = derive_sizes(sla_process, PartsSpec(), {})
+    for pin in partset.pins:
+        a, b = pin.bodies
+        lo, hi = pin.layers
+        centre = four_bar.body(a).point(pin.joint)
+        spacer = shapely.Point(centre).buffer(sizes.boss_radius_mm, 256)
+        for part in partset.body_parts():
+            if part.body in (a, b) or not lo < part.layer < hi:
+                continue
+            rel = relative_poses(motion.pose(a), motion.pose(part.body))
+            outline = part.outline.polygon(0.01)
+            gaps = [shapely.Polygon(transform_points(p, outline)).distance(spacer) for p in rel]
+            assert min(gaps) >= sla_process.running_clearance_mm, (pin.joint, part.name)
+
+
+def test_order_layers_moves_a_crossing_body_out_of_the_pin_range():
+    from fabricate.parts.layers import order_layers
+
+    layers = {"a": 0, "c": 1, "b": 2}
+    ordered = order_layers(layers, [("a", "b", "c")])
+    lo, hi = sorted((ordered["a"], ordered["b"]))
+    assert not lo < ordered["c"] < hi
+    assert sorted(ordered.values()) == [0, 1, 2]
+    assert order_layers(layers, []) == layers

@@ -32,7 +32,7 @@ import numpy as np
 from fabricate.errors import GeometryError
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
 from fabricate.parts.bom import Pin, Spacer, bill_of_materials, pins_and_spacers
-from fabricate.parts.layers import assign_layers, conflict_graph, layer_z
+from fabricate.parts.layers import assign_layers, conflict_graph, layer_z, order_layers, pin_crossings
 from fabricate.parts.model import BulgePath, Hole, Part, circle_polygon
 from fabricate.parts.profiles import circle_hull, fuse_polygons
 from fabricate.parts.spec import PartsSpec
@@ -292,11 +292,16 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
         outlines[b.name] = path
 
     coarse = {n: p.polygon(CONFLICT_CHORD_MM) for n, p in outlines.items()}
+    holes_at = {(body, h.joint): h.centre for body, hs in holes.items() for h in hs}
     poses = {n: motion.pose(n) for n in mechanism.body_names}
     graph = conflict_graph(coarse, poses, process.running_clearance_mm + CONFLICT_CHORD_MM,
                            always=[(a, b) for _, a, b in pin_joints])
     same = [(p.body_a, p.body_b) for p in gear_pairs]
     layers = assign_layers(graph, list(mechanism.body_names), same)
+    # a pin through skipped layers carries a spacer: keep bodies that sweep over it out of that range
+    crossings = pin_crossings(coarse, poses, [(holes_at[(a, name)], a, b) for name, a, b in pin_joints],
+                              radius, process.running_clearance_mm + CONFLICT_CHORD_MM)
+    layers = order_layers(layers, crossings)
 
     thickness, gap = process.thickness_mm, process.layer_gap_mm
     parts: list[Part] = []

@@ -10,12 +10,13 @@ deterministic).
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 import shapely
 
-from fabricate.planar import pose_matrix
+from fabricate.planar import pose_matrix, wrap_angle
 
 #: At most this many poses of the motion are used for the plan-view conflict test.
 MAX_CONFLICT_POSES = 180
@@ -55,7 +56,9 @@ def min_distance_over_motion(outline_ref: np.ndarray, outline_body: np.ndarray, 
     # a point of the moving outline travels at most this far between consecutive samples
     if len(rel) > 1:
         reach = float(np.max(np.hypot(outline_body[:, 0], outline_body[:, 1])))
-        step = np.hypot(np.diff(rel[:, 0]), np.diff(rel[:, 1])) + np.abs(np.diff(rel[:, 2])) * reach
+        # relative angles come wrapped to (-pi, pi]: the turn between samples is the wrapped difference
+        turn = np.abs(wrap_angle(np.diff(rel[:, 2])))
+        step = np.hypot(np.diff(rel[:, 0]), np.diff(rel[:, 1])) + turn * reach
         margin = 0.5 * float(np.max(step))
     else:
         margin = 0.0
@@ -154,6 +157,65 @@ def assign_layers(graph: Mapping[str, set[str]], order: Sequence[str],
         used = {colour[h] for h in group_graph[g] if h in colour}
         colour[g] = next(c for c in range(len(groups) + 1) if c not in used)
     return {n: colour[find(n)] for n in order}
+
+
+def pin_crossings(outlines: Mapping[str, np.ndarray], world_poses: Mapping[str, np.ndarray],
+                  pins: Sequence[tuple[np.ndarray, str, str]], spacer_radius_mm: float, clearance_mm: float
+                  ) -> list[tuple[str, str, str]]:
+    """Bodies that pass over a pin's spacer and so must not sit between the pin's two layers.
+
+    Parameters
+    ----------
+    outlines, world_poses
+        As for :func:`conflict_graph`.
+    pins : sequence of ((2,) centre in body a, body a, body b)
+        Every pin, its position in the coordinates of ``body a``.
+    spacer_radius_mm : float
+        Radius of the spacer tube that fills the skipped layers.
+    clearance_mm : float
+
+    Returns
+    -------
+    list of (body a, body b, body c)
+        ``c`` comes within the clearance of the spacer at the pin of ``a`` and ``b`` somewhere in the motion.
+    """
+    k = len(next(iter(world_poses.values()))) if world_poses else 0
+    pick = np.unique(np.linspace(0, max(k - 1, 0), min(k, MAX_CONFLICT_POSES)).round().astype(int))
+    angles = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
+    out = []
+    for centre, a, b in pins:
+        # a polygon around the spacer circle (circumscribed, so never smaller than the spacer)
+        disc = centre + spacer_radius_mm / np.cos(np.pi / 48) * np.column_stack([np.cos(angles), np.sin(angles)])
+        for c in outlines:
+            if c in (a, b):
+                continue
+            rel = relative_poses(world_poses[a][pick], world_poses[c][pick])
+            if min_distance_over_motion(disc, outlines[c], rel) < clearance_mm:
+                out.append((a, b, c))
+    return out
+
+
+def order_layers(layers: Mapping[str, int], crossings: Sequence[tuple[str, str, str]],
+                 max_layers: int = 7) -> dict[str, int]:
+    """Renumber the layers (keeping who shares a layer) so no body sits between the layers of a pin it
+    passes over.
+
+    Every permutation of up to ``max_layers`` layers is tried; the first with the fewest violations wins
+    (the identity first, so a colouring that already works is kept).
+    """
+    count = 1 + max(layers.values(), default=0)
+    if not crossings or count > max_layers:
+        return dict(layers)
+
+    def violations(perm: tuple[int, ...]) -> int:
+        bad = 0
+        for a, b, c in crossings:
+            lo, hi = sorted((perm[layers[a]], perm[layers[b]]))
+            bad += lo < perm[layers[c]] < hi
+        return bad
+
+    best = min(itertools.permutations(range(count)), key=violations)
+    return {name: best[layer] for name, layer in layers.items()}
 
 
 def layer_z(layer: int, thickness_mm: float, gap_mm: float) -> float:
