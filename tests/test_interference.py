@@ -221,3 +221,25 @@ def test_tube_on_a_pin_bears_and_keeps_pin_clearance(four_bar_motion):
     assert not rows[("crank", "tube_A")].collides
     assert rows[("pin_A", "tube_A")].relation == "pin"
     assert 0.25 - TOL <= rows[("pin_A", "tube_A")].min_clearance_mm <= 0.25
+
+
+@settings(max_examples=40, deadline=None)
+@given(x=st.floats(-30.0, 60.0), y=st.floats(-20.0, 20.0), theta=st.floats(-math.pi, math.pi),
+       search=st.floats(0.2, 5.0))
+def test_clipped_distance_equals_plain_distance(x, y, theta, search):
+    """Non-convex outlines with holes (two slot links) at a random relative pose: the windowed
+    distance equals shapely's distance on the whole outlines when within the search length (1e-9 mm),
+    is +inf beyond it, 0 when touching and -inf when overlapping."""
+    parts = four_bar_parts(make_four_bar())
+    a, b = Outline(parts[2].polygons(TOL)), Outline(parts[3].polygons(TOL))
+    rel = RelativePoses(np.array([[x, y, theta]]))
+    (d,) = planar_clearance(a, b, rel, search)
+    (poly_b,) = b.posed(rel)
+    reference = shapely.distance(a.polygon, poly_b)
+    assume(abs(reference - search) > 1e-6)
+    if a.polygon.intersects(poly_b):
+        assert d == (0.0 if a.polygon.touches(poly_b) else -math.inf)
+    elif reference < search:
+        assert d == pytest.approx(reference, abs=1e-9)
+    else:
+        assert d == math.inf

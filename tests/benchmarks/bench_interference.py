@@ -42,8 +42,8 @@ def seed000(poses: int):
     link = partset.part("link_AB")
     broken = tuple(dataclasses.replace(p, z_mm=link.z_mm, layer=link.layer) if p.name == "middle" else p
                    for p in partset.parts)
-    return [("seed-000 as built", partset.parts, partset.pins, motion),
-            ("seed-000, middle on the gear layer", broken, partset.pins, motion)]
+    return [("seed-000 as built", partset.parts, partset.pins, partset.spacers, motion),
+            ("seed-000, middle on the gear layer", broken, partset.pins, partset.spacers, motion)]
 
 
 def four_bar(poses: int):
@@ -52,19 +52,20 @@ def four_bar(poses: int):
 
     mech = make_four_bar()
     motion = mech.sweep(poses)
-    return [("four-bar as layered", four_bar_parts(mech), None, motion),
+    return [("four-bar as layered", four_bar_parts(mech), None, (), motion),
             ("four-bar, coupler on the ground layer",
-             four_bar_parts(mech, layers={"ground": 0, "crank": 1, "rocker": 2, "coupler": 0}), None, motion)]
+             four_bar_parts(mech, layers={"ground": 0, "crank": 1, "rocker": 2, "coupler": 0}), None, (), motion)]
 
 
-def run_case(name, parts, pins, motion, repeat: int) -> dict:
+def run_case(name, parts, pins, spacers, motion, repeat: int) -> dict:
     times = []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=CLEARANCE, pins=pins)
+        result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=CLEARANCE, pins=pins,
+                                    spacers=spacers)
         times.append(time.perf_counter() - t0)
     t0 = time.perf_counter()
-    naive = naive_interference(parts, motion, chord_tolerance_mm=TOL, pins=pins)
+    naive = naive_interference(parts, motion, chord_tolerance_mm=TOL, pins=pins, spacers=spacers)
     t_naive = time.perf_counter() - t0
     same = set(naive) == {(p.a, p.b) for p in result.pairs} and all(
         np.array_equal(np.nonzero(naive[(p.a, p.b)] > 1e-6)[0], p.collision_indices) for p in result.pairs)
