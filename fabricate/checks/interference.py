@@ -9,18 +9,23 @@ body; pins are cylinders fixed in one body. For two prisms the 3D problem is exa
   (``g`` itself wherever the outlines overlap in plan view, e.g. two links stacked on one pin).
 
 The sweep is therefore (1) a broad phase per pair over all poses at once: z ranges (layers) and the
-distance of bounding circles; (2) the exact planar clearance of the poses left, computed for all of
-them in one vectorised pass (:mod:`fabricate.checks.distance`); (3) manifold3d on the few poses that
-decide the verdict: ``min_gap`` at each pair's closest pose (searching just beyond the planar value)
-and the boolean intersection volume at each colliding pair's worst pose. The kernel's numbers are
-the ones reported, the planar engine only chooses where to ask.
+distance of bounding circles; (2) pairs that one pose settles (a pin on its hole's axis keeps one
+clearance; parts on other layers whose gap alone is enough are at exactly that gap wherever they
+overlap in plan, so one such pose gives the minimum); (3) the exact planar clearance of the poses
+left (:mod:`fabricate.checks.distance`: vectorised posing and overlap test, GEOS distance on
+clipped windows); (4) manifold3d on the few poses that decide the verdict: ``min_gap`` at each
+pair's closest pose (searching just beyond the planar value) and the boolean intersection volume at
+each colliding pair's worst pose. The kernel's numbers are the ones reported (the smaller of the two
+for a clearance); the planar engine chooses where to ask.
 
 Pairs of one body are rigid (no relative motion) and are not swept. Joined pairs (two parts on one
 pin, a pin in the hole of a part of another body) are swept like any other: their clearances are the
 layer gap and the radial pin clearance, and they must meet the minimum like every moving pair. Gear
 parts meshing with each other (same ``gear`` name, different bodies) run with the backlash, far below
 the process clearance: for them only an overlap fails here, the backlash is judged by the gear mesh
-check.
+check. Spacers (tubes, washers) bear on the parts of their joint and on whatever is flush with their
+end faces: touching is allowed there, an overlap is not. A clearance passes when it is at least the
+minimum less the chord tolerance (polygons inscribed in the exact curves can read that much short).
 """
 
 from __future__ import annotations
