@@ -338,7 +338,7 @@ def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tupl
     deviation = None
     if spec.compare_methods:
         other = "approx" if spec.method == "exact" else "exact"
-        dev = [_deviation_um(main, cut_gear(pitch, g, rack, c, method=other, **common))
+        dev = [_deviation_um(main, cut_gear(pitch, g, rack, c, method=other, decimate=False, **common))
                for g, main, c in (("a", cut_a, centres_a), ("b", cut_b, centres_b))]
         deviation = float(max(dev))
     x_work = np.linspace(lo, hi, 721)

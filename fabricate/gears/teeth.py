@@ -127,7 +127,7 @@ def circle_points(radius: float, chord_tolerance: float, start: float = 0.0) -> 
 
 def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np.ndarray, *,
              method: str, delta: float, addendum_mm: float, closed: bool, rack_origin: float,
-             hub_radius_mm: float, chord_tolerance_mm: float) -> GearTeeth:
+             hub_radius_mm: float, chord_tolerance_mm: float, decimate: bool = True) -> GearTeeth:
     """Cut one gear by the rack.
 
     Parameters
@@ -151,6 +151,8 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
         Radius of the hub disk that closes a sector.
     chord_tolerance_mm : float
         Allowed chord error of the decimated outline.
+    decimate : bool
+        False skips the decimation (``outline`` is then the dense outline), for comparisons.
     """
     profile = rack if gear == "a" else rack.for_gear_b()
     z = len(tooth_centres)
@@ -198,8 +200,8 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     poly = orient(_largest_polygon(teeth), 1.0)
     dense = _clean_ring(np.asarray(poly.exterior.coords))
     dense_poly = Polygon(dense)
-    outline = simplify_ring(dense, 0.9 * chord_tolerance_mm)
-    if not Polygon(outline).is_valid:  # pragma: no cover - tolerance far below tooth features
+    outline = simplify_ring(dense, 0.9 * chord_tolerance_mm) if decimate else dense
+    if decimate and not Polygon(outline).is_valid:  # pragma: no cover - tolerance far below tooth features
         simple = shapely.simplify(dense_poly, 0.5 * chord_tolerance_mm, preserve_topology=True)
         outline = _clean_ring(np.asarray(orient(_largest_polygon(simple), 1.0).exterior.coords))
     # tip lands: pieces of the outline lying on the tip curve (a pointed tooth has none)
