@@ -191,9 +191,15 @@ def test_approx_method_is_the_same_involute_for_a_constant_ratio():
 
 
 def test_small_gear_is_flagged_as_undercut():
-    spec = GearSpec(teeth=(12, 12), compare_methods=False, min_teeth=8)
+    spec = GearSpec(teeth=(12, 12), compare_methods=False, min_teeth=8, backlash_mm=0.05)
     pair = make_gear_pair(FormulaLaw("x"), 12.0, (0.0, TWO_PI), spec, closed=True, run_mesh_check=False)
     assert pair.report()["undercut"]
     # radius of curvature 6 mm < h_l / sin^2(alpha) = 1.0 m / sin^2(20 deg) = 8.55 mm
     assert pair.checks["undercut_limit_radius_mm"] == pytest.approx(1.0 / np.sin(np.radians(20)) ** 2, rel=1e-3)
     assert any(text.startswith("undercut") for text in pair.failures())
+    # the trochoid removed part of the flanks: the mesh check sees only what is left, consistently
+    from fabricate.gears import mesh_check
+
+    mesh = mesh_check(pair, steps=720)
+    assert np.all(mesh.interference_area_mm2 == 0.0) and np.nanmin(mesh.backlash_mm) > 0.04
+    assert np.mean(mesh.teeth_in_contact) < pair.checks["contact_ratio"]["min"]  # undercut shortens contact

@@ -212,6 +212,11 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     # involute flanks for the mesh check
     is_flank = element == FLANK
     inside = shapely.contains_xy(tip_poly, chain[:, 0], chain[:, 1])
+    if self_intersecting:
+        # undercut: the fillet trochoid cut away part of the flanks; keep only flank points that are
+        # still on the outline (inside a thin band around it)
+        band = dense_poly.buffer(1e-6, quad_segs=2).difference(dense_poly.buffer(-1e-6, quad_segs=2))
+        inside &= shapely.contains_xy(band, chain[:, 0], chain[:, 1])
     keys = flank_index(flank_u, p, rack_origin)
     flanks: dict[int, np.ndarray] = {}
     count = 2 * z if closed else None
