@@ -347,3 +347,21 @@ def test_order_layers_moves_a_crossing_body_out_of_the_pin_range():
     assert not lo < ordered["c"] < hi
     assert sorted(ordered.values()) == [0, 1, 2]
     assert order_layers(layers, []) == layers
+
+
+def test_mounting_screws_clear_everything_that_moves(four_bar, sla_process):
+    """Independent check at every pose: each mounting boss (screw head) keeps the clearance from every
+    moving part."""
+    motion = four_bar.sweep(181)
+    partset = build_parts(design_for(sla_process), four_bar, motion, [], {})
+    sizes = derive_sizes(sla_process, PartsSpec(), {})
+    mounts = [h for h in partset.part("ground").holes if h.joint.startswith("mount_")]
+    assert len(mounts) == 2
+    for hole in mounts:
+        head = shapely.Point(hole.centre).buffer(sizes.mount_boss_radius_mm, 256)
+        for part in partset.body_parts():
+            if part.body == "ground":
+                continue
+            outline = part.outline.polygon(0.01)
+            gaps = [shapely.Polygon(transform_points(p, outline)).distance(head) for p in motion.pose(part.body)]
+            assert min(gaps) >= sla_process.running_clearance_mm, (hole.joint, part.name, min(gaps))

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import shapely
 
 from fabricate.errors import GeometryError
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
@@ -280,16 +281,19 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
             gear_of[body].append(pair.name)
 
     ground = mechanism.ground
-    _add_mounting(mechanism, motion, ground, circles, holes, gear_polys, sizes, parts_spec)
 
-    outlines: dict[str, BulgePath] = {}
-    for b in mechanism.bodies:
-        centres = np.array([c for c, _ in circles[b.name]]) if circles[b.name] else np.zeros((1, 2))
-        radii = np.array([r for _, r in circles[b.name]]) if circles[b.name] else np.array([radius])
+    def profile(body: str) -> BulgePath:
+        centres = np.array([c for c, _ in circles[body]]) if circles[body] else np.zeros((1, 2))
+        radii = np.array([r for _, r in circles[body]]) if circles[body] else np.array([radius])
         path = circle_hull(centres, radii)
-        if gear_polys[b.name]:
-            path = fuse_polygons(path, gear_polys[b.name], tol)
-        outlines[b.name] = path
+        return fuse_polygons(path, gear_polys[body], tol) if gear_polys[body] else path
+
+    # moving bodies first: the ground's mounting holes keep clear of where they sweep
+    outlines: dict[str, BulgePath] = {b.name: profile(b.name) for b in mechanism.bodies if b.name != ground}
+    _add_mounting(mechanism, motion, ground, circles, holes, gear_polys, sizes, parts_spec,
+                  swept_region(outlines, motion), process.running_clearance_mm)
+    outlines[ground] = profile(ground)
+    outlines = {b.name: outlines[b.name] for b in mechanism.bodies}
 
     coarse = {n: p.polygon(CONFLICT_CHORD_MM) for n, p in outlines.items()}
     holes_at = {(body, h.joint): h.centre for body, hs in holes.items() for h in hs}
@@ -339,17 +343,30 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
                    kerf_mm=process.kerf_mm, copies=copies, hints=hints)
 
 
+def swept_region(outlines: Mapping[str, BulgePath], motion: Motion, poses: int = 90) -> Any:
+    """Plan-view region (shapely geometry, ground coordinates) swept by the given bodies over the motion."""
+    pick = np.unique(np.linspace(0, len(motion.inputs) - 1, min(poses, len(motion.inputs))).round().astype(int))
+    shapes = []
+    for body, path in outlines.items():
+        outline = path.polygon(CONFLICT_CHORD_MM)
+        for pose in motion.pose(body)[pick]:
+            shapes.append(shapely.Polygon(outline @ rotation(pose[2]).T + pose[:2]))
+    return shapely.union_all(shapes) if shapes else shapely.Polygon()
+
+
 def _add_mounting(mechanism: Mechanism, motion: Motion, ground: str,
                   circles: dict[str, list[tuple[np.ndarray, float]]], holes: dict[str, list[Hole]],
-                  gear_polys: dict[str, list[np.ndarray]], sizes: Sizes, parts_spec: PartsSpec) -> None:
-    """Mounting holes on the ground part, in a row on the side away from the moving bodies."""
+                  gear_polys: dict[str, list[np.ndarray]], sizes: Sizes, parts_spec: PartsSpec,
+                  swept: Any, clearance_mm: float) -> None:
+    """Mounting holes on the ground part: a row on the side away from the moving bodies, pushed out until
+    the screw heads (the mounting bosses) keep the clearance from everything that moves."""
     count = parts_spec.mounting_holes
     if count == 0:
         return
     own = np.array([c for c, _ in circles[ground]]) if circles[ground] else np.zeros((1, 2))
     moving = [motion.point(p, b.name) for b in mechanism.bodies if b.name != ground for p in b.points]
-    swept = np.concatenate(moving).mean(axis=0) if moving else own.mean(axis=0) + np.array([0.0, 1.0])
-    away = own.mean(axis=0) - swept
+    swept_centre = np.concatenate(moving).mean(axis=0) if moving else own.mean(axis=0) + np.array([0.0, 1.0])
+    away = own.mean(axis=0) - swept_centre
     norm = float(np.hypot(*away))
     direction = away / norm if norm > 1e-6 else np.array([0.0, -1.0])
     side = np.array([-direction[1], direction[0]])
@@ -357,9 +374,20 @@ def _add_mounting(mechanism: Mechanism, motion: Motion, ground: str,
     for poly in gear_polys[ground]:
         reach = max(reach, float(np.max(poly @ direction)))
     r_mount = sizes.mount_boss_radius_mm
-    base = own.mean(axis=0) @ side * side + (reach + r_mount + 1.0) * direction
     pitch = 2.0 * r_mount + 2.0
-    for k in range(count):
-        centre = base + (k - 0.5 * (count - 1)) * pitch * side
+    offsets = (np.arange(count) - 0.5 * (count - 1)) * pitch
+    base = (own.mean(axis=0) @ side) * side + (reach + r_mount + 1.0) * direction
+    # candidate rows every 0.5 mm outwards; the first whose bosses all clear the swept region wins
+    steps = np.arange(0.0, 400.0, 0.5)
+    centres = (base[None, None, :] + steps[:, None, None] * direction
+               + offsets[None, :, None] * side[None, None, :])
+    if swept.is_empty:
+        chosen = centres[0]
+    else:
+        gaps = shapely.distance(shapely.points(centres.reshape(-1, 2)), swept).reshape(len(steps), count)
+        # +0.5 mm: the region is sampled at discrete poses; parts move a little between them
+        ok = np.all(gaps >= r_mount + clearance_mm + 0.5, axis=1)
+        chosen = centres[int(np.argmax(ok))] if ok.any() else centres[-1]
+    for k, centre in enumerate(chosen):
         holes[ground].append(Hole(f"mount_{k + 1}", centre, sizes.mount_hole_mm, 0.0))
         circles[ground].append((centre, r_mount))
