@@ -1,0 +1,318 @@
+"""Underactuated finger of stacked four-bars driven by one push rod (seed 001), kind ``underactuated``.
+
+The chapter derives the mobility (n for n phalanges), positions, the velocity recursion
+theta_dot_{n+1} = E_n theta_dot_n and the statics, but gives no dimensions. This module
+
+- reads a template (``[finger]``, ``[transmission]``, ``[push_rod]``, ``[springs]``, ``[object]``),
+- computes the free closing motion with return springs (quasi-static: least spring energy at each
+  stroke, joints on their open stops until the springs let them go) and the closing on a cylinder
+  (the same, with the phalanges kept outside it), which yields the contact sequence,
+- computes the contact forces at the end for the template's push force (the force chain of
+  :func:`fabricate.synthesis.underactuated_model.contact_forces`), the velocity ratios E_i and the
+  mobility, and
+- returns a 1-input :class:`~fabricate.mechanism.Mechanism`: the push rod is a slider with a "slide"
+  driver over the stroke; the n-1 phalanx angles the actuator does not fix are "angle" drivers whose
+  laws (monotone cubic interpolants of stroke -> relative angle) come from the closing solution.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import PchipInterpolator
+from scipy.optimize import minimize
+
+from fabricate.errors import SpecError, SynthesisError
+from fabricate.mechanism import Body, Driver, Mechanism, Revolute, Slider
+from fabricate.spec import Table
+from fabricate.synthesis.base import SynthesisResult
+from fabricate.synthesis.underactuated_model import (
+    FingerDesign,
+    FingerPose,
+    contact_forces,
+    crank_rate,
+    distal_rate,
+    finger_pose,
+    palmar_normal,
+    stroke_gradient,
+    transmission_ratios,
+)
+
+
+@dataclass(frozen=True)
+class UnderactuatedSpec:
+    """Validated template tables of the underactuated finger (mm, rad inside; N·mm/rad springs)."""
+
+    design: FingerDesign
+    spring_rates: np.ndarray        # N·mm/rad
+    spring_preloads: np.ndarray     # rad
+    spring_legs: float              # mm
+    stroke: float                   # mm
+    push_force: float               # N
+    cylinder_centre: np.ndarray     # (2,) mm
+    cylinder_radius: float          # mm
+    samples: int
+    source: str
+
+
+def parse_spec(root: Table) -> UnderactuatedSpec:
+    """Read ``[finger]``, ``[transmission]``, ``[push_rod]``, ``[springs]`` and ``[object]``."""
+    finger = root.table("finger")
+    lengths = finger.array("phalanx_lengths_mm", shape=(None,), min_rows=2, positive=True)
+    thickness = finger.number("thickness_mm", positive=True)
+    source = finger.string("source", "")
+    finger.finish()
+    n = len(lengths)
+    tr = root.table("transmission")
+    out_arm = tr.array("output_arm_mm", shape=(n - 1,), positive=True)
+    out_angle = np.radians(tr.array("output_arm_deg", shape=(n - 1,), min=-180.0, max=180.0))
+    in_arm = tr.array("input_arm_mm", shape=(n - 1,), positive=True)
+    in_angle = np.radians(tr.array("input_arm_deg", shape=(n - 1,), min=-180.0, max=180.0))
+    tr.finish()
+    rod = root.table("push_rod")
+    crank = rod.number("crank_mm", positive=True)
+    crank_angle = np.radians(rod.number("crank_deg", min=-180.0, max=180.0))
+    link = rod.number("link_mm", positive=True)
+    rod_y = rod.number("axis_y_mm")
+    stroke = rod.number("stroke_mm", positive=True)
+    push_force = rod.number("push_force_N", positive=True)
+    samples = rod.integer("samples", 121, min=11, max=2001)
+    rod.finish()
+    springs = root.table("springs")
+    rates = springs.array("rate_Nmm_per_deg", shape=(n,), min=0.0) * 180.0 / np.pi
+    preloads = np.radians(springs.array("preload_deg", shape=(n,), min=0.0, max=360.0))
+    legs = springs.number("legs_mm", 15.0, positive=True)
+    springs.finish()
+    obj = root.table("object")
+    centre = obj.array("cylinder_centre_mm", shape=(2,))
+    radius = 0.5 * obj.number("cylinder_diameter_mm", positive=True)
+    obj.finish()
+    design = FingerDesign(lengths=lengths, thickness=thickness, out_arm=out_arm, out_angle=out_angle,
+                          in_arm=in_arm, in_angle=in_angle, crank=crank, crank_angle=crank_angle, link=link,
+                          rod_y=rod_y)
+    try:
+        design.rod_open_x()
+    except ValueError as exc:
+        raise SpecError("push_rod.link_mm", str(exc)) from exc
+    if centre[1] - radius < 0.5 * thickness:
+        raise SpecError("object.cylinder_centre_mm", "the cylinder overlaps the open finger")
+    return UnderactuatedSpec(design, rates, preloads, legs, stroke, push_force, centre, radius, samples, source)
+
+
+# -- closing motion ------------------------------------------------------------------------------
+
+def face_clearance(design: FingerDesign, pose: FingerPose, centre: np.ndarray, radius: float):
+    """Distance from the cylinder surface to each phalanx's palmar face (n,), mm, and the nearest
+    face points (n, 2)."""
+    gaps = np.zeros(design.n)
+    points = np.zeros((design.n, 2))
+    for i in range(design.n):
+        off = 0.5 * design.thickness * palmar_normal(pose.theta[i])
+        a, b = pose.G[i] + off, pose.G[i + 1] + off
+        t = np.clip(np.dot(centre - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
+        points[i] = a + t * (b - a)
+        gaps[i] = np.hypot(*(centre - points[i])) - radius
+    return gaps, points
+
+
+@dataclass(frozen=True)
+class ClosingMotion:
+    """Quasi-static closing: per stroke sample the relative angles (rad) and which phalanges touch."""
+
+    strokes: np.ndarray          # (m,) mm
+    q: np.ndarray                # (m, n) rad
+    touching: np.ndarray         # (m, n) bool
+    contact_order: list          # phalanx indices in the order they first touch
+    contact_strokes: list        # stroke (mm) at each first touch
+    with_object: bool
+
+
+def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: int | None = None,
+                   stroke: float | None = None) -> ClosingMotion:
+    """Least spring energy at each stroke, joints >= 0 (open stops), phalanges outside the cylinder.
+
+    With the object the motion ends at the template's stroke or where every phalanx touches (the
+    finger is then locked: n contacts take its n degrees of freedom).
+
+    Quasi-static, the equilibrium of springs, stops, rod and object at a stroke is a constrained
+    minimum of the spring energy on the set of configurations with that stroke; following it from the
+    open pose with warm starts keeps the physical branch. As in the chapter (section 2.2, "assumed not
+    to turn"), a phalanx that meets the object sticks there: its joint and the proximal ones freeze.
+    """
+    d = spec.design
+    m = samples or spec.samples
+    strokes = np.linspace(0.0, spec.stroke if stroke is None else stroke, m)
+    k, q0 = spec.spring_rates, spec.spring_preloads
+    q = np.zeros(d.n)
+    frozen = 0
+    qs = np.zeros((m, d.n))
+    touching = np.zeros((m, d.n), dtype=bool)
+    scale = float(np.max(k * (q0 + 1.0)) + 1.0)
+
+    def energy(x):
+        return 0.5 * float(np.sum(k * (x + q0) ** 2)) / scale
+
+    def energy_grad(x):
+        return k * (x + q0) / scale
+
+    for idx, s in enumerate(strokes):
+        if idx == 0:
+            continue
+        cons = [{"type": "eq", "fun": lambda x, s=s: finger_pose(d, x).stroke - s,
+                 "jac": lambda x: stroke_gradient(d, x)}]
+        if with_object:
+            cons.append({"type": "ineq", "fun": lambda x: face_clearance(
+                d, finger_pose(d, x), spec.cylinder_centre, spec.cylinder_radius)[0]})
+        bounds = [(q[i], q[i]) if i < frozen else (0.0, np.pi * 0.6) for i in range(d.n)]
+        res = minimize(energy, q, jac=energy_grad, method="SLSQP", constraints=cons,
+                       bounds=bounds, options={"ftol": 1e-13, "maxiter": 200})
+        pose = finger_pose(d, res.x)
+        if pose is None or abs(pose.stroke - s) > 1e-5:
+            raise SynthesisError(f"underactuated: closing motion lost at stroke {s:.3f} mm ({res.message})")
+        q = res.x
+        qs[idx] = q
+        if with_object:
+            touching[idx] = face_clearance(d, pose, spec.cylinder_centre, spec.cylinder_radius)[0] < 1e-4
+            touching[idx, :frozen] = True
+            hit = np.nonzero(touching[idx])[0]
+            if hit.size:
+                # the chapter's assumption: a phalanx stopped by the object no longer turns (it sticks),
+                # so it and every joint proximal to it hold their angles from here on
+                frozen = max(frozen, int(hit.max()) + 1)
+            if touching[idx].all():
+                # every phalanx on the object: the finger is locked, the stroke cannot go on
+                strokes, qs, touching = strokes[: idx + 1], qs[: idx + 1], touching[: idx + 1]
+                break
+    order, at = [], []
+    for i in range(d.n):
+        hits = np.nonzero(touching[:, i])[0]
+        if hits.size:
+            order.append(i)
+            at.append(float(strokes[hits[0]]))
+    ranked = sorted(zip(at, order))
+    return ClosingMotion(strokes, qs, touching, [i for _, i in ranked], [s for s, _ in ranked], with_object)
+
+
+def final_contact_forces(spec: UnderactuatedSpec, motion: ClosingMotion) -> dict:
+    """Contact forces (N) at the end of the closing for the template's push force."""
+    d = spec.design
+    pose = finger_pose(d, motion.q[-1])
+    _, points = face_clearance(d, pose, spec.cylinder_centre, spec.cylinder_radius)
+    torque = spec.spring_rates * (motion.q[-1] + spec.spring_preloads)
+    forces, links = contact_forces(d, pose, spec.push_force, torque, points)
+    return {"forces_N": forces, "link_forces_N": links, "points": points, "pose": pose}
+
+
+# -- mechanism -----------------------------------------------------------------------------------
+
+def build_mechanism(spec: UnderactuatedSpec, motion: ClosingMotion, name: str) -> Mechanism:
+    """Bodies palm, rod, push_link, rocker_i, coupler_i, phalanx_i with a slide driver and n-1 angle
+    drivers (stroke -> relative phalanx angle from the closing motion)."""
+    d = spec.design
+    n = d.n
+    open_pose = finger_pose(d, np.zeros(n))
+    g = open_pose.G
+    bodies = []
+    palm = {"G1": (0.0, 0.0), "G1r": (0.0, 0.0), "rod": (float(open_pose.S[0]) - 10.0, d.rod_y)}
+    bodies.append(Body("palm", palm))
+    bodies.append(Body("rod", {"rod": (-10.0, 0.0), "S": (0.0, 0.0)}))
+    kvec = open_pose.K - open_pose.S
+    bodies.append(Body("push_link", {"S": (0.0, 0.0), "K": (float(np.hypot(*kvec)), 0.0)}))
+    assembly = {"rod": (float(open_pose.S[0]), d.rod_y, 0.0),
+                "push_link": (float(open_pose.S[0]), d.rod_y, float(np.arctan2(kvec[1], kvec[0])))}
+    joints: list = [Slider("rod", "palm", "rod", (1.0, 0.0)), Revolute("S", "rod", "push_link"),
+                    Revolute("K", "push_link", "rocker1")]
+    for i in range(n):
+        pts = {f"G{i + 1}": (0.0, 0.0)}
+        if i + 1 < n:
+            pts[f"G{i + 2}"] = (float(d.lengths[i]), 0.0)
+            pts[f"G{i + 2}r"] = (float(d.lengths[i]), 0.0)
+        else:
+            pts["tip"] = (float(d.lengths[i]), 0.0)
+            pts[f"P{n}"] = tuple((open_pose.P[n - 2] - g[n - 1]).tolist())
+        bodies.append(Body(f"phalanx{i + 1}", pts))
+        assembly[f"phalanx{i + 1}"] = (float(g[i][0]), 0.0, 0.0)
+        parent = "palm" if i == 0 else f"phalanx{i}"
+        joints.append(Revolute(f"G{i + 1}", parent, f"phalanx{i + 1}"))
+    for i in range(n - 1):
+        pts = {f"G{i + 1}r": (0.0, 0.0), f"Q{i + 1}": tuple((open_pose.Q[i] - g[i]).tolist())}
+        if i == 0:
+            pts["K"] = tuple((open_pose.K - g[0]).tolist())
+        else:
+            pts[f"P{i + 1}"] = tuple((open_pose.P[i - 1] - g[i]).tolist())
+        bodies.append(Body(f"rocker{i + 1}", pts))
+        assembly[f"rocker{i + 1}"] = (float(g[i][0]), 0.0, 0.0)
+        parent = "palm" if i == 0 else f"phalanx{i}"
+        joints.append(Revolute(f"G{i + 1}r", parent, f"rocker{i + 1}"))
+        cvec = open_pose.P[i] - open_pose.Q[i]
+        bodies.append(Body(f"coupler{i + 1}", {f"Q{i + 1}": (0.0, 0.0),
+                                               f"P{i + 2}": (float(np.hypot(*cvec)), 0.0)}))
+        assembly[f"coupler{i + 1}"] = (float(open_pose.Q[i][0]), float(open_pose.Q[i][1]),
+                                       float(np.arctan2(cvec[1], cvec[0])))
+        joints.append(Revolute(f"Q{i + 1}", f"rocker{i + 1}", f"coupler{i + 1}"))
+        target = f"rocker{i + 2}" if i + 2 < n else f"phalanx{n}"
+        joints.append(Revolute(f"P{i + 2}", f"coupler{i + 1}", target))
+    drivers = [Driver("slide", "rod", "palm", joint="rod")]
+    for i in range(n - 1):
+        law = PchipInterpolator(motion.strokes, motion.q[:, i])
+        parent = "palm" if i == 0 else f"phalanx{i}"
+        drivers.append(Driver("angle", f"phalanx{i + 1}", parent, law=law))
+    return Mechanism(name=name, bodies=tuple(bodies), ground="palm", joints=tuple(joints), gears=(),
+                     drivers=tuple(drivers), input_range=(0.0, float(motion.strokes[-1])), input_unit="mm",
+                     assembly=assembly)
+
+
+def mobility(n: int) -> dict:
+    """The chapter's count (eq 2.1): m = 3(n-1)+3 moving links, P_L = 4(n-1)+4 lower pairs."""
+    m = 3 * (n - 1) + 3
+    pl = 4 * (n - 1) + 4
+    return {"moving_links": m, "lower_pairs": pl, "dof": 3 * m - 2 * pl, "underactuation": 3 * m - 2 * pl - 1}
+
+
+def synthesise(design) -> SynthesisResult:
+    """Closing motion, contact sequence, final forces, velocity ratios and the mechanism."""
+    spec: UnderactuatedSpec = design.method
+    d = spec.design
+    motion = closing_motion(spec, with_object=True)
+    free = closing_motion(spec, with_object=False, stroke=float(motion.strokes[-1]))
+    final = final_contact_forces(spec, motion)
+    mech = build_mechanism(spec, motion, design.name)
+    pose_end = final["pose"]
+    open_pose = finger_pose(d, np.zeros(d.n))
+    report = {
+        "mobility": {**mobility(d.n), "mechanism_dof": mech.degrees_of_freedom()},
+        "phalanx_lengths_mm": d.lengths.tolist(),
+        "dimensions_source": spec.source,
+        "stroke_mm": spec.stroke,
+        "push_force_N": spec.push_force,
+        "contact_sequence": [f"phalanx{i + 1}" for i in motion.contact_order],
+        "contact_strokes_mm": motion.contact_strokes,
+        "contact_forces_N": {f"phalanx{i + 1}": float(f) for i, f in enumerate(final["forces_N"])},
+        "link_forces_N": [float(v) for v in final["link_forces_N"]],
+        "final_joint_angles_deg": np.degrees(motion.q[-1]).tolist(),
+        "free_closing_joint_angles_deg": np.degrees(free.q[-1]).tolist(),
+        "velocity_ratios": {
+            "E_open": transmission_ratios(open_pose).tolist(),
+            "E_final": transmission_ratios(pose_end).tolist(),
+            "crank_rate_rad_per_mm_open": crank_rate(d, open_pose),
+            "distal_rate_rad_per_mm_final": distal_rate(d, pose_end),
+        },
+    }
+    springs = [{"joint": f"G{i + 1}", "rate_Nmm_per_deg": float(spec.spring_rates[i] * np.pi / 180.0),
+                "preload_deg": float(np.degrees(spec.spring_preloads[i])), "legs_mm": spec.spring_legs,
+                "note": "return spring, opens the joint against its stop"} for i in range(d.n)]
+    parts = {
+        "springs": springs,
+        "purchased": [{"item": f"linear actuator, stroke >= {spec.stroke:.0f} mm, force >= "
+                               f"{spec.push_force:.0f} N", "qty": 1, "note": "drives the push rod"}],
+        "tip_point": "tip",
+        "pads": {f"phalanx{d.n}": {"point": "tip", "radius_mm": 0.5 * d.thickness}},
+    }
+
+    def figures() -> dict[str, bytes]:
+        from fabricate.synthesis.underactuated_plots import closing_figures
+        return closing_figures(spec, motion, free, final)
+
+    data = {"motion": motion, "free": free, "final": final, "spec": spec}
+    return SynthesisResult(mechanism=mech, report=report, figures=figures, data=data, parts=parts)
