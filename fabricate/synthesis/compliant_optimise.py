@@ -231,9 +231,6 @@ def _enumerate_box(tab: _PathTable, grid: ParameterGrid, load: Load, hinge_margi
     e1 = tab.h1[i] * (preload - sigma[r, i])
     w = np.clip(-e0 / np.where(e1 != e0, e1 - e0, 1.0), 0.0, 1.0)
 
-    def at(arr: np.ndarray) -> np.ndarray:
-        return arr[i - 1] + w * (arr[i] - arr[i - 1])
-
     dn = tab.g[i - 1] + w * (tab.g[i] - tab.g[i - 1])
     # only points that would improve on the best so far need the remaining checks
     cand = np.nonzero(ok & (dn >= 0) & (dn < best))

@@ -190,7 +190,7 @@ def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: i
         if hits.size:
             order.append(i)
             at.append(float(strokes[hits[0]]))
-    ranked = sorted(zip(at, order))
+    ranked = sorted(zip(at, order, strict=True))
     return ClosingMotion(strokes, qs, touching, [i for _, i in ranked], [s for s, _ in ranked], with_object)
 
 
