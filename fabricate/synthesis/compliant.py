@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
-from scipy.optimize import brentq, minimize
+from scipy.optimize import brentq, fsolve
 
 from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, LinearLaw, Mechanism, Revolute, Slider
@@ -125,38 +125,67 @@ class GripperMotion:
     on_can: np.ndarray
 
 
-def _stroke(geom: GripperGeometry, x: np.ndarray) -> float:
-    return float(finger_state(geom, x[0], x[1]).stroke)
+def _no_load_residual(geom: GripperGeometry, springs: Springs, x: np.ndarray, s: float) -> np.ndarray:
+    st = finger_state(geom, x[0], x[1])
+    s1, s2 = spring_torques(springs, x[0], x[1])
+    # eqs 1-2 with Fd eliminated: s1 h2 - s2 h1 = 0; scaled so both rows are about mm
+    return np.array([float(st.stroke) - s, float(s1 * st.h2 - s2 * st.h1) / 1e3])
 
 
 def no_load_closing(geom: GripperGeometry, springs: Springs, strokes: np.ndarray) -> np.ndarray:
-    """Eqs 1-2 as least spring energy on the set of poses with each stroke; hinges >= 0 (stops).
+    """Eqs 1-2 over increasing strokes with the hinge stops (phi >= 0) as an active set.
 
-    The rod force is the Lagrange multiplier of the stroke constraint, so a minimum satisfies eqs 1-2
-    where a hinge is free and leaves the hinge on its stop while the rod cannot overcome its preload.
-    Returns (m, 2) angles (phi1, phi2).
+    A hinge stays on its stop while the rod's moment about it is below the spring preload (the stop
+    still pushes back); then both hinges are free and eqs 1-2 hold (Fd eliminated). On a stop the
+    other hinge follows the stroke alone (a 1-D root). Returns (m, 2) angles (phi1, phi2), rad.
     """
-    k1 = springs.k1 * 180.0 / np.pi + 1e-9      # a vanishing rate keeps the tip's minimum unique
-    k2 = springs.k2 * 180.0 / np.pi + 1e-9
-    scale = max(k1, k2) * (1.0 + springs.phi01 + springs.phi02)
-
-    def energy(x):
-        return 0.5 * (k1 * (x[0] + springs.phi01) ** 2 + k2 * (x[1] + springs.phi02) ** 2) / scale
-
-    def grad(x):
-        return np.array([k1 * (x[0] + springs.phi01), k2 * (x[1] + springs.phi02)]) / scale
-
-    x = np.zeros(2)
     out = np.zeros((len(strokes), 2))
+    x = np.zeros(2)
+    mode = None
     for i, s in enumerate(strokes):
         if s <= 0.0:
             continue
-        res = minimize(energy, x + 1e-4, jac=grad, method="SLSQP",
-                       constraints=[{"type": "eq", "fun": lambda v, s=s: _stroke(geom, v) - s}],
-                       bounds=[(0.0, np.pi), (0.0, np.pi)], options={"ftol": 1e-14, "maxiter": 300})
-        if not np.isfinite(res.x).all() or abs(_stroke(geom, res.x) - s) > 1e-6:
+        for _ in range(3):
+            if mode is None or mode in ("B", "C"):
+                candidates = [mode] if mode else ["B", "C"]
+                solved = None
+                for m in candidates:
+                    j = 0 if m == "B" else 1           # the hinge that moves
+                    def one(v, j=j, s=s):
+                        y = np.zeros(2)
+                        y[j] = v
+                        return float(finger_state(geom, y[0], y[1]).stroke) - s
+                    grid = np.linspace(x[j], np.pi, 721)
+                    vals = finger_state(geom, *(np.where(np.arange(2)[:, None] == j, grid, 0.0))).stroke - s
+                    sign = np.nonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))[0]
+                    if sign.size == 0:
+                        continue
+                    v = brentq(one, grid[sign[0]], grid[sign[0] + 1], xtol=1e-14)
+                    y = np.zeros(2)
+                    y[j] = v
+                    st = finger_state(geom, y[0], y[1])
+                    s1, s2 = spring_torques(springs, y[0], y[1])
+                    h_move, h_stop = (st.h1, st.h2) if m == "B" else (st.h2, st.h1)
+                    t_move, t_stop = (s1, s2) if m == "B" else (s2, s1)
+                    fd = t_move / h_move if h_move != 0 else 0.0
+                    if t_stop - fd * h_stop >= -1e-9:      # the stop still holds
+                        solved = (m, y)
+                        break
+                if solved is not None:
+                    mode, x = solved
+                    break
+                mode = "free"
+            if mode == "free":
+                y, info, ok, _ = fsolve(lambda v, s=s: _no_load_residual(geom, springs, v, s), x,
+                                        full_output=True, xtol=1e-13)
+                if ok == 1 and y[0] >= -1e-9 and y[1] >= -1e-9:
+                    x = np.maximum(y, 0.0)
+                    break
+                mode = "B" if y[1] < 0 else "C"
+        else:
             raise SynthesisError(f"compliant_gripper: no-load closing lost at stroke {s:.3f} mm")
-        x = res.x
+        if abs(float(finger_state(geom, x[0], x[1]).stroke) - s) > 1e-6:
+            raise SynthesisError(f"compliant_gripper: no-load closing lost at stroke {s:.3f} mm")
         out[i] = x
     return out
 
