@@ -1,0 +1,58 @@
+"""Figures of the underactuated finger: closing on the cylinder, joint angles against stroke."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+
+def _png(fig) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, metadata={"Software": None})
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def closing_figures(spec, motion, free, final) -> dict[str, bytes]:
+    """``{file name: PNG bytes}``: closing.png (poses on the object), joint_angles.png."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from fabricate.synthesis.underactuated_model import finger_pose
+
+    d = spec.design
+    out: dict[str, bytes] = {}
+    fig, ax = plt.subplots(figsize=(6, 5))
+    ax.add_patch(plt.Circle(spec.cylinder_centre, spec.cylinder_radius, color="0.85"))
+    for k in np.linspace(0, len(motion.strokes) - 1, 5).astype(int):
+        pose = finger_pose(d, motion.q[k])
+        ax.plot(pose.G[:, 0], pose.G[:, 1], "-o", ms=3, lw=2, color=f"C{k % 10}")
+        for i in range(d.n - 1):
+            ax.plot([pose.G[i, 0], pose.Q[i, 0], pose.P[i, 0]], [pose.G[i, 1], pose.Q[i, 1], pose.P[i, 1]],
+                    ":", lw=0.8, color=f"C{k % 10}")
+        ax.plot([pose.S[0], pose.K[0]], [pose.S[1], pose.K[1]], "--", lw=0.8, color=f"C{k % 10}")
+    pts = final["points"]
+    ax.plot(pts[:, 0], pts[:, 1], "kx")
+    ax.set_aspect("equal")
+    order = ", ".join(f"phalanx {i + 1}" for i in motion.contact_order)
+    ax.set_title(f"closing on the cylinder; contact order: {order}")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    out["closing.png"] = _png(fig)
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for i in range(d.n):
+        ax.plot(motion.strokes, np.degrees(motion.q[:, i]), label=f"joint {i + 1}, on object")
+        ax.plot(free.strokes, np.degrees(free.q[:, i]), "--", color=f"C{i}", label=f"joint {i + 1}, free")
+    for s in motion.contact_strokes:
+        ax.axvline(s, color="grey", lw=0.6)
+    ax.set_xlabel("push-rod stroke (mm)")
+    ax.set_ylabel("relative joint angle (deg)")
+    ax.legend(fontsize=7)
+    out["joint_angles.png"] = _png(fig)
+    return out
