@@ -3,8 +3,9 @@ clipped by the tip curve, closed as a full gear or as a sector with a hub, clean
 
 Outlines are (n, 2) float64 in the gear frame (mm), counter-clockwise, no repeated closing vertex,
 valid simple polygons (shapely) with a chord error below the requested tolerance: the dense outline's
-vertices are exact envelope points spaced so that its own chord error is below 0.1 um, and the
-Douglas-Peucker decimation keeps a subset of those vertices within 0.9 x tolerance of it.
+vertices are exact envelope points spaced so that its own chord error is below 1 um (measured about
+0.5 um for module 0.5 against a five times denser sampling), and the Douglas-Peucker decimation keeps
+a subset of those vertices within ``tolerance - 1 um`` of it.
 """
 
 from __future__ import annotations
@@ -163,6 +164,13 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     normals = np.tile(profile.normals, (z, 1))
     element = np.tile(profile.element, z)
     flank_u = np.tile(profile.flank_u, z) + np.repeat(tooth_centres, k)
+    if not closed:
+        # a sector ends exactly where the next period would start (the space centre at the root)
+        end = base[:1] + [tooth_centres[-1] + rack.pitch, 0.0]
+        pts = np.vstack([pts, end])
+        normals = np.vstack([normals, profile.normals[:1]])
+        element = np.concatenate([element, profile.element[:1]])
+        flank_u = np.concatenate([flank_u, [np.nan]])
     s = contact_abscissa(pts, normals)
     if method == "exact":
         frames = pitch.frames(s, gear)
@@ -200,7 +208,8 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     poly = orient(_largest_polygon(teeth), 1.0)
     dense = _clean_ring(np.asarray(poly.exterior.coords))
     dense_poly = Polygon(dense)
-    outline = simplify_ring(dense, 0.9 * chord_tolerance_mm) if decimate else dense
+    budget = max(0.5 * chord_tolerance_mm, chord_tolerance_mm - 0.001)  # leave 1 um for the dense outline
+    outline = simplify_ring(dense, budget) if decimate else dense
     if decimate and not Polygon(outline).is_valid:  # pragma: no cover - tolerance far below tooth features
         simple = shapely.simplify(dense_poly, 0.5 * chord_tolerance_mm, preserve_topology=True)
         outline = _clean_ring(np.asarray(orient(_largest_polygon(simple), 1.0).exterior.coords))
