@@ -164,6 +164,7 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     normals = np.tile(profile.normals, (z, 1))
     element = np.tile(profile.element, z)
     flank_u = np.tile(profile.flank_u, z) + np.repeat(tooth_centres, k)
+    owner = np.repeat(np.arange(z), k)  # the tooth each point belongs to (its osculating circle)
     if not closed:
         # a sector ends exactly where the next period would start (the space centre at the root)
         end = base[:1] + [tooth_centres[-1] + rack.pitch, 0.0]
@@ -171,14 +172,14 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
         normals = np.vstack([normals, profile.normals[:1]])
         element = np.concatenate([element, profile.element[:1]])
         flank_u = np.concatenate([flank_u, [np.nan]])
+        owner = np.concatenate([owner, [z - 1]])
     s = contact_abscissa(pts, normals)
     if method == "exact":
         frames = pitch.frames(s, gear)
     else:
         cf = pitch.frames(np.asarray(tooth_centres, dtype=np.float64), gear)
-        per_point = PitchFrames(np.repeat(cf.point, k, 0), np.repeat(cf.tangent, k, 0),
-                                np.repeat(cf.normal, k, 0), np.repeat(cf.curvature, k))
-        frames = osculating_frames(s, np.repeat(tooth_centres, k), per_point)
+        per_point = PitchFrames(cf.point[owner], cf.tangent[owner], cf.normal[owner], cf.curvature[owner])
+        frames = osculating_frames(s, np.asarray(tooth_centres, dtype=np.float64)[owner], per_point)
     chain = envelope(pts, s, frames, gear)
     p = rack.pitch
     # tip curve: pitch curve offset outwards by the addendum
