@@ -12,8 +12,9 @@ Keys (all optional)
 ``addendum``             float in [0.3, 1.5] × m, default 1.0.
 ``dedendum``             float in [0.5, 2.0] × m, default 1.25; must exceed ``addendum`` (tip clearance).
 ``root_fillet``          float in [0, 0.5] × m, default 0.38. Rack tip round radius (cuts the fillet).
-``backlash_mm``          float in [0, 1], default 0.05. Circumferential backlash of the pair; each gear's
-                         flanks are moved inwards by half of it as a true normal offset.
+``backlash_mm``          float in [0, 1], default 0.05. Circumferential backlash j of the pair at the
+                         pitch curve; each gear's teeth are thinned by j/2, every flank moved into its
+                         tooth by the true normal offset j cos(alpha) / 4.
 ``method``               ``"exact"`` (default: both gears cut by one virtual rack rolling on the pitch
                          curves) or ``"approx"`` (each tooth an involute tooth of the local osculating
                          circle).
