@@ -235,6 +235,18 @@ class Mechanism:
         if np.isscalar(inputs):
             inputs = np.linspace(self.input_range[0], self.input_range[1], int(inputs))
         inputs = np.asarray(inputs, dtype=np.float64)
+        # synthesis, parts and checks sweep the same motion: solve it once per mechanism object
+        cache = self.__dict__.setdefault("_sweep_cache", {})
+        key = inputs.tobytes()
+        if key in cache:
+            return cache[key]
+        motion = self._sweep(inputs)
+        if len(cache) >= 8:
+            cache.pop(next(iter(cache)))
+        cache[key] = motion
+        return motion
+
+    def _sweep(self, inputs: np.ndarray) -> Motion:
         system = _System(self)
         q = system.assemble(inputs[0])
         out = np.empty((len(inputs), len(system.free), 3))
@@ -243,6 +255,10 @@ class Mechanism:
         for i in range(1, len(inputs)):
             q, previous = system.continue_to(q, previous, inputs[i - 1], inputs[i])
             out[i] = q.reshape(-1, 3)
+        inputs = inputs.copy()
+        # the motion is shared through the sweep cache: make it immutable
+        inputs.setflags(write=False)
+        out.setflags(write=False)
         return Motion(inputs=inputs, body_names=self.body_names, ground=self.ground,
                       free=tuple(system.free), q=out, mechanism=self)
 
