@@ -156,23 +156,41 @@ def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: i
     def energy_grad(x):
         return k * (x + q0) / scale
 
-    for idx, s in enumerate(strokes):
-        if idx == 0:
-            continue
-        cons = [{"type": "eq", "fun": lambda x, s=s: finger_pose(d, x).stroke - s,
+    def settle(s: float, start: np.ndarray, frozen: int, max_iter: int = 200) -> tuple[np.ndarray, bool]:
+        cons = [{"type": "eq", "fun": lambda x: finger_pose(d, x).stroke - s,
                  "jac": lambda x: stroke_gradient(d, x)}]
         if with_object:
             cons.append({"type": "ineq", "fun": lambda x: face_clearance(
                 d, finger_pose(d, x), spec.cylinder_centre, spec.cylinder_radius)[0]})
-        bounds = [(q[i], q[i]) if i < frozen else (0.0, np.pi * 0.6) for i in range(d.n)]
-        res = minimize(energy, q, jac=energy_grad, method="SLSQP", constraints=cons,
-                       bounds=bounds, options={"ftol": 1e-13, "maxiter": 200})
+        bounds = [(start[i], start[i]) if i < frozen else (0.0, np.pi * 0.6) for i in range(d.n)]
+        res = minimize(energy, start, jac=energy_grad, method="SLSQP", constraints=cons,
+                       bounds=bounds, options={"ftol": 1e-13, "maxiter": max_iter})
         pose = finger_pose(d, res.x)
-        if pose is None or abs(pose.stroke - s) > 1e-5:
-            raise SynthesisError(f"underactuated: closing motion lost at stroke {s:.3f} mm ({res.message})")
-        q = res.x
+        ok = pose is not None and abs(pose.stroke - s) <= 1e-5
+        if ok and with_object:
+            ok = bool(face_clearance(d, pose, spec.cylinder_centre, spec.cylinder_radius)[0].min() > -1e-5)
+        return res.x, ok
+
+    for idx in range(1, m):
+        x, ok = settle(strokes[idx], q, frozen)
+        if not ok:
+            if not with_object:
+                raise SynthesisError(f"underactuated: closing motion lost at stroke {strokes[idx]:.3f} mm")
+            # the unfrozen phalanges cannot follow the stroke without entering the object: the finger
+            # locked in between; bisect for the stroke where it locks and end there
+            lo, hi, x_lo = strokes[idx - 1], strokes[idx], q
+            for _ in range(18):
+                mid = 0.5 * (lo + hi)
+                x_mid, ok_mid = settle(mid, x_lo, frozen, max_iter=30)
+                if ok_mid:
+                    lo, x_lo = mid, x_mid
+                else:
+                    hi = mid
+            strokes[idx], x = lo, x_lo
+        q = x
         qs[idx] = q
         if with_object:
+            pose = finger_pose(d, q)
             touching[idx] = face_clearance(d, pose, spec.cylinder_centre, spec.cylinder_radius)[0] < 1e-4
             touching[idx, :frozen] = True
             hit = np.nonzero(touching[idx])[0]
@@ -180,7 +198,7 @@ def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: i
                 # the chapter's assumption: a phalanx stopped by the object no longer turns (it sticks),
                 # so it and every joint proximal to it hold their angles from here on
                 frozen = max(frozen, int(hit.max()) + 1)
-            if touching[idx].all():
+            if touching[idx].all() or not ok:
                 # every phalanx on the object: the finger is locked, the stroke cannot go on
                 strokes, qs, touching = strokes[: idx + 1], qs[: idx + 1], touching[: idx + 1]
                 break

@@ -1,0 +1,154 @@
+"""Underactuated stacked four-bar finger (seed 001): mobility, velocity recursion, statics, closing."""
+
+from __future__ import annotations
+
+import json
+import types
+from pathlib import Path
+
+import numpy as np
+import pytest
+import tomllib
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fabricate.errors import SpecError
+from fabricate.planar import circle_circle_intersection, unit
+from fabricate.spec import Table
+from fabricate.synthesis import underactuated as ua
+from fabricate.synthesis.underactuated_model import (
+    contact_forces,
+    crank_rate,
+    distal_rate,
+    finger_pose,
+    palmar_normal,
+    stroke_gradient,
+    transmission_ratios,
+    virtual_work_forces,
+)
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = json.loads((Path(__file__).parent / "data" / "underactuated_closing.json").read_text())
+
+
+def _raw() -> dict:
+    raw = tomllib.loads((ROOT / "templates" / "finger_underactuated.toml").read_text())
+    for key in ("design", "process", "checks"):
+        raw.pop(key)
+    return raw
+
+
+SPEC = ua.parse_spec(Table(_raw()))
+DESIGN = SPEC.design
+
+angles = st.tuples(*[st.floats(0.0, 0.6) for _ in range(3)])
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 5])
+def test_mobility_is_n(n):
+    assert ua.mobility(n)["dof"] == n
+    assert ua.mobility(n)["underactuation"] == n - 1
+
+
+def test_mechanism_mobility_counts_like_the_chapter():
+    motion = ua.ClosingMotion(np.linspace(0, 5, 5), np.zeros((5, 3)), np.zeros((5, 3), bool), [], [], False)
+    mech = ua.build_mechanism(SPEC, motion, "f")
+    assert mech.degrees_of_freedom() == 3
+    assert len(mech.drivers) == 3          # slide + two phalanx angles
+
+
+def _rotate_input_arm(pose, i, delta):
+    """Quadrilateral i with phalanx i held: turn b_i by delta, re-close, return the turn of a_i."""
+    g0, g1 = pose.G[i], pose.G[i + 1]
+    b_vec = pose.Q[i] - g0
+    q_new = g0 + np.array([[np.cos(delta), -np.sin(delta)], [np.sin(delta), np.cos(delta)]]) @ b_vec
+    c = np.hypot(*(pose.P[i] - pose.Q[i]))
+    a = np.hypot(*(pose.P[i] - g1))
+    roots = circle_circle_intersection(g1, a, q_new, c)
+    p_new = roots[np.argmin(np.hypot(*(roots - pose.P[i]).T))]
+    before = np.arctan2(*(pose.P[i] - g1)[::-1])
+    after = np.arctan2(*(p_new - g1)[::-1])
+    return np.arctan2(np.sin(after - before), np.cos(after - before))
+
+
+@settings(max_examples=25, deadline=None)
+@given(angles)
+def test_velocity_ratios_match_finite_differences(q):
+    pose = finger_pose(DESIGN, np.array(q))
+    if pose is None:
+        return
+    ratios = transmission_ratios(pose)
+    h = 1e-6
+    for i in range(DESIGN.n - 1):
+        fd = (_rotate_input_arm(pose, i, h) - _rotate_input_arm(pose, i, -h)) / (2 * h)
+        assert abs(fd - ratios[i]) < 1e-5 * max(1.0, abs(ratios[i]))
+    # slider-crank and the distal chain: with phalanges 1..n-1 held, q_n and psi_1 follow the stroke
+    dq = np.zeros(DESIGN.n)
+    dq[-1] = h
+    hi, lo = finger_pose(DESIGN, pose.q + dq, pose), finger_pose(DESIGN, pose.q - dq, pose)
+    ds = hi.stroke - lo.stroke
+    assert abs((hi.psi[0] - lo.psi[0]) / ds - crank_rate(DESIGN, pose)) < 1e-5 * abs(crank_rate(DESIGN, pose))
+    assert abs(2 * h / ds - distal_rate(DESIGN, pose)) < 1e-5 * abs(distal_rate(DESIGN, pose))
+
+
+@settings(max_examples=25, deadline=None)
+@given(angles, st.floats(5.0, 80.0), st.tuples(*[st.floats(0.2, 0.8) for _ in range(3)]))
+def test_force_chain_agrees_with_virtual_work(q, push, where):
+    pose = finger_pose(DESIGN, np.array(q))
+    if pose is None:
+        return
+    pts = np.array([pose.G[i] + where[i] * (pose.G[i + 1] - pose.G[i])
+                    + 0.5 * DESIGN.thickness * palmar_normal(pose.theta[i]) for i in range(3)])
+    tau = SPEC.spring_rates * (pose.q + SPEC.spring_preloads)
+    chain, _ = contact_forces(DESIGN, pose, push, tau, pts)
+    work = virtual_work_forces(DESIGN, pose, push, tau, pts)
+    assert np.allclose(chain, work, rtol=1e-5, atol=1e-5)
+
+
+def test_stroke_grows_with_every_joint_at_the_open_pose():
+    assert np.all(stroke_gradient(DESIGN, np.zeros(3)) > 0)
+    assert abs(finger_pose(DESIGN, np.zeros(3)).stroke) < 1e-12
+
+
+def test_closing_on_cylinder_sequence_and_forces():
+    res = ua.synthesise(types.SimpleNamespace(method=SPEC, name="finger"))
+    rep = res.report
+    assert rep["contact_sequence"] == DATA["contact_sequence"]
+    assert np.allclose(rep["contact_strokes_mm"], DATA["contact_strokes_mm"], atol=DATA["stroke_tolerance_mm"])
+    forces = np.array(list(rep["contact_forces_N"].values()))
+    assert np.all(forces > 0)
+    assert np.allclose(forces, DATA["contact_forces_N"], atol=DATA["force_tolerance_N"])
+    motion = res.data["motion"]
+    # stroke and sticking: each phalanx keeps its angle once it touched
+    for i, s in zip(motion.contact_order, motion.contact_strokes, strict=True):
+        after = motion.strokes >= s
+        assert np.ptp(motion.q[after, i]) < 1e-9
+    # the generic solver reproduces the closing motion from the drivers
+    sweep = res.mechanism.sweep(motion.strokes)
+    q_mech = np.stack([sweep.relative_angle("phalanx1", "palm"), sweep.relative_angle("phalanx2", "phalanx1"),
+                       sweep.relative_angle("phalanx3", "phalanx2")], -1)
+    assert np.allclose(q_mech, motion.q, atol=1e-6)
+    final = finger_pose(DESIGN, motion.q[-1])
+    gaps, _ = ua.face_clearance(DESIGN, final, SPEC.cylinder_centre, SPEC.cylinder_radius)
+    assert np.all(np.abs(gaps) < 1e-3)
+    pngs = res.figures()
+    assert set(pngs) == {"closing.png", "joint_angles.png"}
+
+
+def test_spec_errors_name_the_field():
+    raw = _raw()
+    raw["transmission"]["output_arm_mm"] = [10.0]
+    with pytest.raises(SpecError, match="transmission.output_arm_mm"):
+        ua.parse_spec(Table(raw))
+    raw = _raw()
+    raw["push_rod"]["link_mm"] = 2.0
+    with pytest.raises(SpecError, match="push_rod.link_mm"):
+        ua.parse_spec(Table(raw))
+    raw = _raw()
+    raw["object"]["cylinder_centre_mm"] = [20.0, 10.0]
+    with pytest.raises(SpecError, match="object.cylinder_centre_mm"):
+        ua.parse_spec(Table(raw))
+
+
+def test_unit_helper_consistency():
+    assert np.allclose(palmar_normal(0.3), unit(0.3 + np.pi / 2))
