@@ -122,9 +122,13 @@ def expected_cut_diameter(part, hole, process) -> float:
 def test_stl_round_trip(name):
     c = case(name)
     tol = c.partset.chord_tolerance_mm
+    flawed = {w.split(":")[0].removeprefix("part ") for w in c.partset.warnings}
     for part in c.partset.parts:
         data = c.files[f"parts/{part.name}.stl"]
         assert validate_stl(data) == []
+        if part.name in flawed:  # holes run into each other: the count and exact area do not apply
+            assert (2 - trimesh.load(io.BytesIO(data), file_type="stl").euler_number) // 2 < len(part.holes)
+            continue
         mesh = trimesh.load(io.BytesIO(data), file_type="stl")
         assert mesh.is_watertight and mesh.is_winding_consistent
         # volume = exact plate area x thickness, within the chord bound (inscribed polygons lose at most
@@ -239,6 +243,8 @@ def test_part_dxf_round_trip(name):
         for circle, hole in zip(circles, part.holes, strict=True):
             assert 2 * circle.dxf.radius == pytest.approx(expected_cut_diameter(part, hole, c.process), abs=1e-6)
             np.testing.assert_allclose([circle.dxf.center.x, circle.dxf.center.y], hole.centre, atol=1e-6)
+        # every contour is a simple closed curve (the kerf offset made no loops)
+        assert all(poly.is_valid for poly in contour_polygons(msp, flatten_mm=1e-3))
         # the outline read back through ezdxf's bulge-to-arc conversion has the exact kerf-offset area
         expected = offset_path(part.outline, kerf / 2).area()
         assert lwpolyline_area(outlines[0]) == pytest.approx(expected, rel=1e-9)
@@ -308,7 +314,7 @@ def test_kinematic_dxf(name):
     labels = " ".join(t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]'))
     for body in c.mechanism.bodies:
         for n in body.points:
-            assert re.search(rf"\b{re.escape(n)} \(", labels)
+            assert re.search(rf"\b{re.escape(n)}[ ,]", labels)
     # the ordinate dimensions locate every joint at the first pose
     located = [d.get_measurement() for d in msp.query("DIMENSION") if d.dimtype == 6]
     for joint in joint_names:

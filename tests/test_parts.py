@@ -76,8 +76,41 @@ def test_offset_path_grows_stadium_and_square_exactly():
     grown = offset_path(circle_hull(np.array([[0.0, 0.0], [length, 0.0]]), r), d)
     assert grown.area() == pytest.approx(2 * (r + d) * length + math.pi * (r + d) ** 2, rel=1e-12)
     square = BulgePath.polyline(np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]))
-    assert offset_path(square, 0.5).area() == pytest.approx(11.0 ** 2, rel=1e-12)
+    # Minkowski sum with a disc: 10^2 + 4*10*d + pi d^2 (round corners as 128-gon: area short by ~3e-4)
+    assert offset_path(square, 0.5).area() == pytest.approx(100 + 20 + math.pi * 0.25, abs=5e-4)
     assert offset_path(square, -0.5).area() == pytest.approx(9.0 ** 2, rel=1e-12)
+    # a comb with slots narrower than twice the offset: the grown outline stays one simple curve
+    comb = [[0.0, 0.0], [10.0, 0.0], [10.0, 5.0]]
+    for k in range(5):
+        x = 10.0 - 2.0 * k
+        comb += [[x - 0.9, 5.0], [x - 0.95, 2.0], [x - 1.05, 2.0], [x - 1.1, 5.0]]
+    comb += [[0.0, 5.0]]
+    grown = offset_path(BulgePath.polyline(np.array(comb)), 0.1)
+    assert shapely.Polygon(grown.vertices).is_valid
+
+
+def bulge_perimeter(path: BulgePath) -> float:
+    """Exact length of a bulge path (chords for lines, r * angle for arcs)."""
+    total = 0.0
+    for i, b in enumerate(path.bulges):
+        chord = float(np.hypot(*(path.vertices[(i + 1) % len(path.vertices)] - path.vertices[i])))
+        if b == 0:
+            total += chord
+        else:
+            theta = 4 * math.atan(abs(b))
+            total += chord / (2 * math.sin(theta / 2)) * theta
+    return total
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.tuples(st.floats(-30, 30), st.floats(-30, 30), st.floats(0.5, 6.0)), min_size=1, max_size=6),
+       st.floats(0.01, 2.0))
+def test_offset_hull_obeys_steiner_formula(circles, d):
+    """For a convex set, area(offset by d) = area + perimeter * d + pi d^2 exactly."""
+    path = circle_hull(np.array([c[:2] for c in circles]), np.array([c[2] for c in circles]))
+    grown = offset_path(path, d)
+    expected = path.area() + bulge_perimeter(path) * d + math.pi * d * d
+    assert grown.area() == pytest.approx(expected, rel=1e-9, abs=1e-9)
 
 
 def test_fuse_polygons_is_union_outline():

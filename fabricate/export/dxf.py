@@ -198,12 +198,16 @@ def kinematic_dxf(mechanism: Any, poses: Mapping[str, np.ndarray]) -> bytes:
                                           override={"dimtxt": text_h, "dimasz": text_h, "dimdec": 3, "dimlfac": 1.0},
                                           dxfattribs={"layer": "DIMENSIONS"})
                 dim.render()
+    # points at one spot (a compound hinge) get one label and one pair of ordinate dimensions
+    spots: dict[tuple[float, float], list[str]] = {}
     for name in sorted(world):
-        p = world[name]
-        is_joint = name in joint_names
+        spots.setdefault((round(float(world[name][0]), 6), round(float(world[name][1]), 6)), []).append(name)
+    for names in spots.values():
+        p = world[names[0]]
+        is_joint = any(n in joint_names for n in names)
         msp.add_circle(tuple(p), 0.6 * text_h if is_joint else 0.3 * text_h,
                        dxfattribs={"layer": "JOINTS" if is_joint else "LABELS"})
-        label = f"{name} ({p[0]:.3f}, {p[1]:.3f})"
+        label = f"{', '.join(names)} ({p[0]:.3f}, {p[1]:.3f})"
         text = msp.add_text(label, height=text_h, dxfattribs={"layer": "LABELS"})
         text.set_placement((float(p[0] + text_h), float(p[1] + text_h)),
                            align=ezdxf.enums.TextEntityAlignment.BOTTOM_LEFT)

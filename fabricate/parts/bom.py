@@ -24,7 +24,9 @@ class Pin:
     Attributes
     ----------
     joint : str
-    bodies : (str, str)
+        Pin name (joint names joined by ``+`` for a compound hinge).
+    bodies : tuple of str
+        Bodies it passes through; the first holds it.
     diameter_mm, length_mm : float
         Nominal diameter; length of the stack it passes through.
     z_mm : float
@@ -34,7 +36,7 @@ class Pin:
     """
 
     joint: str
-    bodies: tuple[str, str]
+    bodies: tuple[str, ...]
     diameter_mm: float
     length_mm: float
     z_mm: float
@@ -49,7 +51,7 @@ class Spacer:
     ----------
     joint : str
     body : str
-        Body whose coordinates ``centre`` is given in (the lower body at the joint).
+        Body whose coordinates ``centre`` is given in (the body holding the pin).
     centre : (2,) array
     inner_diameter_mm, outer_diameter_mm, length_mm, z_mm : float
     lower_layer : int
@@ -68,15 +70,16 @@ class Spacer:
     washer: bool
 
 
-def pins_and_spacers(pin_joints: Sequence[tuple[str, str, str]], layers: Mapping[str, int], pin_mm: float,
-                     hole_mm: float, boss_mm: float, thickness_mm: float, gap_mm: float,
+def pins_and_spacers(pin_joints: Sequence[tuple[str, tuple[str, ...]]], layers: Mapping[str, int],
+                     pin_mm: float, hole_mm: float, boss_mm: float, thickness_mm: float, gap_mm: float,
                      centres: Mapping[tuple[str, str], np.ndarray] | None = None
                      ) -> tuple[list[Pin], list[Spacer]]:
     """Pins sized to their stacks and the spacers / washers between the layers they join.
 
     Parameters
     ----------
-    pin_joints : sequence of (pin name, body a, body b)
+    pin_joints : sequence of (pin name, bodies)
+        Each pin and the bodies it passes through; the first body holds it (and has its hole).
     layers : Mapping[str, int]
         Body -> layer.
     pin_mm, hole_mm, boss_mm : float
@@ -84,29 +87,29 @@ def pins_and_spacers(pin_joints: Sequence[tuple[str, str, str]], layers: Mapping
     thickness_mm, gap_mm : float
         Layer thickness and axial gap.
     centres : Mapping[(body, pin), (2,) array], optional
-        Pin positions in body coordinates; filled in by the caller for spacer parts.
+        Pin positions in body coordinates (spacers are placed in the first body's coordinates).
 
     Returns
     -------
     (list of Pin, list of Spacer)
+        One spacer (or washer) between each pair of consecutive layers the pin joins.
     """
     pins: list[Pin] = []
     spacers: list[Spacer] = []
-    for name, a, b in pin_joints:
-        la, lb = layers[a], layers[b]
-        lo, hi = min(la, lb), max(la, lb)
-        z0, z1 = stack_span([la, lb], thickness_mm, gap_mm)
-        pins.append(Pin(joint=name, bodies=(a, b), diameter_mm=pin_mm, length_mm=z1 - z0, z_mm=z0,
-                        layers=(lo, hi)))
-        length = skipped_gap(lo, hi, thickness_mm, gap_mm)
-        if length <= 0.0:
-            continue
-        lower = a if la <= lb else b
-        centre = (centres or {}).get((lower, name), np.zeros(2))
-        spacers.append(Spacer(joint=name, body=lower, centre=np.asarray(centre, dtype=np.float64),
-                              inner_diameter_mm=hole_mm, outer_diameter_mm=boss_mm, length_mm=length,
-                              z_mm=layer_z(lo, thickness_mm, gap_mm) + thickness_mm, lower_layer=lo,
-                              washer=hi - lo == 1))
+    for name, bodies in pin_joints:
+        occupied = sorted({layers[b] for b in bodies})
+        z0, z1 = stack_span(occupied, thickness_mm, gap_mm)
+        pins.append(Pin(joint=name, bodies=tuple(bodies), diameter_mm=pin_mm, length_mm=z1 - z0, z_mm=z0,
+                        layers=(occupied[0], occupied[-1])))
+        centre = np.asarray((centres or {}).get((bodies[0], name), np.zeros(2)), dtype=np.float64)
+        for lo, hi in zip(occupied[:-1], occupied[1:], strict=True):
+            length = skipped_gap(lo, hi, thickness_mm, gap_mm)
+            if length <= 0.0:
+                continue
+            spacers.append(Spacer(joint=name, body=bodies[0], centre=centre, inner_diameter_mm=hole_mm,
+                                  outer_diameter_mm=boss_mm, length_mm=length,
+                                  z_mm=layer_z(lo, thickness_mm, gap_mm) + thickness_mm, lower_layer=lo,
+                                  washer=hi - lo == 1))
     return pins, spacers
 
 

@@ -87,6 +87,11 @@ class PartSet:
         Polygonisation tolerance for meshes.
     copies : int
         Identical copies of the mechanism (BOM quantities already multiplied).
+    hints : Mapping
+        The synthesis hints used.
+    warnings : tuple of str
+        Geometry the mechanism forces but nobody can make: holes that run into each other (their
+        centres closer than their radii). Parts are still built; the report should carry these.
     """
 
     parts: tuple[Part, ...]
@@ -101,6 +106,7 @@ class PartSet:
     kerf_mm: float
     copies: int = 1
     hints: Mapping[str, Any] = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
 
     def part(self, name: str) -> Part:
         for p in self.parts:
@@ -239,28 +245,40 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
     circles: dict[str, list[tuple[np.ndarray, float]]] = {
         b.name: [(b.point(p), radius) for p in b.points] for b in mechanism.bodies}
     slots: dict[str, list[BulgePath]] = {b.name: [] for b in mechanism.bodies}
-    pin_joints: list[tuple[str, str, str]] = []  # (pin name, body a, body b)
+    pin_joints: list[tuple[str, tuple[str, ...]]] = []  # (pin name, bodies it joins; the first holds it)
+    pin_holes: list[tuple[str, str, np.ndarray]] = []  # (pin name, body, centre): a round hole for the pin
     for joint in mechanism.joints:
         if isinstance(joint, Revolute):
             for body in (joint.body_a, joint.body_b):
-                holes[body].append(Hole(joint.name, mechanism.body(body).point(joint.name), sizes.hole_mm,
-                                        sizes.pin_mm))
-            pin_joints.append((joint.name, joint.body_a, joint.body_b))
+                pin_holes.append((joint.name, body, mechanism.body(body).point(joint.name)))
+            pin_joints.append((joint.name, (joint.body_a, joint.body_b)))
         elif isinstance(joint, Slider):
             axis_a, axis_b, s_min, s_max = _slider_geometry(mechanism, motion, joint, sizes)
-            spacing = 2.0 * radius + 2.0 * process.min_wall_mm  # between the two guide pins
             ref_point = mechanism.body(joint.body_a).point(joint.name)
             rod_point = mechanism.body(joint.body_b).point(joint.name)
+            spacing = _guide_spacing(mechanism.body(joint.body_b), joint.name, rod_point, axis_b, s_min, s_max,
+                                     2.0 * radius + 2.0 * process.min_wall_mm)
             for k, offset in enumerate((0.0, spacing)):
                 name = joint.name if k == 0 else f"{joint.name}_guide"
                 centre = ref_point + offset * axis_a
-                holes[joint.body_a].append(Hole(name, centre, sizes.hole_mm, sizes.pin_mm))
+                pin_holes.append((name, joint.body_a, centre))
                 circles[joint.body_a].append((centre, radius))
-                pin_joints.append((name, joint.body_a, joint.body_b))
+                pin_joints.append((name, (joint.body_a, joint.body_b)))
             # a guide pin at ref + e*axis sits at rod_point - (s - e)*axis_b in the rod: one slot covers both
-            ends = np.array([rod_point - s_max * axis_b, rod_point - (s_min - spacing) * axis_b])
-            slots[joint.body_b].append(circle_hull(ends, sizes.hole_mm / 2.0))
+            ends = np.array([rod_point - (s_max - min(spacing, 0.0)) * axis_b,
+                             rod_point - (s_min - max(spacing, 0.0)) * axis_b])
+            slot = circle_hull(ends, sizes.hole_mm / 2.0)
+            for other in mechanism.body(joint.body_b).points:
+                centre = mechanism.body(joint.body_b).point(other)
+                if other != joint.name and _segment_distance(centre, ends) < sizes.hole_mm:
+                    raise GeometryError(f"slider {joint.name}: the guide slot in {joint.body_b!r} runs into its "
+                                        f"point {other!r}; move the slider point or shorten the stroke")
+            slots[joint.body_b].append(slot)
             circles[joint.body_b] += [(ends[0], radius), (ends[1], radius)]
+    # joints at one spot of a body (a compound hinge) share one hole and one pin
+    pin_joints, pin_holes = merge_coincident_pins(pin_joints, pin_holes)
+    for name, body, centre in pin_holes:
+        holes[body].append(Hole(name, centre, sizes.hole_mm, sizes.pin_mm))
 
     for body, pad in dict(hints.get("pads", {})).items():
         if body not in circles:
@@ -298,12 +316,13 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
     coarse = {n: p.polygon(CONFLICT_CHORD_MM) for n, p in outlines.items()}
     holes_at = {(body, h.joint): h.centre for body, hs in holes.items() for h in hs}
     poses = {n: motion.pose(n) for n in mechanism.body_names}
-    graph = conflict_graph(coarse, poses, process.running_clearance_mm + CONFLICT_CHORD_MM,
-                           always=[(a, b) for _, a, b in pin_joints])
+    on_one_pin = [(a, b) for _, bodies in pin_joints for i, a in enumerate(bodies) for b in bodies[i + 1:]]
+    graph = conflict_graph(coarse, poses, process.running_clearance_mm + CONFLICT_CHORD_MM, always=on_one_pin)
     same = [(p.body_a, p.body_b) for p in gear_pairs]
     layers = assign_layers(graph, list(mechanism.body_names), same)
     # a pin through skipped layers carries a spacer: keep bodies that sweep over it out of that range
-    crossings = pin_crossings(coarse, poses, [(holes_at[(a, name)], a, b) for name, a, b in pin_joints],
+    crossings = pin_crossings(coarse, poses, [(holes_at[(bodies[0], name)], a, b) for name, bodies in pin_joints
+                                              for i, a in enumerate(bodies) for b in bodies[i + 1:]],
                               radius, process.running_clearance_mm + CONFLICT_CHORD_MM)
     layers = order_layers(layers, crossings)
 
@@ -324,13 +343,18 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
     pins, spacers = pins_and_spacers(pin_joints, layers, sizes.pin_mm, sizes.hole_mm,
                                      2.0 * radius, thickness, gap, centres)
     if process.name == "sla":
-        for sp in spacers:
-            if sp.length_mm >= process.thickness_mm - 1e-9:  # thin gaps are washers, bought not printed
-                parts.append(Part(name=safe_name(f"spacer_{sp.joint}"), body=sp.body,
-                                  outline=circle_hull(sp.centre[None, :], sp.outer_diameter_mm / 2.0),
-                                  holes=(Hole(sp.joint, sp.centre, sp.inner_diameter_mm, sizes.pin_mm),),
-                                  thickness_mm=sp.length_mm, z_mm=sp.z_mm, layer=sp.lower_layer + 1,
-                                  process=process.name, role="spacer"))
+        printed = [sp for sp in spacers if sp.length_mm >= process.thickness_mm - 1e-9]  # thin gaps: washers
+        per_pin = {j: sum(q.joint == j for q in printed) for j in {q.joint for q in printed}}
+        seen: dict[str, int] = {}
+        for sp in printed:
+            seen[sp.joint] = seen.get(sp.joint, 0) + 1
+            suffix = f"_{seen[sp.joint]}" if per_pin[sp.joint] > 1 else ""
+            parts.append(Part(name=safe_name(f"spacer_{sp.joint}{suffix}"), body=sp.body,
+                              outline=circle_hull(sp.centre[None, :], sp.outer_diameter_mm / 2.0),
+                              holes=(Hole(sp.joint, sp.centre, sp.inner_diameter_mm, sizes.pin_mm),),
+                              thickness_mm=sp.length_mm, z_mm=sp.z_mm, layer=sp.lower_layer + 1,
+                              process=process.name, role="spacer"))
+    warnings = overlapping_cuts(parts)
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
         raise GeometryError(f"part names collide after sanitising: {sorted(names)}")
@@ -340,7 +364,97 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
                             mounting_mm=parts_spec.mounting_hole_mm)
     return PartSet(parts=tuple(parts), bom=bom, pins=tuple(pins), spacers=tuple(spacers), layers=layers,
                    process=process.name, chord_tolerance_mm=tol, thickness_mm=thickness, layer_gap_mm=gap,
-                   kerf_mm=process.kerf_mm, copies=copies, hints=hints)
+                   kerf_mm=process.kerf_mm, copies=copies, hints=hints, warnings=tuple(warnings))
+
+
+def overlapping_cuts(parts: Sequence[Part]) -> list[str]:
+    """Holes of one part that run into each other or into a slot (the plate would fall apart there)."""
+    found = []
+    for part in parts:
+        holes = list(part.holes)
+        for i, a in enumerate(holes):
+            for b in holes[i + 1:]:
+                gap = float(np.hypot(*(np.asarray(a.centre) - b.centre))) - 0.5 * (a.diameter_mm + b.diameter_mm)
+                if gap < 0:
+                    found.append(f"part {part.name}: holes {a.joint} and {b.joint} overlap by {-gap:.3f} mm; "
+                                 "move the joints apart or use a smaller pin")
+            for slot in getattr(part, "slots", ()):
+                ring = shapely.Polygon(slot.polygon(0.01))
+                if ring.distance(shapely.Point(a.centre)) < 0.5 * a.diameter_mm:
+                    found.append(f"part {part.name}: hole {a.joint} runs into a guide slot")
+    return found
+
+
+def _segment_distance(point: np.ndarray, ends: np.ndarray) -> float:
+    """Distance (mm) from a point to the segment between two ends (2, 2)."""
+    d = ends[1] - ends[0]
+    t = float(np.clip(np.dot(point - ends[0], d) / max(float(np.dot(d, d)), 1e-30), 0.0, 1.0))
+    return float(np.hypot(*(point - ends[0] - t * d)))
+
+
+def _guide_spacing(rod: Any, slider: str, rod_point: np.ndarray, axis_b: np.ndarray, s_min: float,
+                   s_max: float, spacing: float) -> float:
+    """Signed offset (mm, along the slide axis in the reference body) of the second guide pin.
+
+    The slot in the rod covers where both guide pins travel; the second pin goes on the side that keeps
+    the slot furthest from the rod's other points (its pin holes).
+    """
+    others = [rod.point(p) for p in rod.points if p != slider]
+    if not others:
+        return spacing
+    best = (-math.inf, spacing)
+    for e in (spacing, -spacing):
+        ends = np.array([rod_point - (s_max - min(e, 0.0)) * axis_b, rod_point - (s_min - max(e, 0.0)) * axis_b])
+        clearance = min(_segment_distance(p, ends) for p in others)
+        if clearance > best[0] + 1e-9:
+            best = (clearance, e)
+    return best[1]
+
+
+def merge_coincident_pins(pin_joints: Sequence[tuple[str, tuple[str, ...]]],
+                          pin_holes: Sequence[tuple[str, str, np.ndarray]]
+                          ) -> tuple[list[tuple[str, tuple[str, ...]]], list[tuple[str, str, np.ndarray]]]:
+    """Merge pins whose holes coincide in some body (e.g. joints ``G1`` palm-phalanx and ``G1r``
+    palm-rocker at one spot of the palm) into one pin named ``G1+G1r`` through all their bodies.
+
+    Returns
+    -------
+    (pins, holes)
+        Pins as (name, bodies in first-seen order), holes as (pin name, body, centre), one per body and pin.
+    """
+    parent = {name: name for name, _ in pin_joints}
+
+    def find(n: str) -> str:
+        while parent[n] != n:
+            parent[n] = parent[parent[n]]
+            n = parent[n]
+        return n
+
+    spots: dict[tuple[str, float, float], str] = {}
+    for name, body, centre in pin_holes:
+        key = (body, round(float(centre[0]), 9), round(float(centre[1]), 9))
+        if key in spots:
+            a, b = find(spots[key]), find(name)
+            if a != b:
+                parent[b] = a
+        else:
+            spots[key] = name
+    members: dict[str, list[str]] = {}
+    for name, _ in pin_joints:
+        members.setdefault(find(name), []).append(name)
+    label = {root: "+".join(names) for root, names in members.items()}
+    merged: dict[str, list[str]] = {}
+    for name, bodies in pin_joints:
+        seen = merged.setdefault(label[find(name)], [])
+        seen += [b for b in bodies if b not in seen]
+    holes_out: list[tuple[str, str, np.ndarray]] = []
+    done: set[tuple[str, str]] = set()
+    for name, body, centre in pin_holes:
+        key = (label[find(name)], body)
+        if key not in done:
+            done.add(key)
+            holes_out.append((key[0], body, centre))
+    return [(name, tuple(bodies)) for name, bodies in merged.items()], holes_out
 
 
 def swept_region(outlines: Mapping[str, BulgePath], motion: Motion, poses: int = 90) -> Any:

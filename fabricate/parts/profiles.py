@@ -158,6 +158,19 @@ def _drop_collinear(ring: np.ndarray, tol: float = 1e-9) -> np.ndarray:
     return ring[keep]
 
 
+def _offset_polygon(path: BulgePath, distance_mm: float) -> BulgePath:
+    """Offset of a straight-segment path by buffering (see :func:`offset_path`)."""
+    polygon = shapely.Polygon(path.vertices)
+    grown = polygon.buffer(distance_mm, quad_segs=32, join_style="round")
+    if grown.geom_type != "Polygon" or grown.is_empty:
+        raise GeometryError(f"offset by {distance_mm:g} mm splits or removes the profile")
+    ring = _drop_collinear(np.asarray(grown.exterior.coords, dtype=np.float64)[:-1])
+    if polygon_area(ring) < 0:
+        ring = ring[::-1]
+    start = int(np.lexsort((ring[:, 1], ring[:, 0]))[0])
+    return BulgePath.polyline(np.roll(ring, -start, axis=0))
+
+
 def _segment_normals(path: BulgePath) -> tuple[np.ndarray, np.ndarray]:
     """Outward unit normals (for a CCW path) at the start and end of every segment; each (n, 2)."""
     v = path.vertices
@@ -178,12 +191,15 @@ def _segment_normals(path: BulgePath) -> tuple[np.ndarray, np.ndarray]:
 def offset_path(path: BulgePath, distance_mm: float) -> BulgePath:
     """Offset a counter-clockwise closed path outwards by ``distance_mm`` (negative: inwards).
 
-    Vertices move along the bisector of the adjacent segments' normals (a mitre), arcs keep their
-    included angle: exact for paths that are tangent-continuous at their arc ends (every circle hull)
-    and for polygons (mitre joins), which are the two kinds of profile this package makes.
+    A path with arcs (a circle hull: tangent-continuous at its arc ends) is offset exactly: vertices
+    move along their normals and arcs keep their included angle. A polygon (a profile fused with gear
+    teeth) is offset as its Minkowski sum with a disc (round joins, sagitta below 3e-4 of the distance),
+    which trims the loops a vertex-by-vertex offset would make in tight concave corners.
     """
     if distance_mm == 0.0:
         return path
+    if not np.any(path.bulges):
+        return _offset_polygon(path, distance_mm)
     n_start, n_end = _segment_normals(path)
     n_in = np.roll(n_end, 1, axis=0)  # normal of the segment arriving at each vertex
     n_out = n_start
