@@ -398,3 +398,37 @@ def test_mounting_screws_clear_everything_that_moves(four_bar, sla_process):
             outline = part.outline.polygon(0.01)
             gaps = [shapely.Polygon(transform_points(p, outline)).distance(head) for p in motion.pose(part.body)]
             assert min(gaps) >= sla_process.running_clearance_mm, (hole.joint, part.name, min(gaps))
+
+
+def test_compound_hinge_shares_one_pin_and_hole():
+    """Three bodies on one pin (joints J palm-a and Jr palm-b at one spot of the palm)."""
+    from fabricate.parts.bom import pins_and_spacers
+    from fabricate.parts.build import merge_coincident_pins
+
+    joints = [("J", ("palm", "a")), ("Jr", ("palm", "b")), ("K", ("a", "b"))]
+    holes = [("J", "palm", np.zeros(2)), ("J", "a", np.zeros(2)), ("Jr", "palm", np.zeros(2)),
+             ("Jr", "b", np.zeros(2)), ("K", "a", np.array([10.0, 0.0])), ("K", "b", np.array([5.0, 0.0]))]
+    pins, merged_holes = merge_coincident_pins(joints, holes)
+    assert pins == [("J+Jr", ("palm", "a", "b")), ("K", ("a", "b"))]
+    assert [(n, b) for n, b, _ in merged_holes] == [("J+Jr", "palm"), ("J+Jr", "a"), ("J+Jr", "b"),
+                                                    ("K", "a"), ("K", "b")]
+    t, g = 3.0, 0.3
+    made, spacers = pins_and_spacers(pins, {"palm": 0, "a": 2, "b": 3}, 2.0, 2.7, 4.7, t, g)
+    compound = made[0]
+    assert compound.layers == (0, 3) and compound.length_mm == pytest.approx(3 * (t + g) + t)
+    # a spacer between layers 0 and 2 (skipping 1), a washer between 2 and 3
+    on_compound = [s for s in spacers if s.joint == "J+Jr"]
+    assert [(s.lower_layer, s.washer) for s in on_compound] == [(0, False), (2, True)]
+    assert on_compound[0].length_mm == pytest.approx(t + 2 * g)
+    assert sum(s.length_mm for s in on_compound) + 3 * t == pytest.approx(compound.length_mm)
+
+
+def test_overlapping_holes_are_reported(four_bar, sla_process):
+    """A 15 mm pin on a 15 mm crank: its two holes (15.7 mm) run into each other; the part set says so."""
+    import dataclasses
+
+    fat = dataclasses.replace(sla_process, pin_diameter_mm=15.0)
+    partset = build_parts(design_for(fat), four_bar, four_bar.sweep(11), [], {})
+    assert any(w.startswith("part crank: holes O and A overlap by 0.700 mm") for w in partset.warnings)
+    plain = build_parts(design_for(sla_process), four_bar, four_bar.sweep(11), [], {})
+    assert plain.warnings == ()

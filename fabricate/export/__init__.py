@@ -57,7 +57,7 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any
     parts_report : list of dict
         One entry per part: name, process, stl, dxf, volume_mm3, layer, holes [{joint, diameter_mm,
         cut_diameter_mm}], plus role, body, thickness_mm, z_mm, area_mm2, stl_problems, plate and sheet
-        placement.
+        placement, and the part's geometry warnings (e.g. holes running into each other).
 
     Raises
     ------
@@ -103,6 +103,7 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any
             "slots": len(getattr(part, "slots", ())), "stl_problems": problems,
             "plate": {"index": on_plate.sheet, "fits": fits(on_plate, plate_area, spec.plate_spacing_mm)},
             "sheet": {"index": on_sheet.sheet, "fits": fits(on_sheet, plate_area, spec.sheet_margin_mm)},
+            "warnings": [w for w in getattr(partset, "warnings", ()) if w.startswith(f"part {part.name}:")],
         })
     files["print_plate.stl"] = print_plate_stl(parts, cache, plate, plate_area)
     first = motion.poses_at(0)
