@@ -16,7 +16,9 @@ Findings recorded in tests/data/watt_six_bar_paper.json (key ``table2_rounding_f
 - the "circuit defect everywhere" of the printed table is real, not a wrong assembly branch: an
   independent sign test on the exact synthesised positions finds no non-degenerate region point whose
   two loops stay on one branch; with the fitted angles thousands do, and the synthesis then selects
-  an exact region point next to mechanism 1.
+  an exact region point next to mechanism 1;
+- not reproduced: the paper's feasible x ranges of C_d (41.2-61.6, 49.6-56.4, 49.6-52.0 mm); with the
+  fitted angles only the onset of the three-root stretch agrees (49.8 mm).
 """
 
 from __future__ import annotations
@@ -236,6 +238,9 @@ def test_circuit_defects_agree_with_an_independent_branch_test(theta, key):
     one_branch = loop1 & loop2 & ~_degenerate(region, finger)
     assert len(region) == DATA[key]["region_points"]
     assert int(region.passes.sum()) == DATA[key]["region_points_without_circuit_defect"]
+    ranges = region.stage_one.feasible_ranges()
+    for branch, (lo, hi) in DATA[key]["curve_d_feasible_x_mm"].items():
+        assert ranges[int(branch)] == pytest.approx((lo, hi), abs=1e-9)
     # every non-degenerate one-branch point that assembles over the motion passes the positions exactly
     movable = one_branch & np.isfinite(region.K)
     assert np.all(region.tip_error[movable] < 1e-8)
