@@ -11,10 +11,19 @@ torque balances give (eqs 3-6, with f = mu F_n)::
 so the springs enter only through N, and Delta N = F_n2 (D_h / D_s - 1) = G(t) depends on the
 configuration alone. The four spring parameters only choose *where* on the path the hover force first
 reaches F_n2. N is bilinear in (k, phi0), so over any box of spring parameters its range at each t is
-exact from the box corners. That gives a valid lower bound of |Delta N| over a whole box: the least
-|G| over the path samples where a hover crossing is still possible for some member of the box (not
-all members have crossed earlier, and some member has crossed here). Branch and bound over the grid
-indices with that bound visits a tiny part of the ~1.5e9 points and proves the rest cannot do better.
+exact from the box corners. That gives a valid lower bound of Delta N over a whole box: the least
+G >= 0 over the path samples where a hover crossing is still possible for some member of the box
+(not all members have crossed earlier, and some member has crossed here). Branch and bound over the
+grid indices with that bound enumerates only boxes that could still win (about a quarter of the
+~1.5e9 points for the paper's ranges, each box vectorised) and proves the rest cannot do better.
+
+Objective and constraints. The paper minimises Delta N = F_n1 - F_n2 "with F_n2 satisfied" and does
+not list its other constraints. We keep grasps that are physical: hover force reaching F_n2 on the
+physical branch (tip on the can, rod pushing in hover and at rest), both hinges at least
+``hinge_margin`` off their stops (else a stop, not the spring, carries the torque and eqs 4/6 do not
+hold), and Delta N >= 0 (the resting grasp at least the hover force). Without the margin the search
+runs into configurations with the tip hinge a fraction of a degree off its stop, where Delta N
+crosses zero; that is a degenerate optimum, not a design.
 
 The bound is exact up to the sampling of the contact path; within a sample interval the smooth G is
 bracketed by its end values widened by the local second difference (a curvature allowance).
@@ -81,7 +90,7 @@ class _PathTable:
     h2: np.ndarray
     target: np.ndarray       # F_n2 * D_h / (180/pi): the value N*pi/180 must reach
     g: np.ndarray            # Delta N at each sample (N)
-    g_margin: np.ndarray     # curvature allowance of |G| inside the interval ending at each sample
+    g_margin: np.ndarray     # curvature allowance of G inside the interval ending at each sample
     d11: np.ndarray
     d12: np.ndarray
     allowed: np.ndarray      # both hinges at least the margin off their stops
@@ -121,7 +130,7 @@ def _excess_range(tab: _PathTable, grid: ParameterGrid, box: tuple[tuple[int, in
 
 
 def _lower_bound(tab: _PathTable, grid: ParameterGrid, box) -> float:
-    """Least |Delta N| any member of ``box`` can reach (inf if none has a valid hover crossing)."""
+    """Least Delta N >= 0 any member of ``box`` can reach (inf if none has a valid hover crossing)."""
     lo, hi = _excess_range(tab, grid, box)
     n = len(lo)
     crossed_all = np.nonzero(lo >= 0)[0]
