@@ -253,6 +253,16 @@ def build_mechanism(spec: CompliantSpec, motion: GripperMotion, name: str) -> Me
 
 # -- synthesis -----------------------------------------------------------------------------------
 
+#: Drive parts shared by all fingers (paper Fig 1): two lead-screw steppers move the tip and root
+#: drive plates along two guide posts.
+DRIVE_PARTS = (
+    {"item": "stepper motor with lead screw", "qty": 2, "note": "tip drive (1) and root drive (2), Fig 1"},
+    {"item": "guide post", "qty": 2, "note": "joins the motor plate and the finger-base plate (4)"},
+    {"item": "linear bearing", "qty": 4, "note": "each guide post through both drive plates (5)"},
+    {"item": "lead-screw nut", "qty": 2, "note": "one per drive plate (8)"},
+    {"item": "lead-screw support bearing", "qty": 2, "note": "in the finger-base plate (12)"},
+)
+
 def paper_point(spec: CompliantSpec) -> tuple[ContactPath, Grasp]:
     """Grasp of the template's own parameters (the paper's optimum in the shipped template)."""
     path = contact_path(spec.geometry, spec.load.radius, spec.load.mu, n=max(spec.path_samples, 721),
@@ -308,6 +318,7 @@ def synthesise(design) -> SynthesisResult:
         "grasp_force_curve": {"stroke_mm": strokes[::10].tolist(), "F_static_N": f_static[::10].tolist(),
                               "F_hover_N": f_hover[::10].tolist()},
         "fingers": spec.fingers,
+        "drive_parts": [dict(item) for item in DRIVE_PARTS],
     }
     optimum = None
     if spec.grid is not None:
@@ -323,15 +334,14 @@ def synthesise(design) -> SynthesisResult:
              "legs_mm": spec.spring_legs, "note": "large torsion spring, middle hinge (k2)"},
         ],
         "pads": {"tip": {"point": "pad", "radius_mm": g.r}},
+        # per finger (the BOM layer multiplies these by "copies")
         "purchased": [
-            {"item": "stepper motor with lead screw (tip drive)", "qty": 1, "note": "drives the tip drive plate"},
-            {"item": "stepper motor with lead screw (root drive)", "qty": 1, "note": "sets the root angle alpha"},
-            {"item": "linear bearing", "qty": 2, "note": "drive plates on the two guide posts"},
-            {"item": "guide post", "qty": 2, "note": "joins the motor plate and the finger-base plate"},
-            {"item": "lead-screw nut", "qty": 2, "note": "one per drive plate"},
-            {"item": "lead-screw support bearing", "qty": 2, "note": "in the finger-base plate"},
-            {"item": "adjusting knob", "qty": 1, "note": "sets the tip spring preload (per finger)"},
+            {"item": "tip drive rod, 4 mm steel, threaded end", "qty": 1, "note": "pushes the two-force rod"},
+            {"item": "root push rod, 4 mm steel, threaded end", "qty": 1, "note": "sets the root angle alpha"},
+            {"item": "adjusting knob", "qty": 1, "note": "sets the tip spring preload"},
         ],
+        # once per gripper, shared by the fingers: listed apart so they are not multiplied
+        "purchased_shared": list(DRIVE_PARTS),
         "copies": spec.fingers,
         "copy_angle_deg": 360.0 / spec.fingers,
         "tip_point": "tip",
