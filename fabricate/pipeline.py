@@ -104,7 +104,7 @@ def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     if result.mechanism is not None:
         progress("sweep")
         try:
-            motion = result.mechanism.sweep(design.checks.sweep_poses + 1)
+            motion = result.mechanism.sweep(design.checks.sweep_poses)
             report["mechanism"] = mechanism_section(result.mechanism, motion)
         except LockupError as exc:
             failures.append(f"motion: {exc}")
@@ -135,7 +135,7 @@ def run_build(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     mechanism = result.mechanism
     progress("sweep")
     try:
-        motion = mechanism.sweep(design.checks.sweep_poses + 1)
+        motion = mechanism.sweep(design.checks.sweep_poses)
     except LockupError as exc:
         report["synthesis"] = result.report
         report["checks"] = {"passed": False, "failures": [f"motion: {exc}"]}
