@@ -446,3 +446,10 @@ def test_prusaslicer_reports_manifold_without_repair(name, tmp_path):
         for key in repairs:
             m = re.search(rf"{key}\s*=\s*(\d+)", text)
             assert m is None or int(m.group(1)) == 0, (rel, key, text)
+    # the 3MF assembly: one manifold object per part
+    model = tmp_path / "assembly.3mf"
+    model.write_bytes(c.files["assembly.3mf"])
+    run = subprocess.run(["prusa-slicer", "--info", str(model)], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.count("[assembly.3mf]") == len(c.partset.parts)
+    assert run.stdout.count("manifold = yes") == len(c.partset.parts)
