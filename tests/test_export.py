@@ -453,3 +453,33 @@ def test_prusaslicer_reports_manifold_without_repair(name, tmp_path):
     assert run.returncode == 0, run.stderr
     assert run.stdout.count("[assembly.3mf]") == len(c.partset.parts)
     assert run.stdout.count("manifold = yes") == len(c.partset.parts)
+
+
+ENCODE_IN_CHILD = """
+import hashlib, sys
+sys.path.insert(0, {tests!r})
+from test_export import case
+c = case({name!r})
+for key in sorted(c.files):
+    print(key, hashlib.sha256(c.files[key]).hexdigest())
+"""
+
+
+def test_bytes_do_not_depend_on_the_hash_seed():
+    """Two processes with different string-hash seeds write identical files (ezdxf keeps some records
+    in sets; the encoders fix their order)."""
+    import hashlib
+    import os
+    import sys
+    from pathlib import Path
+
+    name = "slider_crank-laser"
+    here = case(name)
+    expected = "".join(f"{k} {hashlib.sha256(here.files[k]).hexdigest()}\n" for k in sorted(here.files))
+    script = ENCODE_IN_CHILD.format(tests=str(Path(__file__).parent), name=name)
+    for seed in ("1", "12345"):
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env,
+                             timeout=300, cwd=Path(__file__).parent.parent)
+        assert run.returncode == 0, run.stderr
+        assert run.stdout == expected

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+from collections import OrderedDict
 from collections.abc import Iterator, Mapping, Sequence
 from typing import Any
 
@@ -62,6 +63,10 @@ def new_document(layers: Sequence[str] = ("CUT", "ENGRAVE"), dimensions: bool = 
 
 def document_bytes(doc: Any) -> bytes:
     """Encode a document as DXF bytes (fixed metadata, UTF-8 for R2007+)."""
+    # ezdxf collects its required CLASS records in a set: their order would follow the process's
+    # string-hash seed, so sort them (the order has no meaning to readers)
+    doc.classes.add_required_classes(doc.dxfversion)  # write() adds them (from a set) unless present
+    doc.classes.classes = OrderedDict(sorted(doc.classes.classes.items()))
     stream = io.StringIO()
     with _fixed_metadata():
         doc.write(stream)
