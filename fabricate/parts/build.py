@@ -16,7 +16,18 @@ Shapes
   axis stays.
 - A slider (push rod) becomes a rounded bar along the slide axis with a slot that runs on two guide pins
   fixed in the reference body (two pins so the rod cannot turn).
-- The ground part gets mounting holes on the side away from the moving parts.
+- The ground part gets mounting holes on the side away from the moving parts, pushed out until the
+  screw heads clear everything that moves.
+- Holes: pin + 2 x radial running clearance + the process's hole compensation (the finished hole; the
+  laser kerf is applied by the DXF exporter only). Joints at one spot of a body (a compound hinge)
+  share one hole and one pin.
+
+Layers and pins
+---------------
+Bodies that come within the clearance of each other anywhere over the motion get different layers
+(:mod:`fabricate.parts.layers`); meshing gears share one. The layers are then ordered so that no body
+sweeps over a pin between the two layers it joins (there a spacer fills the skipped layers). Pins are
+cut to their stack; spacers (SLA: printed parts when at least a layer thick) and washers fill the gaps.
 """
 
 from __future__ import annotations
