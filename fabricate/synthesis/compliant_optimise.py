@@ -3,19 +3,35 @@
 Why it can be fast
 ------------------
 For a fixed root angle alpha and seat length c the finger touching the can is a one-parameter family
-of configurations (the contact path, closed form in phi2). At a configuration t of that path the two
-torque balances give (eqs 3-6, with f = mu F_n)::
+of configurations (the contact path, closed form in phi2, sampled at ``samples`` points). At a
+configuration t of that path the two torque balances give (eqs 3-6, with f = mu F_n)::
 
     F_n1 = N / D_s,  F_hover = N / D_h,  N = 180/pi * [k2 (phi2 + phi02) h1 - k1 (phi1 + phi01) h2]
 
 so the springs enter only through N, and Delta N = F_n2 (D_h / D_s - 1) = G(t) depends on the
 configuration alone. The four spring parameters only choose *where* on the path the hover force first
-reaches F_n2. N is bilinear in (k, phi0), so over any box of spring parameters its range at each t is
-exact from the box corners. That gives a valid lower bound of Delta N over a whole box: the least
-G >= 0 over the path samples where a hover crossing is still possible for some member of the box
-(not all members have crossed earlier, and some member has crossed here). Branch and bound over the
-grid indices with that bound enumerates only boxes that could still win (about a quarter of the
-~1.5e9 points for the paper's ranges, each box vectorised) and proves the rest cannot do better.
+reaches F_n2. A grid point whose first crossing lies in the sample interval (t_{i-1}, t_i] gets
+Delta N = G(t_{i-1}) + w (G(t_i) - G(t_{i-1})) with w in [0, 1] (linear interpolation, exactly what
+:func:`evaluate_points` and :func:`brute_force` compute). So
+
+1. every interval has an exact lower bound L_i: the least of that linear G over the part of the
+   interval where both hinges keep ``hinge_margin`` off their stops and G >= 0 (both linear in w too)
+   (:func:`interval_bounds`; 178 paths x about 40 intervals for the paper's grid, a few ms);
+2. intervals are searched in order of L_i, path by path in order of their least L_i; the first ones
+   give a good incumbent at once, and an interval with L_i >= the incumbent is dropped unsearched;
+3. searching interval i of a path finds *every* grid point whose first crossing is there, without
+   enumerating the grid: with h1 > 0 the hover condition at sample j reads ``k2 phi02 >= sigma_j``,
+   ``sigma_j = (target_j + k1 (phi1_j + phi01) h2_j) / h1_j - k2 phi2_j`` depends on the triple
+   (k1, k2, phi01) only; the first crossing is at i exactly when ``sigma_i <= k2 phi02 < min_{j<i}
+   sigma_j``, an interval of phi02 found by one sorted search per triple. sigma and its running
+   minimum are computed once per path (31 x 31 x 91 triples x path samples, vectorised);
+4. the points found are valued with the same arithmetic as :func:`evaluate_points`, and those that
+   beat the incumbent are re-evaluated by :func:`evaluate_points` itself (the reference).
+
+The certificate (:class:`OptimumResult`): every grid point either crosses first in a searched interval
+(then it was valued exactly), or in an interval whose bound ``pruned_bound`` >= the optimum, or it
+never gives a valid grasp. The phi02 ranges are widened by a relative 1e-9 so that rounding between
+the sigma form and the direct form of the hover condition cannot lose a point.
 
 Objective and constraints. The paper minimises Delta N = F_n1 - F_n2 "with F_n2 satisfied" and does
 not list its other constraints. We keep grasps that are physical: hover force reaching F_n2 on the
@@ -25,14 +41,13 @@ hold), and Delta N >= 0 (the resting grasp at least the hover force). Without th
 runs into configurations with the tip hinge a fraction of a degree off its stop, where Delta N
 crosses zero; that is a degenerate optimum, not a design.
 
-The bound is exact up to the sampling of the contact path; within a sample interval the smooth G is
-bracketed by its end values widened by the local second difference (a curvature allowance).
-``tests/test_compliant.py`` checks the result against plain enumeration of a sub-grid.
+The optimum is that of the sampled path (linear interpolation between samples), like
+:func:`brute_force`; ``tests/test_compliant.py`` checks it against plain enumeration of a sub-grid
+and the caller re-solves the winning point exactly (:func:`~fabricate.synthesis.compliant_model.solve_grasp`).
 """
 
 from __future__ import annotations
 
-import heapq
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,7 +63,8 @@ from fabricate.synthesis.compliant_model import (
 
 @dataclass(frozen=True)
 class ParameterGrid:
-    """The six searched axes (Table 1): alpha (rad), c (mm), k1, k2 (N·mm/deg), phi01, phi02 (rad)."""
+    """The six searched axes (Table 1): alpha (rad), c (mm), k1, k2 (N·mm/deg), phi01, phi02 (rad).
+    Each axis is ascending; k1, k2, phi01, phi02 are >= 0."""
 
     alpha: np.ndarray
     c: np.ndarray
@@ -65,7 +81,14 @@ class ParameterGrid:
 
 @dataclass(frozen=True)
 class OptimumResult:
-    """Best grid point, its Delta N (N) and the certificate of the search."""
+    """Best grid point, its Delta N (N) on the sampled path and the certificate of the search.
+
+    ``pruned_bound`` (N) is the least interval bound of everything not searched (inf if all was
+    searched); it is >= ``delta_n``, so no grid point left out can beat the optimum.
+    ``lower_bound = min(pruned_bound, delta_n)``: no grid point at all has a smaller Delta N.
+    ``points_evaluated`` counts the grid points whose first crossing lies in a searched interval
+    (each valued exactly), ``points_verified`` those re-evaluated by :func:`evaluate_points`.
+    """
 
     alpha: float
     c: float
@@ -75,9 +98,14 @@ class OptimumResult:
     phi02: float
     delta_n: float
     lower_bound: float
+    pruned_bound: float
     grid_points: int
     points_evaluated: int
-    boxes_bounded: int
+    points_verified: int
+    paths: int
+    paths_searched: int
+    intervals: int
+    intervals_searched: int
 
 
 @dataclass
@@ -90,13 +118,11 @@ class _PathTable:
     h2: np.ndarray
     target: np.ndarray       # F_n2 * D_h / (180/pi): the value N*pi/180 must reach
     g: np.ndarray            # Delta N at each sample (N)
-    g_margin: np.ndarray     # curvature allowance of G inside the interval ending at each sample
     d11: np.ndarray
     d12: np.ndarray
-    allowed: np.ndarray      # both hinges at least the margin off their stops
 
 
-def _table(path: ContactPath, load: Load, hinge_margin: float) -> _PathTable | None:
+def _table(path: ContactPath, load: Load) -> _PathTable | None:
     st = path.state
     if len(path.phi2) < 3:
         return None
@@ -104,73 +130,50 @@ def _table(path: ContactPath, load: Load, hinge_margin: float) -> _PathTable | N
     den_s = st.d11 * st.h2 - st.d21 * st.h1
     den_h = den_s + load.mu * (st.d12 * st.h2 - st.d22 * st.h1)
     g = fn2 * (den_h / den_s - 1.0)
-    second = np.abs(np.diff(g, 2))
-    margin = np.zeros_like(g)
-    margin[1:] = np.maximum(np.concatenate([[second[0]], second]), np.concatenate([second, [second[-1]]]))
-    allowed = (st.phi1 >= hinge_margin) & (st.phi2 >= hinge_margin)
-    return _PathTable(st.phi1, st.phi2, st.h1, st.h2, fn2 * den_h / DEG_PER_RAD, g, margin, st.d11, st.d12,
-                      allowed)
+    return _PathTable(st.phi1, st.phi2, st.h1, st.h2, fn2 * den_h / DEG_PER_RAD, g, st.d11, st.d12)
 
 
-def _product_range(lo1: float, hi1: float, lo2: np.ndarray, hi2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    corners = np.stack([lo1 * lo2, lo1 * hi2, hi1 * lo2, hi1 * hi2])
-    return corners.min(0), corners.max(0)
+def interval_bounds(tab: _PathTable, hinge_margin: float = 0.0) -> np.ndarray:
+    """Least Delta N (N) any grid point whose hover force first reaches F_n2 in (t_{i-1}, t_i] can
+    get, for every i (entry 0 is inf: a crossing at the first sample is not a valid grasp).
+
+    The value there is ``G(w) = g[i-1] + w (g[i] - g[i-1])``; the admissible w are those in [0, 1]
+    with phi1(w), phi2(w) >= ``hinge_margin`` and G(w) >= 0 (all linear in w), an interval
+    [w_lo, w_hi]; G is linear, so its least value is at one end. The interval is widened by 1e-9 so
+    the bound is never above a value :func:`evaluate_points` can compute; inf where no w is admissible.
+    """
+    n = len(tab.g)
+    w_lo = np.zeros(n - 1)
+    w_hi = np.ones(n - 1)
+    for arr, floor in ((tab.phi1, hinge_margin), (tab.phi2, hinge_margin), (tab.g, 0.0)):
+        a0 = arr[:-1] - floor
+        slope = arr[1:] - arr[:-1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            root = -a0 / slope
+        w_lo = np.where(slope > 0, np.maximum(w_lo, root), w_lo)
+        w_hi = np.where(slope < 0, np.minimum(w_hi, root), w_hi)
+        # flat: admissible everywhere or nowhere
+        w_hi = np.where((slope == 0) & (a0 < 0), -1.0, w_hi)
+    w_lo = np.clip(w_lo - 1e-9, 0.0, 1.0)
+    w_hi = np.clip(w_hi + 1e-9, -1.0, 1.0)
+    g0, dg = tab.g[:-1], np.diff(tab.g)
+    least = np.maximum(np.minimum(g0 + w_lo * dg, g0 + w_hi * dg), 0.0)
+    out = np.full(n, np.inf)
+    out[1:] = np.where(w_lo <= w_hi, least, np.inf)
+    return out
 
 
-def _excess_range(tab: _PathTable, grid: ParameterGrid, box: tuple[tuple[int, int], ...]):
-    """Least and greatest of N*pi/180 - target over a box of spring indices, at every path sample."""
-    (k1a, k1b), (k2a, k2b), (p1a, p1b), (p2a, p2b) = box
-    a_lo, a_hi = _product_range(grid.k2[k2a], grid.k2[k2b], tab.phi2 + grid.phi02[p2a], tab.phi2 + grid.phi02[p2b])
-    b_lo, b_hi = _product_range(grid.k1[k1a], grid.k1[k1b], tab.phi1 + grid.phi01[p1a], tab.phi1 + grid.phi01[p1b])
-    ta = np.stack([a_lo * tab.h1, a_hi * tab.h1])
-    tb = np.stack([-b_lo * tab.h2, -b_hi * tab.h2])
-    lo = ta.min(0) + tb.min(0) - tab.target
-    hi = ta.max(0) + tb.max(0) - tab.target
-    return lo, hi
-
-
-def _lower_bound(tab: _PathTable, grid: ParameterGrid, box) -> float:
-    """Least Delta N >= 0 any member of ``box`` can reach (inf if none has a valid hover crossing)."""
-    lo, hi = _excess_range(tab, grid, box)
-    n = len(lo)
-    crossed_all = np.nonzero(lo >= 0)[0]
-    last = int(crossed_all[0]) if crossed_all.size else n - 1
-    idx = np.arange(1, last + 1)
-    idx = idx[hi[idx] >= 0]
-    if idx.size == 0:
-        return np.inf
-    idx = idx[tab.allowed[idx] | tab.allowed[idx - 1]]
-    g0, g1 = tab.g[idx - 1], tab.g[idx]
-    idx = idx[np.maximum(g0, g1) + tab.g_margin[idx] >= 0]      # Delta N < 0 throughout: excluded
-    if idx.size == 0:
-        return np.inf
-    g0, g1 = tab.g[idx - 1], tab.g[idx]
-    least = np.where(np.minimum(g0, g1) <= 0, 0.0, np.minimum(g0, g1) - tab.g_margin[idx])
-    return float(max(least.min(), 0.0))
-
-
-def evaluate_points(tab: _PathTable, k1: np.ndarray, k2: np.ndarray, phi01: np.ndarray, phi02: np.ndarray,
-                    load: Load, hinge_margin: float = 0.0) -> np.ndarray:
-    """Delta N (N) of each spring set (arrays (m,)) on one path; NaN where the grasp is not valid:
-    the hover force never reaches F_n2, or reaches it with a hinge within ``hinge_margin`` (rad) of
-    its stop, or with the rod pulling, or with Delta N < 0 (resting grasp below the hover force).
-    The crossing is interpolated linearly between path samples."""
-    n1 = (k2[:, None] * (tab.phi2 + phi02[:, None]) * tab.h1
-          - k1[:, None] * (tab.phi1 + phi01[:, None]) * tab.h2)
-    ex = n1 - tab.target
-    above = ex >= 0
-    i = np.argmax(above, axis=1)
-    ok = above.any(axis=1) & (i > 0)
-    i = np.where(ok, i, 1)
-    rows = np.arange(len(k1))
-    e0, e1 = ex[rows, i - 1], ex[rows, i]
+def _value_at_crossing(tab: _PathTable, i: np.ndarray, e0: np.ndarray, e1: np.ndarray, k1: np.ndarray,
+                       phi01: np.ndarray, load: Load, hinge_margin: float) -> np.ndarray:
+    """Delta N (N) of spring sets whose hover excess goes from e0 < 0 at sample i-1 to e1 >= 0 at
+    sample i (linear interpolation of the crossing), NaN where the grasp is not valid."""
     w = np.clip(-e0 / np.where(e1 != e0, e1 - e0, 1.0), 0.0, 1.0)
 
     def at(arr: np.ndarray) -> np.ndarray:
         return arr[i - 1] + w * (arr[i] - arr[i - 1])
 
     dn = at(tab.g)
-    ok &= (at(tab.phi1) >= hinge_margin) & (at(tab.phi2) >= hinge_margin) & (dn >= 0)
+    ok = (at(tab.phi1) >= hinge_margin) & (at(tab.phi2) >= hinge_margin) & (dn >= 0)
     fn2 = load.hover_force
     s1 = k1 * DEG_PER_RAD * (at(tab.phi1) + phi01)
     # rod force must push (compression) in hover and in the static grasp
@@ -180,15 +183,39 @@ def evaluate_points(tab: _PathTable, k1: np.ndarray, k2: np.ndarray, phi01: np.n
     return np.where(ok, dn, np.nan)
 
 
+def _excess(tab: _PathTable, j: int | np.ndarray, k1: np.ndarray, k2: np.ndarray, phi01: np.ndarray,
+            phi02: np.ndarray) -> np.ndarray:
+    """N*pi/180 - target at sample(s) j: >= 0 once the hover force has reached F_n2."""
+    n1 = k2 * (tab.phi2[j] + phi02) * tab.h1[j] - k1 * (tab.phi1[j] + phi01) * tab.h2[j]
+    return n1 - tab.target[j]
+
+
+def evaluate_points(tab: _PathTable, k1: np.ndarray, k2: np.ndarray, phi01: np.ndarray, phi02: np.ndarray,
+                    load: Load, hinge_margin: float = 0.0) -> np.ndarray:
+    """Delta N (N) of each spring set (arrays (m,)) on one path; NaN where the grasp is not valid:
+    the hover force never reaches F_n2, or reaches it with a hinge within ``hinge_margin`` (rad) of
+    its stop, or with the rod pulling, or with Delta N < 0 (resting grasp below the hover force).
+    The crossing is interpolated linearly between path samples. The reference evaluation."""
+    ex = _excess(tab, slice(None), k1[:, None], k2[:, None], phi01[:, None], phi02[:, None])
+    above = ex >= 0
+    i = np.argmax(above, axis=1)
+    ok = above.any(axis=1) & (i > 0)
+    i = np.where(ok, i, 1)
+    rows = np.arange(len(k1))
+    dn = _value_at_crossing(tab, i, ex[rows, i - 1], ex[rows, i], k1, phi01, load, hinge_margin)
+    return np.where(ok, dn, np.nan)
+
+
 def build_tables(geom: GripperGeometry, grid: ParameterGrid, load: Load, samples: int = 721,
                  hinge_margin: float = 0.0) -> list[tuple[int, int, _PathTable]]:
-    """Contact-path tables for every (alpha, c) of the grid that can touch the can at all."""
+    """Contact-path tables for every (alpha, c) of the grid that can touch the can at all.
+    (``hinge_margin`` is accepted for compatibility; the tables do not depend on it.)"""
     out = []
     for ia, alpha in enumerate(grid.alpha):
         for ic, c in enumerate(grid.c):
             g = GripperGeometry(geom.a1, geom.a2, geom.a3, geom.b, float(c), geom.d, geom.l1, geom.l2,
                                 geom.r, float(alpha))
-            tab = _table(contact_path(g, load.radius, load.mu, n=samples), load, hinge_margin)
+            tab = _table(contact_path(g, load.radius, load.mu, n=samples), load)
             if tab is not None:
                 out.append((ia, ic, tab))
     return out
@@ -206,119 +233,136 @@ def brute_force(geom: GripperGeometry, grid: ParameterGrid, load: Load, samples:
     return out
 
 
-def _enumerate_box(tab: _PathTable, grid: ParameterGrid, load: Load, hinge_margin: float,
-                   box: tuple[tuple[int, int], ...], best: float = np.inf) -> tuple[float, tuple[int, ...]]:
-    """Exact least Delta N >= 0 over every grid point of a box of (k1, k2, phi01, phi02) indices on
-    one path (inf if none is valid and below ``best``).
+@dataclass
+class _Search:
+    """Incumbent and counters of one :func:`optimise` run."""
 
-    With h1 > 0 on the path the hover condition reads ``k2 phi02 >= sigma(t)`` with
-    ``sigma = (target + k1 (phi1 + phi01) h2) / h1 - k2 phi2``; the first crossing for a preload is
-    where the running minimum of sigma drops to ``k2 phi02``, found for all preloads at once by one
-    sorted search (each row offset so the rows stay ordered).
+    value: float = np.inf
+    where: tuple[int, ...] | None = None
+    points: int = 0
+    verified: int = 0
+
+    def offer(self, value: float, where: tuple[int, ...]) -> None:
+        # ties go to the smallest grid index, so the answer does not depend on the search order
+        if value < self.value or (value == self.value and self.where is not None and where < self.where):
+            self.value, self.where = value, where
+
+
+#: relative widening of the phi02 ranges (sigma form against direct form of the hover condition)
+_RANGE_TOLERANCE = 1e-9
+
+
+def _search_path(tab: _PathTable, bounds: np.ndarray, grid: ParameterGrid, load: Load, hinge_margin: float,
+                 head: tuple[int, int], state: _Search, max_cells: int = 4_000_000) -> np.ndarray:
+    """Value every grid point of one (alpha, c) path whose first hover crossing lies in an interval
+    with ``bounds[i] < state.value``, intervals in order of their bound; updates ``state``.
+
+    Returns the mask of intervals searched for every spring set (the others keep their bound).
     """
-    k1_index, k2_index, p01_index, p02_index = (np.arange(lo, hi + 1) for lo, hi in box)
-    k1 = grid.k1[k1_index][:, None, None]
-    k2 = grid.k2[k2_index][None, :, None]
-    p01 = grid.phi01[p01_index][None, None, :]
-    phi02 = grid.phi02[p02_index]
-    shape = (len(k1_index), len(k2_index), len(p01_index))
-    n = len(tab.phi2)
-    sigma = ((tab.target + (k1[..., None] * (tab.phi1 + p01[..., None])) * tab.h2) / tab.h1
-             - k2[..., None] * tab.phi2)
-    sigma = np.clip(sigma.reshape(-1, n), -_BIG / 4, _BIG / 4)
-    running = np.minimum.accumulate(sigma, axis=1)
-    rows = running.shape[0]
-    offset = np.arange(rows)[:, None] * _BIG
-    keys = (-running + offset).ravel()
-    preload = (k2 * np.ones(shape)).reshape(-1)[:, None] * phi02[None, :]       # k2 phi02 (rows, P)
-    queries = (-preload + offset)
-    i = np.searchsorted(keys, queries.ravel(), side="left").reshape(rows, -1) - (np.arange(rows) * n)[:, None]
-    ok = (i > 0) & (i < n)
-    i = np.clip(i, 1, n - 1)
-    r = np.arange(rows)[:, None]
-    e0 = tab.h1[i - 1] * (preload - sigma[r, i - 1])
-    e1 = tab.h1[i] * (preload - sigma[r, i])
-    w = np.clip(-e0 / np.where(e1 != e0, e1 - e0, 1.0), 0.0, 1.0)
+    k1, k2, p01, p02 = grid.k1, grid.k2, grid.phi01, grid.phi02
+    searched = np.zeros(len(bounds), dtype=bool)
+    wanted = np.nonzero(bounds < state.value)[0]
+    if wanted.size == 0:
+        return searched
+    order = wanted[np.argsort(bounds[wanted], kind="stable")]
+    m = int(wanted.max()) + 1
+    per_k1 = len(p01) * len(k2) * m
+    step = max(1, int(max_cells // per_k1))
+    complete = np.ones(len(bounds), dtype=bool)
+    for start in range(0, len(k1), step):
+        k1_index = np.arange(start, min(start + step, len(k1)))
+        # sigma_j for every triple (k1, phi01, k2) of this block, rows in C order of those three axes
+        spring_c = k1[k1_index][:, None, None] * (tab.phi1[:m] + p01[None, :, None])
+        a = (tab.target[:m] + spring_c * tab.h2[:m]) / tab.h1[:m]
+        sigma = (a[:, :, None, :] - k2[None, None, :, None] * tab.phi2[:m]).reshape(-1, m)
+        running = np.minimum.accumulate(sigma, axis=1)
+        row_k1, row_p01, row_k2 = (ax.ravel() for ax in np.meshgrid(k1_index, np.arange(len(p01)),
+                                                                     np.arange(len(k2)), indexing="ij"))
+        k2_row = k2[row_k2]
+        for i in order:
+            if bounds[i] >= state.value:
+                complete[i] = False
+                continue
+            s, r = sigma[:, i], running[:, i - 1]
+            tol = _RANGE_TOLERANCE * (1.0 + np.abs(s) + np.abs(r))
+            p_lo, p_hi = s - tol, r + tol                  # first crossing at i: p_lo <= k2 phi02 < p_hi
+            rows = np.nonzero((p_lo < p_hi) & (p_lo <= k2_row * p02[-1]) & (p_hi > k2_row * p02[0]))[0]
+            if rows.size == 0:
+                continue
+            kr = k2_row[rows]
+            safe = np.where(kr > 0, kr, 1.0)
+            # k2 = 0: k2 phi02 = 0 for every phi02, inside [p_lo, p_hi) by the row filter above
+            lo = np.where(kr > 0, np.searchsorted(p02, p_lo[rows] / safe, side="left"), 0)
+            hi = np.where(kr > 0, np.searchsorted(p02, p_hi[rows] / safe, side="left"), len(p02))
+            counts = np.maximum(hi - lo, 0)
+            total = int(counts.sum())
+            if total == 0:
+                continue
+            state.points += total
+            rep = np.repeat(rows, counts)
+            j02 = np.repeat(lo - (np.cumsum(counts) - counts), counts) + np.arange(total)
+            kk1, kk2, pp01, pp02 = k1[row_k1[rep]], k2_row[rep], p01[row_p01[rep]], p02[j02]
+            e0 = _excess(tab, i - 1, kk1, kk2, pp01, pp02)
+            e1 = _excess(tab, i, kk1, kk2, pp01, pp02)
+            dn = _value_at_crossing(tab, i, e0, e1, kk1, pp01, load, hinge_margin)
+            _verify(tab, load, hinge_margin, head, state, dn, rep, row_k1, row_p01, row_k2, j02, grid)
+    searched[order] = complete[order]
+    return searched
 
-    dn = tab.g[i - 1] + w * (tab.g[i] - tab.g[i - 1])
-    # only points that would improve on the best so far need the remaining checks
-    cand = np.nonzero(ok & (dn >= 0) & (dn < best))
-    if cand[0].size == 0:
-        return np.inf, (0, 0, 0, 0)
-    ic, wc, dnc = i[cand], w[cand], dn[cand]
 
-    def at(arr: np.ndarray) -> np.ndarray:
-        return arr[ic - 1] + wc * (arr[ic] - arr[ic - 1])
-
-    ph1, ph2 = at(tab.phi1), at(tab.phi2)
-    k1r = np.broadcast_to(k1, shape).reshape(-1)[cand[0]]
-    p01r = np.broadcast_to(p01, shape).reshape(-1)[cand[0]]
-    s1 = k1r * DEG_PER_RAD * (ph1 + p01r)
-    fn2 = load.hover_force
-    h1, d11 = at(tab.h1), at(tab.d11)
-    good = (ph1 >= hinge_margin) & (ph2 >= hinge_margin)
-    good &= ((s1 + fn2 * (d11 + load.mu * at(tab.d12))) / h1 > 0) & ((s1 + (fn2 + dnc) * d11) / h1 > 0)
-    if not good.any():
-        return np.inf, (0, 0, 0, 0)
-    k = int(np.argmin(np.where(good, dnc, np.inf)))
-    row, col = int(cand[0][k]), int(cand[1][k])
-    a, b2, c1 = np.unravel_index(row, shape)
-    return float(dnc[k]), (int(k1_index[a]), int(k2_index[b2]), int(p01_index[c1]), int(p02_index[col]))
-
-
-_BIG = 1.0e9
+def _verify(tab: _PathTable, load: Load, hinge_margin: float, head: tuple[int, int], state: _Search,
+            dn: np.ndarray, rep: np.ndarray, row_k1: np.ndarray, row_p01: np.ndarray, row_k2: np.ndarray,
+            j02: np.ndarray, grid: ParameterGrid) -> None:
+    """Re-evaluate with :func:`evaluate_points`, smallest first, every point whose value beats the
+    incumbent (a point let in by the range tolerance may cross elsewhere: its true value counts)."""
+    pending = np.nonzero(dn <= state.value)[0]
+    pending = pending[np.argsort(dn[pending], kind="stable")]
+    while pending.size:
+        batch, pending = pending[:256], pending[256:]
+        r = rep[batch]
+        i1, i2, j1, j2 = row_k1[r], row_k2[r], row_p01[r], j02[batch]
+        true = evaluate_points(tab, grid.k1[i1], grid.k2[i2], grid.phi01[j1], grid.phi02[j2], load,
+                               hinge_margin)
+        state.verified += len(batch)
+        for b in np.nonzero(np.isfinite(true))[0]:
+            state.offer(float(true[b]), head + (int(i1[b]), int(i2[b]), int(j1[b]), int(j2[b])))
+        pending = pending[dn[pending] <= state.value]
 
 
 def optimise(geom: GripperGeometry, grid: ParameterGrid, load: Load, samples: int = 361,
-             hinge_margin: float = 0.0, leaf_size: int = 40000) -> OptimumResult:
-    """Least Delta N >= 0 over the whole grid, exactly (up to the path sampling), and fast.
+             hinge_margin: float = 0.0) -> OptimumResult:
+    """Least Delta N >= 0 over the whole grid, exactly (for the sampled path), and fast.
 
-    Branch and bound: boxes of grid indices (one (alpha, c) slab each, split along the spring axis with
-    the most indices) are taken in order of their lower bound (:func:`_lower_bound`, the least Delta N
-    any member could reach); a box whose bound is not below the best value found so far is dropped,
-    small boxes are enumerated exactly by :func:`_enumerate_box`. ``lower_bound`` is the least bound
-    of everything dropped: no dropped grid point can beat the optimum.
+    Paths (alpha, c) in order of their least interval bound (:func:`interval_bounds`), on each path the
+    intervals in order of their bound; an interval is searched (:func:`_search_path`: every grid point
+    crossing there valued) only while its bound is below the best value found so far. The first
+    interval searched seeds the incumbent; after it nearly every path and interval is dropped unseen.
     """
-    tables = build_tables(geom, grid, load, samples, hinge_margin)
-    full = ((0, len(grid.k1) - 1), (0, len(grid.k2) - 1), (0, len(grid.phi01) - 1), (0, len(grid.phi02) - 1))
-    heap: list = []
-    boxes = 0
-    for t_index, (_, _, tab) in enumerate(tables):
-        lb = _lower_bound(tab, grid, full)
-        boxes += 1
-        if np.isfinite(lb):
-            heapq.heappush(heap, (lb, boxes, t_index, full))
-    best = (np.inf, None)
-    evaluated = 0
-    dropped = np.inf
-    while heap:
-        lb, _, t_index, box = heapq.heappop(heap)
-        if lb >= best[0]:
-            dropped = min(dropped, lb)
+    tables = build_tables(geom, grid, load, samples)
+    bounds = [interval_bounds(tab, hinge_margin) for _, _, tab in tables]
+    least = np.array([b.min() for b in bounds])
+    state = _Search()
+    searched = [np.zeros(len(b), dtype=bool) for b in bounds]
+    paths_searched = 0
+    for t in np.argsort(least, kind="stable"):
+        if least[t] >= state.value:
             break
-        ia, ic, tab = tables[t_index]
-        sizes = [hi - lo + 1 for lo, hi in box]
-        if int(np.prod(sizes)) <= leaf_size:
-            value, where = _enumerate_box(tab, grid, load, hinge_margin, box, best[0])
-            evaluated += int(np.prod(sizes))
-            if value < best[0]:
-                best = (value, (ia, ic) + where)
-            continue
-        dim = int(np.argmax(sizes))
-        lo, hi = box[dim]
-        mid = (lo + hi) // 2
-        for part in ((lo, mid), (mid + 1, hi)):
-            child = box[:dim] + (part,) + box[dim + 1:]
-            clb = max(_lower_bound(tab, grid, child), lb)
-            boxes += 1
-            if clb < best[0]:
-                heapq.heappush(heap, (clb, boxes, t_index, child))
-            else:
-                dropped = min(dropped, clb)
-    if best[1] is None:
+        ia, ic, tab = tables[t]
+        searched[t] = _search_path(tab, bounds[t], grid, load, hinge_margin, (ia, ic), state)
+        paths_searched += 1
+    if state.where is None:
         raise ValueError("no grid point gives a valid grasp")
-    ia, ic, i1, i2, j1, j2 = best[1]
+    pruned = min((float(b[~s].min()) for b, s in zip(bounds, searched, strict=True) if (~s).any()),
+                 default=np.inf)
+    # the certificate: an interval is left unsearched only when its bound is not below the incumbent,
+    # which only decreases, so everything not searched is bounded by at least the optimum
+    if pruned < state.value:
+        raise RuntimeError(f"compliant optimiser: unsearched bound {pruned} below the optimum {state.value}")
+    ia, ic, i1, i2, j1, j2 = state.where
     return OptimumResult(alpha=float(grid.alpha[ia]), c=float(grid.c[ic]), k1=float(grid.k1[i1]),
                          k2=float(grid.k2[i2]), phi01=float(grid.phi01[j1]), phi02=float(grid.phi02[j2]),
-                         delta_n=best[0], lower_bound=float(min(dropped, best[0])),
-                         grid_points=grid.size, points_evaluated=evaluated, boxes_bounded=boxes)
+                         delta_n=state.value, lower_bound=min(pruned, state.value), pruned_bound=pruned,
+                         grid_points=grid.size, points_evaluated=state.points, points_verified=state.verified,
+                         paths=len(tables), paths_searched=paths_searched,
+                         intervals=int(sum(len(b) - 1 for b in bounds)),
+                         intervals_searched=int(sum(s.sum() for s in searched)))
