@@ -22,10 +22,11 @@ on the open-pose branch); the stroke follows. Everything here is pure numpy.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
-from fabricate.planar import circle_circle_intersection, cross2, perp, unit
+from fabricate.planar import cross2, perp, unit
 
 
 @dataclass(frozen=True)
@@ -70,6 +71,12 @@ class FingerDesign:
         p = g[1:-1] + self.in_arm[:, None] * unit(self.in_angle)
         return np.hypot(*(p - q).T)
 
+    @cached_property
+    def loop_constants(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """Coupler lengths (n-1,), open-pose loop orientations (n-1,) and the rod's open x (mm),
+        computed once per design: the closing solver evaluates thousands of poses of one design."""
+        return self.coupler_lengths(), _open_orientation(self), self.rod_open_x()
+
     def rod_open_x(self) -> float:
         k = self.crank * unit(self.crank_angle)
         dy = k[1] - self.rod_y
@@ -93,15 +100,28 @@ class FingerPose:
     stroke: float
 
 
-def _pick(points: np.ndarray | None, centre: np.ndarray, far: np.ndarray, sign: float) -> np.ndarray | None:
-    """Of two circle intersections, the one that keeps the quadrilateral's open-pose orientation
-    (sign of cross(Q - G, P - Q)): the same assembly mode, never the mirrored one."""
-    if points is None or len(points) == 0:
-        return None
-    pts = np.atleast_2d(points)
-    turn = cross2(pts - centre, far - pts)
-    k = int(np.argmax(turn * sign))
-    return pts[k] if turn[k] * sign > 0 else None
+@dataclass(frozen=True)
+class FingerPoses:
+    """:class:`FingerPose` for m configurations at once (leading axis m); ``valid`` (m,) is False where
+    a loop cannot close (the other entries there are meaningless)."""
+
+    q: np.ndarray            # (m, n)
+    theta: np.ndarray        # (m, n)
+    G: np.ndarray            # (m, n+1, 2)
+    Q: np.ndarray            # (m, n-1, 2)
+    P: np.ndarray            # (m, n-1, 2)
+    psi: np.ndarray          # (m, n-1)
+    K: np.ndarray            # (m, 2)
+    S: np.ndarray            # (m, 2)
+    stroke: np.ndarray       # (m,)
+    valid: np.ndarray        # (m,) bool
+
+    def pose(self, k: int) -> FingerPose | None:
+        """Configuration ``k`` as a :class:`FingerPose` (None if it does not close)."""
+        if not self.valid[k]:
+            return None
+        return FingerPose(q=self.q[k], theta=self.theta[k], G=self.G[k], Q=self.Q[k], P=self.P[k],
+                          psi=self.psi[k], K=self.K[k], S=self.S[k], stroke=float(self.stroke[k]))
 
 
 def _open_orientation(design: FingerDesign) -> np.ndarray:
@@ -109,6 +129,62 @@ def _open_orientation(design: FingerDesign) -> np.ndarray:
     q = g[:-2] + design.out_arm[:, None] * unit(design.out_angle)
     p = g[1:-1] + design.in_arm[:, None] * unit(design.in_angle)
     return np.sign(cross2(q - g[:-2], p - q))
+
+
+def finger_poses(design: FingerDesign, q: np.ndarray, psi_reference: np.ndarray | None = None) -> FingerPoses:
+    """Vectorised :func:`finger_pose` over configurations ``q`` (m, n), rad.
+
+    Of the two circle intersections for Q_i the one keeping the open pose's loop orientation
+    (sign of cross(Q - G, P - Q)) is taken. With e the unit vector G_i -> P_{i+1}, the roots are
+    ``base +- h perp(e)`` and that cross product is ``-+ h d``, so the root is
+    ``base - sign * h * perp(e)`` and exists only for h > 0 (the loop closes with a non-zero turn).
+    ``psi_reference`` (m, n-1) only unwraps the rocker angles (default: the phalanx angle theta_i).
+    """
+    q = np.atleast_2d(np.asarray(q, dtype=np.float64))
+    m, n = q.shape
+    couplers, orientation, rod_open_x = design.loop_constants
+    theta = np.cumsum(q, axis=1)
+    cos_t, sin_t = np.cos(theta), np.sin(theta)
+    G = np.zeros((m, n + 1, 2))
+    G[:, 1:, 0] = np.cumsum(design.lengths * cos_t, axis=1)
+    G[:, 1:, 1] = np.cumsum(design.lengths * sin_t, axis=1)
+    Q = np.zeros((m, n - 1, 2))
+    P = np.zeros((m, n - 1, 2))
+    psi = np.zeros((m, n - 1))
+    valid = np.ones(m, dtype=bool)
+    angle = design.in_angle[n - 2] + theta[:, n - 1]
+    P[:, n - 2, 0] = G[:, n - 1, 0] + design.in_arm[n - 2] * np.cos(angle)
+    P[:, n - 2, 1] = G[:, n - 1, 1] + design.in_arm[n - 2] * np.sin(angle)
+    for i in range(n - 2, -1, -1):           # rocker i+1 (0-based i) about G[i]
+        dx = P[:, i, 0] - G[:, i, 0]
+        dy = P[:, i, 1] - G[:, i, 1]
+        dist = np.hypot(dx, dy)
+        ok = dist > 0.0
+        dist = np.where(ok, dist, 1.0)
+        b, c = design.out_arm[i], couplers[i]
+        a = (b * b - c * c + dist * dist) / (2.0 * dist)
+        h2 = b * b - a * a
+        ok &= (h2 > 0.0) & (orientation[i] != 0.0)
+        h = np.sqrt(np.where(ok, h2, 0.0))
+        ex, ey = dx / dist, dy / dist
+        Q[:, i, 0] = G[:, i, 0] + a * ex + orientation[i] * h * ey
+        Q[:, i, 1] = G[:, i, 1] + a * ey - orientation[i] * h * ex
+        valid &= ok
+        raw = np.arctan2(Q[:, i, 1] - G[:, i, 1], Q[:, i, 0] - G[:, i, 0]) - design.out_angle[i]
+        ref = psi_reference[:, i] if psi_reference is not None else theta[:, i]
+        psi[:, i] = ref + np.arctan2(np.sin(raw - ref), np.cos(raw - ref))   # unwrap near ref
+        if i > 0:
+            angle = design.in_angle[i - 1] + psi[:, i]
+            P[:, i - 1, 0] = G[:, i, 0] + design.in_arm[i - 1] * np.cos(angle)
+            P[:, i - 1, 1] = G[:, i, 1] + design.in_arm[i - 1] * np.sin(angle)
+    angle = design.crank_angle + psi[:, 0]
+    K = design.crank * np.stack([np.cos(angle), np.sin(angle)], -1)
+    rise = K[:, 1] - design.rod_y
+    reach = design.link**2 - rise**2
+    valid &= reach > 0.0
+    S = np.stack([K[:, 0] - np.sqrt(np.where(valid, reach, 0.0)), np.full(m, design.rod_y)], -1)
+    return FingerPoses(q=q, theta=theta, G=G, Q=Q, P=P, psi=psi, K=K, S=S, stroke=S[:, 0] - rod_open_x,
+                       valid=valid)
 
 
 def finger_pose(design: FingerDesign, q: np.ndarray, previous: FingerPose | None = None) -> FingerPose | None:
@@ -119,52 +195,48 @@ def finger_pose(design: FingerDesign, q: np.ndarray, previous: FingerPose | None
     assembly mode. ``previous`` only helps to unwrap the rocker angles.
     """
     q = np.asarray(q, dtype=np.float64)
-    n = design.n
-    theta = np.cumsum(q)
-    G = np.zeros((n + 1, 2))
-    for i in range(n):
-        G[i + 1] = G[i] + design.lengths[i] * unit(theta[i])
-    c = design.coupler_lengths()
-    orientation = _open_orientation(design)
-    Q = np.zeros((n - 1, 2))
-    P = np.zeros((n - 1, 2))
-    psi = np.zeros(n - 1)
-    # P_n rides on phalanx n
-    P[n - 2] = G[n - 1] + design.in_arm[n - 2] * unit(design.in_angle[n - 2] + theta[n - 1])
-    for i in range(n - 2, -1, -1):           # rocker i+1 (0-based i) about G[i]
-        try:
-            roots = circle_circle_intersection(G[i], design.out_arm[i], P[i], c[i])
-        except ValueError:          # the loop cannot close here
-            return None
-        qi = _pick(roots, G[i], P[i], orientation[i])
-        if qi is None:
-            return None
-        Q[i] = qi
-        psi[i] = np.arctan2(*(qi - G[i])[::-1]) - design.out_angle[i]
-        ref = previous.psi[i] if previous is not None else theta[i]
-        psi[i] = ref + np.arctan2(np.sin(psi[i] - ref), np.cos(psi[i] - ref))   # unwrap near ref
-        if i > 0:
-            P[i - 1] = G[i] + design.in_arm[i - 1] * unit(design.in_angle[i - 1] + psi[i])
-    K = design.crank * unit(design.crank_angle + psi[0])
-    dy = K[1] - design.rod_y
-    if abs(dy) >= design.link:
+    ref = previous.psi[None, :] if previous is not None else None
+    pose = finger_poses(design, q[None, :], ref).pose(0)
+    if pose is None:
         return None
-    S = np.array([K[0] - np.sqrt(design.link**2 - dy**2), design.rod_y])
-    return FingerPose(q=q, theta=theta, G=G, Q=Q, P=P, psi=psi, K=K, S=S,
-                      stroke=float(S[0] - design.rod_open_x()))
+    return FingerPose(q=q, theta=pose.theta, G=pose.G, Q=pose.Q, P=pose.P, psi=pose.psi, K=pose.K,
+                      S=pose.S, stroke=pose.stroke)
 
 
 def stroke_gradient(design: FingerDesign, q: np.ndarray, step: float = 1e-6) -> np.ndarray:
-    """d(stroke)/dq_j (mm/rad), shape (n,), by central differences of :func:`finger_pose`."""
-    base = finger_pose(design, q)
-    out = np.zeros(design.n)
-    for j in range(design.n):
-        dq = np.zeros(design.n)
-        dq[j] = step
-        hi = finger_pose(design, q + dq, base)
-        lo = finger_pose(design, q - dq, base)
-        out[j] = (hi.stroke - lo.stroke) / (2 * step)
-    return out
+    """d(stroke)/dq_j (mm/rad), shape (n,), by central differences of :func:`finger_pose` (kept as
+    the independent check of :func:`stroke_gradients` and of the force chain)."""
+    q = np.asarray(q, dtype=np.float64)
+    n = design.n
+    stencil = q + step * np.concatenate([np.eye(n), -np.eye(n)])
+    strokes = finger_poses(design, stencil).stroke
+    return (strokes[:n] - strokes[n:]) / (2 * step)
+
+
+def stroke_gradients(design: FingerDesign, poses: FingerPoses) -> np.ndarray:
+    """d(stroke)/dq_j (mm/rad) at every configuration, shape (m, n), in closed form.
+
+    Virtual work: a unit push on the rod with no springs needs, at joint j, exactly the moment
+    ``ds/dq_j`` to be held. The force chain of :func:`contact_forces` gives that moment: push link
+    force ``1 / u_SK.x``; each rocker passes the moment of its incoming link to its coupler; the
+    moment about G_j of the coupler that drives the distal part (rocker j's input moment for
+    j < n-1, coupler n-1's moment at P_n for the last joint).
+    """
+    n = poses.q.shape[1]
+    u_sk = (poses.K - poses.S) / design.link                          # (m, 2)
+    force = u_sk / u_sk[:, :1]                                        # push link force for unit push
+    arm = poses.K - poses.G[:, 0]
+    grad = np.zeros_like(poses.q)
+    for i in range(n - 1):
+        moment_in = cross2(arm, force)                                # on rocker i about G_i
+        grad[:, i] = moment_in
+        coupler = poses.P[:, i] - poses.Q[:, i]
+        coupler = coupler / np.hypot(coupler[:, 0], coupler[:, 1])[:, None]
+        tension = moment_in / cross2(poses.Q[:, i] - poses.G[:, i], coupler)
+        force = tension[:, None] * coupler
+        arm = poses.P[:, i] - poses.G[:, i + 1]
+    grad[:, n - 1] = cross2(arm, force)                               # coupler n-1 on phalanx n at P_n
+    return grad
 
 
 def transmission_ratios(pose: FingerPose) -> np.ndarray:
