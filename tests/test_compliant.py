@@ -219,6 +219,11 @@ def test_mechanism_sweeps_the_closing_motion():
     assert all(v[:8] == b"\x89PNG\r\n\x1a\n" for v in pngs.values())
 
 
+def test_template_checks_interference_over_at_least_360_poses():
+    raw = tomllib.loads((ROOT / "templates" / "gripper_compliant.toml").read_text())
+    assert raw["checks"]["sweep_poses"] >= 360
+
+
 def test_spec_errors_name_the_field():
     raw = _raw()
     raw["finger"]["d_mm"] = -1.0

@@ -16,7 +16,7 @@ Delta N = G(t_{i-1}) + w (G(t_i) - G(t_{i-1})) with w in [0, 1] (linear interpol
 
 1. every interval has an exact lower bound L_i: the least of that linear G over the part of the
    interval where both hinges keep ``hinge_margin`` off their stops and G >= 0 (both linear in w too)
-   (:func:`interval_bounds`; 178 paths x about 40 intervals for the paper's grid, a few ms);
+   (:func:`interval_bounds`; 178 paths x about 33 intervals for the paper's grid, about 30 ms);
 2. intervals are searched in order of L_i, path by path in order of their least L_i; the first ones
    give a good incumbent at once, and an interval with L_i >= the incumbent is dropped unsearched;
 3. searching interval i of a path finds *every* grid point whose first crossing is there, without
