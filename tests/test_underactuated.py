@@ -21,8 +21,10 @@ from fabricate.synthesis.underactuated_model import (
     crank_rate,
     distal_rate,
     finger_pose,
+    finger_poses,
     palmar_normal,
     stroke_gradient,
+    stroke_gradients,
     transmission_ratios,
     virtual_work_forces,
 )
@@ -119,6 +121,9 @@ def test_closing_on_cylinder_sequence_and_forces():
     assert np.all(forces > 0)
     assert np.allclose(forces, DATA["contact_forces_N"], atol=DATA["force_tolerance_N"])
     motion = res.data["motion"]
+    assert motion.fallbacks == 0 and res.data["free"].fallbacks == 0     # every equilibrium by Newton
+    assert np.allclose(rep["final_joint_angles_deg"], DATA["final_joint_angles_deg"],
+                       atol=DATA["angle_tolerance_deg"])
     # stroke and sticking: each phalanx keeps its angle once it touched
     for i, s in zip(motion.contact_order, motion.contact_strokes, strict=True):
         after = motion.strokes >= s
@@ -152,3 +157,70 @@ def test_spec_errors_name_the_field():
 
 def test_unit_helper_consistency():
     assert np.allclose(palmar_normal(0.3), unit(0.3 + np.pi / 2))
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(angles, min_size=1, max_size=6))
+def test_batched_poses_equal_single_poses(qs):
+    batch = finger_poses(DESIGN, np.array(qs))
+    for k, q in enumerate(qs):
+        single = finger_pose(DESIGN, np.array(q))
+        assert (single is None) == (not batch.valid[k])
+        if single is not None:
+            for field in ("G", "Q", "P", "psi", "K", "S"):
+                assert np.allclose(getattr(batch, field)[k], getattr(single, field), rtol=0, atol=1e-12)
+            assert abs(batch.stroke[k] - single.stroke) < 1e-12
+
+
+def test_closed_form_stroke_gradient_matches_differences():
+    qs = np.random.default_rng(7).uniform(0.0, 0.9, (40, 3))
+    poses = finger_poses(DESIGN, qs)
+    closed = stroke_gradients(DESIGN, poses)
+    for k in range(len(qs)):
+        fd = stroke_gradient(DESIGN, qs[k])
+        # central differences with h = 1e-6 carry ~1e-10 mm/rad of rounding
+        assert np.allclose(closed[k], fd, rtol=1e-7, atol=1e-8)
+    # a wrong sign or a missing link in the chain would break this at the open pose
+    assert np.all(closed[0] != 0)
+
+
+def test_face_clearance_gradient_matches_differences():
+    qs = np.random.default_rng(11).uniform(0.0, 0.9, (20, 3))
+    centre, radius = SPEC.cylinder_centre, SPEC.cylinder_radius
+    gaps, points, grads = ua.face_geometry(DESIGN, finger_poses(DESIGN, qs), centre, radius)
+    h = 1e-6
+    for i in range(3):
+        dq = np.zeros(3)
+        dq[i] = h
+        hi = ua.face_geometry(DESIGN, finger_poses(DESIGN, qs + dq), centre, radius)[0]
+        lo = ua.face_geometry(DESIGN, finger_poses(DESIGN, qs - dq), centre, radius)[0]
+        assert np.allclose(grads[:, :, i], (hi - lo) / (2 * h), atol=1e-6)
+    single = ua.face_clearance(DESIGN, finger_pose(DESIGN, qs[3]), centre, radius)
+    assert np.allclose(single[0], gaps[3], atol=1e-12) and np.allclose(single[1], points[3], atol=1e-12)
+
+
+def _frozen_before(touching, idx):
+    hits = np.nonzero(touching[:idx].any(axis=0))[0]
+    return int(hits.max()) + 1 if hits.size else 0
+
+
+@pytest.mark.parametrize("with_object", [True, False])
+def test_newton_equilibria_match_slsqp(with_object):
+    """Every stroke sample of the closing (stops, contacts and frozen joints included) is the one SLSQP
+    finds on the same problem from the same start. At 21 samples the stroke after the lock lies beyond
+    the push link's reach, where Newton gives up and SLSQP (once) confirms the lock."""
+    motion = ua.closing_motion(SPEC, with_object=with_object, samples=21)
+    assert motion.fallbacks == (1 if with_object else 0)
+    settler = ua._Settler(SPEC, with_object)
+    last = len(motion.strokes) - (2 if with_object else 1)        # the lock sample comes from bisection
+    for idx in range(1, last + 1):
+        frozen = _frozen_before(motion.touching, idx) if with_object else 0
+        ref, ok = settler._slsqp(motion.strokes[idx], motion.q[idx - 1], frozen)
+        assert ok
+        assert np.allclose(motion.q[idx], ref, atol=1e-7), idx
+    if with_object:
+        # the same lock as at the template's 41 samples (both bisect to 0.75 / 2^18 mm or finer)
+        assert motion.touching[-1].all() and motion.contact_order == [0, 1, 2]
+        assert abs(motion.strokes[-1] - DATA["contact_strokes_mm"][2]) < 1e-5
+    else:
+        assert np.all(motion.q[:, 2] == 0.0)      # the distal preload keeps joint 3 on its stop

@@ -155,6 +155,7 @@ class ClosingMotion:
     contact_order: list          # phalanx indices in the order they first touch
     contact_strokes: list        # stroke (mm) at each first touch
     with_object: bool
+    fallbacks: int = 0           # equilibria the active-set Newton left to SLSQP
 
 
 _UPPER_STOP = 0.6 * np.pi          # rad, the joints' closed stop (far beyond any grasp)
@@ -207,8 +208,8 @@ class _Settler:
             stencil[1 + np.arange(nf), free] += step
             stencil[1 + nf + np.arange(nf), free] -= step
             ev = self.evaluate(stencil)
-            if not ev["valid"][0]:
-                return None
+            if not ev["valid"][0] or not np.isfinite(ev["ds"]).all():
+                return None              # a loop opened or the push link reached its dead point
             grads = [ev["ds"]] + [ev["dgaps"][:, j] for j in contacts]   # each (1+2nf, n)
             normals = np.stack([g[0, free] for g in grads], -1)           # (nf, 1+nc)
             values = np.array([ev["stroke"][0] - target] + [ev["gaps"][0, j] for j in contacts])
@@ -303,8 +304,10 @@ class _Settler:
                 if mu < worst:
                     worst, release = mu, ("contact", j)
             if release is None:
-                self.lower, self.upper, self.contacts = lower, upper, contacts
-                return x_new, self._acceptable(x_new, target)
+                ok = self._acceptable(x_new, target)
+                if ok:
+                    self.lower, self.upper, self.contacts = lower, upper, contacts
+                return x_new, ok
             {"lower": lower, "upper": upper, "contact": contacts}[release[0]].discard(release[1])
             x = x_new
         self.fallbacks += 1
@@ -334,12 +337,14 @@ class _Settler:
                        jac=lambda x: k * (x + q0) / scale, method="SLSQP", constraints=cons,
                        bounds=bounds, options={"ftol": 1e-13, "maxiter": max_iter})
         x = np.clip(res.x, [b[0] for b in bounds], [b[1] for b in bounds])
-        self.lower = {i for i in range(frozen, n) if x[i] <= 1e-12}
-        self.upper = {i for i in range(frozen, n) if x[i] >= _UPPER_STOP - 1e-12}
-        if self.with_object:
-            gaps = self.evaluate(x[None])["gaps"][0]
-            self.contacts = {j for j in range(frozen, n) if gaps[j] < 1e-9}
-        return x, self._acceptable(x, target)
+        ok = self._acceptable(x, target)
+        if ok:                       # a failed attempt must not leave its guesses for the next stroke
+            self.lower = {i for i in range(frozen, n) if x[i] <= 1e-12}
+            self.upper = {i for i in range(frozen, n) if x[i] >= _UPPER_STOP - 1e-12}
+            if self.with_object:
+                gaps = self.evaluate(x[None])["gaps"][0]
+                self.contacts = {j for j in range(frozen, n) if gaps[j] < 1e-9}
+        return x, ok
 
 
 def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: int | None = None,
@@ -372,16 +377,13 @@ def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: i
             # the unfrozen phalanges cannot follow the stroke without entering the object: the finger
             # locked in between; bisect for the stroke where it locks and end there
             lo, hi, x_lo = strokes[idx - 1], strokes[idx], q
-            active = (settler.lower, settler.upper, settler.contacts)
             for _ in range(18):
                 mid = 0.5 * (lo + hi)
                 x_mid, ok_mid = settler.settle(mid, x_lo, frozen)
                 if ok_mid:
                     lo, x_lo = mid, x_mid
-                    active = (settler.lower, settler.upper, settler.contacts)
                 else:
                     hi = mid
-                    settler.lower, settler.upper, settler.contacts = active
             strokes[idx], x = lo, x_lo
         q = x
         qs[idx] = q
@@ -405,7 +407,8 @@ def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: i
             order.append(i)
             at.append(float(strokes[hits[0]]))
     ranked = sorted(zip(at, order, strict=True))
-    return ClosingMotion(strokes, qs, touching, [i for _, i in ranked], [s for s, _ in ranked], with_object)
+    return ClosingMotion(strokes, qs, touching, [i for _, i in ranked], [s for s, _ in ranked], with_object,
+                         settler.fallbacks)
 
 
 def final_contact_forces(spec: UnderactuatedSpec, motion: ClosingMotion) -> dict:

@@ -220,11 +220,13 @@ def stroke_gradients(design: FingerDesign, poses: FingerPoses) -> np.ndarray:
     ``ds/dq_j`` to be held. The force chain of :func:`contact_forces` gives that moment: push link
     force ``1 / u_SK.x``; each rocker passes the moment of its incoming link to its coupler; the
     moment about G_j of the coupler that drives the distal part (rocker j's input moment for
-    j < n-1, coupler n-1's moment at P_n for the last joint).
+    j < n-1, coupler n-1's moment at P_n for the last joint). Not finite where the push link stands
+    square to the rod (its dead point: the rod cannot turn the crank) or where a pose does not close.
     """
     n = poses.q.shape[1]
     u_sk = (poses.K - poses.S) / design.link                          # (m, 2)
-    force = u_sk / u_sk[:, :1]                                        # push link force for unit push
+    with np.errstate(divide="ignore", invalid="ignore"):              # inf/nan at the link's dead point
+        force = u_sk / u_sk[:, :1]                                    # push link force for unit push
     arm = poses.K - poses.G[:, 0]
     grad = np.zeros_like(poses.q)
     for i in range(n - 1):
