@@ -159,14 +159,14 @@ def test_interval_bounds_hold_for_every_point_of_a_path():
 
 
 def test_search_in_blocks_gives_the_same_optimum(monkeypatch):
-    """Long paths or fine grids are searched in blocks of k1 (bounded memory): same answer."""
+    """Long paths or fine grids are searched in blocks of k1 and of points (bounded memory): same answer."""
     import fabricate.synthesis.compliant_optimise as co
 
     grid = ParameterGrid(np.radians([80.0, 85.0]), np.arange(0, 3.0), np.arange(0, 31.0, 3),
                          np.arange(0, 31.0, 3), np.radians(np.arange(0, 181, 6.0)), np.radians(np.arange(0, 181, 4.0)))
     margin = np.radians(5.0)
     whole = optimise(GEOM, grid, LOAD, samples=121, hinge_margin=margin)
-    monkeypatch.setattr(co._search_path, "__defaults__", (2000,))
+    monkeypatch.setattr(co._search_path, "__defaults__", (2000, 500))
     blocks = optimise(GEOM, grid, LOAD, samples=121, hinge_margin=margin)
     assert blocks.delta_n == whole.delta_n and (blocks.k1, blocks.k2, blocks.phi01, blocks.phi02) == (
         whole.k1, whole.k2, whole.phi01, whole.phi02)

@@ -253,11 +253,14 @@ _RANGE_TOLERANCE = 1e-9
 
 
 def _search_path(tab: _PathTable, bounds: np.ndarray, grid: ParameterGrid, load: Load, hinge_margin: float,
-                 head: tuple[int, int], state: _Search, max_cells: int = 4_000_000) -> np.ndarray:
+                 head: tuple[int, int], state: _Search, max_cells: int = 4_000_000,
+                 max_points: int = 1_000_000) -> np.ndarray:
     """Value every grid point of one (alpha, c) path whose first hover crossing lies in an interval
     with ``bounds[i] < state.value``, intervals in order of their bound; updates ``state``.
 
-    Returns the mask of intervals searched for every spring set (the others keep their bound).
+    ``max_cells`` caps the sigma table (triples x samples, one block of k1 at a time) and
+    ``max_points`` the points valued at once. Returns the mask of intervals searched for every spring
+    set (the others keep their bound).
     """
     k1, k2, p01, p02 = grid.k1, grid.k2, grid.phi01, grid.phi02
     searched = np.zeros(len(bounds), dtype=bool)
@@ -295,17 +298,21 @@ def _search_path(tab: _PathTable, bounds: np.ndarray, grid: ParameterGrid, load:
             lo = np.where(kr > 0, np.searchsorted(p02, p_lo[rows] / safe, side="left"), 0)
             hi = np.where(kr > 0, np.searchsorted(p02, p_hi[rows] / safe, side="left"), len(p02))
             counts = np.maximum(hi - lo, 0)
-            total = int(counts.sum())
-            if total == 0:
-                continue
-            state.points += total
-            rep = np.repeat(rows, counts)
-            j02 = np.repeat(lo - (np.cumsum(counts) - counts), counts) + np.arange(total)
-            kk1, kk2, pp01, pp02 = k1[row_k1[rep]], k2_row[rep], p01[row_p01[rep]], p02[j02]
-            e0 = _excess(tab, i - 1, kk1, kk2, pp01, pp02)
-            e1 = _excess(tab, i, kk1, kk2, pp01, pp02)
-            dn = _value_at_crossing(tab, i, e0, e1, kk1, pp01, load, hinge_margin)
-            _verify(tab, load, hinge_margin, head, state, dn, rep, row_k1, row_p01, row_k2, j02, grid)
+            state.points += int(counts.sum())
+            # value the points in blocks of about max_points (bounded memory however many cross here)
+            cuts = np.searchsorted(np.cumsum(counts), np.arange(max_points, counts.sum(), max_points))
+            for part in np.split(np.arange(rows.size), cuts):
+                c = counts[part]
+                total = int(c.sum())
+                if total == 0:
+                    continue
+                rep = np.repeat(rows[part], c)
+                j02 = np.repeat(lo[part] - (np.cumsum(c) - c), c) + np.arange(total)
+                kk1, kk2, pp01, pp02 = k1[row_k1[rep]], k2_row[rep], p01[row_p01[rep]], p02[j02]
+                e0 = _excess(tab, i - 1, kk1, kk2, pp01, pp02)
+                e1 = _excess(tab, i, kk1, kk2, pp01, pp02)
+                dn = _value_at_crossing(tab, i, e0, e1, kk1, pp01, load, hinge_margin)
+                _verify(tab, load, hinge_margin, head, state, dn, rep, row_k1, row_p01, row_k2, j02, grid)
     searched[order] = complete[order]
     return searched
 
