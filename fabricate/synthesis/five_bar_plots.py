@@ -6,30 +6,19 @@ tags in the PNG metadata, fixed size and dpi.
 
 from __future__ import annotations
 
-import io
 from typing import Any
 
 import numpy as np
+
+from fabricate.plotting import png_bytes, pyplot
 
 #: Figure size (inches) and resolution shared by every plot.
 FIGSIZE = (6.4, 4.8)
 DPI = 100
 
 
-def _pyplot() -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _png(fig: Any) -> bytes:
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=DPI, metadata={"Software": None})
-    _pyplot().close(fig)
-    return buffer.getvalue()
+    return png_bytes(fig, DPI)
 
 
 def _draw_finger(ax: Any, targets: Any, index: int, **style: Any) -> None:
@@ -50,7 +39,7 @@ def _branch_lines(ax: Any, points: np.ndarray, branch: np.ndarray, mask: np.ndar
 
 def hinge_curves_png(data: Any) -> bytes:
     """Fig 8: the A- and B-curves at the first pose with the finger and the chosen hinges."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=FIGSIZE)
     dom, t = data.domain, data.targets
     every = np.ones(len(dom.status), dtype=bool)
@@ -75,7 +64,7 @@ def hinge_curves_png(data: Any) -> bytes:
 
 def feasible_domain_png(data: Any) -> bytes:
     """Fig 9: the feasible parts of the hinge curves inside the limits box for A."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(FIGSIZE[0] * 1.5, FIGSIZE[1]))
     dom, spec = data.domain, data.spec
     ok = dom.feasible
@@ -105,7 +94,7 @@ def feasible_domain_png(data: Any) -> bytes:
 
 def gear_ratio_png(data: Any) -> bytes:
     """Fig 10: transmission ratio and pitch radii over the working range."""
-    plt = _pyplot()
+    plt = pyplot()
     law = data.dyad.law
     fig, (ax_i, ax_r) = plt.subplots(2, 1, figsize=FIGSIZE, sharex=True)
     x = np.degrees(law.x)
@@ -124,7 +113,7 @@ def gear_ratio_png(data: Any) -> bytes:
 
 def trajectory_png(data: Any) -> bytes:
     """Fig 12: fingertip trajectory of the solved mechanism with the target poses."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=FIGSIZE)
     t, motion = data.targets, data.motion
     tip = motion.point("P", "distal")

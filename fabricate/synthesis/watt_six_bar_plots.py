@@ -5,29 +5,16 @@ sizes); nothing is written to disk here.
 
 from __future__ import annotations
 
-import io
-
 import numpy as np
 
+from fabricate.plotting import png_bytes, pyplot
 from fabricate.synthesis.watt_six_bar_burmester import CubicCurve, grid_in_range, sample_curve
 
 _BRANCH_COLOURS = ("tab:blue", "tab:orange", "tab:green")
 
 
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _png(fig) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, metadata={"Software": None})
-    _pyplot().close(fig)
-    return buf.getvalue()
+    return png_bytes(fig, 110)
 
 
 def _view(boxes: list[np.ndarray], margin: float = 0.6) -> tuple[float, float, float, float]:
@@ -56,7 +43,7 @@ def _draw_box(ax, box: np.ndarray, name: str, colour: str = "0.3") -> None:
 
 def plot_curve_d(spec, region, choice) -> bytes:
     """C_d and C_e (whole curves near the boxes), the feasible segments of C_d and the chosen d, e."""
-    plt = _pyplot()
+    plt = pyplot()
     one = region.stage_one
     box_d, box_e = spec.box("d"), spec.box("e")
     view = _view([box_d, box_e])
@@ -91,7 +78,7 @@ def plot_curve_d0(spec, finger, choice) -> bytes:
     """C_d0 and C_f for the chosen dyad d-e, with the boxes and the chosen d0, f."""
     from fabricate.synthesis.watt_six_bar_region import stage_two_curves
 
-    plt = _pyplot()
+    plt = pyplot()
     curve_d0, curve_f = stage_two_curves(finger, choice.d, choice.e)
     box_d0, box_f = spec.box("d0"), spec.box("f")
     view = _view([box_d0, box_f])
@@ -116,7 +103,7 @@ def plot_curve_d0(spec, finger, choice) -> bytes:
 
 def plot_region(spec, region, refined, choice) -> bytes:
     """The solution region (d_x, d0_x) coloured by K; K > limit grey, circuit defects hollow."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(8.0, 6.0))
     finite = np.isfinite(region.K)
     over = finite & (region.K > spec.k_max)
