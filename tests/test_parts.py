@@ -215,12 +215,14 @@ def test_pins_and_spacers_fill_the_stack(four_bar, sla_process):
 def test_bom_copies_springs_and_purchased(four_bar, sla_process):
     hints = {"copies": 3, "springs": [{"joint": "A", "rate_Nmm_per_deg": 30.0, "preload_deg": 5.0,
                                        "legs_mm": 10.0, "note": "torsion"}],
-             "purchased": [{"item": "micro servo", "qty": 1, "note": "driver"}]}
+             "purchased": [{"item": "micro servo", "qty": 1, "note": "driver"}],
+             "purchased_shared": [{"item": "base plate", "qty": 1, "note": "holds all copies"}]}
     partset = build_parts(design_for(sla_process), four_bar, four_bar.sweep(61), [], hints)
     pins = sum(row["qty"] for row in partset.bom if row["kind"] == "pin")
     assert pins == 3 * len(four_bar.joints)
     assert next(r for r in partset.bom if r["kind"] == "spring")["qty"] == 3
-    assert next(r for r in partset.bom if r["kind"] == "purchased")["qty"] == 3
+    assert next(r for r in partset.bom if r["item"] == "micro servo")["qty"] == 3
+    assert next(r for r in partset.bom if r["item"] == "base plate")["qty"] == 1
     json.dumps(partset.bom)  # JSON-ready
 
 

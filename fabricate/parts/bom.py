@@ -161,4 +161,9 @@ def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Map
         rows.append({"item": str(item.get("item", "item")), "kind": "purchased",
                      "qty": int(item.get("qty", 1)) * copies, "joints": [],
                      "description": str(item.get("note", ""))})
+    # items shared by all copies (one drive for a three-finger gripper) are not multiplied
+    for item in hints.get("purchased_shared", ()) or ():
+        rows.append({"item": str(item.get("item", "item")), "kind": "purchased",
+                     "qty": int(item.get("qty", 1)), "joints": [],
+                     "description": str(item.get("note", "")), "shared": True})
     return rows
