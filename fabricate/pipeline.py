@@ -7,6 +7,7 @@ failed run never leaves half a result.
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import shutil
 import tempfile
@@ -125,7 +126,7 @@ def run_build(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
         Invalid input or nothing feasible (the CLI exits 2 and writes nothing).
     """
     from fabricate.checks import run_checks
-    from fabricate.export import export_all
+    from fabricate.export import export_all, export_previews
     from fabricate.gears import build_gear_pairs
     from fabricate.parts.build import build_parts
 
@@ -147,8 +148,11 @@ def run_build(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     report["gears"] = [pair.report() for pair in gear_pairs]
     progress("parts")
     partset = build_parts(design, mechanism, motion, gear_pairs, result.parts)
+    # pictures take as long as everything else: draw them in a forked child on the second core
+    pictures = Background([result.figures, lambda: gear_pictures(gear_pairs),
+                           lambda: export_previews(design, partset, motion)])
     progress("exports")
-    exported, parts_report = export_all(design, partset, mechanism, motion)
+    exported, parts_report = export_all(design, partset, mechanism, motion, previews=False)
     files.update(exported)
     report["parts"] = parts_report
     report["bom"] = list(getattr(partset, "bom", []))
@@ -160,19 +164,73 @@ def run_build(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
         failures += [f"gear {pair.name}: {text}" for text in pair.failures()]
     report["checks"] = {"passed": not failures, "failures": failures}
     progress("plots")
-    for name, data in sorted(result.figures().items()):
-        files[f"plots/{name}"] = data
     for name, data in sorted(checks.figures().items()):
         files[f"plots/{name}"] = data
-    if gear_pairs:
-        from fabricate.export.gear_plots import pair_gif, pair_png
-
-        for pair in gear_pairs:
-            x_mid = 0.5 * (pair.working_range[0] + pair.working_range[1])
-            files[f"gears/{pair.name}_mesh.png"] = pair_png(pair, x_mid)
-            files[f"gears/{pair.name}_turning.gif"] = pair_gif(pair, 36)
+    files.update(pictures.result())
     return _finish(report, files, exit_code=0 if not failures else 1, synthesis=result, motion=motion,
                    partset=partset, gear_pairs=gear_pairs, checks=checks)
+
+
+def gear_pictures(gear_pairs: list[Any]) -> dict[str, bytes]:
+    """Each gear pair in mesh (PNG, mid-range) and turning (GIF)."""
+    if not gear_pairs:
+        return {}
+    from fabricate.export.gear_plots import pair_gif, pair_png
+
+    files = {}
+    for pair in gear_pairs:
+        x_mid = 0.5 * (pair.working_range[0] + pair.working_range[1])
+        files[f"gears/{pair.name}_mesh.png"] = pair_png(pair, x_mid)
+        files[f"gears/{pair.name}_turning.gif"] = pair_gif(pair, 36)
+    return files
+
+
+def _run_jobs(jobs: list[Callable[[], dict[str, bytes]]]) -> dict[str, bytes]:
+    files: dict[str, bytes] = {}
+    for job in jobs:
+        files.update(job())
+    return files
+
+
+def _child(jobs: list[Callable[[], dict[str, bytes]]], conn: Any) -> None:
+    try:
+        conn.send((True, _run_jobs(jobs)))
+    except BaseException as exc:  # the parent redoes the work serially and raises there
+        conn.send((False, repr(exc)))
+    finally:
+        conn.close()
+
+
+class Background:
+    """Run jobs returning ``{path: bytes}`` in a forked child process while the caller goes on.
+
+    Where ``fork`` is unavailable, or ``FABRICATE_SERIAL`` is set, or the child fails, the jobs run in
+    the calling process when :meth:`result` is asked for, so the outcome never depends on it.
+    """
+
+    def __init__(self, jobs: list[Callable[[], dict[str, bytes]]]) -> None:
+        self.jobs = jobs
+        self._process = None
+        if os.environ.get("FABRICATE_SERIAL") or "fork" not in multiprocessing.get_all_start_methods():
+            return
+        ctx = multiprocessing.get_context("fork")
+        self._conn, sender = ctx.Pipe(duplex=False)
+        self._process = ctx.Process(target=_child, args=(jobs, sender), daemon=True)
+        self._process.start()
+        sender.close()
+
+    def result(self) -> dict[str, bytes]:
+        if self._process is not None:
+            try:
+                ok, payload = self._conn.recv()
+            except (EOFError, OSError):
+                ok, payload = False, None
+            self._conn.close()
+            self._process.join()
+            self._process = None
+            if ok:
+                return payload
+        return _run_jobs(self.jobs)
 
 
 def _finish(report: dict[str, Any], files: dict[str, bytes], **kw: Any) -> BuildOutcome:

@@ -36,7 +36,7 @@ def _bom_csv(rows: list[dict[str, Any]]) -> bytes:
     return buffer.getvalue().encode("utf-8")
 
 
-def export_all(design: Any, partset: Any, mechanism: Any, motion: Any
+def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews: bool = True
                ) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
     """Every export of a part set.
 
@@ -49,6 +49,8 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any
     mechanism : Mechanism
     motion : Motion
         The sweep; its first pose is the assembly pose.
+    previews : bool
+        Include the preview pictures (the pipeline draws them separately, see :func:`export_previews`).
 
     Returns
     -------
@@ -65,7 +67,6 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any
         When a written STL does not read back as a closed solid (a bug, never a design finding).
     """
     from fabricate.export.dxf import kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
-    from fabricate.export.previews import assembly_png, motion_gif
     from fabricate.export.stl import (
         SolidCache,
         assembly_3mf,
@@ -110,8 +111,18 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any
     files["assembly.3mf"] = assembly_3mf(parts, cache, first, title=design.name)
     files["sheet.dxf"] = sheet_dxf(parts, kerf, sheet, plate_area)
     files["kinematic.dxf"] = kinematic_dxf(mechanism, first)
-    tip = partset.hints.get("tip_point") if hasattr(partset, "hints") else None
-    files["previews/assembly.png"] = assembly_png(parts, motion, spec.preview_poses, tip, title=design.name)
-    files["previews/motion.gif"] = motion_gif(parts, motion, spec.gif_frames)
+    if previews:
+        files.update(export_previews(design, partset, motion))
     files["bom.csv"] = _bom_csv(list(partset.bom))
     return files, entries
+
+
+def export_previews(design: Any, partset: Any, motion: Any) -> dict[str, bytes]:
+    """The assembly at several poses (PNG) and its motion (GIF), keyed by relative path."""
+    from fabricate.export.previews import assembly_png, motion_gif
+
+    parts = list(partset.parts)
+    spec = design.parts
+    tip = partset.hints.get("tip_point") if hasattr(partset, "hints") else None
+    return {"previews/assembly.png": assembly_png(parts, motion, spec.preview_poses, tip, title=design.name),
+            "previews/motion.gif": motion_gif(parts, motion, spec.gif_frames)}
