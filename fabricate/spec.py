@@ -406,5 +406,10 @@ def load_design(path: str | Path) -> DesignSpec:
     parts = parse_parts_spec(root.table("parts", {}))
     method = KINDS[kind].parse_spec(root)
     root.finish()
+    bore = getattr(gears, "bore_mm", None)
+    if bore is not None and abs(bore - process.pin_diameter_mm) > 1e-9:
+        # every joint, gear axes included, turns on a pin of the process diameter
+        raise SpecError("gears.bore_mm", f"{bore:g} mm differs from the pin diameter {process.pin_diameter_mm:g} mm "
+                                         "the gears turn on; set process.pin_diameter_mm to it or leave bore_mm out")
     return DesignSpec(name=name, kind=kind, description=description, template=path, process=process,
                       checks=checks, gears=gears, parts=parts, method=method)

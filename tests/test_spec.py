@@ -85,3 +85,17 @@ def test_shipped_templates_exclude_process_profiles():
                 max_size=20))
 def test_valid_number_lists_round_trip(values):
     assert np.array_equal(check_array(values, "v"), np.asarray(values, dtype=np.float64))
+
+
+def test_gear_bore_must_match_the_pin(tmp_path):
+    from fabricate.spec import load_design
+
+    text = ("[design]\nname = 'g'\nkind = 'gear_pair'\n[gear_pair]\nfamily = 'elliptic'\neccentricity = 0.2\n"
+            "closed = true\n[gears]\nmodule_mm = 1.0\nteeth = [30, 30]\nbore_mm = 3.0\n")
+    path = tmp_path / "g.toml"
+    path.write_text(text)
+    with pytest.raises(SpecError, match="differs from the pin diameter 2 mm") as info:
+        load_design(path)
+    assert info.value.path == "gears.bore_mm"
+    path.write_text(text.replace("[gear_pair]", "[process]\npin_diameter_mm = 3.0\n[gear_pair]"))
+    assert load_design(path).gears.bore_mm == 3.0
