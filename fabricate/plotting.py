@@ -20,6 +20,27 @@ def pyplot() -> Any:
     return plt
 
 
+def figure(size: tuple[float, float], dpi: float) -> Any:
+    """A standalone figure (not registered with pyplot) on an Agg canvas."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=size, dpi=dpi)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def gif_bytes(images: list[Any], frame_ms: int, **options: Any) -> bytes:
+    """Animated GIF (looping) of Pillow images."""
+    buffer = io.BytesIO()
+    images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:], duration=frame_ms, loop=0,
+                   **options)
+    return buffer.getvalue()
+
+
 def png_bytes(fig: Any, dpi: float | None = None) -> bytes:
     """Render a figure to PNG bytes and release it.
 

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import io
-
 import numpy as np
 
 from fabricate.checks.interference import InterferenceResult
+from fabricate.plotting import png_bytes, pyplot
 
 #: Pairs drawn: the closest ones (the others are in the report's table).
 MAX_PAIRS = 12
@@ -19,11 +18,7 @@ def clearance_png(result: InterferenceResult, max_pairs: int = MAX_PAIRS) -> byt
     away from their closest pose) dotted. Colliding poses are marked on the zero line.
     Deterministic bytes (no timestamps in the metadata).
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     # spacers bearing on their joint touch by design: leave them to the table
     shown = [p for p in result.pairs if p.relation != "bearing"]
     pairs = sorted(shown, key=lambda p: (p.min_clearance_mm, p.a, p.b))[:max_pairs]
@@ -49,7 +44,4 @@ def clearance_png(result: InterferenceResult, max_pairs: int = MAX_PAIRS) -> byt
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     # fixed margins (tight_layout would draw the figure twice)
     fig.subplots_adjust(left=0.07, right=0.75, bottom=0.11, top=0.92)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None})
-    plt.close(fig)
-    return buf.getvalue()
+    return png_bytes(fig)

@@ -6,29 +6,17 @@ Gears are drawn in the carrier frame: axis A at the origin, axis B at ``(a, 0)``
 
 from __future__ import annotations
 
-import io
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
+from fabricate.plotting import figure, gif_bytes, png_bytes
+
 
 def _figure(size: tuple[float, float] = (6.0, 4.0), dpi: int = 100) -> tuple[Any, Any]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=size, dpi=dpi)
-    FigureCanvasAgg(fig)
+    fig = figure(size, dpi)
     return fig, fig.add_subplot(1, 1, 1)
-
-
-def _png(fig: Any) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None})
-    return buf.getvalue()
 
 
 def _placed(pair: Any, x_a: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -62,14 +50,7 @@ def _draw_pair(ax: Any, pair: Any, x_a: float, zoom: bool) -> None:
 
 def pair_png(pair: Any, x_a: float) -> bytes:
     """The pair in mesh at driving angle ``x_a`` (rad): whole pair and a zoom on the pitch point."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(10.0, 4.6), dpi=110)
-    FigureCanvasAgg(fig)
+    fig = figure((10.0, 4.6), 110)
     ax1, ax2 = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
     _draw_pair(ax1, pair, x_a, zoom=False)
     _draw_pair(ax2, pair, x_a, zoom=True)
@@ -84,7 +65,7 @@ def pair_png(pair: Any, x_a: float) -> bytes:
         ax.set_xlabel("x (mm)")
         ax.tick_params(labelsize=7)
     fig.subplots_adjust(left=0.06, right=0.98, bottom=0.12, top=0.92, wspace=0.15)
-    return _png(fig)
+    return png_bytes(fig)
 
 
 def pair_gif(pair: Any, frames: int) -> bytes:
@@ -120,9 +101,7 @@ def pair_gif(pair: Any, frames: int) -> bytes:
         fig.canvas.draw()
         rgba = np.asarray(fig.canvas.buffer_rgba())
         images.append(Image.fromarray(rgba[..., :3].copy()).convert("P", palette=Image.ADAPTIVE, colors=64))
-    buf = io.BytesIO()
-    images[0].save(buf, format="GIF", save_all=True, append_images=images[1:], duration=80, loop=0)
-    return buf.getvalue()
+    return gif_bytes(images, 80)
 
 
 def law_png(law: Callable, working_range: tuple[float, float], center_distance_mm: float) -> bytes:
@@ -138,4 +117,4 @@ def law_png(law: Callable, working_range: tuple[float, float], center_distance_m
     ax2.set_ylabel("transmission ratio i = -law'")
     ax.set_title(f"gear law, centre distance {center_distance_mm:.3f} mm", fontsize=9)
     fig.subplots_adjust(left=0.12, right=0.86, bottom=0.14, top=0.9)
-    return _png(fig)
+    return png_bytes(fig)

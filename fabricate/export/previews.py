@@ -7,7 +7,6 @@ colour, holes as background discs.
 
 from __future__ import annotations
 
-import io
 from collections.abc import Sequence
 from typing import Any
 
@@ -15,6 +14,7 @@ import numpy as np
 
 from fabricate.parts.model import Part, circle_polygon
 from fabricate.planar import transform_points
+from fabricate.plotting import gif_bytes, png_bytes, pyplot
 
 #: Layer colours (RGB 0-255), cycled.
 PALETTE = [(31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189),
@@ -66,11 +66,9 @@ def assembly_png(parts: Sequence[Part], motion: Any, poses: int = 4, tip_point: 
     title : str
         Figure title.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
+
+    plt = pyplot()
 
     shapes = _shapes(parts)
     indices = pose_indices(len(motion.inputs), poses)
@@ -114,10 +112,7 @@ def assembly_png(parts: Sequence[Part], motion: Any, poses: int = 4, tip_point: 
         fig.suptitle(title, fontsize=9)
     # fixed margins: tight_layout costs more than the drawing itself
     fig.subplots_adjust(left=0.06, right=0.99, bottom=0.14, top=0.86, wspace=0.08)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=100, metadata={"Software": None})
-    plt.close(fig)
-    return buffer.getvalue()
+    return png_bytes(fig, 100)
 
 
 def motion_gif(parts: Sequence[Part], motion: Any, frames: int = 24, size_px: int = 360,
@@ -169,7 +164,4 @@ def motion_gif(parts: Sequence[Part], motion: Any, frames: int = 24, size_px: in
                     draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=0)
         images.append(image)
     sequence = images + images[-2:0:-1]
-    buffer = io.BytesIO()
-    sequence[0].save(buffer, format="GIF", save_all=True, append_images=sequence[1:], duration=frame_ms,
-                     loop=0, optimize=False, disposal=1)
-    return buffer.getvalue()
+    return gif_bytes(sequence, frame_ms, optimize=False, disposal=1)
