@@ -403,35 +403,33 @@ class _System:
                 r[3 * self.index[reference] + 2] -= 1.0
             return r
 
+        def projection(body_a: str, body_b: str, pa_local: np.ndarray, pb_local: np.ndarray,
+                       direction: np.ndarray) -> None:
+            """Row and value of (p_b - p_a) . u, u a unit direction fixed in body_a."""
+            u_world = rotation(self._pose(q, body_a)[2]) @ (direction / np.hypot(*direction))
+            pa, pb = world(body_a, pa_local), world(body_b, pb_local)
+            r = row()
+            grad = [np.zeros(n), np.zeros(n)]
+            add_point_terms(grad, body_b, pb_local, 1.0)
+            add_point_terms(grad, body_a, pa_local, -1.0)
+            r += grad[0] * u_world[0] + grad[1] * u_world[1]
+            if body_a in self.index:  # u turns with body_a
+                r[3 * self.index[body_a] + 2] += float(np.dot(pb - pa, np.array([-u_world[1], u_world[0]])))
+            res.append(float(np.dot(pb - pa, u_world)))
+
         rev_res, rev_jac = self._revolute_block(q)
         rows.extend(rev_jac)
         res.extend(rev_res)
         dres_ds.extend([0.0] * len(rev_res))
-        for j in self.others:
-            pa_local = self.bodies[j.body_a].point(j.name)
-            pb_local = self.bodies[j.body_b].point(j.name)
-            pa, pb = world(j.body_a, pa_local), world(j.body_b, pb_local)
-            if True:
-                tha = self._pose(q, j.body_a)[2]
-                thb = self._pose(q, j.body_b)[2]
-                angle_row(j.body_b, j.body_a)
-                res.append(thb - tha - j.angle)
-                dres_ds.append(0.0)
-                # (pb - pa) . n_world = 0, n = axis turned +90 deg in body_a's frame
-                axis = np.asarray(j.axis, dtype=np.float64)
-                axis = axis / np.hypot(*axis)
-                n_local = np.array([-axis[1], axis[0]])
-                n_world = rotation(tha) @ n_local
-                r = row()
-                gx = [np.zeros(n), np.zeros(n)]
-                add_point_terms(gx, j.body_b, pb_local, 1.0)
-                add_point_terms(gx, j.body_a, pa_local, -1.0)
-                r += gx[0] * n_world[0] + gx[1] * n_world[1]
-                if j.body_a in self.index:
-                    dn = np.array([-n_world[1], n_world[0]])
-                    r[3 * self.index[j.body_a] + 2] += float(np.dot(pb - pa, dn))
-                res.append(float(np.dot(pb - pa, n_world)))
-                dres_ds.append(0.0)
+        for j in self.others:  # sliders: relative rotation locked, point b on a's line
+            angle_row(j.body_b, j.body_a)
+            res.append(self._pose(q, j.body_b)[2] - self._pose(q, j.body_a)[2] - j.angle)
+            dres_ds.append(0.0)
+            # (pb - pa) . n = 0 with n the slide axis turned +90 deg, fixed in body_a
+            axis = np.asarray(j.axis, dtype=np.float64)
+            projection(j.body_a, j.body_b, self.bodies[j.body_a].point(j.name), self.bodies[j.body_b].point(j.name),
+                       np.array([-axis[1], axis[0]]))
+            dres_ds.append(0.0)
         for g in self.mech.gears:
             thc = self._pose(q, g.carrier)[2]
             xa = self._pose(q, g.gear_a)[2] - thc
@@ -450,22 +448,9 @@ class _System:
                 res.append(self._pose(q, d.body)[2] - self._pose(q, d.reference)[2] - value)
             else:
                 slider = next(j for j in self.mech.joints if j.name == d.joint)
-                pa_local = self.bodies[d.reference].point(d.joint)
-                pb_local = self.bodies[d.body].point(d.joint)
-                pa, pb = world(d.reference, pa_local), world(d.body, pb_local)
-                axis = np.asarray(slider.axis, dtype=np.float64)
-                axis = axis / np.hypot(*axis)
-                tha = self._pose(q, d.reference)[2]
-                a_world = rotation(tha) @ axis
-                r = row()
-                gx = [np.zeros(n), np.zeros(n)]
-                add_point_terms(gx, d.body, pb_local, 1.0)
-                add_point_terms(gx, d.reference, pa_local, -1.0)
-                r += gx[0] * a_world[0] + gx[1] * a_world[1]
-                if d.reference in self.index:
-                    da = np.array([-a_world[1], a_world[0]])
-                    r[3 * self.index[d.reference] + 2] += float(np.dot(pb - pa, da))
-                res.append(float(np.dot(pb - pa, a_world)) - value)
+                projection(d.reference, d.body, self.bodies[d.reference].point(d.joint),
+                           self.bodies[d.body].point(d.joint), np.asarray(slider.axis, dtype=np.float64))
+                res[-1] -= value
             dres_ds.append(-dvalue)
         jac = np.array(rows).reshape(len(res), n) if want_jacobian else None
         return np.asarray(res), jac, np.asarray(dres_ds)
