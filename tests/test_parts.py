@@ -434,3 +434,20 @@ def test_overlapping_holes_are_reported(four_bar, sla_process):
     assert any(w.startswith("part crank: holes O and A overlap by 0.700 mm") for w in partset.warnings)
     plain = build_parts(design_for(sla_process), four_bar, four_bar.sweep(11), [], {})
     assert plain.warnings == ()
+
+
+def test_pad_segment_is_the_circular_segment():
+    from fabricate.parts.build import pad_segment
+    from fabricate.planar import polygon_area
+
+    centre = np.array([40.0, 36.0])
+    start, end = np.array([40.0, 0.0]), np.array([76.0, 36.0])  # a quarter arc of radius 36
+    ring = pad_segment(centre, start, end, 0.005)
+    exact = 0.5 * 36.0**2 * (math.pi / 2 - 1.0)
+    assert polygon_area(ring) > 0
+    # inscribed chords lose at most sagitta x arc length
+    assert exact - 0.005 * 36.0 * math.pi / 2 <= polygon_area(ring) <= exact
+    assert np.allclose(np.hypot(*(ring - centre).T)[1:-1], 36.0)  # every vertex but the chord ends lies on the arc
+    assert np.all(ring[:, 0] - ring[:, 1] >= 40.0 - 1e-9)  # the segment lies beyond the chord x - y = 40
+    with pytest.raises(GeometryError, match="not one circle"):
+        pad_segment(centre, start, np.array([70.0, 36.0]), 0.005)

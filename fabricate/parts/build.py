@@ -48,7 +48,7 @@ from fabricate.parts.layers import assign_layers, conflict_graph, layer_z, order
 from fabricate.parts.model import BulgePath, Hole, Part, circle_polygon
 from fabricate.parts.profiles import circle_hull, fuse_polygons
 from fabricate.parts.spec import PartsSpec
-from fabricate.planar import rotation
+from fabricate.planar import polygon_area, rotation, wrap_angle
 from fabricate.spec import ProcessSpec
 
 #: Chord tolerance (mm) of the coarse outlines used only for the layer conflict test.
@@ -291,6 +291,7 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
     for name, body, centre in pin_holes:
         holes[body].append(Hole(name, centre, sizes.hole_mm, sizes.pin_mm))
 
+    fused_polys: dict[str, list[np.ndarray]] = {b.name: [] for b in mechanism.bodies}
     for body, pad in dict(hints.get("pads", {})).items():
         if body not in circles:
             raise GeometryError(f"pad hint names unknown body {body!r}")
@@ -298,15 +299,20 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
         if pad.get("point") not in points:
             raise GeometryError(f"pad hint: body {body!r} has no point {pad.get('point')!r}")
         r_pad = parts_spec.pad_radius_mm or float(pad.get("radius_mm", radius))
-        circles[body].append((mechanism.body(body).point(pad["point"]), max(r_pad, radius)))
+        centre = mechanism.body(body).point(pad["point"])
+        if "arc" in pad:  # a curved face: the circular segment between two named points on the circle
+            ends = [mechanism.body(body).point(name) for name in pad["arc"]]
+            circles[body] += [(ends[0], radius), (ends[1], radius)]
+            fused_polys[body].append(pad_segment(centre, ends[0], ends[1], tol))
+        else:
+            circles[body].append((centre, max(r_pad, radius)))
 
-    gear_polys: dict[str, list[np.ndarray]] = {b.name: [] for b in mechanism.bodies}
     gear_of: dict[str, list[str]] = {b.name: [] for b in mechanism.bodies}
     for pair in gear_pairs:
         for side in ("a", "b"):
             body, axis, outline = gear_outline_in_body(mechanism, pair, side)
             centre = mechanism.body(body).point(axis)
-            gear_polys[body] += [outline, circle_polygon(centre, sizes.hub_mm, tol)]
+            fused_polys[body] += [outline, circle_polygon(centre, sizes.hub_mm, tol)]
             gear_of[body].append(pair.name)
 
     ground = mechanism.ground
@@ -315,11 +321,11 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
         centres = np.array([c for c, _ in circles[body]]) if circles[body] else np.zeros((1, 2))
         radii = np.array([r for _, r in circles[body]]) if circles[body] else np.array([radius])
         path = circle_hull(centres, radii)
-        return fuse_polygons(path, gear_polys[body], tol) if gear_polys[body] else path
+        return fuse_polygons(path, fused_polys[body], tol) if fused_polys[body] else path
 
     # moving bodies first: the ground's mounting holes keep clear of where they sweep
     outlines: dict[str, BulgePath] = {b.name: profile(b.name) for b in mechanism.bodies if b.name != ground}
-    _add_mounting(mechanism, motion, ground, circles, holes, gear_polys, sizes, parts_spec,
+    _add_mounting(mechanism, motion, ground, circles, holes, fused_polys, sizes, parts_spec,
                   swept_region(outlines, motion), process.running_clearance_mm)
     outlines[ground] = profile(ground)
     outlines = {b.name: outlines[b.name] for b in mechanism.bodies}
@@ -479,9 +485,26 @@ def swept_region(outlines: Mapping[str, BulgePath], motion: Motion, poses: int =
     return shapely.union_all(shapes) if shapes else shapely.Polygon()
 
 
+def pad_segment(centre: np.ndarray, start: np.ndarray, end: np.ndarray, chord_tolerance_mm: float) -> np.ndarray:
+    """The circular segment cut from the circle about ``centre`` by the chord ``start``–``end`` (the minor
+    arc's side), as a CCW polygon (n, 2) whose arc has sagitta ≤ the tolerance.
+
+    Raises
+    ------
+    GeometryError
+        When the two points are not on one circle about ``centre``.
+    """
+    r0, r1 = float(np.hypot(*(start - centre))), float(np.hypot(*(end - centre)))
+    if abs(r0 - r1) > 1e-6 * max(r0, 1.0) or r0 == 0.0:
+        raise GeometryError(f"pad arc ends are {r0:.4g} and {r1:.4g} mm from the pad centre: not one circle")
+    turn = float(wrap_angle(np.arctan2(*(end - centre)[::-1]) - np.arctan2(*(start - centre)[::-1])))
+    ring = BulgePath(np.array([start, end]), np.array([np.tan(turn / 4.0), 0.0])).polygon(chord_tolerance_mm)
+    return ring if polygon_area(ring) > 0 else ring[::-1]
+
+
 def _add_mounting(mechanism: Mechanism, motion: Motion, ground: str,
                   circles: dict[str, list[tuple[np.ndarray, float]]], holes: dict[str, list[Hole]],
-                  gear_polys: dict[str, list[np.ndarray]], sizes: Sizes, parts_spec: PartsSpec,
+                  fused_polys: dict[str, list[np.ndarray]], sizes: Sizes, parts_spec: PartsSpec,
                   swept: Any, clearance_mm: float) -> None:
     """Mounting holes on the ground part: a row on the side away from the moving bodies, pushed out until
     the screw heads (the mounting bosses) keep the clearance from everything that moves."""
@@ -496,7 +519,7 @@ def _add_mounting(mechanism: Mechanism, motion: Motion, ground: str,
     direction = away / norm if norm > 1e-6 else np.array([0.0, -1.0])
     side = np.array([-direction[1], direction[0]])
     reach = float(np.max(own @ direction)) + sizes.boss_radius_mm
-    for poly in gear_polys[ground]:
+    for poly in fused_polys[ground]:
         reach = max(reach, float(np.max(poly @ direction)))
     r_mount = sizes.mount_boss_radius_mm
     pitch = 2.0 * r_mount + 2.0

@@ -223,7 +223,7 @@ def build_mechanism(spec: CompliantSpec, motion: GripperMotion, name: str) -> Me
         Body("root", {"A": (0.0, 0.0), "B": (g.a1, 0.0)}),
         Body("middle", {"B": (0.0, 0.0), "C": (g.a2, 0.0)}),
         Body("tip", {"C": (0.0, 0.0), "D": (g.a3, 0.0), "E": (g.a3, g.c), "pad": (g.a3 + g.b, g.r),
-                     "tip": (g.a3 + g.b + g.r, g.r)}),
+                     "pad_start": (g.a3 + g.b, 0.0), "tip": (g.a3 + g.b + g.r, g.r)}),
         Body("two_force_rod", {"E": (0.0, 0.0), "M": (g.d, 0.0)}),
         Body("drive_rod", {"M": (0.0, 0.0), "drive": (0.0, 30.0)}),
     )
@@ -338,7 +338,8 @@ def synthesise(design) -> SynthesisResult:
             {"joint": "B", "rate_Nmm_per_deg": spec.springs.k2, "preload_deg": float(np.degrees(spec.springs.phi02)),
              "legs_mm": spec.spring_legs, "note": "large torsion spring, middle hinge (k2)"},
         ],
-        "pads": {"tip": {"point": "pad", "radius_mm": g.r}},
+        # the fingertip arc of radius r runs from its tangent point on the phalanx to the tip
+        "pads": {"tip": {"point": "pad", "radius_mm": g.r, "arc": ["pad_start", "tip"]}},
         # per finger (the BOM layer multiplies these by "copies")
         "purchased": [
             {"item": "tip drive rod, 4 mm steel, threaded end", "qty": 1, "note": "pushes the two-force rod"},
