@@ -328,32 +328,40 @@ class _System:
                                   default=1.0))
         revolutes = [j for j in mech.joints if isinstance(j, Revolute)]
         self.others = [j for j in mech.joints if not isinstance(j, Revolute)]
-        # revolute constraints are most of every mechanism: keep them as index arrays
-        self.rev_a = np.array([self.index.get(j.body_a, -1) for j in revolutes], dtype=np.int64)
-        self.rev_b = np.array([self.index.get(j.body_b, -1) for j in revolutes], dtype=np.int64)
-        self.rev_la = np.array([self.bodies[j.body_a].point(j.name) for j in revolutes]).reshape(-1, 2)
-        self.rev_lb = np.array([self.bodies[j.body_b].point(j.name) for j in revolutes]).reshape(-1, 2)
+        # revolute constraints are most of every mechanism: both ends of all of them at once, with
+        # the Jacobian's constant (+-1) entries and the flat positions of its angle entries precomputed
+        k = len(revolutes)
+        self.rev_body = np.array([[self.index.get(j.body_a, -1) for j in revolutes],
+                                  [self.index.get(j.body_b, -1) for j in revolutes]], dtype=np.int64).reshape(2, k)
+        self.rev_local = np.array([[self.bodies[j.body_a].point(j.name) for j in revolutes],
+                                   [self.bodies[j.body_b].point(j.name) for j in revolutes]]).reshape(2, k, 2)
+        sign = np.array([1.0, -1.0])[:, None]
+        free = self.rev_body >= 0
+        rows = np.broadcast_to(np.arange(k), (2, k))[free]
+        cols = 3 * self.rev_body[free]
+        self.rev_free = free
+        self.rev_sign = np.broadcast_to(sign, (2, k))[free]
+        self.rev_const = np.zeros((2 * k, self.n))
+        self.rev_const[2 * rows, cols] = self.rev_sign
+        self.rev_const[2 * rows + 1, cols + 1] = self.rev_sign
+        self.rev_flat_x = (2 * rows) * self.n + cols + 2
+        self.rev_flat_y = (2 * rows + 1) * self.n + cols + 2
 
     def _revolute_block(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Residuals (2k,) and Jacobian rows (2k, n) of the k revolute joints."""
-        k = len(self.rev_a)
-        poses = np.vstack([q.reshape(-1, 3), np.zeros((1, 3))])  # index -1 is the ground
-        jac = np.zeros((2 * k, self.n))
-        res = np.zeros(2 * k)
-        rows = np.arange(k)
-        for idx, local, sign in ((self.rev_a, self.rev_la, 1.0), (self.rev_b, self.rev_lb, -1.0)):
-            th = poses[idx, 2]
-            c, s = np.cos(th), np.sin(th)
-            wx = c * local[:, 0] - s * local[:, 1]
-            wy = s * local[:, 0] + c * local[:, 1]
-            res[0::2] += sign * (wx + poses[idx, 0])
-            res[1::2] += sign * (wy + poses[idx, 1])
-            free = idx >= 0
-            r, b = rows[free], idx[free]
-            jac[2 * r, 3 * b] += sign
-            jac[2 * r + 1, 3 * b + 1] += sign
-            jac[2 * r, 3 * b + 2] += sign * -wy[free]
-            jac[2 * r + 1, 3 * b + 2] += sign * wx[free]
+        poses = np.vstack([q.reshape(-1, 3), np.zeros((1, 3))])[self.rev_body]  # (2, k, 3); -1 is the ground
+        c, s = np.cos(poses[..., 2]), np.sin(poses[..., 2])
+        local = self.rev_local
+        wx = c * local[..., 0] - s * local[..., 1]
+        wy = s * local[..., 0] + c * local[..., 1]
+        res = np.empty(2 * local.shape[1])
+        res[0::2] = (wx + poses[..., 0])[0] - (wx + poses[..., 0])[1]
+        res[1::2] = (wy + poses[..., 1])[0] - (wy + poses[..., 1])[1]
+        jac = self.rev_const.copy()
+        flat = jac.reshape(-1)
+        # the two ends of one joint are different bodies: no entry is written twice
+        flat[self.rev_flat_x] = -self.rev_sign * wy[self.rev_free]
+        flat[self.rev_flat_y] = self.rev_sign * wx[self.rev_free]
         return res, jac
 
     def _pose(self, q: np.ndarray, name: str) -> np.ndarray:
