@@ -68,40 +68,45 @@ def pair_png(pair: Any, x_a: float) -> bytes:
     return png_bytes(fig)
 
 
-def pair_gif(pair: Any, frames: int) -> bytes:
+def pair_gif(pair: Any, frames: int, size_px: int = 384, frame_ms: int = 80) -> bytes:
     """The pair turning through its working range, ``frames`` frames, as an animated GIF.
 
-    One figure is drawn once; each frame only moves the two gear patches (fast and deterministic).
+    Drawn with Pillow on a fixed palette (no per-frame quantising): fast and deterministic. The
+    carrier frame is drawn with axis A at the origin and y up.
     """
-    from matplotlib.patches import Polygon as PolygonPatch
-    from PIL import Image
+    from PIL import Image, ImageDraw
 
     lo, hi = pair.working_range
     xs = np.linspace(lo, hi, int(frames), endpoint=not pair.closed)
     out_a0, out_b0, _, _ = _placed(pair, lo)
     centre_b = np.array([pair.center_distance_mm, 0.0])
-    reach = max(np.abs(out_a0).max(), np.abs(out_b0 - centre_b).max())
-    fig, ax = _figure((4.8, 3.2), 80)
-    patch_a = PolygonPatch(out_a0, closed=True, fc="#4c72b0", ec="#1f3b63", alpha=0.6, lw=0.6)
-    patch_b = PolygonPatch(out_b0, closed=True, fc="#dd8452", ec="#7a3d17", alpha=0.6, lw=0.6)
-    ax.add_patch(patch_a)
-    ax.add_patch(patch_b)
-    for centre in ((0.0, 0.0), tuple(centre_b)):
-        ax.plot(*centre, "k+", ms=5)
-    ax.set_aspect("equal")
-    ax.set_xlim(-reach * 1.05, pair.center_distance_mm + reach * 1.05)
-    ax.set_ylim(-reach * 1.05, reach * 1.05)
-    ax.set_axis_off()
-    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.99)
+    reach = 1.05 * max(np.abs(out_a0).max(), np.abs(out_b0 - centre_b).max())
+    lo_xy = np.array([-reach, -reach])
+    scale = size_px / float(pair.center_distance_mm + 2.0 * reach)
+    width, height = size_px, max(16, int(round(2.0 * reach * scale)))
+
+    def pixels(points: np.ndarray) -> list[tuple[float, float]]:
+        x = (points[:, 0] - lo_xy[0]) * scale
+        y = height - (points[:, 1] - lo_xy[1]) * scale  # image y points down
+        return [(round(float(a), 2), round(float(b), 2)) for a, b in zip(x, y, strict=True)]
+
+    # index 0 white, 1 dark outline, 2 gear a, 3 gear b
+    palette = [255, 255, 255, 40, 40, 40, 76, 114, 176, 221, 132, 82]
+    palette += [0] * (768 - len(palette))
     images = []
     for x in xs:
         out_a, out_b, _, _ = _placed(pair, float(x))
-        patch_a.set_xy(out_a)
-        patch_b.set_xy(out_b)
-        fig.canvas.draw()
-        rgba = np.asarray(fig.canvas.buffer_rgba())
-        images.append(Image.fromarray(rgba[..., :3].copy()).convert("P", palette=Image.ADAPTIVE, colors=64))
-    return gif_bytes(images, 80)
+        image = Image.new("P", (width, height), 0)
+        image.putpalette(palette)
+        draw = ImageDraw.Draw(image)
+        draw.polygon(pixels(out_a), fill=2, outline=1)
+        draw.polygon(pixels(out_b), fill=3, outline=1)
+        for centre, bore in ((np.zeros(2), pair.bore_a_mm), (centre_b, pair.bore_b_mm)):
+            (cx, cy), = pixels(centre[None, :])
+            r = 0.5 * bore * scale
+            draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=0, outline=1)
+        images.append(image)
+    return gif_bytes(images, frame_ms, optimize=False, disposal=1)
 
 
 def law_png(law: Callable, working_range: tuple[float, float], center_distance_mm: float) -> bytes:
