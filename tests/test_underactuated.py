@@ -219,8 +219,37 @@ def test_newton_equilibria_match_slsqp(with_object):
         assert ok
         assert np.allclose(motion.q[idx], ref, atol=1e-7), idx
     if with_object:
-        # the same lock as at the template's 41 samples (both bisect to 0.75 / 2^18 mm or finer)
+        # the same lock as at the template's 41 samples (both located to 1e-6 mm)
         assert motion.touching[-1].all() and motion.contact_order == [0, 1, 2]
         assert abs(motion.strokes[-1] - DATA["contact_strokes_mm"][2]) < 1e-5
     else:
         assert np.all(motion.q[:, 2] == 0.0)      # the distal preload keeps joint 3 on its stop
+
+
+def test_events_located_and_driver_laws_match_a_dense_solve():
+    """Contacts and stop releases between stroke samples are located (not snapped to the 0.375 mm grid)
+    and the drivers, split at them, follow a 601-sample solve (0.025 mm grid, events not located: an
+    independent reference whose contact strokes are late by at most one step)."""
+    res = ua.synthesise(types.SimpleNamespace(method=SPEC, name="finger"))
+    motion = res.data["motion"]
+    dense = ua.closing_motion(SPEC, samples=601, locate_events=False)
+    step = SPEC.stroke / 600
+    assert dense.contact_order == motion.contact_order
+    for coarse, fine in zip(motion.contact_strokes, dense.contact_strokes, strict=True):
+        assert -step - 1e-9 <= coarse - fine <= 1e-6          # located at or before the dense sample
+        assert abs(coarse - fine) < 0.05
+    # both contacts before the lock are events (with the stop releases they cause)
+    assert all(np.min(np.abs(np.array(motion.events) - s)) < 1e-9 for s in motion.contact_strokes[:2])
+    inside = dense.strokes <= motion.strokes[-1]
+    for i, driver in enumerate(res.mechanism.drivers[1:]):
+        law = driver.law
+        assert np.max(np.abs(law(dense.strokes[inside]) - dense.q[inside, i])) < 1e-3   # rad
+        # the derivative the mechanism's velocity solve uses, against differences of the law itself
+        x = np.linspace(0.1, motion.strokes[-1] - 0.1, 97)
+        x = x[np.min(np.abs(x[:, None] - np.array(motion.events)[None]), axis=1) > 2e-4]
+        fd = (law(x + 1e-5) - law(x - 1e-5)) / 2e-5
+        assert np.allclose(law(x, 1), fd, atol=1e-5)
+        assert isinstance(law(1.0), float)
+    # without locating, the coarse grid snaps the first contact to a sample 0.3 mm late
+    snapped = ua.closing_motion(SPEC, locate_events=False)
+    assert snapped.contact_strokes[0] - dense.contact_strokes[0] > 0.3

@@ -12,7 +12,8 @@ theta_dot_{n+1} = E_n theta_dot_n and the statics, but gives no dimensions. This
   mobility, and
 - returns a 1-input :class:`~fabricate.mechanism.Mechanism`: the push rod is a slider with a "slide"
   driver over the stroke; the n-1 phalanx angles the actuator does not fix are "angle" drivers whose
-  laws (monotone cubic interpolants of stroke -> relative angle) come from the closing solution.
+  laws (cubic splines of stroke -> relative angle, split where a contact or a stop changes the
+  motion, :class:`PiecewiseLaw`) come from the closing solution.
 """
 
 from __future__ import annotations
@@ -20,8 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
-from scipy.optimize import minimize
+from scipy.optimize import brentq, minimize
 
 from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute, Slider
@@ -32,6 +32,7 @@ from fabricate.synthesis.underactuated_model import (
     FingerDesign,
     FingerPose,
     FingerPoses,
+    PiecewiseLaw,
     contact_forces,
     crank_rate,
     distal_rate,
@@ -156,6 +157,7 @@ class ClosingMotion:
     contact_strokes: list        # stroke (mm) at each first touch
     with_object: bool
     fallbacks: int = 0           # equilibria the active-set Newton left to SLSQP
+    events: tuple = ()           # strokes (mm) where the active set changed: kinks of q(stroke)
 
 
 _UPPER_STOP = 0.6 * np.pi          # rad, the joints' closed stop (far beyond any grasp)
@@ -184,6 +186,13 @@ class _Settler:
         self.upper: set[int] = set()             # joints on their closed stop
         self.contacts: set[int] = set()          # faces on the cylinder
         self.fallbacks = 0
+
+    def state(self) -> tuple[set, set, set]:
+        """The active set (settle replaces these sets, never edits them, so references suffice)."""
+        return self.lower, self.upper, self.contacts
+
+    def restore(self, state: tuple[set, set, set]) -> None:
+        self.lower, self.upper, self.contacts = state
 
     # derivatives at m configurations ------------------------------------------------------------
     def evaluate(self, q: np.ndarray) -> dict:
@@ -313,6 +322,69 @@ class _Settler:
         self.fallbacks += 1
         return self._slsqp(target, start, frozen)
 
+    def margin(self, target: float, start: np.ndarray, frozen: int, state: tuple | None = None) -> float:
+        """How far the active set ``state`` (default: the current one) still holds at stroke ``target``.
+
+        The equilibrium with that set fixed (Newton from ``start``) is measured by its smallest slack:
+        free joint angles off their stops (rad), faces off the cylinder (mm), stop torques (N·mm) and
+        contact multipliers. Positive: the set still holds; negative (or -inf if no equilibrium with
+        that set exists): an event happened before ``target``. Only the sign and the zero matter.
+        """
+        lower, upper, contacts = self.state() if state is None else state
+        n = self.design.n
+        movable = [i for i in range(n) if i >= frozen]
+        lower = sorted(i for i in lower if i >= frozen)
+        upper = sorted(i for i in upper if i >= frozen)
+        contacts = sorted(j for j in contacts if j >= frozen) if self.with_object else []
+        free = np.array([i for i in movable if i not in lower and i not in upper], dtype=int)
+        if len(free) < 1 + len(contacts):
+            return -np.inf
+        x = np.asarray(start, dtype=np.float64).copy()
+        x[lower] = 0.0
+        x[upper] = _UPPER_STOP
+        solved = self._newton(x, free, contacts, target)
+        if solved is None:
+            return -np.inf
+        x_new, mult, ev = solved
+        slack = [x_new[free], _UPPER_STOP - x_new[free], mult[1:]]
+        residual = self.rates * (x_new + self.preloads) - mult[0] * ev["ds"][0]
+        for mu, j in zip(mult[1:], contacts, strict=True):
+            residual = residual - mu * ev["dgaps"][0, j]
+        slack += [residual[lower], -residual[upper]]
+        if self.with_object:
+            slack.append(ev["gaps"][0, [j for j in movable if j not in contacts]])
+        return float(np.min(np.concatenate(slack)))
+
+    def locate_event(self, lo: float, hi: float, x_lo: np.ndarray, frozen: int, resolution: float
+                     ) -> tuple[float, np.ndarray, bool, bool]:
+        """The first change of the current active set in strokes (lo, hi] and the equilibrium there.
+
+        The change is the root of :meth:`margin` (positive at ``lo``), found by Brent's method to
+        ``resolution`` (mm); -inf past a lost equilibrium keeps the bracket. Returns (stroke, q, ok,
+        event): the equilibrium just past the change (ok, event) or, if none settles there (the finger
+        locked), the last one before it (not ok).
+        """
+        state = self.state()
+
+        def margin(s: float) -> float:
+            return max(self.margin(s, x_lo, frozen, state), -1e6)
+
+        if margin(lo) <= 0.0:             # the set at lo was no equilibrium set (the open pose on all
+            x, ok = self.settle(hi, x_lo, frozen)          # its stops): nothing to locate
+            return (hi, x, True, False) if ok else (lo, np.asarray(x_lo, dtype=np.float64), False, False)
+        if margin(hi) > 0.0:            # no change of this set: the settle took another branch
+            root = hi
+        else:
+            root = brentq(margin, lo, hi, xtol=0.25 * resolution)
+        past = min(root + 0.5 * resolution, hi)
+        x, ok = self.settle(past, x_lo, frozen)
+        if ok:
+            return past, x, True, True
+        self.restore(state)
+        before = max(root - 0.5 * resolution, lo)
+        x, ok = self.settle(before, x_lo, frozen)
+        return before, x, False, False
+
     def _acceptable(self, x: np.ndarray, target: float) -> bool:
         """The reference test of an equilibrium: stroke met and no face inside the cylinder."""
         ev = self.evaluate(x[None])
@@ -348,7 +420,7 @@ class _Settler:
 
 
 def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: int | None = None,
-                   stroke: float | None = None) -> ClosingMotion:
+                   stroke: float | None = None, locate_events: bool = True) -> ClosingMotion:
     """Least spring energy at each stroke, joints >= 0 (open stops), phalanges outside the cylinder.
 
     With the object the motion ends at the template's stroke or where every phalanx touches (the
@@ -358,57 +430,83 @@ def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: i
     minimum of the spring energy on the set of configurations with that stroke; following it from the
     open pose with warm starts keeps the physical branch. As in the chapter (section 2.2, "assumed not
     to turn"), a phalanx that meets the object sticks there: its joint and the proximal ones freeze.
+
+    Where the active set changes between two stroke samples (a face meets the cylinder, a joint
+    leaves or reaches a stop) the joint angles have a kink; with ``locate_events`` the stroke of that
+    event is found by bisection (to 1e-6 mm) and inserted as a sample, so contact strokes do not snap
+    to the stroke grid and the driver laws can be split there (``ClosingMotion.events``). Without it
+    (the reference for tests) an event is only seen at the next grid sample.
     """
     d = spec.design
     m = samples or spec.samples
-    strokes = np.linspace(0.0, spec.stroke if stroke is None else stroke, m)
-    q = np.zeros(d.n)
-    frozen = 0
-    qs = np.zeros((m, d.n))
-    touching = np.zeros((m, d.n), dtype=bool)
+    grid = np.linspace(0.0, spec.stroke if stroke is None else stroke, m)
     settler = _Settler(spec, with_object)
     settler.lower = {i for i in range(d.n)}           # the open pose rests on every open stop
+    strokes, qs, touching = [0.0], [np.zeros(d.n)], [np.zeros(d.n, dtype=bool)]
+    events: list[float] = []
+    q = np.zeros(d.n)
+    frozen = 0
+    resolution = 1e-6                                 # mm, event strokes are located to this
+    locked = False
 
-    for idx in range(1, m):
-        x, ok = settler.settle(strokes[idx], q, frozen)
-        if not ok:
-            if not with_object:
-                raise SynthesisError(f"underactuated: closing motion lost at stroke {strokes[idx]:.3f} mm")
-            # the unfrozen phalanges cannot follow the stroke without entering the object: the finger
-            # locked in between; bisect for the stroke where it locks and end there
-            lo, hi, x_lo = strokes[idx - 1], strokes[idx], q
-            for _ in range(18):
-                mid = 0.5 * (lo + hi)
-                x_mid, ok_mid = settler.settle(mid, x_lo, frozen)
-                if ok_mid:
-                    lo, x_lo = mid, x_mid
-                else:
-                    hi = mid
-            strokes[idx], x = lo, x_lo
-        q = x
-        qs[idx] = q
-        if with_object:
-            pose = finger_pose(d, q)
-            touching[idx] = face_clearance(d, pose, spec.cylinder_centre, spec.cylinder_radius)[0] < 1e-4
-            touching[idx, :frozen] = True
-            hit = np.nonzero(touching[idx])[0]
-            if hit.size:
-                # the chapter's assumption: a phalanx stopped by the object no longer turns (it sticks),
-                # so it and every joint proximal to it hold their angles from here on
-                frozen = max(frozen, int(hit.max()) + 1)
-            if touching[idx].all() or not ok:
-                # every phalanx on the object: the finger is locked, the stroke cannot go on
-                strokes, qs, touching = strokes[: idx + 1], qs[: idx + 1], touching[: idx + 1]
+    def signature() -> tuple:
+        return tuple(frozenset(i for i in part if i >= frozen)
+                     for part in (settler.lower, settler.upper, settler.contacts))
+
+    for target in grid[1:]:
+        for _ in range(2 * d.n + 2):                  # at most this many events between two samples
+            state, before = settler.state(), signature()
+            x, ok = settler.settle(target, q, frozen)
+            changed = locate_events and ok and signature() != before
+            if ok and not changed:
+                s_new, event = float(target), False
+            elif not ok and not with_object:
+                raise SynthesisError(f"underactuated: closing motion lost at stroke {target:.3f} mm")
+            else:
+                # the first stroke in (previous sample, target] where the active set changes or the
+                # equilibrium is lost (the unfrozen phalanges cannot follow the stroke without entering
+                # the object: the finger locked); found as the root of the margin of the active set
+                # that held at the previous sample, then the equilibrium just past it is the sample
+                lo, x_lo = strokes[-1], q
+                settler.restore(state)
+                s_new, x, ok, event = settler.locate_event(lo, float(target), x_lo, frozen, resolution)
+                if not ok and not with_object:
+                    raise SynthesisError(f"underactuated: closing motion lost at stroke {s_new:.3f} mm")
+            q = x
+            strokes.append(s_new)
+            qs.append(q)
+            touch = np.zeros(d.n, dtype=bool)
+            if event:
+                events.append(s_new)
+            if with_object:
+                pose = finger_pose(d, q)
+                touch = face_clearance(d, pose, spec.cylinder_centre, spec.cylinder_radius)[0] < 1e-4
+                touch[:frozen] = True
+                hit = np.nonzero(touch)[0]
+                if hit.size:
+                    # the chapter's assumption: a phalanx stopped by the object no longer turns (it
+                    # sticks), so it and every joint proximal to it hold their angles from here on
+                    frozen = max(frozen, int(hit.max()) + 1)
+            touching.append(touch)
+            if with_object and (touch.all() or not ok):
+                locked = True                         # every phalanx on the object: the stroke ends
                 break
+            if s_new >= target - resolution:
+                if s_new != target:                   # the event is the grid sample
+                    strokes[-1] = float(target)
+                break
+        if locked:
+            break
+    strokes_arr, qs_arr, touching_arr = np.array(strokes), np.array(qs), np.array(touching)
     order, at = [], []
     for i in range(d.n):
-        hits = np.nonzero(touching[:, i])[0]
+        hits = np.nonzero(touching_arr[:, i])[0]
         if hits.size:
             order.append(i)
-            at.append(float(strokes[hits[0]]))
+            at.append(float(strokes_arr[hits[0]]))
     ranked = sorted(zip(at, order, strict=True))
-    return ClosingMotion(strokes, qs, touching, [i for _, i in ranked], [s for s, _ in ranked], with_object,
-                         settler.fallbacks)
+    return ClosingMotion(strokes_arr, qs_arr, touching_arr, [i for _, i in ranked], [s for s, _ in ranked],
+                         with_object, settler.fallbacks, tuple(events))
 
 
 def final_contact_forces(spec: UnderactuatedSpec, motion: ClosingMotion) -> dict:
@@ -472,7 +570,7 @@ def build_mechanism(spec: UnderactuatedSpec, motion: ClosingMotion, name: str) -
         joints.append(Revolute(f"P{i + 2}", f"coupler{i + 1}", target))
     drivers = [Driver("slide", "rod", "palm", joint="rod")]
     for i in range(n - 1):
-        law = PchipInterpolator(motion.strokes, motion.q[:, i])
+        law = PiecewiseLaw(motion.strokes, motion.q[:, i], motion.events)
         parent = "palm" if i == 0 else f"phalanx{i}"
         drivers.append(Driver("angle", f"phalanx{i + 1}", parent, law=law))
     return Mechanism(name=name, bodies=tuple(bodies), ground="palm", joints=tuple(joints), gears=(),

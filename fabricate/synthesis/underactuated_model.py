@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from fabricate.planar import cross2, perp, unit
 
@@ -350,3 +351,46 @@ def virtual_work_forces(design: FingerDesign, pose: FingerPose, push_force: floa
             jac[m, j] = float(nm @ perp(contact_points[m] - pose.G[j]))
     rhs = push_force * stroke_gradient(design, pose.q) - spring_torque
     return np.linalg.solve(jac.T, rhs)
+
+
+class PiecewiseLaw:
+    """A driver law ``law(x, nu=0)`` made of cubic splines joined at given breaks (a kink at each).
+
+    One interpolant through all samples smears the kink of an event over the neighbouring stroke
+    intervals; split there each piece is smooth and the not-a-knot cubic is accurate to O(h^4).
+    A piece of two samples is a straight line. Points of one piece closer than ``min_gap`` (mm) to
+    the previous kept one are dropped (an event sample next to a grid sample would make a tiny interval).
+
+    Parameters
+    ----------
+    x, y : (m,) arrays
+        Strictly increasing samples (mm) and their values (rad).
+    breaks : sequence of float
+        Sample abscissae where the law may kink.
+    """
+
+    def __init__(self, x: np.ndarray, y: np.ndarray, breaks=(), min_gap: float = 1e-3):
+        x = np.asarray(x, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)
+        inner = sorted(b for b in breaks if x[0] < b < x[-1])
+        edges = [float(x[0]), *inner, float(x[-1])]
+        self.breaks = np.array(inner)
+        self.pieces = []
+        for a, b in zip(edges[:-1], edges[1:], strict=True):
+            idx = np.nonzero((x >= a - 1e-12) & (x <= b + 1e-12))[0]
+            keep = [idx[0]]
+            for k in idx[1:-1]:
+                if x[k] - x[keep[-1]] >= min_gap and x[idx[-1]] - x[k] >= min_gap:
+                    keep.append(k)
+            keep.append(idx[-1])
+            self.pieces.append(CubicSpline(x[keep], y[keep]))
+
+    def __call__(self, x, nu: int = 0):
+        x_arr = np.asarray(x, dtype=np.float64)
+        which = np.searchsorted(self.breaks, x_arr, side="right")
+        out = np.empty(x_arr.shape)
+        for k, piece in enumerate(self.pieces):
+            mask = which == k
+            if np.any(mask):
+                out[mask] = piece(x_arr[mask], nu)
+        return out if out.ndim else float(out)
