@@ -494,6 +494,8 @@ def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: i
             if s_new >= target - resolution:
                 if s_new != target:                   # the event is the grid sample
                     strokes[-1] = float(target)
+                    if event:
+                        events[-1] = float(target)
                 break
         if locked:
             break
