@@ -91,24 +91,8 @@ class PitchCurves:
 
     def radii(self, x: np.ndarray, gear: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
                                                         np.ndarray]:
-        """Polar pitch radius and its first two x-derivatives, the polar angle and its x-derivative.
-
-        Returns
-        -------
-        r, dr, ddr, theta, dtheta : (n,) arrays (mm, mm/rad, mm/rad^2, rad, -)
-        """
-        x = np.asarray(x, dtype=np.float64)
-        i = -law_derivative(self.law, x, 1)
-        di = -law_derivative(self.law, x, 2)
-        ddi = -law_derivative(self.law, x, 3)
-        q = 1.0 + i
-        # r_a = a i/(1+i) = a - a/(1+i); r_b = a/(1+i)
-        rb = self.a / q
-        drb = -self.a * di / q**2
-        ddrb = -self.a * (ddi / q**2 - 2.0 * di**2 / q**3)
-        if gear == "a":
-            return self.a - rb, -drb, -ddrb, -x, -np.ones_like(x)
-        return rb, drb, ddrb, np.pi - np.asarray(self.law(x), dtype=np.float64), i
+        """See :func:`pitch_radii`."""
+        return pitch_radii(self.law, self.a, x, gear)
 
     def speed(self, x: np.ndarray) -> np.ndarray:
         """``ds/dx_a`` (mm/rad), the same for both gears (rolling without slip)."""
@@ -138,24 +122,8 @@ class PitchCurves:
 
     # -- frames ----------------------------------------------------------------------------------
     def frames_at_x(self, x: np.ndarray, gear: str) -> PitchFrames:
-        """Pitch point, tangent (direction of increasing s), outward normal and curvature at ``x_a``."""
-        r, dr, ddr, th, dth = self.radii(x, gear)
-        u = np.stack([np.cos(th), np.sin(th)], -1)
-        v = np.stack([-np.sin(th), np.cos(th)], -1)
-        # P = r u(theta(x)); P' = r' u + r theta' v; P'' = (r'' - r theta'^2) u + (2 r' theta' + r theta'') v
-        # theta'' = 0 for gear a, -law'' for gear b
-        ddth = np.zeros_like(r) if gear == "a" else -law_derivative(self.law, x, 2)
-        d1 = dr[..., None] * u + (r * dth)[..., None] * v
-        d2 = (ddr - r * dth**2)[..., None] * u + (2 * dr * dth + r * ddth)[..., None] * v
-        speed = np.hypot(d1[..., 0], d1[..., 1])
-        t = d1 / speed[..., None]
-        if gear == "a":
-            n = np.stack([-t[..., 1], t[..., 0]], -1)
-        else:
-            n = np.stack([t[..., 1], -t[..., 0]], -1)
-        # curvature towards the axis: -(dt/ds).n = -(P''.n)/|P'|^2
-        curvature = -(d2[..., 0] * n[..., 0] + d2[..., 1] * n[..., 1]) / speed**2
-        return PitchFrames(r[..., None] * u, t, n, curvature)
+        """See :func:`pitch_frames`."""
+        return pitch_frames(self.law, self.a, x, gear)
 
     def frames(self, s: np.ndarray, gear: str) -> PitchFrames:
         """:meth:`frames_at_x` at rolled arc length ``s`` (wrapped for closed gears)."""
@@ -165,3 +133,49 @@ class PitchCurves:
         """Pitch points (n, 2) of ``gear`` at driving angles ``x`` (rad)."""
         r, _, _, th, _ = self.radii(x, gear)
         return r[..., None] * np.stack([np.cos(th), np.sin(th)], -1)
+
+
+def pitch_radii(law: Callable, center_distance: float, x: np.ndarray, gear: str
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Polar pitch radius of ``gear`` (``"a"`` or ``"b"``) and its first two x-derivatives, the polar angle
+    and its x-derivative, at driving angles ``x`` (rad), from rolling without slip.
+
+    Returns
+    -------
+    r, dr, ddr, theta, dtheta : (n,) arrays (mm, mm/rad, mm/rad^2, rad, -)
+    """
+    x = np.asarray(x, dtype=np.float64)
+    a = float(center_distance)
+    i = -law_derivative(law, x, 1)
+    di = -law_derivative(law, x, 2)
+    ddi = -law_derivative(law, x, 3)
+    q = 1.0 + i
+    # r_a = a i/(1+i) = a - a/(1+i); r_b = a/(1+i)
+    rb = a / q
+    drb = -a * di / q**2
+    ddrb = -a * (ddi / q**2 - 2.0 * di**2 / q**3)
+    if gear == "a":
+        return a - rb, -drb, -ddrb, -x, -np.ones_like(x)
+    return rb, drb, ddrb, np.pi - np.asarray(law(x), dtype=np.float64), i
+
+
+def pitch_frames(law: Callable, center_distance: float, x: np.ndarray, gear: str) -> PitchFrames:
+    """Pitch point, tangent (direction of increasing s), outward normal and curvature (positive where
+    the curve is convex) of ``gear`` at driving angles ``x`` (rad)."""
+    r, dr, ddr, th, dth = pitch_radii(law, center_distance, x, gear)
+    u = np.stack([np.cos(th), np.sin(th)], -1)
+    v = np.stack([-np.sin(th), np.cos(th)], -1)
+    # P = r u(theta(x)); P' = r' u + r theta' v; P'' = (r'' - r theta'^2) u + (2 r' theta' + r theta'') v
+    # theta'' = 0 for gear a, -law'' for gear b
+    ddth = np.zeros_like(r) if gear == "a" else -law_derivative(law, x, 2)
+    d1 = dr[..., None] * u + (r * dth)[..., None] * v
+    d2 = (ddr - r * dth**2)[..., None] * u + (2 * dr * dth + r * ddth)[..., None] * v
+    speed = np.hypot(d1[..., 0], d1[..., 1])
+    t = d1 / speed[..., None]
+    if gear == "a":
+        n = np.stack([-t[..., 1], t[..., 0]], -1)
+    else:
+        n = np.stack([t[..., 1], -t[..., 0]], -1)
+    # curvature towards the axis: -(dt/ds).n = -(P''.n)/|P'|^2
+    curvature = -(d2[..., 0] * n[..., 0] + d2[..., 1] * n[..., 1]) / speed**2
+    return PitchFrames(r[..., None] * u, t, n, curvature)

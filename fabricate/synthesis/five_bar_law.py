@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from fabricate.gears.pitch import pitch_frames, pitch_radii
+
 #: Samples of the gear law used for feasibility (ratio, curvature) and the report.
 LAW_SAMPLES = 241
 
@@ -56,14 +58,10 @@ class GearLaw:
         return float(self.x[0]), float(self.x[-1])
 
 
-def _polar_curvature_radius(r: np.ndarray, r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
-    """Signed radius of curvature of a polar curve r(phi) from r, dr/dphi, d2r/dphi2."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return (r * r + r1 * r1) ** 1.5 / (r * r + 2.0 * r1 * r1 - r * r2)
-
-
 def gear_law(knots_a: np.ndarray, knots_b: np.ndarray, centre_distance: float) -> GearLaw:
-    """Spline the law through the poses and derive the pitch curves by rolling without slip.
+    """Spline the law through the poses and derive the pitch curves by rolling without slip
+    (:func:`fabricate.gears.pitch.pitch_radii` / :func:`~fabricate.gears.pitch.pitch_frames`, the same
+    curves the gear generator cuts).
 
     Parameters
     ----------
@@ -75,17 +73,12 @@ def gear_law(knots_a: np.ndarray, knots_b: np.ndarray, centre_distance: float) -
     order = np.argsort(knots_a)
     law = CubicSpline(knots_a[order], knots_b[order])
     x = np.linspace(knots_a[order[0]], knots_a[order[-1]], LAW_SAMPLES)
-    i, di, ddi = -law(x, 1), -law(x, 2), -law(x, 3)
     a = centre_distance
     with np.errstate(divide="ignore", invalid="ignore"):
-        r_a, r_b = a * i / (1.0 + i), a / (1.0 + i)
-        # sun: pitch point at polar angle -x_a in its gear frame, r_a(x_a)
-        ra_x = a * di / (1.0 + i) ** 2
-        ra_xx = a * (ddi * (1.0 + i) - 2.0 * di * di) / (1.0 + i) ** 3
-        rho_a = _polar_curvature_radius(r_a, -ra_x, ra_xx)
-        # planet: polar angle pi - x_b, d(angle)/dx_a = i
-        rb_x = -ra_x
-        rb_xx = a * (2.0 * di * di - ddi * (1.0 + i)) / (1.0 + i) ** 3
-        rho_b = _polar_curvature_radius(r_b, rb_x / i, (rb_xx * i - rb_x * di) / i ** 3)
-    return GearLaw(law=law, knots_a=knots_a, knots_b=knots_b, centre_distance=a, x=x, ratio=i,
+        r_a = pitch_radii(law, a, x, "a")[0]
+        r_b = pitch_radii(law, a, x, "b")[0]
+        # signed radius of curvature, positive where convex
+        rho_a = 1.0 / pitch_frames(law, a, x, "a").curvature
+        rho_b = 1.0 / pitch_frames(law, a, x, "b").curvature
+    return GearLaw(law=law, knots_a=knots_a, knots_b=knots_b, centre_distance=a, x=x, ratio=-law(x, 1),
                    r_a=r_a, r_b=r_b, rho_a=rho_a, rho_b=rho_b)
