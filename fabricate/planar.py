@@ -60,6 +60,19 @@ def pose_matrix(pose: np.ndarray) -> np.ndarray:
     return out
 
 
+def relative_poses(pose_ref: np.ndarray, pose_body: np.ndarray) -> np.ndarray:
+    """Poses (n, 3) of a body in the frame of a reference body, from both world poses (n, 3).
+
+    The relative angle is the plain difference (not wrapped), so it stays continuous over a sweep.
+    """
+    pose_ref = np.asarray(pose_ref, dtype=np.float64)
+    pose_body = np.asarray(pose_body, dtype=np.float64)
+    c, s = np.cos(pose_ref[:, 2]), np.sin(pose_ref[:, 2])
+    dx = pose_body[:, 0] - pose_ref[:, 0]
+    dy = pose_body[:, 1] - pose_ref[:, 1]
+    return np.column_stack([c * dx + s * dy, -s * dx + c * dy, pose_body[:, 2] - pose_ref[:, 2]])
+
+
 def circle_circle_intersection(c1: np.ndarray, r1: float, c2: np.ndarray, r2: float) -> np.ndarray:
     """Both intersection points of two circles, left of c1→c2 first; shape (2, 2).
 

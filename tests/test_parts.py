@@ -16,11 +16,11 @@ from hypothesis import strategies as st
 from fabricate.errors import GeometryError, SpecError
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
 from fabricate.parts.build import build_parts, derive_sizes, gear_outline_in_body
-from fabricate.parts.layers import assign_layers, relative_poses
+from fabricate.parts.layers import assign_layers
 from fabricate.parts.model import BulgePath
 from fabricate.parts.profiles import circle_hull, fuse_polygons, offset_path
 from fabricate.parts.spec import PartsSpec, parse_parts_spec
-from fabricate.planar import polygon_area, rotation, transform_points
+from fabricate.planar import polygon_area, relative_poses, rotation, transform_points
 from fabricate.spec import Table
 
 DATA = json.loads((Path(__file__).parent / "data" / "parts_expected.json").read_text())

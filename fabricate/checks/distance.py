@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
-from fabricate.planar import polygon_area
+from fabricate.planar import polygon_area, relative_poses
 
 
 @dataclass(frozen=True)
@@ -39,12 +39,7 @@ class RelativePoses:
     @staticmethod
     def between(pose_a: np.ndarray, pose_b: np.ndarray) -> RelativePoses:
         """From world poses of A and B, each (n, 3)."""
-        pose_a = np.asarray(pose_a, dtype=np.float64)
-        pose_b = np.asarray(pose_b, dtype=np.float64)
-        c, s = np.cos(pose_a[:, 2]), np.sin(pose_a[:, 2])
-        dx = pose_b[:, 0] - pose_a[:, 0]
-        dy = pose_b[:, 1] - pose_a[:, 1]
-        return RelativePoses(np.column_stack([c * dx + s * dy, -s * dx + c * dy, pose_b[:, 2] - pose_a[:, 2]]))
+        return RelativePoses(relative_poses(pose_a, pose_b))
 
     def inverse(self) -> RelativePoses:
         """Poses of frame A in frame B."""

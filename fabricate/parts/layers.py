@@ -16,18 +16,10 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import shapely
 
-from fabricate.planar import pose_matrix, wrap_angle
+from fabricate.planar import relative_poses, wrap_angle
 
 #: At most this many poses of the motion are used for the plan-view conflict test.
 MAX_CONFLICT_POSES = 180
-
-
-def relative_poses(pose_ref: np.ndarray, pose_body: np.ndarray) -> np.ndarray:
-    """Poses (n, 3) of a body in the frame of a reference body, from both world poses (n, 3)."""
-    m_ref = pose_matrix(pose_ref)
-    m_body = pose_matrix(pose_body)
-    rel = np.linalg.inv(m_ref) @ m_body
-    return np.column_stack([rel[:, 0, 2], rel[:, 1, 2], np.arctan2(rel[:, 1, 0], rel[:, 0, 0])])
 
 
 def min_distance_over_motion(outline_ref: np.ndarray, outline_body: np.ndarray, rel: np.ndarray) -> float:
