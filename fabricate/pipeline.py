@@ -95,24 +95,27 @@ def synthesise(design: DesignSpec, progress: Progress = _quiet) -> SynthesisResu
     return KINDS[design.kind].synthesise(design)
 
 
-def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
-    """Synthesis only: report.json with design, mechanism and synthesis, plus the method's plots."""
+def _synthesis_stage(design: DesignSpec, progress: Progress
+                     ) -> tuple[SynthesisResult, dict[str, Any], Motion | None, list[str]]:
+    """Synthesis and the swept motion; a lock-up inside the range is a design failure, not an error."""
     result = synthesise(design, progress)
     report: dict[str, Any] = {"design": design_section(design)}
-    files: dict[str, bytes] = {}
-    motion = None
-    failures: list[str] = []
-    if result.mechanism is not None:
-        progress("sweep")
-        try:
-            motion = result.mechanism.sweep(design.checks.sweep_poses)
-            report["mechanism"] = mechanism_section(result.mechanism, motion)
-        except LockupError as exc:
-            failures.append(f"motion: {exc}")
+    progress("sweep")
+    try:
+        motion = result.mechanism.sweep(design.checks.sweep_poses)
+    except LockupError as exc:
+        report["synthesis"] = result.report
+        return result, report, None, [f"motion: {exc}"]
+    report["mechanism"] = mechanism_section(result.mechanism, motion)
     report["synthesis"] = result.report
+    return result, report, motion, []
+
+
+def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
+    """Synthesis only: report.json with design, mechanism and synthesis, plus the method's plots."""
+    result, report, motion, failures = _synthesis_stage(design, progress)
     progress("plots")
-    for name, data in sorted(result.figures().items()):
-        files[f"plots/{name}"] = data
+    files = {f"plots/{name}": data for name, data in sorted(result.figures().items())}
     report["checks"] = {"passed": not failures, "failures": failures}
     return _finish(report, files, exit_code=1 if failures else 0, synthesis=result, motion=motion)
 
@@ -130,19 +133,12 @@ def run_build(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     from fabricate.gears import build_gear_pairs
     from fabricate.parts.build import build_parts
 
-    result = synthesise(design, progress)
-    report: dict[str, Any] = {"design": design_section(design)}
+    result, report, motion, failures = _synthesis_stage(design, progress)
     files: dict[str, bytes] = {}
-    mechanism = result.mechanism
-    progress("sweep")
-    try:
-        motion = mechanism.sweep(design.checks.sweep_poses)
-    except LockupError as exc:
-        report["synthesis"] = result.report
-        report["checks"] = {"passed": False, "failures": [f"motion: {exc}"]}
+    if motion is None:
+        report["checks"] = {"passed": False, "failures": failures}
         return _finish(report, files, exit_code=1, synthesis=result)
-    report["mechanism"] = mechanism_section(mechanism, motion)
-    report["synthesis"] = result.report
+    mechanism = result.mechanism
     progress("gears")
     gear_pairs = build_gear_pairs(mechanism, design.gears, design.process.chord_tolerance_mm)
     report["gears"] = [pair.report() for pair in gear_pairs]

@@ -121,3 +121,20 @@ def test_same_template_gives_byte_identical_files(builds, name):
     assert files_one == files_two
     differing = [rel for rel in files_one if (one / rel).read_bytes() != (two / rel).read_bytes()]
     assert differing == []
+
+
+def test_lockup_inside_the_range_is_a_design_failure(monkeypatch):
+    """A mechanism that cannot move through its own range: exit 1 and the report says where."""
+    import fabricate.pipeline as pipeline
+    from fabricate.spec import load_design
+    from fabricate.synthesis.base import SynthesisResult
+    from tests.conftest import make_four_bar
+
+    locking = make_four_bar(crank=25.0, coupler=30.0, rocker=20.0, ground=40.0, start_deg=0.0, end_deg=180.0)
+    monkeypatch.setattr(pipeline, "synthesise", lambda design, progress: SynthesisResult(locking, {"note": "x"}))
+    for run in (pipeline.run_build, pipeline.run_synth):
+        outcome = run(load_design("finger_five_bar_ncg"))
+        assert outcome.exit_code == 1
+        (failure,) = outcome.report["checks"]["failures"]
+        assert failure.startswith("motion:") and "lock-up" in failure
+        assert {"report.json", "report.md"} <= set(outcome.files)
