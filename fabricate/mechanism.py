@@ -251,9 +251,8 @@ class Mechanism:
         q = system.assemble(inputs[0])
         out = np.empty((len(inputs), len(system.free), 3))
         out[0] = q.reshape(-1, 3)
-        previous = None
         for i in range(1, len(inputs)):
-            q, previous = system.continue_to(q, previous, inputs[i - 1], inputs[i])
+            q = system.continue_to(q, inputs[i - 1], inputs[i])
             out[i] = q.reshape(-1, 3)
         inputs = inputs.copy()
         # the motion is shared through the sweep cache: make it immutable
@@ -375,10 +374,7 @@ class _System:
             return float(np.radians(s)), float(np.pi / 180.0)
         return float(s), 1.0
 
-    def residual(self, q: np.ndarray, s: float) -> np.ndarray:
-        return self.jacobian(q, s, want_jacobian=False)[0]
-
-    def jacobian(self, q: np.ndarray, s: float, want_jacobian: bool = True):
+    def jacobian(self, q: np.ndarray, s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Residual vector (m,), Jacobian (m, n) and d(residual)/ds (m,) at poses ``q``."""
         rows: list[np.ndarray] = []
         res: list[float] = []
@@ -460,7 +456,7 @@ class _System:
                            self.bodies[d.body].point(d.joint), np.asarray(slider.axis, dtype=np.float64))
                 res[-1] -= value
             dres_ds.append(-dvalue)
-        jac = np.array(rows).reshape(len(res), n) if want_jacobian else None
+        jac = np.array(rows).reshape(len(res), n)
         return np.asarray(res), jac, np.asarray(dres_ds)
 
     def newton(self, q: np.ndarray, s: float, max_iter: int = 30):
@@ -498,7 +494,7 @@ class _System:
             raise LockupError(s, f"{self.mech.name}: cannot assemble the first pose")
         return q
 
-    def _step_ok(self, q_old: np.ndarray, q_new: np.ndarray, s: float) -> bool:
+    def _step_ok(self, q_old: np.ndarray, q_new: np.ndarray) -> bool:
         # a step is suspicious when a body turns more than 0.3 rad or moves more than 30 % of the
         # mechanism's size: the predictor landed near another branch rather than following this one
         d = (q_new - q_old).reshape(-1, 3)
@@ -510,8 +506,7 @@ class _System:
             return 0.0
         return float(np.sign(np.linalg.det(jac)))
 
-    def continue_to(self, q: np.ndarray, previous: tuple[np.ndarray, float] | None, s0: float,
-                    s1: float) -> tuple[np.ndarray, tuple[np.ndarray, float]]:
+    def continue_to(self, q: np.ndarray, s0: float, s1: float) -> np.ndarray:
         """Follow the branch from (q at s0) to s1 with an adaptive step; raise at lock-up."""
         s = s0
         _, jac, ds = self.jacobian(q, s)
@@ -525,19 +520,18 @@ class _System:
             tangent = _solve_square(jac, -ds) if jac.shape[0] == jac.shape[1] \
                 else np.linalg.lstsq(jac, -ds, rcond=None)[0]
             q_new, ok, jac_new, ds_new = self.newton(q + tangent * h, s + h)
-            if ok and self._step_ok(q, q_new, s + h):
+            if ok and self._step_ok(q, q_new):
                 sign = self._orientation(jac_new)
                 if sign0 != 0.0 and sign != 0.0 and sign != sign0:
                     raise LockupError(s + h, f"{self.mech.name}: the motion passes a singular pose "
                                              "(branch change)")
-                previous = (q, s)
                 q, s, jac, ds = q_new, s + h, jac_new, ds_new
                 h_mag *= 1.5
                 continue
             h_mag *= 0.5
             if h_mag < min_h:
                 raise LockupError(s, f"{self.mech.name}: lock-up, no assembly beyond this input")
-        return q, previous if previous is not None else (q, s)
+        return q
 
 
 
