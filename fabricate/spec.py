@@ -31,8 +31,20 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-#: Folder of the shipped templates (next to the package in a source checkout).
-TEMPLATE_DIR = Path(__file__).resolve().parent.parent / "templates"
+
+def _template_dir() -> Path:
+    # A wheel carries the repository's templates/ as fabricate/templates (setup.py maps it there); a
+    # source checkout or an editable install reads the one copy at the repository's top level.
+    package = Path(__file__).resolve().parent
+    inside = package / "templates"
+    return inside if inside.is_dir() else package.parent / "templates"
+
+
+#: Folder of the shipped templates and process profiles.
+TEMPLATE_DIR = _template_dir()
+
+#: Largest template file read (a design template is a few kB; this keeps a stray binary out of memory).
+MAX_TEMPLATE_BYTES = 1_000_000
 
 _MISSING = object()
 
@@ -237,9 +249,11 @@ def find_template(name_or_path: str | Path) -> Path:
     candidate = Path(name_or_path)
     if candidate.is_file():
         return candidate
+    if candidate.exists():
+        raise SpecError("", f"template {name_or_path} is not a file")
     stem = candidate.name[:-5] if candidate.name.endswith(".toml") else candidate.name
     shipped = TEMPLATE_DIR / f"{stem}.toml"
-    if shipped.is_file() and candidate.parent == Path("."):
+    if shipped.is_file() and candidate.parent == Path(".") and not stem.startswith("process_"):
         return shipped
     raise SpecError("", f"template not found: {name_or_path} (see 'fabricate list')")
 
@@ -249,15 +263,35 @@ def shipped_templates() -> list[Path]:
     return sorted(p for p in TEMPLATE_DIR.glob("*.toml") if not p.name.startswith("process_"))
 
 
-def read_toml(path: Path) -> dict[str, Any]:
-    """Parse a TOML file; syntax errors become :class:`SpecError` naming the file and line."""
+def read_text(path: Path) -> str:
+    """A template's text: UTF-8 with or without a byte-order mark; anything else is a :class:`SpecError`."""
     try:
         with open(path, "rb") as fh:
-            return tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(str(path), f"invalid TOML: {exc}") from exc
+            data = fh.read(MAX_TEMPLATE_BYTES + 1)
     except OSError as exc:
         raise SpecError(str(path), f"cannot read: {exc.strerror}") from exc
+    if len(data) > MAX_TEMPLATE_BYTES:
+        raise SpecError(str(path), f"larger than {MAX_TEMPLATE_BYTES} bytes: not a design template")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise SpecError(str(path), f"not UTF-8 text (byte {exc.start}: {data[exc.start:exc.start + 1]!r}); "
+                                   "save the template as UTF-8") from exc
+
+
+def parse_toml(text: str, source: str) -> dict[str, Any]:
+    """Parse TOML text; syntax errors become :class:`SpecError` naming ``source`` and the line."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(source, f"invalid TOML: {exc}") from exc
+    except RecursionError as exc:  # tomllib recurses per nesting level of arrays and inline tables
+        raise SpecError(source, "invalid TOML: nested too deeply") from exc
+
+
+def read_toml(path: Path) -> dict[str, Any]:
+    """Read and parse a TOML file (see :func:`read_text`, :func:`parse_toml`)."""
+    return parse_toml(read_text(path), str(path))
 
 
 @dataclass(frozen=True)
@@ -358,6 +392,8 @@ class DesignSpec:
     name, kind, description : str
     template : Path
         Where it was read from.
+    template_text : str
+        The template exactly as validated (embedded in report.json so a build can be re-made from it).
     process : ProcessSpec
     checks : ChecksSpec
     gears : fabricate.gears.spec.GearSpec
@@ -377,22 +413,35 @@ class DesignSpec:
     gears: Any
     parts: Any
     method: Any
+    template_text: str = ""
 
 
 def load_design(path: str | Path) -> DesignSpec:
-    """Load and validate a template into a :class:`DesignSpec`.
+    """Load and validate a template file (a path, or a shipped template's name) into a :class:`DesignSpec`.
 
     Raises
     ------
     SpecError
         On the first invalid field, naming its path.
     """
+    path = find_template(path)
+    return design_from_text(read_text(path), path)
+
+
+def design_from_text(text: str, path: str | Path) -> DesignSpec:
+    """Validate a template given as text; ``path`` is where it came from (its file name goes in reports).
+
+    ``fabricate check DIR`` rebuilds from the text embedded in a report with this, so the verdict depends
+    neither on the working folder nor on later edits of the file.
+    """
     from fabricate.gears.spec import parse_gear_spec
     from fabricate.parts.spec import parse_parts_spec
     from fabricate.synthesis import KINDS
 
-    path = find_template(path)
-    root = Table(read_toml(path))
+    path = Path(path)
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    root = Table(parse_toml(text, str(path)))
     design = root.table("design")
     name = design.string("name")
     if not name or any(c in name for c in "/\\:") or name.startswith("."):
@@ -412,4 +461,4 @@ def load_design(path: str | Path) -> DesignSpec:
         raise SpecError("gears.bore_mm", f"{bore:g} mm differs from the pin diameter {process.pin_diameter_mm:g} mm "
                                          "the gears turn on; set process.pin_diameter_mm to it or leave bore_mm out")
     return DesignSpec(name=name, kind=kind, description=description, template=path, process=process,
-                      checks=checks, gears=gears, parts=parts, method=method)
+                      checks=checks, gears=gears, parts=parts, method=method, template_text=text)

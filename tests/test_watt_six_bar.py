@@ -45,6 +45,19 @@ DATA = json.loads((Path(__file__).parent / "data" / "watt_six_bar_paper.json").r
 TEMPLATE = TEMPLATE_DIR / "finger_watt_six_bar.toml"
 
 
+
+def assert_grid_count(actual: int, expected: int) -> None:
+    """A count of 0.2 mm grid points inside a region agrees with the recorded one within 0.2 % (at least 3).
+
+    Whether a grid point on the region's boundary is in or out turns on the last digits of a root, which
+    move with numpy/scipy patch releases (18521 against 18522 was seen); the region itself does not move.
+    A zero stays exactly zero: "no point passes" is the finding, not a boundary effect.
+    """
+    if expected == 0:
+        assert actual == 0
+    else:
+        assert abs(actual - expected) <= max(3, 2e-3 * expected), (actual, expected)
+
 def _template_root(path: Path = TEMPLATE, edit=None) -> Table:
     data = read_toml(path)
     if edit is not None:
@@ -181,9 +194,9 @@ def test_distance_to_curve_finds_a_known_offset():
 def test_region_of_the_printed_tables(paper_region):
     measured = DATA["measured"]
     region = paper_region
-    assert len(region) == measured["region_points"]
-    assert int(np.sum(region.K <= DATA["k_max"])) == measured["region_points_K_ok"]
-    assert int(region.passes.sum()) == measured["region_points_without_circuit_defect"]
+    assert_grid_count(len(region), measured["region_points"])
+    assert_grid_count(int(np.sum(region.K <= DATA["k_max"])), measured["region_points_K_ok"])
+    assert_grid_count(int(region.passes.sum()), measured["region_points_without_circuit_defect"])
     ranges = region.stage_one.feasible_ranges()
     for key, (lo, hi) in measured["curve_d_feasible_x_mm"].items():
         assert ranges[int(key)] == pytest.approx((lo, hi), abs=1e-9)
@@ -266,7 +279,7 @@ def test_paper_template_builds_a_finger_that_passes_the_positions(paper_result):
     assert rep["torque_virtual_power_max_difference_Nmm"] < 1e-6
     sel = rep["selected"]
     assert abs(sel["d"][0] - 51.4) <= 0.5 and abs(sel["d0"][0] + 6.4) <= 0.5  # near mechanism 1
-    assert rep["region"]["points"] == DATA["measured"]["region_points"]
+    assert_grid_count(rep["region"]["points"], DATA["measured"]["region_points"])
     assert rep["reference"]["tip_error_mm"]["max"] < 0.5
     # the full motion at the checks' resolution, no lock-up, and the fingertip through the positions
     motion = mech.sweep(361)
