@@ -1,13 +1,14 @@
-"""Command line: ``fabricate build|synth|check|list``.
+"""Command line: ``fabricate build|synth|check|list|init``.
 
 Exit codes: 0 all checks pass; 1 the design fails a check (files are written, the report says why);
-2 invalid input or usage (nothing is written).
+2 invalid input or usage (nothing is written); 3 an internal error (a bug: please report it with the
+template); 130 interrupted (Ctrl-C; the previous output is left as it was).
 """
 
 from __future__ import annotations
 
 import argparse
-import json
+import re
 import sys
 import time
 from pathlib import Path
@@ -16,7 +17,7 @@ from fabricate import __version__
 from fabricate.errors import FabricateError, SpecError
 
 DEFAULT_TEMPLATE = "finger_five_bar_ncg"
-EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 
 
 class _Parser(argparse.ArgumentParser):
@@ -40,96 +41,136 @@ def _parser() -> argparse.ArgumentParser:
     p = _Parser(prog="fabricate", description=__doc__.splitlines()[0])
     p.add_argument("--version", action="version", version=f"fabricate {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    b = sub.add_parser("build", help="the whole pipeline into an output directory")
+    b = sub.add_parser("build", help="the whole pipeline into an output folder")
     b.add_argument("template", nargs="?", default=DEFAULT_TEMPLATE,
                    help=f"template path or shipped name (default {DEFAULT_TEMPLATE})")
-    b.add_argument("-o", "--output", type=Path, help="output directory (default outputs/<template name>/)")
-    b.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     s = sub.add_parser("synth", help="synthesis only: report.json and plots")
     s.add_argument("template")
-    s.add_argument("-o", "--output", type=Path)
-    s.add_argument("-q", "--quiet", action="store_true")
-    c = sub.add_parser("check", help="re-run the checks of a template or an output directory")
-    c.add_argument("target", help="template, or a directory written by 'fabricate build'")
+    for cmd, default in ((b, "outputs/<design name>/"), (s, "outputs/<design name>-synth/")):
+        cmd.add_argument("-o", "--output", type=Path,
+                         help=f"output folder (default {default}): new, empty, or a previous fabricate output")
+        cmd.add_argument("--force", action="store_true",
+                         help="replace an output folder that holds files fabricate did not write")
+        cmd.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+    c = sub.add_parser("check", help="verify an output folder (files, contents, rebuild) or check a template")
+    c.add_argument("target", help="template, or a folder written by 'fabricate build'")
     c.add_argument("-q", "--quiet", action="store_true")
     sub.add_parser("list", help="templates shipped")
+    i = sub.add_parser("init", help="write an editable copy of a shipped template into the current folder")
+    i.add_argument("name", help="name of the new design (writes NAME.toml)")
+    i.add_argument("--from", dest="source", default=DEFAULT_TEMPLATE,
+                   help=f"template to copy (default {DEFAULT_TEMPLATE})")
     return p
 
 
-def _out_dir(args: argparse.Namespace, name: str) -> Path:
-    return args.output if args.output is not None else Path("outputs") / name
-
-
-def _summary(report: dict, out: Path | None) -> None:
+def _summary(report: dict, out: Path | None, failures: list[str] | None = None) -> None:
     checks = report.get("checks", {})
+    failures = list(checks.get("failures", [])) if failures is None else failures
     where = f" -> {out}" if out is not None else ""
-    verdict = "passed" if checks.get("passed") else "FAILED"
-    print(f"{report['design']['name']}: checks {verdict}{where}")
-    for failure in checks.get("failures", []):
+    print(f"{report['design']['name']}: checks {'passed' if not failures else 'FAILED'}{where}")
+    for failure in failures:
         print(f"  - {failure}")
 
 
-def _check_directory(directory: Path, quiet: bool) -> int:
-    """Re-run the checks of a build directory: its files are re-validated, its template rebuilt."""
-    from fabricate.export.stl import validate_stl
-    from fabricate.pipeline import run_build
-    from fabricate.spec import TEMPLATE_DIR, load_design
+def _build(args: argparse.Namespace) -> int:
+    from fabricate.output import check_output_dir, write_output
+    from fabricate.pipeline import run_build, run_synth
+    from fabricate.spec import load_design
 
-    report_path = directory / "report.json"
-    try:
-        report = json.loads(report_path.read_text(encoding="utf-8"))
-        template = report["design"]["template"]
-    except (OSError, ValueError, KeyError) as exc:
-        raise SpecError(str(report_path), f"not a fabricate output directory ({exc})") from exc
-    problems: list[str] = []
-    for rel in report.get("files", []):
-        path = directory / rel
-        if not path.is_file():
-            problems.append(f"{rel}: missing")
-        elif rel.endswith(".stl"):
-            problems += [f"{rel}: {p}" for p in validate_stl(path.read_bytes())]
-    candidates = [Path(template), TEMPLATE_DIR.parent / template]
-    found = next((c for c in candidates if c.is_file()), None)
-    if found is None:
-        raise SpecError("design.template", f"template {template} of {directory} not found")
-    outcome = run_build(load_design(found), _progress(quiet))
-    failures = problems + list(outcome.report["checks"]["failures"])
-    outcome.report["checks"] = {"passed": not failures, "failures": failures}
-    _summary(outcome.report, None)
+    design = load_design(args.template)
+    stage = args.command
+    default = Path("outputs") / (design.name if stage == "build" else f"{design.name}-synth")
+    protect = [design.template]
+    # refuse a bad output folder before the work, and again under the lock when writing
+    out = check_output_dir(args.output or default, force=args.force, stage=stage, protect=protect)
+    outcome = (run_build if stage == "build" else run_synth)(design, _progress(args.quiet))
+    write_output(outcome.files, out, force=args.force, stage=stage, protect=protect)
+    if not args.quiet:
+        _summary(outcome.report, out)
+    return outcome.exit_code
+
+
+def _check(args: argparse.Namespace) -> int:
+    from fabricate.pipeline import run_build
+    from fabricate.spec import load_design
+
+    target = Path(args.target)
+    if not target.is_dir():
+        outcome = run_build(load_design(args.target), _progress(args.quiet))
+        _summary(outcome.report, None)
+        return outcome.exit_code
+    from fabricate.verify import verify_output
+
+    problems, report = verify_output(target, _progress(args.quiet))
+    if report is None:
+        print(f"{target}: FAILED")
+        for problem in problems:
+            print(f"  - {problem}")
+        return EXIT_FAILED
+    failures = problems + list(report.get("checks", {}).get("failures", []))
+    _summary(report, None, failures)
     return EXIT_OK if not failures else EXIT_FAILED
+
+
+def _list() -> int:
+    from fabricate.spec import read_toml, shipped_templates
+
+    for path in shipped_templates():
+        design = read_toml(path).get("design", {})
+        print(f"{path.stem:28s} {design.get('kind', '?'):18s} {design.get('description', '')}")
+    return EXIT_OK
+
+
+def _init(args: argparse.Namespace) -> int:
+    from fabricate.spec import design_from_text, find_template, read_text
+
+    name = args.name[:-5] if args.name.endswith(".toml") else args.name
+    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}", name):
+        raise SpecError("NAME", f"expected a plain design name (letters, digits, _ . -), got \"{args.name}\"")
+    source = find_template(args.source)
+    text = read_text(source)
+    # the copy's [design] name is the new name, so its default output folder is its own
+    text, count = re.subn(r'(?ms)^(\[design\][^\[]*?^\s*name\s*=\s*)("[^"\n]*"|\'[^\'\n]*\')',
+                          lambda m: f'{m.group(1)}"{name}"', text, count=1)
+    if count != 1:
+        raise SpecError(str(source), "has no [design] name to replace")
+    target = Path.cwd() / f"{name}.toml"
+    design_from_text(text, target)  # the copy must be a valid template before it is written
+    try:
+        with open(target, "x", encoding="utf-8") as fh:
+            fh.write(text)
+    except FileExistsError as exc:
+        raise SpecError(str(target), "exists already; init never overwrites a file") from exc
+    except OSError as exc:
+        raise SpecError(str(target), f"cannot be written: {exc.strerror}") from exc
+    print(f"wrote {target.name} (from {source.name}); build it with: fabricate build {target.name}")
+    return EXIT_OK
 
 
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
-    from fabricate.pipeline import run_build, run_synth, write_atomically
-    from fabricate.spec import load_design, shipped_templates
-
     try:
         if args.command == "list":
-            from fabricate.spec import read_toml
-
-            for path in shipped_templates():
-                design = read_toml(path).get("design", {})
-                print(f"{path.stem:28s} {design.get('kind', '?'):18s} {design.get('description', '')}")
-            return EXIT_OK
+            return _list()
+        if args.command == "init":
+            return _init(args)
         if args.command == "check":
-            target = Path(args.target)
-            if target.is_dir():
-                return _check_directory(target, args.quiet)
-            outcome = run_build(load_design(args.target), _progress(args.quiet))
-            _summary(outcome.report, None)
-            return outcome.exit_code
-        design = load_design(args.template)
-        runner = run_build if args.command == "build" else run_synth
-        outcome = runner(design, _progress(args.quiet))
-        out = _out_dir(args, design.name)
-        write_atomically(outcome.files, out)
-        if not args.quiet:
-            _summary(outcome.report, out)
-        return outcome.exit_code
-    except FabricateError as exc:  # invalid input, nothing feasible, or a kernel failure: nothing written
+            return _check(args)
+        return _build(args)
+    except FabricateError as exc:  # invalid input, nothing feasible, a refused folder: nothing written
         print(f"fabricate: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    except KeyboardInterrupt:
+        print("fabricate: interrupted; nothing was written (a previous output is unchanged)", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except MemoryError:
+        print("fabricate: error: out of memory; a count or tolerance in the template asks for more than this "
+              "machine has (see the bounds in README.md)", file=sys.stderr)
+        return EXIT_USAGE
+    except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, never a traceback
+        print(f"fabricate: internal error: {type(exc).__name__}: {exc} (a bug in fabricate {__version__}; "
+              "please report it with the template)", file=sys.stderr)
+        return EXIT_INTERNAL
 
 
 if __name__ == "__main__":  # pragma: no cover

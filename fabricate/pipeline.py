@@ -1,26 +1,26 @@
 """The whole pipeline: template → spec → synthesis → mechanism → gears → parts → exports and checks.
 
-Everything is computed in memory into ``{relative path: bytes}``; only :func:`write_atomically` touches
-the file system, into a temporary sibling directory renamed into place when every file is written, so a
-failed run never leaves half a result.
+Everything is computed in memory into ``{relative path: bytes}``; only :mod:`fabricate.output` touches
+the file system, into a temporary sibling directory swapped into place when every file is written, so a
+failed run never leaves half a result. report.json carries a manifest of every other file (size, sha256)
+and the template text itself, so ``fabricate check DIR`` can verify the files and rebuild them.
 """
 
 from __future__ import annotations
 
+import hashlib
 import multiprocessing
 import os
-import shutil
-import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from fabricate import __version__
-from fabricate.errors import LockupError
+from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
 from fabricate.mechanism import Mechanism, Motion
 from fabricate.report import report_json, report_markdown
-from fabricate.spec import TEMPLATE_DIR, DesignSpec
+from fabricate.spec import DesignSpec
 from fabricate.synthesis import KINDS
 from fabricate.synthesis.base import SynthesisResult
 
@@ -55,21 +55,12 @@ def _quiet(_: str) -> None:
     pass
 
 
-def template_label(path: Path) -> str:
-    """How the report names a template: relative to the shipped folder or the working directory."""
-    path = path.resolve()
-    for base in (TEMPLATE_DIR.parent, Path.cwd()):
-        try:
-            return path.relative_to(base.resolve()).as_posix()
-        except ValueError:
-            continue
-    return path.as_posix()
-
-
-def design_section(design: DesignSpec) -> dict[str, Any]:
-    return {"name": design.name, "kind": design.kind, "template": template_label(design.template),
+def design_section(design: DesignSpec, stage: str) -> dict[str, Any]:
+    # the template's file name only: a folder in the report would make its bytes depend on where the
+    # build ran (the template itself is embedded as template_text)
+    return {"name": design.name, "kind": design.kind, "template": Path(design.template).name,
             "fabricate_version": __version__, "description": design.description,
-            "process": design.process.name}
+            "process": design.process.name, "stage": stage}
 
 
 def mechanism_section(mechanism: Mechanism, motion: Motion) -> dict[str, Any]:
@@ -95,11 +86,11 @@ def synthesise(design: DesignSpec, progress: Progress = _quiet) -> SynthesisResu
     return KINDS[design.kind].synthesise(design)
 
 
-def _synthesis_stage(design: DesignSpec, progress: Progress
+def _synthesis_stage(design: DesignSpec, progress: Progress, stage: str
                      ) -> tuple[SynthesisResult, dict[str, Any], Motion | None, list[str]]:
     """Synthesis and the swept motion; a lock-up inside the range is a design failure, not an error."""
     result = synthesise(design, progress)
-    report: dict[str, Any] = {"design": design_section(design)}
+    report: dict[str, Any] = {"design": design_section(design, stage)}
     progress("sweep")
     try:
         motion = result.mechanism.sweep(design.checks.sweep_poses)
@@ -113,57 +104,96 @@ def _synthesis_stage(design: DesignSpec, progress: Progress
 
 def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     """Synthesis only: report.json with design, mechanism and synthesis, plus the method's plots."""
-    result, report, motion, failures = _synthesis_stage(design, progress)
+    result, report, motion, failures = _synthesis_stage(design, progress, "synth")
     progress("plots")
     files = {f"plots/{name}": data for name, data in sorted(result.figures().items())}
     report["checks"] = {"passed": not failures, "failures": failures}
-    return _finish(report, files, exit_code=1 if failures else 0, synthesis=result, motion=motion)
+    return _finish(design, report, files, exit_code=1 if failures else 0, synthesis=result, motion=motion)
+
+
+def _kernel_failures() -> tuple[type[BaseException], ...]:
+    """Exceptions of the numeric and geometry kernels that a design can provoke (not bugs of ours)."""
+    import numpy as np
+    import shapely.errors
+
+    from fabricate.errors import GeometryError
+
+    return (GeometryError, np.linalg.LinAlgError, shapely.errors.GEOSException, shapely.errors.ShapelyError,
+            FloatingPointError, OverflowError, ZeroDivisionError, ValueError)
 
 
 def run_build(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     """The whole pipeline in memory.
+
+    A geometry or numeric kernel failing after synthesis (GEOS, manifold, a singular matrix) is a design
+    failure named in the report with the stage it happened in (exit code 1), never a bare exception.
 
     Raises
     ------
     SpecError, SynthesisError
         Invalid input or nothing feasible (the CLI exits 2 and writes nothing).
     """
+    result, report, motion, failures = _synthesis_stage(design, progress, "build")
+    if motion is None:
+        report["checks"] = {"passed": False, "failures": failures}
+        return _finish(design, report, {}, exit_code=1, synthesis=result)
+    stage = ["gears"]
+    try:
+        return _build_stages(design, result, report, motion, progress, stage)
+    except (SpecError, SynthesisError):
+        raise
+    except _kernel_failures() as exc:
+        if isinstance(exc, FabricateError):
+            text = str(exc)
+        else:
+            text = f"{type(exc).__name__}: {exc}".strip().rstrip(":")
+        failure = f"{stage[0]}: this design cannot be made ({text})"
+        report["checks"] = {"passed": False, "failures": [failure]}
+        return _finish(design, report, {}, exit_code=1, synthesis=result, motion=motion)
+
+
+def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str, Any], motion: Motion,
+                  progress: Progress, stage: list[str]) -> BuildOutcome:
+    """Gears, parts, exports, checks and pictures; ``stage[0]`` names the stage running (for failures)."""
     from fabricate.checks import run_checks
     from fabricate.export import export_all, export_previews
     from fabricate.gears import build_gear_pairs
     from fabricate.parts.build import build_parts
 
-    result, report, motion, failures = _synthesis_stage(design, progress)
+    def enter(name: str) -> None:
+        stage[0] = name
+        progress(name)
+
     files: dict[str, bytes] = {}
-    if motion is None:
-        report["checks"] = {"passed": False, "failures": failures}
-        return _finish(report, files, exit_code=1, synthesis=result)
     mechanism = result.mechanism
-    progress("gears")
+    enter("gears")
     gear_pairs = build_gear_pairs(mechanism, design.gears, design.process.chord_tolerance_mm)
     report["gears"] = [pair.report() for pair in gear_pairs]
-    progress("parts")
+    enter("parts")
     partset = build_parts(design, mechanism, motion, gear_pairs, result.parts)
     # pictures take as long as everything else: draw them in a forked child on the second core
     pictures = Background([result.figures, lambda: gear_pictures(gear_pairs),
                            lambda: export_previews(design, partset, motion)])
-    progress("exports")
-    exported, parts_report = export_all(design, partset, mechanism, motion, previews=False)
-    files.update(exported)
-    report["parts"] = parts_report
-    report["bom"] = list(getattr(partset, "bom", []))
-    progress("checks")
-    checks = run_checks(design, partset, mechanism, motion, gear_pairs)
-    report["interference"] = checks.interference
-    failures = list(checks.failures)
-    for pair in gear_pairs:
-        failures += [f"gear {pair.name}: {text}" for text in pair.failures()]
-    report["checks"] = {"passed": not failures, "failures": failures}
-    progress("plots")
-    for name, data in sorted(checks.figures().items()):
-        files[f"plots/{name}"] = data
-    files.update(pictures.result())
-    return _finish(report, files, exit_code=0 if not failures else 1, synthesis=result, motion=motion,
+    try:
+        enter("exports")
+        exported, parts_report = export_all(design, partset, mechanism, motion, previews=False)
+        files.update(exported)
+        report["parts"] = parts_report
+        report["bom"] = list(getattr(partset, "bom", []))
+        enter("checks")
+        checks = run_checks(design, partset, mechanism, motion, gear_pairs)
+        report["interference"] = checks.interference
+        failures = list(checks.failures)
+        for pair in gear_pairs:
+            failures += [f"gear {pair.name}: {text}" for text in pair.failures()]
+        report["checks"] = {"passed": not failures, "failures": failures}
+        enter("plots")
+        for name, data in sorted(checks.figures().items()):
+            files[f"plots/{name}"] = data
+        files.update(pictures.result())
+    finally:
+        pictures.cancel()
+    return _finish(design, report, files, exit_code=0 if not failures else 1, synthesis=result, motion=motion,
                    partset=partset, gear_pairs=gear_pairs, checks=checks)
 
 
@@ -228,42 +258,28 @@ class Background:
                 return payload
         return _run_jobs(self.jobs)
 
+    def cancel(self) -> None:
+        """Stop the child if its result was never asked for (the build failed or was interrupted)."""
+        if self._process is not None:
+            self._process.terminate()
+            self._process.join()
+            self._conn.close()
+            self._process = None
 
-def _finish(report: dict[str, Any], files: dict[str, bytes], **kw: Any) -> BuildOutcome:
-    """Add report.json / report.md and the file list (every path relative to the output directory)."""
+
+def manifest(files: dict[str, bytes]) -> list[dict[str, Any]]:
+    """Every file's path, size in bytes and sha256, sorted by path."""
+    return [{"path": rel, "bytes": len(data), "sha256": hashlib.sha256(data).hexdigest()}
+            for rel, data in sorted(files.items())]
+
+
+def _finish(design: DesignSpec, report: dict[str, Any], files: dict[str, bytes], **kw: Any) -> BuildOutcome:
+    """Add report.md, then report.json with the file list, the manifest of every other file and the
+    template text (every path relative to the output directory)."""
     images = [p for p in sorted(files) if p.endswith((".png", ".gif"))]
     report["files"] = sorted(set(files) | {"report.json", "report.md"})
     files["report.md"] = report_markdown(report, images).encode("utf-8")
+    report["manifest"] = manifest(files)
+    report["template_text"] = design.template_text
     files["report.json"] = report_json(report)
     return BuildOutcome(report=report, files=files, **kw)
-
-
-def write_atomically(files: dict[str, bytes], out_dir: Path) -> None:
-    """Write every file into a temporary sibling of ``out_dir`` and rename it into place.
-
-    An existing ``out_dir`` is replaced only after the new one is complete.
-    """
-    out_dir = Path(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".tmp", dir=out_dir.parent))
-    try:
-        for rel, data in sorted(files.items()):
-            target = tmp / rel
-            target.parent.mkdir(parents=True, exist_ok=True)
-            with open(target, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
-        os.chmod(tmp, 0o755)
-        if out_dir.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".old", dir=out_dir.parent))
-            os.rmdir(old)
-            os.replace(out_dir, old)
-            os.replace(tmp, out_dir)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, out_dir)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from fabricate.cli import main
-from fabricate.pipeline import write_atomically
+from fabricate.output import write_atomically
 from fabricate.spec import shipped_templates
 
 REPORT_KEYS = {"design", "mechanism", "synthesis", "gears", "parts", "interference", "checks", "files"}

@@ -59,7 +59,9 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     parts_report : list of dict
         One entry per part: name, process, stl, dxf, volume_mm3, layer, holes [{joint, diameter_mm,
         cut_diameter_mm}], plus role, body, thickness_mm, z_mm, area_mm2, stl_problems, plate and sheet
-        placement, and the part's geometry warnings (e.g. holes running into each other).
+        placement, and the part's geometry warnings (e.g. holes running into each other). ``volume_mm3`` is
+        the exact profile area times the thickness, ``stl_volume_mm3`` the polygonised solid's (what
+        ``fabricate check`` holds the STL and 3MF to).
 
     Raises
     ------
@@ -70,6 +72,7 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     from fabricate.export.stl import (
         SolidCache,
         assembly_3mf,
+        mesh_volume,
         part_stl,
         plate_layout,
         print_plate_stl,
@@ -90,13 +93,15 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
         stl_path, dxf_path = f"parts/{part.name}.stl", f"parts/{part.name}.dxf"
         stl = part_stl(part, cache)
         problems = validate_stl(stl)
+        vertices, faces = cache.flat_mesh(part)
         if problems:
             raise GeometryError(f"part {part.name}: STL {', '.join(problems)}")
         files[stl_path] = stl
         files[dxf_path] = part_dxf(part, kerf)
         entries.append({
             "name": part.name, "process": part.process, "stl": stl_path, "dxf": dxf_path,
-            "volume_mm3": round(part.volume_mm3(), 4), "layer": part.layer,
+            "volume_mm3": round(part.volume_mm3(), 4), "stl_volume_mm3": round(mesh_volume(vertices, faces), 4),
+            "layer": part.layer,
             "holes": [{"joint": h.joint, "diameter_mm": round(h.diameter_mm, 6),
                        "cut_diameter_mm": round(h.diameter_mm - kerf, 6)} for h in part.holes],
             "role": part.role, "body": part.body, "thickness_mm": part.thickness_mm,

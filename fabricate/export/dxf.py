@@ -229,6 +229,29 @@ def kinematic_dxf(mechanism: Any, poses: Mapping[str, np.ndarray]) -> bytes:
 
 def audit_problems(data: bytes) -> list[str]:
     """Read DXF bytes back and list what ezdxf's auditor fixed or found (empty means clean)."""
-    doc = ezdxf.read(io.StringIO(data.decode("utf-8")))
+    problems, _ = read_dxf(data)
+    return problems
+
+
+def read_dxf(data: bytes) -> tuple[list[str], list[float]]:
+    """Read DXF bytes back: ezdxf's audit findings and the diameters of the circles on layer CUT.
+
+    Returns
+    -------
+    problems : list of str
+        Unreadable text or structure, and whatever the auditor fixed or found (empty means clean).
+    cut_diameters_mm : list of float
+        Diameter of every CIRCLE on layer CUT (the laser's holes), sorted.
+    """
+    try:
+        doc = ezdxf.read(io.StringIO(data.decode("utf-8")))
+    except UnicodeDecodeError as exc:
+        return [f"not UTF-8 text (byte {exc.start})"], []
+    except ezdxf.DXFError as exc:
+        return [f"not a readable DXF ({exc})"], []
     auditor = doc.audit()
-    return [str(e.message) for e in auditor.errors] + [str(f.message) for f in auditor.fixes]
+    problems = [str(e.message) for e in auditor.errors] + [str(f.message) for f in auditor.fixes]
+    if doc.units != units.MM:
+        problems.append(f"drawing units are {units.unit_name(doc.units)}, not mm")
+    diameters = sorted(2.0 * float(e.dxf.radius) for e in doc.modelspace().query('CIRCLE[layer=="CUT"]'))
+    return problems, diameters

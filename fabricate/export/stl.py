@@ -62,6 +62,11 @@ def stl_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
     return trimesh.exchange.stl.export_stl(_mesh(vertices, faces))
 
 
+def mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """Enclosed volume (mm^3) of a closed triangle mesh, vertices (n, 3) mm and triangles (m, 3)."""
+    return float(_mesh(vertices, faces).volume)
+
+
 def part_stl(part: Part, cache: SolidCache) -> bytes:
     """Binary STL of one part in its own coordinates, bottom face on z = 0 (its print orientation)."""
     return stl_bytes(*cache.flat_mesh(part))
@@ -69,12 +74,12 @@ def part_stl(part: Part, cache: SolidCache) -> bytes:
 
 def validate_stl(data: bytes, expected_volume_mm3: float | None = None,
                  rel_tol: float = 1e-3) -> list[str]:
-    """Problems found by reading STL bytes back with trimesh (an empty list means a valid solid).
+    """Problems found by reading binary STL bytes back with trimesh (an empty list means a valid solid).
 
     Parameters
     ----------
     data : bytes
-        Binary STL.
+        Binary STL (what fabricate writes).
     expected_volume_mm3 : float, optional
         Also compare the volume with this value.
     rel_tol : float
@@ -83,15 +88,30 @@ def validate_stl(data: bytes, expected_volume_mm3: float | None = None,
     Returns
     -------
     list of str
-        Human-readable problems: not watertight, inconsistent winding, non-positive volume, volume off.
+        Human-readable problems: truncated, not watertight, inconsistent winding, non-positive volume,
+        volume off.
     """
+    # a binary STL is an 80-byte header, a triangle count and 50 bytes a triangle: check that first, or
+    # trimesh falls back to its ASCII reader and reports something unrelated
+    if len(data) < 84:
+        return [f"not a binary STL ({len(data)} bytes, shorter than its 84-byte header)"]
+    count = int.from_bytes(data[80:84], "little")
+    if len(data) != 84 + 50 * count:
+        return [f"truncated or not a binary STL: {len(data)} bytes, its header announces {count} triangles "
+                f"({84 + 50 * count} bytes)"]
     try:
         mesh = trimesh.load(io.BytesIO(data), file_type="stl", process=True)
     except Exception as exc:  # noqa: BLE001 - any decoder failure is a finding
         return [f"cannot be read back: {exc}"]
-    problems = []
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         return ["no triangles"]
+    return mesh_problems(mesh, expected_volume_mm3, rel_tol)
+
+
+def mesh_problems(mesh: trimesh.Trimesh, expected_volume_mm3: float | None = None,
+                  rel_tol: float = 1e-3) -> list[str]:
+    """What makes ``mesh`` not a closed solid of the expected volume (see :func:`validate_stl`)."""
+    problems = []
     if not mesh.is_watertight:
         problems.append("not watertight")
     if not mesh.is_winding_consistent:
@@ -102,6 +122,48 @@ def validate_stl(data: bytes, expected_volume_mm3: float | None = None,
     if expected_volume_mm3 is not None and abs(volume - expected_volume_mm3) > rel_tol * abs(expected_volume_mm3):
         problems.append(f"volume {volume:.6g} mm^3 differs from {expected_volume_mm3:.6g} mm^3")
     return problems
+
+
+def read_3mf(data: bytes) -> tuple[dict[str, trimesh.Trimesh], list[str]]:
+    """The named objects of a 3MF (core spec) and what is wrong with the package.
+
+    The container is read with the standard library (the 3MF writer above is ours too); each object's
+    mesh is handed to trimesh, so callers validate it with :func:`mesh_problems`.
+
+    Returns
+    -------
+    objects : dict[str, trimesh.Trimesh]
+        Object name -> mesh, in file order (vertices in mm).
+    problems : list of str
+        Unreadable zip or XML, a unit other than millimetre, duplicate names, bad triangle indices.
+    """
+    import xml.etree.ElementTree as ET
+
+    ns = "{http://schemas.microsoft.com/3dmanufacturing/core/2015/02}"
+    try:
+        with zipfile.ZipFile(io.BytesIO(data)) as archive:
+            model = ET.fromstring(archive.read("3D/3dmodel.model"))
+    except (zipfile.BadZipFile, KeyError, ET.ParseError, OSError, EOFError, ValueError) as exc:
+        return {}, [f"not a readable 3MF package ({type(exc).__name__}: {exc})"]
+    problems = []
+    if model.get("unit", "millimeter") != "millimeter":
+        problems.append(f"unit is {model.get('unit')}, not millimeter")
+    objects: dict[str, trimesh.Trimesh] = {}
+    for obj in model.iter(f"{ns}object"):
+        name = obj.get("name") or f"object {obj.get('id')}"
+        try:
+            vertices = np.array([[float(v.get(k)) for k in "xyz"] for v in obj.iter(f"{ns}vertex")])
+            faces = np.array([[int(t.get(k)) for k in ("v1", "v2", "v3")] for t in obj.iter(f"{ns}triangle")])
+        except (TypeError, ValueError) as exc:
+            problems.append(f"object {name}: unreadable mesh ({exc})")
+            continue
+        if len(faces) == 0 or faces.min() < 0 or faces.max() >= len(vertices):
+            problems.append(f"object {name}: no triangles or triangle indices outside its vertices")
+            continue
+        if name in objects:
+            problems.append(f"object name {name} appears twice")
+        objects[name] = _mesh(vertices, faces)
+    return objects, problems
 
 
 def plate_layout(parts: Sequence[Part], cache: SolidCache, build_area_mm: tuple[float, float],
