@@ -1,0 +1,254 @@
+"""Output folders never destroy anything: what ``-o`` may be, locking, leftovers of killed runs, Ctrl-C."""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from fabricate.cli import main
+from fabricate.errors import SpecError
+from fabricate.output import check_output_dir, previous_output, write_output
+from fabricate.pipeline import manifest
+
+FAST = "gear_pair_elliptic"  # the quickest shipped template to build
+
+
+def fake_output(tag: str, n_files: int = 5) -> dict[str, bytes]:
+    """A small but complete fabricate output: files plus a report.json listing them with a manifest."""
+    files = {f"parts/p{i}.txt": f"{tag} {i}\n".encode() * 200 for i in range(n_files)}
+    report = {"design": {"name": "x", "fabricate_version": "test", "stage": "build"}, "parts": [],
+              "files": sorted([*files, "report.json"]), "manifest": manifest(files), "tag": tag}
+    files["report.json"] = json.dumps(report).encode()
+    return files
+
+
+def _tree(root: Path) -> dict[str, bytes]:
+    return {p.relative_to(root).as_posix(): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def _siblings(parent: Path) -> list[str]:
+    return sorted(p.name for p in parent.iterdir())
+
+
+# -- what -o may be -----------------------------------------------------------------------------------
+
+def test_a_folder_with_user_files_is_refused_before_any_work(tmp_path, capsys):
+    out = tmp_path / "x"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep")
+    start = time.perf_counter()
+    assert main(["build", FAST, "-o", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "notes.txt" in err and str(out) in err and "--force" in err
+    assert _tree(out) == {"notes.txt": b"keep"}
+    assert _siblings(tmp_path) == ["x"]
+    assert time.perf_counter() - start < 2.0  # refused before synthesis (a build takes several seconds)
+
+
+def test_force_replaces_a_foreign_folder(tmp_path):
+    out = tmp_path / "x"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep")
+    write_output(fake_output("a"), out, force=True)
+    assert _tree(out) == fake_output("a")
+
+
+def test_the_templates_own_folder_is_refused_even_with_force(tmp_path, capsys):
+    src = tmp_path / "designs"
+    src.mkdir()
+    from fabricate.spec import TEMPLATE_DIR
+
+    template = src / "mine.toml"
+    template.write_bytes((TEMPLATE_DIR / f"{FAST}.toml").read_bytes())
+    for extra in ([], ["--force"]):
+        assert main(["build", str(template), "-o", str(src), "-q", *extra]) == 2
+        assert "mine.toml, the template being built" in capsys.readouterr().err
+        assert _siblings(src) == ["mine.toml"]
+
+
+@pytest.mark.parametrize("kind", ["file", "symlink_to_dir", "symlink_to_file", "dangling_symlink"])
+def test_a_file_or_link_is_refused(tmp_path, capsys, kind):
+    target = tmp_path / "real"
+    out = tmp_path / "out"
+    if kind == "file":
+        out.write_text("data")
+    elif kind == "symlink_to_dir":
+        target.mkdir()
+        out.symlink_to(target)
+    elif kind == "symlink_to_file":
+        target.write_text("data")
+        out.symlink_to(target)
+    else:
+        out.symlink_to(tmp_path / "nowhere")
+    before = _siblings(tmp_path)
+    for extra in ([], ["--force"]):
+        assert main(["build", FAST, "-o", str(out), "-q", *extra]) == 2
+        err = capsys.readouterr().err
+        assert str(out) in err and ("symbolic link" in err or "is a file" in err)
+    assert _siblings(tmp_path) == before
+    assert out.is_symlink() == (kind != "file")
+
+
+def test_the_current_folder_and_its_parents_are_refused(tmp_path, monkeypatch, capsys):
+    inner = tmp_path / "work"
+    inner.mkdir()
+    monkeypatch.chdir(inner)
+    for out in (".", str(inner), str(tmp_path)):
+        assert main(["build", FAST, "-o", out, "-q", "--force"]) == 2
+        assert "current folder" in capsys.readouterr().err
+    assert _siblings(inner) == []
+
+
+def test_unusable_locations_are_named_before_any_work(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    cases = {str(blocker / "sub" / "out"): "is a file, not a folder",
+             str(tmp_path / ("n" * 300)): "bytes long"}
+    for out, needle in cases.items():
+        assert main(["build", FAST, "-o", out, "-q"]) == 2
+        err = capsys.readouterr().err
+        assert needle in err and "Traceback" not in err
+    assert _siblings(tmp_path) == ["file"]
+
+
+def test_a_folder_that_cannot_be_written_is_named(tmp_path, capsys, monkeypatch):
+    # root writes into read-only folders, so the system's refusal is simulated where it is asked for
+    import fabricate.output as output
+
+    def refuse(*_args, **_kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(output.tempfile, "mkdtemp", refuse)
+    out = tmp_path / "ro" / "out"
+    assert main(["build", FAST, "-o", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "cannot be written" in err and "Permission denied" in err
+    assert _siblings(tmp_path) == []
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root may write into a read-only folder")
+def test_a_read_only_folder_is_refused(tmp_path, capsys):
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    try:
+        assert main(["build", FAST, "-o", str(ro / "out"), "-q"]) == 2
+        assert "cannot be written" in capsys.readouterr().err
+    finally:
+        ro.chmod(0o755)
+
+
+def test_a_previous_output_is_replaced_but_not_with_a_user_file_in_it(tmp_path):
+    out = tmp_path / "out"
+    write_output(fake_output("a"), out)
+    write_output(fake_output("b"), out)  # a previous fabricate output: replaced without --force
+    assert _tree(out) == fake_output("b")
+    (out / "parts" / "mine.txt").write_text("keep")
+    with pytest.raises(SpecError, match=r"parts/mine.txt, which fabricate did not write"):
+        write_output(fake_output("c"), out)
+    assert (out / "parts" / "mine.txt").read_text() == "keep"
+    assert previous_output(out)["tag"] == "b"
+
+
+def test_synth_never_replaces_a_build(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["build", FAST, "-q"]) == 0
+    build = tmp_path / "outputs" / FAST
+    before = _tree(build)
+    assert main(["synth", FAST, "-q"]) == 0  # its own default folder
+    assert _tree(build) == before
+    assert (tmp_path / "outputs" / f"{FAST}-synth" / "report.json").is_file()
+    assert main(["synth", FAST, "-o", str(build), "-q"]) == 2
+    assert "holds a full build" in capsys.readouterr().err
+    assert _tree(build) == before
+
+
+# -- leftovers, concurrency, interruption ---------------------------------------------------------------
+
+def test_leftovers_of_killed_runs_are_removed_by_the_next_run(tmp_path):
+    out = tmp_path / "out"
+    write_output(fake_output("a"), out)
+    script = (
+        "import os, sys, time\n"
+        "import fabricate.output as o\n"
+        "real = os.fsync\n"
+        "def slow(fd):\n"
+        "    real(fd); open(sys.argv[2], 'w').close(); time.sleep(60)\n"
+        "o.os.fsync = slow\n"
+        "from tests.test_output import fake_output\n"
+        "o.write_output(fake_output('b', 40), sys.argv[1])\n"
+    )
+    marker = tmp_path / "writing"
+    child = subprocess.Popen([sys.executable, "-c", script, str(out), str(marker)],
+                             cwd=Path(__file__).resolve().parent.parent)
+    try:
+        deadline = time.monotonic() + 60
+        while not marker.exists():
+            assert child.poll() is None and time.monotonic() < deadline
+            time.sleep(0.02)
+        child.send_signal(signal.SIGKILL)
+    finally:
+        child.wait()
+    leftovers = [n for n in _siblings(tmp_path) if n.startswith(".out.")]
+    assert any(n.endswith(".tmp") for n in leftovers)  # the killed run left its half-written folder
+    assert _tree(out) == fake_output("a")  # and the previous output untouched
+    write_output(fake_output("c"), out)
+    assert _siblings(tmp_path) == ["out", "writing"]
+    assert _tree(out) == fake_output("c")
+
+
+def _hammer(out: str, tag: str, rounds: int, errors: multiprocessing.Queue) -> None:
+    try:
+        for k in range(rounds):
+            write_output(fake_output(f"{tag}{k}"), out)
+    except BaseException as exc:  # noqa: BLE001 - reported to the parent
+        errors.put(f"{tag}: {type(exc).__name__}: {exc}")
+
+
+def test_concurrent_writers_are_serialised(tmp_path):
+    out = tmp_path / "out"
+    ctx = multiprocessing.get_context("fork")
+    errors = ctx.Queue()
+    workers = [ctx.Process(target=_hammer, args=(str(out), tag, 40, errors)) for tag in "abcd"]
+    for w in workers:
+        w.start()
+    for w in workers:
+        w.join(120)
+    found = []
+    while not errors.empty():
+        found.append(errors.get())
+    assert found == [] and all(w.exitcode == 0 for w in workers)
+    tree = _tree(out)
+    tag = json.loads(tree["report.json"])["tag"]
+    assert tree == fake_output(tag)  # one writer's complete output, nothing mixed
+    assert _siblings(tmp_path) == ["out"]  # no temporary, old or lock file left
+
+
+def test_ctrl_c_exits_130_with_one_line_and_the_previous_output_intact(tmp_path):
+    out = tmp_path / "out"
+    write_output(fake_output("a"), out)
+    child = subprocess.Popen([sys.executable, "-m", "fabricate", "build", "finger_five_bar_ncg", "-o", str(out)],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(2.5)  # inside synthesis or later (a build takes several seconds)
+    child.send_signal(signal.SIGINT)
+    stdout, stderr = child.communicate(timeout=60)
+    assert child.returncode == 130, (stdout, stderr)
+    assert "Traceback" not in stderr and len(stderr.strip().splitlines()) == 1
+    assert "interrupted" in stderr
+    assert _tree(out) == fake_output("a")
+    assert _siblings(tmp_path) == ["out"]
+
+
+def test_check_output_dir_accepts_new_and_empty_folders(tmp_path):
+    assert check_output_dir(tmp_path / "new" / "deeper") == tmp_path / "new" / "deeper"
+    (tmp_path / "empty").mkdir()
+    assert check_output_dir(tmp_path / "empty") == tmp_path / "empty"
+    assert _siblings(tmp_path) == ["empty"]  # checking writes nothing

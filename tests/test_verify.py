@@ -1,0 +1,231 @@
+"""``fabricate check DIR`` verifies what is on disk: one tampering per file type, each named with exit 1."""
+
+from __future__ import annotations
+
+import io
+import json
+import shutil
+import zipfile
+from collections.abc import Callable
+from pathlib import Path
+
+import ezdxf
+import numpy as np
+import pytest
+import trimesh
+
+from fabricate.cli import main
+from fabricate.output import write_output
+from fabricate.pipeline import run_build
+from fabricate.spec import TEMPLATE_DIR, load_design
+
+FAST = "gear_pair_elliptic"
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("built") / FAST
+    outcome = run_build(load_design(FAST))
+    assert outcome.exit_code == 0
+    write_output(outcome.files, out)
+    return out
+
+
+_REBUILDS: dict[tuple[str, str], object] = {}
+
+
+@pytest.fixture(autouse=True)
+def _one_rebuild_per_template(monkeypatch):
+    """Every check rebuilds its embedded template; most tamperings here share one, so build it once
+    (the real pipeline, only not repeated: a test-time saving of ~5 s a case)."""
+    import fabricate.pipeline as pipeline
+
+    real = pipeline.run_build
+
+    def cached(design, progress=lambda _m: None):
+        key = (Path(design.template).name, design.template_text)
+        if key not in _REBUILDS:
+            _REBUILDS[key] = real(design, progress)
+        return _REBUILDS[key]
+
+    monkeypatch.setattr(pipeline, "run_build", cached)
+
+
+@pytest.fixture
+def copy(built, tmp_path) -> Path:
+    target = tmp_path / FAST
+    shutil.copytree(built, target)
+    return target
+
+
+def _check(directory: Path, capsys) -> tuple[int, str]:
+    code = main(["check", str(directory), "-q"])
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.out + captured.err
+    return code, captured.out
+
+
+def _report(directory: Path) -> dict:
+    return json.loads((directory / "report.json").read_text())
+
+
+def test_an_untouched_output_passes(copy, capsys):
+    code, out = _check(copy, capsys)
+    assert code == 0, out
+    assert "checks passed" in out
+
+
+def _dxf_hole_radius_x3(d: Path) -> str:
+    path = d / "parts" / "carrier.dxf"
+    doc = ezdxf.read(io.StringIO(path.read_text()))
+    circle = doc.modelspace().query('CIRCLE[layer=="CUT"]').first
+    circle.dxf.radius *= 3.0
+    stream = io.StringIO()
+    doc.write(stream)
+    path.write_text(stream.getvalue())
+    return "parts/carrier.dxf: cut holes"
+
+
+def _dxf_garbage(d: Path) -> str:
+    (d / "sheet.dxf").write_text("garbage")
+    return "sheet.dxf: not a readable DXF"
+
+
+def _stl_scaled(d: Path) -> str:
+    path = d / "parts" / "gear_a.stl"
+    mesh = trimesh.load(io.BytesIO(path.read_bytes()), file_type="stl")
+    mesh.apply_scale(1.5)
+    assert mesh.is_watertight  # still a perfectly good solid: only its size betrays it
+    path.write_bytes(trimesh.exchange.stl.export_stl(mesh))
+    return "parts/gear_a.stl: volume"
+
+
+def _stl_truncated(d: Path) -> str:
+    path = d / "print_plate.stl"
+    path.write_bytes(path.read_bytes()[:-37])
+    return "print_plate.stl: truncated"
+
+
+def _3mf_corrupt(d: Path) -> str:
+    path = d / "assembly.3mf"
+    data = bytearray(path.read_bytes())
+    data[len(data) // 2: len(data) // 2 + 64] = b"\0" * 64
+    path.write_bytes(bytes(data))
+    return "assembly.3mf: not a readable 3MF"
+
+
+def _3mf_object_dropped(d: Path) -> str:
+    path = d / "assembly.3mf"
+    with zipfile.ZipFile(path) as archive:
+        entries = {name: archive.read(name) for name in archive.namelist()}
+    model = entries["3D/3dmodel.model"].decode()
+    start = model.index('<object id="3"')
+    model = model[:start] + model[model.index("</object>", start) + len("</object>"):]
+    entries["3D/3dmodel.model"] = model.replace('<item objectid="3"/>', "").encode()
+    with zipfile.ZipFile(path, "w") as archive:
+        for name, data in entries.items():
+            archive.writestr(name, data)
+    return "assembly.3mf: objects"
+
+
+def _png_corrupt(d: Path) -> str:
+    path = d / "previews" / "assembly.png"
+    path.write_bytes(path.read_bytes()[:200])
+    return "previews/assembly.png: not a readable image"
+
+
+def _file_list_emptied(d: Path) -> str:
+    report = _report(d)
+    report["files"] = []
+    (d / "report.json").write_text(json.dumps(report, indent=2))
+    return "report.json: its file list and its manifest disagree"
+
+
+def _template_edited_in_report(d: Path) -> str:
+    report = _report(d)
+    report["template_text"] = report["template_text"].replace("teeth = [30, 30]", "teeth = [32, 32]")
+    assert "teeth = [32, 32]" in report["template_text"]
+    (d / "report.json").write_text(json.dumps(report, indent=2))
+    return "parts/gear_a.stl: differs from a rebuild of the embedded template"
+
+
+def _template_swapped(d: Path) -> str:
+    report = _report(d)
+    report["template_text"] = (TEMPLATE_DIR / "finger_five_bar_ncg.toml").read_text()
+    (d / "report.json").write_text(json.dumps(report, indent=2))
+    return "a rebuild of the embedded template does not write it"
+
+
+def _file_deleted(d: Path) -> str:
+    (d / "bom.csv").unlink()
+    return "bom.csv: missing"
+
+
+def _file_added(d: Path) -> str:
+    (d / "parts" / "extra.stl").write_bytes((d / "parts" / "gear_a.stl").read_bytes())
+    return "parts/extra.stl: not written by fabricate"
+
+
+def _bom_edited(d: Path) -> str:
+    path = d / "bom.csv"
+    path.write_text(path.read_text().replace("pin", "pun", 1))  # same size: only the hash tells
+    return "bom.csv: contents differ from the manifest"
+
+
+TAMPERINGS: dict[str, Callable[[Path], str]] = {
+    "dxf_hole_radius_x3": _dxf_hole_radius_x3, "dxf_garbage": _dxf_garbage, "stl_scaled_1.5": _stl_scaled,
+    "stl_truncated": _stl_truncated, "3mf_corrupt": _3mf_corrupt, "3mf_object_dropped": _3mf_object_dropped,
+    "png_corrupt": _png_corrupt, "report_file_list_emptied": _file_list_emptied,
+    "template_edited": _template_edited_in_report, "template_swapped": _template_swapped,
+    "file_deleted": _file_deleted, "file_added": _file_added, "csv_edited": _bom_edited,
+}
+
+
+@pytest.mark.parametrize("name", sorted(TAMPERINGS))
+def test_tampering_is_caught_and_named(copy, capsys, name):
+    needle = TAMPERINGS[name](copy)
+    code, out = _check(copy, capsys)
+    assert code == 1
+    assert needle in out, out
+
+
+def test_a_broken_report_is_named(copy, capsys):
+    (copy / "report.json").write_text("{ not json")
+    code, out = _check(copy, capsys)
+    assert code == 1 and "report.json: not valid JSON" in out
+
+
+def test_a_folder_without_a_report_is_a_usage_error(tmp_path, capsys):
+    assert main(["check", str(tmp_path)]) == 2
+    assert "not a fabricate output folder" in capsys.readouterr().err
+
+
+def test_the_verdict_depends_neither_on_the_folder_nor_on_later_edits(tmp_path, monkeypatch, capsys):
+    designs = tmp_path / "designs"
+    designs.mkdir()
+    (designs / "pair.toml").write_bytes((TEMPLATE_DIR / f"{FAST}.toml").read_bytes())
+    monkeypatch.chdir(designs)
+    assert main(["build", "pair.toml", "-o", str(tmp_path / "out"), "-q"]) == 0  # a relative template path
+    report = _report(tmp_path / "out")
+    assert report["design"]["template"] == "pair.toml"
+    assert report["template_text"] == (designs / "pair.toml").read_text()
+    assert {m["path"] for m in report["manifest"]} | {"report.json"} == set(report["files"])
+    (designs / "pair.toml").write_text("edited after the build")
+    monkeypatch.chdir(tmp_path)
+    code, out = _check(tmp_path / "out", capsys)
+    assert code == 0, out
+
+
+def test_manifest_sizes_and_hashes_are_those_on_disk(built):
+    import hashlib
+
+    report = _report(built)
+    for item in report["manifest"]:
+        data = (built / item["path"]).read_bytes()
+        assert len(data) == item["bytes"]
+        assert hashlib.sha256(data).hexdigest() == item["sha256"]
+    # the STL volumes the check holds parts to are the meshes' own, and close to area x thickness
+    for part in report["parts"]:
+        mesh = trimesh.load(built / part["stl"])
+        assert mesh.volume == pytest.approx(part["stl_volume_mm3"], rel=1e-6)
+        assert np.isclose(part["stl_volume_mm3"], part["volume_mm3"], rtol=1e-3)
