@@ -1,0 +1,91 @@
+"""Installs anywhere: the wheel carries every template and process profile and builds from a foreign folder;
+``fabricate init`` writes an editable copy and never overwrites."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from fabricate.cli import main
+from fabricate.spec import TEMPLATE_DIR, load_design
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory) -> tuple[Path, Path]:
+    """The project built as a wheel and installed (without dependencies: those of this environment serve)
+    into a folder of its own; returns (wheel, site folder)."""
+    work = tmp_path_factory.mktemp("wheel")
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q",
+                    "-w", str(work / "dist"), str(ROOT)], check=True, cwd=work)
+    (wheel,) = (work / "dist").glob("fabricate-*.whl")
+    site = work / "site"
+    subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(site), str(wheel)],
+                   check=True, cwd=work)
+    return wheel, site
+
+
+def _run(site: Path, cwd: Path, *args: str) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONSAFEPATH")}
+    env["PYTHONPATH"] = str(site)
+    return subprocess.run([sys.executable, "-m", "fabricate", *args], cwd=cwd, env=env, capture_output=True,
+                          text=True, timeout=300)
+
+
+def test_the_wheel_carries_every_template(installed):
+    wheel, _ = installed
+    names = set(zipfile.ZipFile(wheel).namelist())
+    shipped = sorted(p.name for p in (ROOT / "templates").glob("*.toml"))
+    assert len(shipped) >= 7 and any(n.startswith("process_") for n in shipped)
+    for name in shipped:
+        assert f"fabricate/templates/{name}" in names, name
+        data = zipfile.ZipFile(wheel).read(f"fabricate/templates/{name}")
+        assert data == (ROOT / "templates" / name).read_bytes()  # the one source, packaged as it is
+
+
+def test_installed_it_lists_and_builds_from_a_foreign_folder(installed, tmp_path):
+    _, site = installed
+    foreign = tmp_path / "elsewhere"
+    foreign.mkdir()
+    where = subprocess.run([sys.executable, "-c", "import fabricate; print(fabricate.__file__)"], cwd=foreign,
+                           env={**os.environ, "PYTHONPATH": str(site)}, capture_output=True, text=True)
+    assert Path(where.stdout.strip()).is_relative_to(site)  # the installed copy, not this checkout
+    listed = _run(site, foreign, "list")
+    assert listed.returncode == 0
+    for path in sorted((ROOT / "templates").glob("*.toml")):
+        assert (path.stem in listed.stdout) == (not path.name.startswith("process_"))
+    built = _run(site, foreign, "build", "gear_pair_elliptic", "-q")
+    assert built.returncode == 0, built.stderr
+    report = json.loads((foreign / "outputs" / "gear_pair_elliptic" / "report.json").read_text())
+    assert report["design"]["process"] == "sla" and report["checks"]["passed"]
+    # an explicit path to a template outside any checkout, with a process profile found in the wheel
+    (foreign / "mine.toml").write_bytes((ROOT / "templates" / "gear_pair_elliptic.toml").read_bytes())
+    explicit = _run(site, tmp_path, "build", str(foreign / "mine.toml"), "-o", str(tmp_path / "o2"), "-q")
+    assert explicit.returncode == 0, explicit.stderr
+    assert (tmp_path / "o2" / "assembly.3mf").is_file()
+
+
+def test_init_writes_an_editable_copy_and_never_overwrites(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["init", "my_finger"]) == 0
+    copy = tmp_path / "my_finger.toml"
+    design = load_design(copy)
+    assert design.name == "my_finger" and design.kind == "five_bar_ncg"
+    shipped = (TEMPLATE_DIR / "finger_five_bar_ncg.toml").read_text()
+    assert copy.read_text() == shipped.replace('name = "finger_five_bar_ncg"', 'name = "my_finger"', 1)
+    copy.write_text(copy.read_text() + "\n# my edit\n")
+    assert main(["init", "my_finger"]) == 2
+    assert "never overwrites" in capsys.readouterr().err
+    assert copy.read_text().endswith("# my edit\n")
+    assert main(["init", "pair", "--from", "gear_pair_elliptic"]) == 0
+    assert load_design(tmp_path / "pair.toml").kind == "gear_pair"
+    assert main(["init", "../escape"]) == 2
+    assert main(["init", "x", "--from", "no_such_template"]) == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["my_finger.toml", "pair.toml"]
