@@ -1,0 +1,90 @@
+"""Gear properties a user depends on, with expected values from closed forms written here.
+
+Written to kill mutants of ``fabricate/gears`` (see ``tests/benchmarks/mutation_report.md``): the sector's
+hub is the hub that was asked for, and the transmission error is the larger of the two flank errors.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+import pytest
+import shapely
+from shapely.geometry import LineString, Point, Polygon
+
+from fabricate.gears import GearSpec, make_gear_pair
+from fabricate.gears.law import FormulaLaw
+
+MODULE = 0.5
+HUB_MM = 4.0  # hub diameter asked for
+
+
+@cache
+def sector_pair():
+    spec = GearSpec(module_mm=MODULE, backlash_mm=0.05, compare_methods=False, hub_diameter_mm=HUB_MM)
+    return make_gear_pair(FormulaLaw("0.8*x + 0.05*sin(2*x)"), 18.0, (0.1, 0.9), spec, closed=False,
+                          chord_tolerance_mm=0.005, run_mesh_check=False)
+
+
+@cache
+def spur_pair(z: int = 24, module: float = 1.0, backlash: float = 0.1):
+    """Two equal circular gears (law x_b = -x_a): exact involute spur gears."""
+    spec = GearSpec(teeth=(z, z), module_mm=module, backlash_mm=backlash, compare_methods=False, mesh_steps=720)
+    return make_gear_pair(FormulaLaw("x"), z * module, (0.0, 2 * np.pi), spec, closed=True)
+
+
+def ray_extent(outline: np.ndarray, direction: np.ndarray) -> float:
+    """Distance from the axis (origin) to the outline along ``direction`` (nearest crossing)."""
+    ray = LineString([(0.0, 0.0), tuple(200.0 * direction)])
+    hit = Polygon(outline).exterior.intersection(ray)
+    return float(min(Point(0.0, 0.0).distance(g) for g in getattr(hit, "geoms", [hit])))
+
+
+@pytest.mark.parametrize("gear", ["a", "b"])
+def test_sector_hub_is_the_hub_asked_for(gear):
+    """Away from the teeth the sector is its hub: the outline's extent there is the hub radius, and the
+    area is at most the toothed fan (pitch curve pushed out by the addendum, closed at the axis) plus
+    the hub disc."""
+    pair = sector_pair()
+    cut, pitch = (pair.cut_a, pair.pitch_a) if gear == "a" else (pair.cut_b, pair.pitch_b)
+    outline = np.asarray(cut.outline)
+    assert Polygon(outline).is_valid
+    # opposite the teeth: the direction away from the mean direction of the pitch curve
+    mean = np.mean(pitch / np.hypot(*pitch.T)[:, None], axis=0)
+    away = -mean / np.hypot(*mean)
+    for turn in (-0.5, 0.0, 0.5):  # three rays over the back of the hub
+        c, s = np.cos(turn), np.sin(turn)
+        d = np.array([c * away[0] - s * away[1], s * away[0] + c * away[1]])
+        assert ray_extent(outline, d) == pytest.approx(HUB_MM / 2, abs=0.005)
+    # area bound: the fan up to the tip curve plus the hub disc (generous: the fan uses 1.1 addendum)
+    r = np.hypot(*pitch.T)[:, None]
+    tip = pitch * (r + 1.1 * MODULE) / r
+    fan = Polygon(np.vstack([[0.0, 0.0], tip]))
+    if not fan.is_valid:
+        fan = shapely.make_valid(fan)
+    bound = fan.area + np.pi * (HUB_MM / 2) ** 2
+    assert Polygon(outline).area <= bound
+    # and the teeth are there: more than the fan up to the root curve
+    root = pitch * (r - 1.25 * MODULE - 0.1) / r
+    assert Polygon(outline).area > Polygon(np.vstack([[0.0, 0.0], root])).area
+
+
+def test_spur_transmission_error_is_the_larger_flank_error():
+    """For equal involute spur gears each flank's designed free play is backlash / (2 r) (the flank
+    thinning j cos(alpha) / 4 over the base radius r cos(alpha), twice): the transmission error at a
+    step is the larger of |play - designed| over the two flanks, and the report gives its maximum."""
+    z, module, backlash = 24, 1.0, 0.1
+    pair = spur_pair(z, module, backlash)
+    mesh = pair.mesh
+    r = z * module / 2
+    lag = backlash / (2 * r)
+    ok = np.isfinite(mesh.free_plus) & np.isfinite(mesh.free_minus)
+    assert ok.mean() > 0.99
+    err = np.maximum(np.abs(mesh.free_plus[ok] - lag), np.abs(mesh.free_minus[ok] - lag))
+    np.testing.assert_allclose(np.abs(mesh.transmission_error[ok]), err, rtol=1e-9, atol=1e-15)
+    assert pair.report()["transmission_error_deg"] == pytest.approx(np.degrees(err.max()), rel=1e-9)
+    # total free rotation is the backlash over the pitch radius (closed form, 1 um)
+    np.testing.assert_allclose((mesh.free_plus[ok] + mesh.free_minus[ok]) * r, backlash, atol=1e-3)
+    # the errors of the two flanks differ: the max/min choice matters for this pair
+    assert np.mean(np.abs(np.abs(mesh.free_plus[ok] - lag) - np.abs(mesh.free_minus[ok] - lag)) > 0) > 0.5
