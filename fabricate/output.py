@@ -25,7 +25,7 @@ import os
 import shutil
 import signal
 import tempfile
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -263,14 +263,26 @@ def _write_tree(files: Mapping[str, bytes], root: Path) -> None:
     os.chmod(root, 0o755)
 
 
-def write_atomically(files: Mapping[str, bytes], out_dir: str | Path) -> None:
+def write_atomically(files: Mapping[str, bytes], out_dir: str | Path,
+                     before: Callable[[Path], Any] | None = None) -> Path:
     """Write ``{relative path: bytes}`` into a temporary sibling of ``out_dir`` and swap it into place.
 
-    An existing ``out_dir`` is replaced only once the new one is complete; on any failure (Ctrl-C
-    included) the temporary folder is removed and the old output is left as it was. The caller decides
-    whether ``out_dir`` may be replaced (:func:`check_output_dir`, :func:`write_output`).
+    Under the folder's lock: leftovers of killed runs are removed, ``before(out_dir)`` runs (the caller's
+    last word on whether the folder may be replaced), then the files are written and swapped in. An
+    existing ``out_dir`` is replaced only once the new one is complete; on any failure (Ctrl-C included)
+    the temporary folder is removed and the old output is left as it was.
     """
     out_dir = Path(os.path.abspath(out_dir))
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    with _locked(out_dir.parent, out_dir.name):
+        remove_leftovers(out_dir.parent, out_dir.name)
+        if before is not None:
+            before(out_dir)
+        _swap_in(files, out_dir)
+    return out_dir
+
+
+def _swap_in(files: Mapping[str, bytes], out_dir: Path) -> None:
     tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".tmp", dir=out_dir.parent))
     try:
         _write_tree(files, tmp)
@@ -292,10 +304,10 @@ def write_atomically(files: Mapping[str, bytes], out_dir: str | Path) -> None:
 
 def write_output(files: Mapping[str, bytes], out: str | Path, *, force: bool = False, stage: str = "build",
                  protect: Sequence[Path] = ()) -> Path:
-    """Write a whole output folder safely: lock, clean up, re-check, write, swap.
+    """Write a whole output folder safely: check it (again, under the lock), then :func:`write_atomically`.
 
-    The folder is checked again under the lock: another writer may have filled it since the first
-    check (its result, a fabricate output, may then be replaced).
+    The folder is checked again under the lock because another writer may have filled it since the
+    first check (its result, a fabricate output, may then be replaced).
 
     Raises
     ------
@@ -304,15 +316,8 @@ def write_output(files: Mapping[str, bytes], out: str | Path, *, force: bool = F
     """
     out = Path(os.path.abspath(out))
     try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise _refuse(out, f"cannot be created: {exc.strerror}") from exc
-    try:
-        with _locked(out.parent, out.name):
-            remove_leftovers(out.parent, out.name)
-            check_output_dir(out, force=force, stage=stage, protect=protect)
-            write_atomically(files, out)
+        return write_atomically(files, out, before=lambda o: check_output_dir(o, force=force, stage=stage,
+                                                                             protect=protect))
     except OSError as exc:
         where = exc.filename or out
         raise _refuse(out, f"cannot be written: {where}: {exc.strerror or exc}") from exc
-    return out
