@@ -336,6 +336,8 @@ class ProcessSpec:
 
 def parse_process(table: Table) -> ProcessSpec:
     """Read ``[process]``: a profile name plus overrides of the profile's fields."""
+    from fabricate.bounds import MIN_CHORD_TOLERANCE_MM
+
     profile = table.string("profile", "sla", choices=("sla", "laser"))
     base_path = TEMPLATE_DIR / f"process_{profile}.toml"
     base = read_toml(base_path) if base_path.is_file() else {}
@@ -345,19 +347,22 @@ def parse_process(table: Table) -> ProcessSpec:
             merged[key] = table.data[key]
             table._used.add(key)
     t = Table(merged, table.path or "process")
+    # every length is bounded (bounds.MAX_LENGTH_MM and tighter where the process makes sense): a
+    # huge pin or wall turns into geometry no kernel can build; the chord tolerance's lower bound
+    # caps the vertex count of every polygonised arc (memory and time grow as 1/sqrt(tolerance))
     spec = ProcessSpec(
         name=profile,
         running_clearance_mm=t.number("running_clearance_mm", min=0.0, max=5.0),
         hole_compensation_mm=t.number("hole_compensation_mm", 0.0, min=-2.0, max=2.0),
-        min_wall_mm=t.number("min_wall_mm", positive=True),
-        min_pin_mm=t.number("min_pin_mm", positive=True),
-        layer_gap_mm=t.number("layer_gap_mm", min=0.0),
-        thickness_mm=t.number("thickness_mm", positive=True),
+        min_wall_mm=t.number("min_wall_mm", positive=True, max=50.0),
+        min_pin_mm=t.number("min_pin_mm", positive=True, max=50.0),
+        layer_gap_mm=t.number("layer_gap_mm", min=0.0, max=50.0),
+        thickness_mm=t.number("thickness_mm", positive=True, max=100.0),
         kerf_mm=t.number("kerf_mm", 0.0, min=0.0, max=2.0),
-        min_feature_mm=t.number("min_feature_mm", positive=True),
-        build_volume_mm=tuple(t.array("build_volume_mm", shape=(3,), positive=True).tolist()),
-        pin_diameter_mm=t.number("pin_diameter_mm", positive=True),
-        chord_tolerance_mm=t.number("chord_tolerance_mm", 0.005, positive=True, max=1.0),
+        min_feature_mm=t.number("min_feature_mm", positive=True, max=10.0),
+        build_volume_mm=tuple(t.array("build_volume_mm", shape=(3,), positive=True, max=10000.0).tolist()),
+        pin_diameter_mm=t.number("pin_diameter_mm", positive=True, max=50.0),
+        chord_tolerance_mm=t.number("chord_tolerance_mm", 0.005, min=MIN_CHORD_TOLERANCE_MM, max=1.0),
     )
     t.finish()
     if spec.pin_diameter_mm < spec.min_pin_mm:
@@ -375,9 +380,12 @@ class ChecksSpec:
 
 
 def parse_checks(table: Table) -> ChecksSpec:
+    """Read ``[checks]``; ``sweep_poses`` is bounded by :data:`fabricate.bounds.MAX_SWEEP_POSES`."""
+    from fabricate.bounds import MAX_SWEEP_POSES
+
     spec = ChecksSpec(
-        sweep_poses=table.integer("sweep_poses", 360, min=2, max=100000),
-        min_clearance_mm=table.number("min_clearance_mm", None, min=0.0),
+        sweep_poses=table.integer("sweep_poses", 360, min=2, max=MAX_SWEEP_POSES),
+        min_clearance_mm=table.number("min_clearance_mm", None, min=0.0, max=50.0),
     )
     table.finish()
     return spec
@@ -424,8 +432,12 @@ def load_design(path: str | Path) -> DesignSpec:
     SpecError
         On the first invalid field, naming its path.
     """
+    from fabricate.bounds import preflight
+
     path = find_template(path)
-    return design_from_text(read_text(path), path)
+    design = design_from_text(read_text(path), path)
+    preflight(design)  # counts whose product drives memory or time (each field alone is already bounded)
+    return design
 
 
 def design_from_text(text: str, path: str | Path) -> DesignSpec:

@@ -29,6 +29,10 @@ import shapely
 
 from fabricate.planar import polygon_area, relative_poses
 
+#: Largest number of posed outline vertices built at once by :func:`planar_clearance` (about 0.3 GB
+#: of shapely geometry at ~150 bytes per vertex).
+POSED_VERTICES_PER_CHUNK = 2_000_000
+
 
 @dataclass(frozen=True)
 class RelativePoses:
@@ -127,6 +131,13 @@ def planar_clearance(a: Outline, b: Outline, rel: RelativePoses, search_mm: floa
         the boundaries touch; ``-inf`` where the interiors overlap.
     """
     n = len(rel.q)
+    # every posed copy of B is a shapely polygon held at once: pose in chunks of at most
+    # POSED_VERTICES_PER_CHUNK vertices so memory stays bounded for any number of poses (a chunk
+    # boundary only drops the distance guess of one pose, which is retried at full size anyway)
+    chunk = max(1, POSED_VERTICES_PER_CHUNK // max(1, len(b.vertices)))
+    if n > chunk:
+        return np.concatenate([planar_clearance(a, b, RelativePoses(rel.q[i:i + chunk]), search_mm)
+                               for i in range(0, n, chunk)])
     out = np.full(n, np.inf)
     if n == 0:
         return out
@@ -179,4 +190,8 @@ def _clipped_distance(a: Outline, poly_b: shapely.Polygon, bounds_b: np.ndarray,
 
 def overlap_areas(a: Outline, b: Outline, rel: RelativePoses) -> np.ndarray:
     """Area (mm^2) of the overlap of ``a`` and ``b`` posed by each of ``rel`` (n,)."""
-    return np.asarray(shapely.area(shapely.intersection(a.polygon, b.posed(rel))), dtype=np.float64)
+    chunk = max(1, POSED_VERTICES_PER_CHUNK // max(1, len(b.vertices)))  # bounded memory, as above
+    return np.concatenate([
+        np.asarray(shapely.area(shapely.intersection(a.polygon, b.posed(RelativePoses(rel.q[i:i + chunk])))),
+                   dtype=np.float64)
+        for i in range(0, len(rel.q), chunk)] or [np.zeros(0)])

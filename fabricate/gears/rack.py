@@ -71,6 +71,41 @@ class RackProfile:
         return RackProfile(pts, normals, self.element, self.flank_u, self.pitch)
 
 
+#: Smallest half-width (× module) of the cutter's tip flat (the gear's root flat) kept by
+#: :func:`rack_fit`: below it the flat degenerates to a point and the round corners would cross.
+MIN_ROOT_LAND = 0.02
+
+
+def rack_fit(pressure_angle: float, dedendum: float) -> tuple[float, float]:
+    """Largest dedendum and root fillet (× module) the rack tooth space holds at ``pressure_angle``.
+
+    The flank of gear a's cutter crosses the root line ``v = -h_f`` at ``u = -p/4 - h_f tan(alpha)``;
+    the cutter's tip flat (gear a's root) must keep a half-width of :data:`MIN_ROOT_LAND` before the
+    half period ``-p/2``, so ``h_f <= (pi/4 - land) / tan(alpha)``. A round of radius ``rho``
+    tangent to the flat and the flank has its centre at ``u = -p/4 + ((rho - h_f) sin(alpha) - rho) /
+    cos(alpha)`` (see :func:`basic_rack`), which gives the largest radius for a dedendum.
+
+    Parameters
+    ----------
+    pressure_angle : float
+        rad, in (0, pi/2).
+    dedendum : float
+        The wanted dedendum × module.
+
+    Returns
+    -------
+    (float, float)
+        ``(max_dedendum, max_root_fillet)``: the deepest root the tooth space holds at all, and the
+        largest fillet for ``min(dedendum, max_dedendum)`` (0 when none fits), both × module.
+    """
+    sa, ca = np.sin(pressure_angle), np.cos(pressure_angle)
+    quarter = np.pi / 4
+    max_dedendum = (quarter - MIN_ROOT_LAND) * ca / sa
+    hf = min(dedendum, max_dedendum)
+    rho = (quarter * ca - MIN_ROOT_LAND * ca - hf * sa) / (1.0 - sa)
+    return float(max_dedendum), float(min(max(rho, 0.0), hf))
+
+
 def basic_rack(module: float, pressure_angle: float, dedendum: float, root_fillet: float,
                addendum: float = 1.0, flank_points: int = 241, round_points: int = 25,
                flat_points: int = 5) -> RackProfile:

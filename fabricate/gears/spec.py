@@ -8,7 +8,11 @@ Keys (all optional)
 -------------------
 ``module_mm``            float > 0. Module m in mm. Absent: chosen automatically — for a closed pair from
                          the tooth count and centre distance, for a sector 0.5 mm (an SLA-sized module).
-``pressure_angle_deg``   float in [10, 35], default 20. Pressure angle of the generating rack.
+``pressure_angle_deg``   float in [10, 35], default 20. Pressure angle of the generating rack. Above about
+                         22 degrees the default root fillet no longer fits the rack's tooth space and
+                         is reduced to the largest that does (above about 31 degrees also the default
+                         dedendum); a ``root_fillet`` or ``dedendum`` given explicitly that does not fit
+                         is an error naming its limit.
 ``addendum``             float in [0.3, 1.5] × m, default 1.0.
 ``dedendum``             float in [0.5, 2.0] × m, default 1.25; must exceed ``addendum`` (tip clearance).
 ``root_fillet``          float in [0, 0.5] × m, default 0.38. Rack tip round radius (cuts the fillet).
@@ -21,13 +25,15 @@ Keys (all optional)
 ``compare_methods``      bool, default true. Also build the other method and report the largest deviation
                          between the two outlines in µm.
 ``spare_teeth``          int >= 1, default 1. Extra engagements beyond each end of a sector's range.
-``mesh_steps``           int >= 720, default 720. Poses of the mesh check over the working range.
+``mesh_steps``           int in [720, 7200], default 720. Poses of the mesh check over the working range
+                         (time grows with steps × outline vertices; the bound keeps the check within
+                         the resource budget of :mod:`fabricate.bounds`).
 ``closed``               bool. Absent: as the design kind says (sector for a finger, closed for a gear pair).
-``teeth``                [z_a, z_b], integers >= 3. Tooth counts of a closed pair (with the centre distance
+``teeth``                [z_a, z_b], integers in [3, 400]. Tooth counts of a closed pair (with the centre distance
                          they fix the module, unless ``module_mm`` is given, which then fixes the
                          centre distance).
-``min_teeth``            int >= 3, default 8. Fewest teeth a closed gear may have (a check).
-``bore_mm``              float > 0. Bore of each gear on its axis. Absent: the process pin diameter.
+``min_teeth``            int in [3, 400], default 8. Fewest teeth a closed gear may have (a check).
+``bore_mm``              float in (0, 50]. Bore of each gear on its axis. Absent: the process pin diameter.
 ``hub_diameter_mm``      float > 0. Hub around the bore. Absent: the parts layer decides.
 
 Example
@@ -45,7 +51,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from fabricate.bounds import MAX_MESH_STEPS, MAX_TEETH
 from fabricate.errors import SpecError
+from fabricate.gears.rack import MIN_ROOT_LAND, rack_fit
 from fabricate.spec import Table
 
 METHODS = ("exact", "approx")
@@ -135,23 +143,24 @@ def parse_gear_spec(table: Table) -> GearSpec:
     method = table.string("method", "exact", choices=METHODS)
     compare = table.boolean("compare_methods", True)
     spare = table.integer("spare_teeth", 1, min=1, max=20)
-    steps = table.integer("mesh_steps", 720, min=720, max=200000)
+    steps = table.integer("mesh_steps", 720, min=720, max=MAX_MESH_STEPS)
     closed = table.boolean("closed") if table.has("closed") else None
-    teeth_arr = table.array("teeth", None, shape=(2,), min=3, max=2000)
+    teeth_arr = table.array("teeth", None, shape=(2,), min=3, max=MAX_TEETH)
     teeth: tuple[int, int] | None = None
     if teeth_arr is not None:
         for i, z in enumerate(teeth_arr):
             if z != round(z):
                 raise SpecError(f"{table.field('teeth')}[{i}]", f"expected a whole number, got {z:g}")
         teeth = (int(teeth_arr[0]), int(teeth_arr[1]))
-    min_teeth = table.integer("min_teeth", 8, min=3, max=1000)
-    bore = table.number("bore_mm", None, positive=True, max=500.0)
+    min_teeth = table.integer("min_teeth", 8, min=3, max=MAX_TEETH)
+    bore = table.number("bore_mm", None, positive=True, max=50.0)
     hub = table.number("hub_diameter_mm", None, positive=True, max=1000.0)
     table.finish()
     if dedendum <= addendum:
         raise SpecError(table.field("dedendum"),
                         f"dedendum {dedendum:g} m must exceed addendum {addendum:g} m (tip clearance); "
                         f"use dedendum >= {addendum + 0.25:g}")
+    dedendum, fillet = _fit_rack(table, pressure, addendum, dedendum, fillet)
     if hub is not None and bore is not None and hub <= bore:
         raise SpecError(table.field("hub_diameter_mm"),
                         f"hub {hub:g} mm must be larger than the bore {bore:g} mm")
@@ -163,3 +172,39 @@ def parse_gear_spec(table: Table) -> GearSpec:
                     root_fillet=fillet, backlash_mm=backlash, method=method, compare_methods=compare,
                     spare_teeth=spare, mesh_steps=steps, closed=closed, teeth=teeth, min_teeth=min_teeth,
                     bore_mm=bore, hub_diameter_mm=hub)
+
+
+def _fit_rack(table: Table, pressure_deg: float, addendum: float, dedendum: float,
+              fillet: float) -> tuple[float, float]:
+    """The dedendum and root fillet actually cut: the template's, or the largest that fit the rack.
+
+    A steep pressure angle narrows the rack's tooth space at the root (see
+    :func:`fabricate.gears.rack.rack_fit`). Defaults adapt to it so that every pressure angle of the
+    documented range builds; values the template gives explicitly are kept or refused with their limit.
+    """
+    max_dedendum, _ = rack_fit(math.radians(pressure_deg), dedendum)
+    if dedendum > max_dedendum:
+        if table.has("dedendum"):
+            raise SpecError(table.field("dedendum"),
+                            f"dedendum {dedendum:g} m does not fit the rack's tooth space at pressure angle "
+                            f"{pressure_deg:g} deg; at most {_floor3(max_dedendum):g} m")
+        if max_dedendum <= addendum:
+            # the other gear's tip would reach this gear's root: no tip clearance is left
+            limit = math.degrees(math.atan((math.pi / 4 - MIN_ROOT_LAND) / addendum))
+            raise SpecError(table.field("pressure_angle_deg"),
+                            f"at {pressure_deg:g} deg the rack's tooth space is {max_dedendum:.3g} m deep, not "
+                            f"deeper than the addendum {addendum:g} m; at most {math.floor(limit * 10) / 10:g} deg "
+                            "with this addendum (or a smaller addendum)")
+        dedendum = max_dedendum
+    _, max_fillet = rack_fit(math.radians(pressure_deg), dedendum)
+    if fillet > max_fillet:
+        if table.has("root_fillet"):
+            raise SpecError(table.field("root_fillet"),
+                            f"root fillet {fillet:g} m does not fit the rack's tooth space at pressure angle "
+                            f"{pressure_deg:g} deg with dedendum {dedendum:g} m; at most {_floor3(max_fillet):g} m")
+        fillet = max_fillet
+    return dedendum, fillet
+
+
+def _floor3(value: float) -> float:
+    return math.floor(value * 1000.0) / 1000.0

@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 import shapely
 
-from fabricate.errors import GeometryError
+from fabricate.errors import GeometryError, SpecError
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
 from fabricate.parts.bom import Pin, Spacer, bill_of_materials, pins_and_spacers
 from fabricate.parts.layers import assign_layers, conflict_graph, layer_z, order_layers, pin_crossings
@@ -371,6 +371,7 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
                               holes=(Hole(sp.joint, sp.centre, sp.inner_diameter_mm, sizes.pin_mm),),
                               thickness_mm=sp.length_mm, z_mm=sp.z_mm, layer=sp.lower_layer + 1,
                               process=process.name, role="spacer"))
+    _check_pin_webs(parts, process)
     warnings = overlapping_cuts(parts)
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
@@ -382,6 +383,33 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
     return PartSet(parts=tuple(parts), bom=bom, pins=tuple(pins), spacers=tuple(spacers), layers=layers,
                    process=process.name, chord_tolerance_mm=tol, thickness_mm=thickness, layer_gap_mm=gap,
                    kerf_mm=process.kerf_mm, copies=copies, hints=hints, warnings=tuple(warnings))
+
+
+def _check_pin_webs(parts: Sequence[Part], process: ProcessSpec) -> None:
+    """Refuse a pin so large that two joint holes of one part run into each other.
+
+    Overlapping holes make the plate's outline an invalid polygon (no geometry kernel can build or
+    check it), and the pin diameter is the field to blame: the message gives the largest pin that
+    leaves the process's minimum wall between the two holes.
+    """
+    for part in parts:
+        joint_holes = [h for h in part.holes if not h.joint.startswith("mount_")]
+        for i, a in enumerate(joint_holes):
+            for b in joint_holes[i + 1:]:
+                distance = float(np.hypot(*(np.asarray(a.centre) - b.centre)))
+                if distance < 1e-9:
+                    continue  # one pin through two joint names (merged coincident pins)
+                web = distance - 0.5 * (a.diameter_mm + b.diameter_mm)
+                if web < process.min_wall_mm:
+                    largest = (distance - process.min_wall_mm - 2.0 * process.running_clearance_mm
+                               - process.hole_compensation_mm)
+                    limit = (f"at most {math.floor(largest * 100) / 100:g} mm" if largest >= process.min_pin_mm
+                             else "no pin of the process fits; move the joints apart")
+                    raise SpecError("process.pin_diameter_mm",
+                                    f"{process.pin_diameter_mm:g} mm pins: holes {a.joint} and {b.joint} of part "
+                                    f"{part.name} are {distance:.3g} mm apart and would leave "
+                                    f"{web:.3g} mm of wall between them (the process needs "
+                                    f"{process.min_wall_mm:g} mm); {limit}")
 
 
 def overlapping_cuts(parts: Sequence[Part]) -> list[str]:

@@ -24,6 +24,12 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 from scipy.optimize import brentq, fsolve
 
+from fabricate.bounds import (
+    MAX_GRID_AXIS,
+    MAX_LENGTH_MM,
+    MAX_PATH_SAMPLES,
+    MAX_SPRING_RATE,
+)
 from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, LinearLaw, Mechanism, Revolute, Slider
 from fabricate.spec import Table
@@ -65,6 +71,8 @@ def _grid_axis(table: Table, key: str, scale: float, lo: float, hi: float) -> np
     if step <= 0 or stop < start:
         raise SpecError(table.field(key), "expected [start, stop, step] with step > 0 and stop >= start")
     count = int(np.floor((stop - start) / step + 1e-9)) + 1
+    if count > MAX_GRID_AXIS:  # checked before the axis is made (a step of 1e-300 would not fit memory)
+        raise SpecError(table.field(key), f"{count} grid values, over the bound of {MAX_GRID_AXIS}; use a larger step")
     return (start + step * np.arange(count)) * scale
 
 
@@ -72,23 +80,28 @@ def parse_spec(root: Table) -> CompliantSpec:
     """Read ``[finger]``, ``[springs]``, ``[object]``, ``[optimisation]``, ``[drive]``."""
     f = root.table("finger")
     geom = GripperGeometry(
-        a1=f.number("a1_mm", positive=True), a2=f.number("a2_mm", positive=True),
-        a3=f.number("a3_mm", positive=True), b=f.number("b_mm", min=0.0), c=f.number("c_mm", min=0.0),
-        d=f.number("d_mm", positive=True), l1=f.number("l1_mm", positive=True),
-        l2=f.number("l2_mm", positive=True), r=f.number("pad_radius_mm", positive=True),
+        a1=f.number("a1_mm", positive=True, max=MAX_LENGTH_MM), a2=f.number("a2_mm", positive=True, max=MAX_LENGTH_MM),
+        a3=f.number("a3_mm", positive=True, max=MAX_LENGTH_MM), b=f.number("b_mm", min=0.0, max=MAX_LENGTH_MM),
+        c=f.number("c_mm", min=0.0, max=MAX_LENGTH_MM),
+        d=f.number("d_mm", positive=True, max=MAX_LENGTH_MM),
+        l1=f.number("l1_mm", positive=True, max=MAX_LENGTH_MM),
+        l2=f.number("l2_mm", positive=True, max=MAX_LENGTH_MM),
+        r=f.number("pad_radius_mm", positive=True, max=MAX_LENGTH_MM),
         alpha=np.radians(f.number("alpha_deg", min=0.0, max=90.0)))
     pad_arc = np.radians(f.number("pad_arc_deg", 90.0, positive=True, max=180.0))
     f.finish()
     s = root.table("springs")
-    springs = Springs(k1=s.number("k1_Nmm_per_deg", min=0.0), k2=s.number("k2_Nmm_per_deg", min=0.0),
+    springs = Springs(k1=s.number("k1_Nmm_per_deg", min=0.0, max=MAX_SPRING_RATE),
+                      k2=s.number("k2_Nmm_per_deg", min=0.0, max=MAX_SPRING_RATE),
                       phi01=s.number("phi01_rad", min=0.0, max=2 * np.pi),
                       phi02=s.number("phi02_rad", min=0.0, max=2 * np.pi))
-    legs = s.number("legs_mm", 20.0, positive=True)
+    legs = s.number("legs_mm", 20.0, positive=True, max=MAX_LENGTH_MM)
     s.finish()
     o = root.table("object")
-    load = Load(diameter=o.number("diameter_mm", positive=True), mass=o.number("mass_kg", positive=True),
-                mu=o.number("friction", positive=True, max=2.0), safety=o.number("safety", positive=True),
-                g=o.number("gravity", 9.8, positive=True))
+    load = Load(diameter=o.number("diameter_mm", positive=True, max=MAX_LENGTH_MM),
+                mass=o.number("mass_kg", positive=True, max=1000.0),
+                mu=o.number("friction", positive=True, max=2.0), safety=o.number("safety", positive=True, max=100.0),
+                g=o.number("gravity", 9.8, positive=True, max=100.0))
     o.finish()
     opt = root.table("optimisation", {})
     enabled = opt.boolean("enabled", True)
@@ -104,10 +117,10 @@ def parse_spec(root: Table) -> CompliantSpec:
     if not enabled:
         grid = None
     min_hinge = np.radians(opt.number("min_hinge_deg", 5.0, min=0.0, max=45.0))
-    samples = opt.integer("path_samples", 181, min=31, max=5001)
+    samples = opt.integer("path_samples", 181, min=31, max=MAX_PATH_SAMPLES)
     opt.finish()
     dr = root.table("drive", {})
-    overtravel = dr.number("overtravel_mm", 1.0, min=0.0)
+    overtravel = dr.number("overtravel_mm", 1.0, min=0.0, max=MAX_LENGTH_MM)
     fingers = dr.integer("fingers", 3, min=1, max=12)
     dr.finish()
     return CompliantSpec(geom, springs, load, pad_arc, grid, min_hinge, samples, legs, overtravel, fingers)

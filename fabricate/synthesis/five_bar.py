@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from fabricate.bounds import MAX_KAPPA_SAMPLES, MAX_LENGTH_MM, MIN_CURVE_STEP_MM
 from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, GearCoupling, Mechanism, Motion, Revolute
 from fabricate.planar import rotation, unit, wrap_angle
@@ -46,6 +47,8 @@ SELECTION_RULES = ("x_A", "least_pose_error")
 #: Minimum number of poses: with fewer, the four smallest eigenvectors of M^T M span an arbitrary
 #: part of a larger null space and the family is not determined by the poses.
 MIN_POSES = 4
+#: Most target poses (each adds a row to the constraint matrix and a knot to the gear law).
+MAX_POSES = 100
 
 
 # -- spec ------------------------------------------------------------------------------------------
@@ -101,9 +104,10 @@ class FiveBarSpec:
     x_A_mm: float | None
 
 
-def _interval(table: Table, key: str, default: Any = None, *, positive: bool = False) -> tuple[float, float]:
-    arr = table.array(key, default, shape=(2,), positive=positive) if default is not None \
-        else table.array(key, shape=(2,), positive=positive)
+def _interval(table: Table, key: str, default: Any = None, *, positive: bool = False,
+              bound: float = MAX_LENGTH_MM) -> tuple[float, float]:
+    arr = table.array(key, default, shape=(2,), positive=positive, min=-bound, max=bound) if default is not None \
+        else table.array(key, shape=(2,), positive=positive, min=-bound, max=bound)
     arr = np.asarray(arr, dtype=np.float64)
     if not arr[0] < arr[1]:
         raise SpecError(table.field(key), f"expected [low, high] with low < high, got {arr.tolist()}")
@@ -120,10 +124,13 @@ def parse_spec(root: Table) -> FiveBarSpec:
         empty ranges, a selection rule without its target.
     """
     finger = root.table("finger")
-    lengths = finger.array("lengths_mm", shape=(3,), positive=True)
-    origin = finger.array("origin_mm", [0.0, 0.0], shape=(2,))
-    poses = finger.array("poses_deg", shape=(None, 3), min_rows=MIN_POSES)
-    pad = finger.number("pad_radius_mm", 5.0, positive=True)
+    # magnitudes and counts are bounded (fabricate.bounds): a 1e300 mm phalanx overflows the mapping
+    lengths = finger.array("lengths_mm", shape=(3,), positive=True, max=MAX_LENGTH_MM)
+    origin = finger.array("origin_mm", [0.0, 0.0], shape=(2,), min=-MAX_LENGTH_MM, max=MAX_LENGTH_MM)
+    poses = finger.array("poses_deg", shape=(None, 3), min_rows=MIN_POSES, min=-720.0, max=720.0)
+    if len(poses) > MAX_POSES:
+        raise SpecError(finger.field("poses_deg"), f"{len(poses)} poses, over the bound of {MAX_POSES}")
+    pad = finger.number("pad_radius_mm", 5.0, positive=True, max=200.0)
     finger.finish()
     proximal = np.diff(np.unwrap(np.radians(poses[:, 0])))
     if not (np.all(proximal > 0) or np.all(proximal < 0)):
@@ -135,17 +142,17 @@ def parse_spec(root: Table) -> FiveBarSpec:
         origin_mm=tuple(float(v) for v in origin),
         poses_deg=tuple(tuple(float(v) for v in row) for row in poses),
         pad_radius_mm=pad,
-        kappa_samples=syn.integer("kappa_samples", 2001, min=50, max=200000),
-        curve_step_mm=syn.number("curve_step_mm", 0.25, positive=True),
+        kappa_samples=syn.integer("kappa_samples", 2001, min=50, max=MAX_KAPPA_SAMPLES),
+        curve_step_mm=syn.number("curve_step_mm", 0.25, min=MIN_CURVE_STEP_MM, max=MAX_LENGTH_MM),
         a_x_mm=_interval(syn, "a_x_mm"),
         a_y_mm=_interval(syn, "a_y_mm"),
         ab_length_mm=_interval(syn, "ab_length_mm", positive=True),
         bc_length_mm=_interval(syn, "bc_length_mm", positive=True),
-        max_length_error_mm=syn.number("max_length_error_mm", 0.5, positive=True),
-        transmission_ratio=_interval(syn, "transmission_ratio", [0.2, 5.0], positive=True),
-        min_pitch_curvature_radius_mm=syn.number("min_pitch_curvature_radius_mm", 2.0, min=0.0),
+        max_length_error_mm=syn.number("max_length_error_mm", 0.5, positive=True, max=MAX_LENGTH_MM),
+        transmission_ratio=_interval(syn, "transmission_ratio", [0.2, 5.0], positive=True, bound=1000.0),
+        min_pitch_curvature_radius_mm=syn.number("min_pitch_curvature_radius_mm", 2.0, min=0.0, max=MAX_LENGTH_MM),
         select=syn.string("select", "least_pose_error", choices=SELECTION_RULES),
-        x_A_mm=syn.number("x_A_mm", None),
+        x_A_mm=syn.number("x_A_mm", None, min=-MAX_LENGTH_MM, max=MAX_LENGTH_MM),
     )
     if spec.select == "x_A" and spec.x_A_mm is None:
         raise SpecError(syn.field("x_A_mm"), 'missing required field (select = "x_A" needs it)')
@@ -322,10 +329,14 @@ def hinge_domain(spec: FiveBarSpec, targets: FingerTargets, family: km.DyadFamil
 
 def _empty_domain_message(domain: HingeDomain) -> str:
     counts = domain.rejected_counts()
+    if len(domain.status) == 0:
+        # the kinematic mapping traced no real dyad at all: the poses admit no hinge pair A/B, which
+        # no synthesis limit can cure (the finger itself is to blame)
+        return ("no feasible hinge A/B: the target poses admit no hinge curve (no real dyad); check "
+                "finger.lengths_mm and finger.poses_deg")
     parts = [f"{counts[name]} by {field}" for name, field in REJECTIONS if counts[name]]
-    last = next((field for name, field in reversed(REJECTIONS) if counts[name]), None)
-    detail = "; ".join(parts) if parts else "none were found"
-    return (f"no feasible hinge A/B: of {len(domain.status)} hinge-curve points, rejected {detail}; "
+    last = next(field for name, field in reversed(REJECTIONS) if counts[name])
+    return (f"no feasible hinge A/B: of {len(domain.status)} hinge-curve points, rejected {'; '.join(parts)}; "
             f"the last limit that removed candidates is {last}")
 
 

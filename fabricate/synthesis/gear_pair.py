@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from fabricate.bounds import MAX_TEETH
 from fabricate.errors import SpecError
 from fabricate.gears.law import FormulaLaw, check_ratio, elliptic_formula, samples_law
 from fabricate.gears.pitch import PitchCurves
@@ -65,23 +66,25 @@ def parse_spec(root: Table) -> GearPairSpec:
     if family == "elliptic" and t.has("family"):
         ecc = t.number("eccentricity", min=0.0, max=0.95)
     formula = t.string("law", None)
-    samples = t.array("law_samples_deg", None, shape=(None, 2), min_rows=3)
+    samples = t.array("law_samples_deg", None, shape=(None, 2), min_rows=3, min=-3600.0, max=3600.0)
+    if samples is not None and len(samples) > 10000:
+        raise SpecError(t.field("law_samples_deg"), f"{len(samples)} samples, over the bound of 10000")
     if samples is not None:
         family = "samples"
     closed = t.boolean("closed", True)
     default_range = [0.0, 360.0] if closed else None
     if closed:
-        rng = t.array("working_range_deg", default_range, shape=(2,))
+        rng = t.array("working_range_deg", default_range, shape=(2,), min=-3600.0, max=3600.0)
         rng = np.asarray(rng, dtype=np.float64)
         if abs(rng[1] - rng[0] - 360.0) > 1e-9:
             raise SpecError(t.field("working_range_deg"), "a closed pair turns through 360 deg; "
                                                           "leave working_range_deg out or set closed = false")
     else:
-        rng = t.array("working_range_deg", shape=(2,))
+        rng = t.array("working_range_deg", shape=(2,), min=-3600.0, max=3600.0)
         if not rng[1] > rng[0]:
             raise SpecError(t.field("working_range_deg"), "expected [lo, hi] with lo < hi")
     center = t.number("center_distance_mm", None, positive=True, max=5000.0)
-    teeth_arr = t.array("teeth", None, shape=(2,), min=3, max=2000)
+    teeth_arr = t.array("teeth", None, shape=(2,), min=3, max=MAX_TEETH)
     teeth = None
     if teeth_arr is not None:
         if np.any(teeth_arr != np.round(teeth_arr)):

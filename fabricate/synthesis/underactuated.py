@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq, minimize
 
+from fabricate.bounds import MAX_FORCE_N, MAX_LENGTH_MM, MAX_SPRING_RATE, MAX_STROKE_SAMPLES
 from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute, Slider
 from fabricate.planar import cross2
@@ -59,37 +60,44 @@ class UnderactuatedSpec:
     source: str
 
 
+#: Most phalanges of one finger (each adds a four-bar, a body pair and a spring).
+MAX_PHALANGES = 8
+
+
 def parse_spec(root: Table) -> UnderactuatedSpec:
     """Read ``[finger]``, ``[transmission]``, ``[push_rod]``, ``[springs]`` and ``[object]``."""
     finger = root.table("finger")
-    lengths = finger.array("phalanx_lengths_mm", shape=(None,), min_rows=2, positive=True)
-    thickness = finger.number("thickness_mm", positive=True)
+    lengths = finger.array("phalanx_lengths_mm", shape=(None,), min_rows=2, positive=True, max=MAX_LENGTH_MM)
+    if len(lengths) > MAX_PHALANGES:
+        raise SpecError(finger.field("phalanx_lengths_mm"),
+                        f"{len(lengths)} phalanges, over the bound of {MAX_PHALANGES}")
+    thickness = finger.number("thickness_mm", positive=True, max=200.0)
     source = finger.string("source", "")
     finger.finish()
     n = len(lengths)
     tr = root.table("transmission")
-    out_arm = tr.array("output_arm_mm", shape=(n - 1,), positive=True)
+    out_arm = tr.array("output_arm_mm", shape=(n - 1,), positive=True, max=MAX_LENGTH_MM)
     out_angle = np.radians(tr.array("output_arm_deg", shape=(n - 1,), min=-180.0, max=180.0))
-    in_arm = tr.array("input_arm_mm", shape=(n - 1,), positive=True)
+    in_arm = tr.array("input_arm_mm", shape=(n - 1,), positive=True, max=MAX_LENGTH_MM)
     in_angle = np.radians(tr.array("input_arm_deg", shape=(n - 1,), min=-180.0, max=180.0))
     tr.finish()
     rod = root.table("push_rod")
-    crank = rod.number("crank_mm", positive=True)
+    crank = rod.number("crank_mm", positive=True, max=MAX_LENGTH_MM)
     crank_angle = np.radians(rod.number("crank_deg", min=-180.0, max=180.0))
-    link = rod.number("link_mm", positive=True)
-    rod_y = rod.number("axis_y_mm")
-    stroke = rod.number("stroke_mm", positive=True)
-    push_force = rod.number("push_force_N", positive=True)
-    samples = rod.integer("samples", 121, min=11, max=2001)
+    link = rod.number("link_mm", positive=True, max=MAX_LENGTH_MM)
+    rod_y = rod.number("axis_y_mm", min=-MAX_LENGTH_MM, max=MAX_LENGTH_MM)
+    stroke = rod.number("stroke_mm", positive=True, max=MAX_LENGTH_MM)
+    push_force = rod.number("push_force_N", positive=True, max=MAX_FORCE_N)
+    samples = rod.integer("samples", 121, min=11, max=MAX_STROKE_SAMPLES)
     rod.finish()
     springs = root.table("springs")
-    rates = springs.array("rate_Nmm_per_deg", shape=(n,), min=0.0) * 180.0 / np.pi
+    rates = springs.array("rate_Nmm_per_deg", shape=(n,), min=0.0, max=MAX_SPRING_RATE) * 180.0 / np.pi
     preloads = np.radians(springs.array("preload_deg", shape=(n,), min=0.0, max=360.0))
-    legs = springs.number("legs_mm", 15.0, positive=True)
+    legs = springs.number("legs_mm", 15.0, positive=True, max=MAX_LENGTH_MM)
     springs.finish()
     obj = root.table("object")
-    centre = obj.array("cylinder_centre_mm", shape=(2,))
-    radius = 0.5 * obj.number("cylinder_diameter_mm", positive=True)
+    centre = obj.array("cylinder_centre_mm", shape=(2,), min=-MAX_LENGTH_MM, max=MAX_LENGTH_MM)
+    radius = 0.5 * obj.number("cylinder_diameter_mm", positive=True, max=MAX_LENGTH_MM)
     obj.finish()
     design = FingerDesign(lengths=lengths, thickness=thickness, out_arm=out_arm, out_angle=out_angle,
                           in_arm=in_arm, in_angle=in_angle, crank=crank, crank_angle=crank_angle, link=link,

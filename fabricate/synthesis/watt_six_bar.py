@@ -26,6 +26,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fabricate.bounds import (
+    MAX_FORCE_N,
+    MAX_LENGTH_MM,
+    MAX_REFINE_SEEDS,
+    MAX_REGION_SAMPLES,
+    MAX_STATICS_SAMPLES,
+)
 from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute
 from fabricate.spec import DesignSpec, Table
@@ -89,7 +96,7 @@ class WattSixBarSpec:
 def parse_spec(root: Table) -> WattSixBarSpec:
     """Read ``[finger]``, ``[boxes]``, ``[region]``, ``[selection]`` and the optional ``[reference]``."""
     finger = root.table("finger")
-    lengths = finger.array("phalanx_lengths_mm", shape=(3,), positive=True)
+    lengths = finger.array("phalanx_lengths_mm", shape=(3,), positive=True, max=MAX_LENGTH_MM)
     angles = [finger.array(f"theta{k}_deg", shape=(4,), min=-360.0, max=360.0) for k in (1, 2, 3)]
     pad = finger.number("tip_pad_radius_mm", 5.0, positive=True, max=50.0)
     finger.finish()
@@ -109,7 +116,7 @@ def parse_spec(root: Table) -> WattSixBarSpec:
     boxes_t = root.table("boxes")
     boxes = []
     for name in BOX_NAMES:
-        box = boxes_t.array(name, shape=(4,), min=-1000.0, max=1000.0)
+        box = boxes_t.array(name, shape=(4,), min=-MAX_LENGTH_MM, max=MAX_LENGTH_MM)
         if not (box[0] < box[1] and box[2] < box[3]):
             raise SpecError(boxes_t.field(name), "expected [x_min, x_max, y_min, y_max] with min < max")
         boxes.append((name, tuple(float(v) for v in box)))
@@ -117,23 +124,24 @@ def parse_spec(root: Table) -> WattSixBarSpec:
 
     region = root.table("region", {})
     step = region.number("step_mm", 0.2, positive=True, max=10.0)
-    k_max = region.number("k_max", 20.0, positive=True)
-    force = region.number("force_N", 1.0, positive=True)
-    samples = region.integer("statics_samples", 41, min=3, max=2001)
+    k_max = region.number("k_max", 20.0, positive=True, max=1e6)
+    force = region.number("force_N", 1.0, positive=True, max=MAX_FORCE_N)
+    samples = region.integer("statics_samples", 41, min=3, max=MAX_STATICS_SAMPLES)
     tol = region.number("tip_tolerance_mm", 0.5, positive=True, max=50.0)
     clearance = region.number("min_pin_to_middle_mm", 0.0, min=0.0, max=100.0)
     region.finish()
     box_d = dict(boxes)["d"]
     box_d0 = dict(boxes)["d0"]
     for name, box in (("d", box_d), ("d0", box_d0)):
-        if (box[1] - box[0]) / step > 20000:
-            raise SpecError(region.field("step_mm"), f"step too fine for the {name} box (over 20000 samples)")
+        if (box[1] - box[0]) / step > MAX_REGION_SAMPLES:
+            raise SpecError(region.field("step_mm"),
+                            f"step too fine for the {name} box (over {MAX_REGION_SAMPLES} samples)")
 
     sel = root.table("selection", {})
     rule = sel.string("rule", "nearest", choices=("nearest", "least_k"))
     target = None
     if rule == "nearest":
-        t = sel.array("target", shape=(2,))
+        t = sel.array("target", shape=(2,), min=-MAX_LENGTH_MM, max=MAX_LENGTH_MM)
         target = (float(t[0]), float(t[1]))
     elif sel.has("target"):
         sel.array("target", shape=(2,))
@@ -144,14 +152,14 @@ def parse_spec(root: Table) -> WattSixBarSpec:
             raise SpecError(sel.field("branches"), "expected two whole numbers 1..3")
         branches = (int(b[0]), int(b[1]))
     refine = sel.boolean("refine", True)
-    seeds = sel.integer("refine_seeds", 600, min=1, max=100000)
+    seeds = sel.integer("refine_seeds", 600, min=1, max=MAX_REFINE_SEEDS)
     sel.finish()
 
     reference: list[tuple[str, tuple[float, float]]] = []
     if root.has("reference"):
         ref = root.table("reference")
         for name in ("d", "e", "f", "d0"):
-            p = ref.array(name, shape=(2,))
+            p = ref.array(name, shape=(2,), min=-MAX_LENGTH_MM, max=MAX_LENGTH_MM)
             reference.append((name, (float(p[0]), float(p[1]))))
         ref.string("note", "")
         ref.finish()
