@@ -39,7 +39,6 @@ from fabricate.export.stl import (
     validate_stl,
 )
 from fabricate.parts.build import build_parts
-from fabricate.parts.profiles import offset_path
 from fabricate.parts.spec import PartsSpec
 from fabricate.spec import ProcessSpec, load_design, shipped_templates
 from fabricate.synthesis import KINDS
@@ -108,12 +107,43 @@ def perimeter_mm(part) -> float:
     return float(sum(shapely.LinearRing(r).length for r in rings))
 
 
-def expected_cut_diameter(part, hole, process) -> float:
-    """Finished hole minus the kerf: pin + 2 x radial clearance (+ SLA compensation) - kerf."""
+def expected_cut_diameter(hole, c) -> float:
+    """Finished hole minus the kerf, from the process and the design alone (never from the part model):
+    pin (or the mounting screw of ``[parts]``) + 2 x radial clearance (+ SLA compensation) - kerf."""
+    process = c.process
     if hole.joint.startswith("mount_"):
-        return hole.diameter_mm - process.kerf_mm
-    return (process.pin_diameter_mm + 2 * process.running_clearance_mm + process.hole_compensation_mm
-            - process.kerf_mm)
+        nominal = c.design.parts.mounting_hole_mm
+    else:
+        nominal = process.pin_diameter_mm
+    return nominal + 2 * process.running_clearance_mm + process.hole_compensation_mm - process.kerf_mm
+
+
+def bulge_path_polygon(vertices, bulges, chord_mm: float = 1e-4) -> shapely.Polygon:
+    """A closed line/arc path as a fine polygon, built here from the raw vertices and bulges with ezdxf's
+    bulge-to-arc conversion (not the part model's own polygonisation)."""
+    pts = []
+    n = len(vertices)
+    for i in range(n):
+        p0, p1, b = np.asarray(vertices[i], float), np.asarray(vertices[(i + 1) % n], float), float(bulges[i])
+        pts.append(p0)
+        if b == 0.0:
+            continue
+        centre, start, end, radius = bulge_to_arc(p0, p1, b)
+        sweep = (end - start) % (2 * math.pi)
+        k = max(8, math.ceil(sweep / (2 * math.acos(1 - chord_mm / radius))))
+        t = start + sweep * np.arange(1, k) / k
+        arc = np.column_stack([centre[0] + radius * np.cos(t), centre[1] + radius * np.sin(t)])
+        pts.extend(arc if b > 0 else arc[::-1])
+    return shapely.Polygon(np.array(pts))
+
+
+def offset_area(vertices, bulges, distance_mm: float) -> tuple[float, float]:
+    """Area of a closed path offset by ``distance_mm`` (Minkowski sum with a disc, or erosion when
+    negative), by shapely from the raw path, and a bound on its polygonisation error (mm^2)."""
+    poly = bulge_path_polygon(vertices, bulges)
+    if distance_mm != 0.0:
+        poly = poly.buffer(distance_mm, quad_segs=512)
+    return float(poly.area), 2e-4 * float(poly.length) + 1e-9
 
 
 # -- STL ----------------------------------------------------------------------------------------
@@ -241,13 +271,17 @@ def test_part_dxf_round_trip(name):
         circles = msp.query('CIRCLE[layer=="CUT"]')
         assert len(circles) == len(part.holes)
         for circle, hole in zip(circles, part.holes, strict=True):
-            assert 2 * circle.dxf.radius == pytest.approx(expected_cut_diameter(part, hole, c.process), abs=1e-6)
+            assert 2 * circle.dxf.radius == pytest.approx(expected_cut_diameter(hole, c), abs=1e-6)
             np.testing.assert_allclose([circle.dxf.center.x, circle.dxf.center.y], hole.centre, atol=1e-6)
         # every contour is a simple closed curve (the kerf offset made no loops)
         assert all(poly.is_valid for poly in contour_polygons(msp, flatten_mm=1e-3))
-        # the outline read back through ezdxf's bulge-to-arc conversion has the exact kerf-offset area
-        expected = offset_path(part.outline, kerf / 2).area()
-        assert lwpolyline_area(outlines[0]) == pytest.approx(expected, rel=1e-9)
+        # the outline read back through ezdxf's bulge-to-arc conversion has the area of the part's outline
+        # grown by kerf / 2, and each slot the area of the slot shrunk by kerf / 2 (shapely, from raw paths)
+        expected, slack = offset_area(part.outline.vertices, part.outline.bulges, kerf / 2)
+        assert abs(lwpolyline_area(outlines[0]) - expected) <= slack
+        for entity, slot in zip(list(outlines)[1:], getattr(part, "slots", ()), strict=True):
+            expected, slack = offset_area(slot.vertices, slot.bulges, -kerf / 2)
+            assert abs(abs(lwpolyline_area(entity)) - expected) <= slack
         # no duplicate contours
         keys = [tuple(np.round(np.array(e.get_points("xyb")).ravel(), 6)) for e in outlines]
         keys += [(round(e.dxf.center.x, 6), round(e.dxf.center.y, 6), round(e.dxf.radius, 6)) for e in circles]
