@@ -39,14 +39,24 @@ MIN_CHORD_TOLERANCE_MM = 0.001
 MAX_SWEEP_POSES = 10000
 #: ``gears.mesh_steps``: poses of the gear mesh check.
 MAX_MESH_STEPS = 7200
-#: ``gears.teeth`` / ``gear_pair.teeth``: teeth of one closed gear.
+#: ``gears.teeth`` / ``gear_pair.teeth`` and the teeth a module gives: teeth of one gear (cost grows
+#: faster than linearly: 200 + 200 teeth built in 15 s, 400 + 400 in 98 s).
 MAX_TEETH = 200
+#: ``gears.mesh_steps`` × (z_a + z_b): the mesh check's work (7200 steps of a 30 + 30 pair: ~15 s).
+MAX_MESH_STEP_TEETH = 450_000
+#: Measured seconds per step and tooth of the mesh check (for the estimate in messages).
+MESH_SECONDS_PER_TOOTH_STEP = 3.5e-5
 #: ``synthesis.kappa_samples`` (five-bar): samples of the hinge curves (a Python loop per sample).
 MAX_KAPPA_SAMPLES = 10000
 #: ``synthesis.curve_step_mm`` (five-bar): smallest refinement step of the hinge curves.
 MIN_CURVE_STEP_MM = 0.01
 #: ``region.step_mm`` (Watt six-bar): the x sampling of the Burmester curves, per box.
 MAX_REGION_SAMPLES = 20000
+#: Watt six-bar region work: d samples × d0 samples × statics samples (the shipped template is 8.3e5;
+#: 4.1e6 took 8 s and 0.4 GB of synthesis, 4.1e7 over 100 s and 2 GB).
+MAX_REGION_WORK = 8.0e6
+#: Measured MB of peak memory per unit of region work (0.4 GB at 4.1e6).
+REGION_MB_PER_WORK = 1.0e-4
 #: ``region.statics_samples`` (Watt six-bar).
 MAX_STATICS_SAMPLES = 2001
 #: ``selection.refine_seeds`` (Watt six-bar): least-squares refinements started.
@@ -58,17 +68,21 @@ MAX_PATH_SAMPLES = 5001
 #: ``optimisation`` grid of the compliant gripper: points of one axis, and of the whole grid.
 MAX_GRID_AXIS = 2001
 MAX_GRID_POINTS = 1.0e12
-
-
-def _estimate_sweep_mb(poses: int, samples: int) -> float:
-    """Peak memory (MB) the pose-dependent arrays of a sweep need beyond the fixed part."""
-    # 0.2 MB per pose was measured for the five-bar finger's interference sweep; the constant is the
-    # slope of peak RSS against sweep_poses (360 -> 3600 poses: +660 MB)
-    return 0.2 * poses + 0.0 * samples
+#: k1 × k2 × phi01 values × path samples tabulated by the certified search (1.6e8 took 4.5 s and
+#: 0.36 GB in all).
+MAX_SPRING_TABLE = 2.0e8
 
 
 def preflight(design: Any) -> None:
     """Estimate the cost of a validated design and refuse one that would exceed the budget.
+
+    Products of counts that the field bounds alone do not cap:
+
+    - compliant gripper: the optimisation grid (points per axis and in all);
+    - Watt six-bar: the solution region's d samples × d0 samples × statics samples.
+
+    (The gear mesh check's steps × teeth is refused where the tooth counts are known, in
+    :mod:`fabricate.gears.pair`.)
 
     Parameters
     ----------
@@ -82,11 +96,7 @@ def preflight(design: Any) -> None:
     method = design.method
     grid = getattr(method, "grid", None)
     if grid is not None:
-        axes = [(name, len(getattr(grid, name))) for name in ("alpha", "c", "k1", "k2", "phi01", "phi02")]
-        for name, count in axes:
-            if count > MAX_GRID_AXIS:
-                raise SpecError(f"optimisation.{_GRID_FIELDS[name]}",
-                                f"{count} grid values, over the bound of {MAX_GRID_AXIS}; use a larger step")
+        axes = [(name, len(getattr(grid, name))) for name in _GRID_FIELDS]
         total = 1.0
         for _, count in axes:
             total *= count
@@ -95,6 +105,28 @@ def preflight(design: Any) -> None:
             raise SpecError(f"optimisation.{_GRID_FIELDS[largest]}",
                             f"the grid has {total:.3g} points, over the bound of {MAX_GRID_POINTS:.0e}; "
                             "use a larger step on this axis")
+        # the certified search tabulates every (k1, k2, phi01) triple along each contact path
+        triples = len(grid.k1) * len(grid.k2) * len(grid.phi01)
+        work = float(triples) * method.path_samples
+        if work > MAX_SPRING_TABLE:
+            raise SpecError("optimisation.path_samples" if triples * 31 <= MAX_SPRING_TABLE
+                            else "optimisation.k1_Nmm_per_deg",
+                            f"{len(grid.k1)} × {len(grid.k2)} × {len(grid.phi01)} spring triples × "
+                            f"{method.path_samples} path samples = {work:.3g}, over the bound of "
+                            f"{MAX_SPRING_TABLE:.0e}; at most {int(MAX_SPRING_TABLE // triples)} path samples "
+                            "with these axes, or larger steps on k1, k2, phi01")
+    if design.kind == "watt_six_bar":
+        counts = [int((box[1] - box[0]) / method.step_mm + 1e-9) + 1 for box in (method.box("d"), method.box("d0"))]
+        work = float(counts[0] * counts[1] * method.statics_samples)
+        if work > MAX_REGION_WORK:
+            most = int(MAX_REGION_WORK / (counts[0] * counts[1]))
+            fix = (f"at most {most} statics samples at this step" if most >= 3
+                   else "use a larger region.step_mm")
+            raise SpecError("region.statics_samples" if most >= 3 else "region.step_mm",
+                            f"{counts[0]} × {counts[1]} region samples × {method.statics_samples} statics samples "
+                            f"= {work:.3g}, over the bound of {MAX_REGION_WORK:.0e} (about "
+                            f"{REGION_MB_PER_WORK * work / 1024:.1f} GB estimated against "
+                            f"{MEMORY_BUDGET_MB / 1024:.0f} GB); {fix}")
 
 
 _GRID_FIELDS = {"alpha": "alpha_deg", "c": "c_mm", "k1": "k1_Nmm_per_deg", "k2": "k2_Nmm_per_deg",

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
+from fabricate.bounds import MAX_MESH_STEP_TEETH, MAX_TEETH, MESH_SECONDS_PER_TOOTH_STEP
 from fabricate.errors import SpecError
 from fabricate.gears.checks import (
     check_feasible,
@@ -183,6 +184,25 @@ def _range(values: np.ndarray) -> list[float]:
     return [float(np.min(values)), float(np.max(values))]
 
 
+def _check_teeth(z_a: int, z_b: int, module: float, spec: GearSpec) -> None:
+    """Refuse a pair whose tooth count or mesh check would exceed the resource bounds.
+
+    Cutting and checking cost grows with the teeth (outline vertices) and, for the mesh check, with
+    ``mesh_steps`` × teeth; see :mod:`fabricate.bounds`. The message names the field to change.
+    """
+    if max(z_a, z_b) > MAX_TEETH:
+        field = "gears.teeth" if spec.teeth is not None else "gears.module_mm"
+        raise SpecError(field, f"the pitch curves need {z_a} and {z_b} teeth at module {module:.3g} mm, over the "
+                               f"bound of {MAX_TEETH} teeth per gear; use a module of at least "
+                               f"{module * max(z_a, z_b) / MAX_TEETH:.3g} mm")
+    work = spec.mesh_steps * (z_a + z_b)
+    if work > MAX_MESH_STEP_TEETH:
+        raise SpecError("gears.mesh_steps",
+                        f"{spec.mesh_steps} steps × {z_a + z_b} teeth = {work} tooth-steps, over the bound of "
+                        f"{MAX_MESH_STEP_TEETH} (about {MESH_SECONDS_PER_TOOTH_STEP * work:.0f} s estimated); "
+                        f"at most {max(720, MAX_MESH_STEP_TEETH // (z_a + z_b))} steps")
+
+
 def _closed_teeth(law: Callable, x0: float, spec: GearSpec, center_distance: float) -> tuple[int, int]:
     """Tooth counts of a closed pair from the template (teeth or module) and the law's closure."""
     turns = -(float(law(x0 + TWO_PI)) - float(law(x0))) / TWO_PI
@@ -307,6 +327,7 @@ def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tupl
                 break
             grow *= 1.5
         reach = (1.25 + spec.spare_teeth) * p
+        _check_teeth(int((s_hi - s_lo + 2 * reach) / p), int((s_hi - s_lo + 2 * reach) / p), module, spec)
         k_a = np.arange(np.ceil((s_lo - reach) / p), np.floor((s_hi + reach) / p) + 1)
         k_b = np.arange(np.ceil((s_lo - reach) / p - 0.5), np.floor((s_hi + reach) / p - 0.5) + 1)
         centres_a, centres_b = k_a * p, (k_b + 0.5) * p
@@ -318,6 +339,7 @@ def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tupl
         if x_ends[1] - x_ends[0] >= TWO_PI or sweep_b >= TWO_PI:
             raise SpecError(f"gears.{name}.closed", "the sector with its spare teeth spans a full turn; "
                                                     "use closed = true")
+    _check_teeth(z_a, z_b, module, spec)
     curv = curvature_summary(pitch, x_cover)
     check_feasible(curv, module, spec)
     delta = spec.backlash_mm * np.cos(alpha) / 4.0

@@ -6,7 +6,7 @@ and the centre distance come from the mechanism (a :class:`~fabricate.mechanism.
 
 Keys (all optional)
 -------------------
-``module_mm``            float > 0. Module m in mm. Absent: chosen automatically — for a closed pair from
+``module_mm``            float in [0.05, 50]. Module m in mm. Absent: chosen automatically — for a closed pair from
                          the tooth count and centre distance, for a sector 0.5 mm (an SLA-sized module).
 ``pressure_angle_deg``   float in [10, 35], default 20. Pressure angle of the generating rack. Above about
                          22 degrees the default root fillet no longer fits the rack's tooth space and
@@ -57,6 +57,8 @@ from fabricate.gears.rack import MIN_ROOT_LAND, rack_fit
 from fabricate.spec import Table
 
 METHODS = ("exact", "approx")
+#: Smallest module: finer teeth than no process resolves (SLA min feature 0.3 mm) only cost time.
+MIN_MODULE_MM = 0.05
 
 
 @dataclass(frozen=True)
@@ -134,7 +136,7 @@ def parse_gear_spec(table: Table) -> GearSpec:
     SpecError
         On a field out of range, naming ``gears.<key>`` and the accepted range.
     """
-    module = table.number("module_mm", None, positive=True, max=50.0)
+    module = table.number("module_mm", None, min=MIN_MODULE_MM, max=50.0)
     pressure = table.number("pressure_angle_deg", 20.0, min=10.0, max=35.0)
     addendum = table.number("addendum", 1.0, min=0.3, max=1.5)
     dedendum = table.number("dedendum", 1.25, min=0.5, max=2.0)

@@ -1,0 +1,144 @@
+"""Mutated shipped templates: every outcome is an exit code (0, 1, 2), never a traceback.
+
+Values are scaled by random factors (0, negative, 1e9, 1e300), replaced by inf / nan or by values of
+another type (string, list, bool, table), keys are deleted and byte noise is inserted into the TOML
+text. Each mutation must end in ``main([...])`` returning 0, 1 or 2, with no "Traceback" and no
+"internal error" (errors are named where they arise, not by the CLI's catch-all), in bounded time.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from fabricate.cli import main
+from fabricate.spec import parse_toml, shipped_templates
+
+TEMPLATES = {p.name: p.read_text(encoding="utf-8") for p in shipped_templates()}
+#: A build that validates can still take the whole pipeline (a few seconds to ~20 s on two cores).
+MAX_SECONDS = 120.0
+
+
+def _value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float) and not math.isfinite(v):
+        return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
+    if isinstance(v, (int, float)):
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, list):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    return "{" + ", ".join(f"{json.dumps(k)} = {_value(x)}" for k, x in v.items()) + "}"
+
+
+def _toml(data: dict[str, Any]) -> str:
+    lines: list[str] = []
+
+    def table(prefix: str, d: dict[str, Any]) -> None:
+        if prefix:
+            lines.append(f"[{prefix}]")
+        for k, v in d.items():
+            if not isinstance(v, dict):
+                lines.append(f"{json.dumps(k)} = {_value(v)}")
+        for k, v in d.items():
+            if isinstance(v, dict):
+                table(f"{prefix}.{json.dumps(k)}" if prefix else json.dumps(k), v)
+
+    table("", data)
+    return "\n".join(lines) + "\n"
+
+
+def _leaves(d: dict[str, Any], prefix: tuple = ()) -> list[tuple]:
+    """Paths (keys and list indices) of every scalar in a parsed template."""
+    out = []
+    items = d.items() if isinstance(d, dict) else enumerate(d)
+    for k, v in items:
+        if isinstance(v, (dict, list)):
+            out += _leaves(v, prefix + (k,))
+            if isinstance(v, list):
+                out.append(prefix + (k,))
+        else:
+            out.append(prefix + (k,))
+    return out
+
+
+def _set(d: Any, path: tuple, value: Any) -> None:
+    for k in path[:-1]:
+        d = d[k]
+    d[path[-1]] = value
+
+
+def _delete(d: Any, path: tuple) -> None:
+    for k in path[:-1]:
+        d = d[k]
+    if isinstance(d, dict):
+        del d[path[-1]]
+    else:
+        d.pop(path[-1])
+
+
+def _get(d: Any, path: tuple) -> Any:
+    for k in path:
+        d = d[k]
+    return d
+
+
+FACTORS = [0.0, -1.0, 1e9, 1e300, 1e-9, 0.5, 2.0, 10.0]
+SPECIALS = [math.inf, -math.inf, math.nan, "x", [1.0, 2.0], True, {"a": 1}, "1e300", -1]
+
+
+@st.composite
+def mutated(draw: st.DrawFn) -> str:
+    name = draw(st.sampled_from(sorted(TEMPLATES)))
+    text = TEMPLATES[name]
+    kind = draw(st.sampled_from(["scale", "special", "delete", "noise", "scale", "special"]))
+    if kind == "noise":
+        data = text.encode("utf-8")
+        pos = draw(st.integers(0, len(data)))
+        noise = draw(st.binary(min_size=1, max_size=8))
+        return (data[:pos] + noise + data[pos:]).decode("utf-8", errors="replace")
+    data = parse_toml(text, name)
+    leaves = [p for p in _leaves(data) if p[0] != "design"]
+    for _ in range(draw(st.integers(1, 3))):
+        path = draw(st.sampled_from(leaves))
+        try:
+            current = _get(data, path)
+        except (KeyError, IndexError, TypeError):
+            continue  # an earlier mutation removed or replaced its parent
+        if kind == "delete":
+            _delete(data, path)
+            leaves = [p for p in _leaves(data) if p[0] != "design"]
+            if not leaves:
+                break
+        elif kind == "scale" and isinstance(current, (int, float)) and not isinstance(current, bool):
+            factor = draw(st.sampled_from(FACTORS))
+            scaled = current * factor
+            _set(data, path, int(scaled) if isinstance(current, int) and abs(scaled) < 2**63 else scaled)
+        else:
+            _set(data, path, draw(st.sampled_from(SPECIALS)))
+    return _toml(data)
+
+
+@settings(max_examples=40, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(text=mutated())
+def test_mutated_templates_exit_with_a_code_and_no_traceback(text: str, tmp_path_factory, capsys) -> None:
+    work = tmp_path_factory.mktemp("fuzz")
+    template = Path(work) / "mutated.toml"
+    template.write_text(text, encoding="utf-8")
+    start = time.perf_counter()
+    code = main(["build", str(template), "-o", str(Path(work) / "out"), "-q"])
+    elapsed = time.perf_counter() - start
+    captured = capsys.readouterr()
+    assert code in (0, 1, 2), captured.err
+    assert "Traceback" not in captured.out + captured.err
+    assert "internal error" not in captured.err, captured.err
+    assert elapsed < MAX_SECONDS
