@@ -104,17 +104,7 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
         out += _table(keys, [[row.get(k, "") for k in keys] for row in bom]) + [""]
     inter = report.get("interference", {})
     if inter:
-        out += ["## Interference", ""]
-        out += [f"Poses: {inter.get('poses')} · pairs checked: {inter.get('pairs_checked')} · "
-                f"smallest clearance: {_fmt(inter.get('min_clearance_mm'))} mm", ""]
-        if inter.get("collisions"):
-            out += _table(["a", "b", "input", "volume mm³"],
-                          [[c.get("a"), c.get("b"), c.get("input_deg"), c.get("volume_mm3")]
-                           for c in inter["collisions"]]) + [""]
-        pairs = inter.get("pairs", [])
-        if pairs:
-            keys = [k for k in ("a", "b", "min_clearance_mm", "at_input", "kind") if k in pairs[0]]
-            out += _table(keys, [[p.get(k) for k in keys] for p in pairs]) + [""]
+        out += interference_markdown(inter)
     if images:
         out += ["## Pictures", ""]
         out += [f"![{path}]({path})" for path in images] + [""]
@@ -122,3 +112,66 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
     if files:
         out += ["## Files", ""] + [f"- `{f}`" for f in files] + [""]
     return "\n".join(out)
+
+
+#: How each kind of contact in the interference sweep is judged, in the words report.md uses.
+CONTACT_KINDS = {
+    "moving": ("parts moving past each other", "the running clearance",
+               "their closest approach over the motion keeps the running clearance"),
+    "pin": ("a pin in its hole", "the running clearance",
+            "the hole is the pin plus the running clearance (and the process's compensation)"),
+    "joined": ("parts stacked on one pin", "the running clearance",
+               "the layer gap between their faces keeps them apart axially"),
+    "meshing": ("gear teeth in mesh", "the backlash band of the gear mesh check",
+                "teeth must come close: their flank gap is the backlash, held to its band below, not to "
+                "the running clearance"),
+    "bearing": ("a spacer or washer on its parts", "no overlap (contact allowed)",
+                "a spacer carries the axial load face to face: touching is its job, overlapping is not"),
+}
+
+
+def interference_markdown(inter: Mapping[str, Any]) -> list[str]:
+    """report.md's interference section: one line per kind of contact (what it is held to and why it
+    passes), then every pair, worst first (least margin over its requirement)."""
+    pairs = [p for p in inter.get("pairs", []) if isinstance(p, Mapping)]
+    collisions = inter.get("collisions", [])
+    out = ["## Interference", "",
+           f"Poses: {inter.get('poses')} · pairs checked: {inter.get('pairs_checked')} · collisions: "
+           f"{len(collisions)} · smallest clearance between moving parts: {_fmt(inter.get('min_clearance_mm'))} mm "
+           f"(required {_fmt(inter.get('required_clearance_mm'))} mm). Gear mesh and bearing contacts are "
+           "held to their own limits:", ""]
+    rows = []
+    for kind, (what, held_to, why) in CONTACT_KINDS.items():
+        group = [p for p in pairs if p.get("kind", p.get("relation")) == kind]
+        if not group:
+            continue
+        worst = min(group, key=lambda p: (p.get("min_clearance_mm") is None, p.get("min_clearance_mm") or 0.0))
+        passed = all(p.get("ok", True) for p in group)
+        rows.append([what, len(group), worst.get("min_clearance_mm"), f"{worst.get('a')} – {worst.get('b')}",
+                     held_to, ("passes: " + why) if passed else "FAILS"])
+    out += _table(["contact", "pairs", "smallest gap mm", "closest pair", "held to", "verdict"], rows) + [""]
+    for mesh in inter.get("gear_mesh", []):
+        if isinstance(mesh, Mapping) and mesh.get("backlash_mm"):
+            out += [f"Gear mesh {mesh.get('name')}: backlash {_fmt(mesh.get('backlash_mm'))} mm within "
+                    f"{_fmt(mesh.get('backlash_allowed_mm'))} mm, interference area "
+                    f"{_fmt(mesh.get('interference_area_mm2'))} mm², transmission error "
+                    f"{_fmt(mesh.get('transmission_error_deg'))}°: {'passes' if mesh.get('passed') else 'FAILS'}.",
+                    ""]
+    if collisions:
+        out += ["Collisions:", ""]
+        out += _table(["a", "b", "input", "volume mm³"],
+                      [[c.get("a"), c.get("b"), c.get("input_deg"), c.get("volume_mm3")] for c in collisions])
+        out += [""]
+    if pairs:
+        def margin(p: Mapping[str, Any]) -> tuple[int, float, str, str]:
+            gap = p.get("min_clearance_mm")
+            gap = float("-inf") if gap is None or p.get("collides") else float(gap)
+            return (0 if not p.get("ok", True) else 1, gap - float(p.get("required_mm") or 0.0),
+                    str(p.get("a")), str(p.get("b")))
+
+        out += ["Every pair, worst first (least margin over what it is held to):", ""]
+        out += _table(["a", "b", "contact", "smallest gap mm", "required mm", "margin mm", "at input", "ok"],
+                      [[p.get("a"), p.get("b"), p.get("kind", p.get("relation")), p.get("min_clearance_mm"),
+                        p.get("required_mm"), margin(p)[1], p.get("at_input", p.get("input_deg")), p.get("ok")]
+                       for p in sorted(pairs, key=margin)]) + [""]
+    return out

@@ -19,8 +19,10 @@ def clearance_png(result: InterferenceResult, max_pairs: int = MAX_PAIRS) -> byt
     Deterministic bytes (no timestamps in the metadata).
     """
     plt = pyplot()
-    # spacers bearing on their joint touch by design: leave them to the table
-    shown = [p for p in result.pairs if p.relation != "bearing"]
+    # the plot's line is the running clearance: spacers bearing on their joint touch by design and gear
+    # teeth are held to their backlash, so both are named in a note instead of drawn under the line
+    own_limits = ("bearing", "meshing")
+    shown = [p for p in result.pairs if p.relation not in own_limits]
     pairs = sorted(shown, key=lambda p: (p.min_clearance_mm, p.a, p.b))[:max_pairs]
     fig, ax = plt.subplots(figsize=(10.0, 4.5), dpi=100)
     x = result.inputs
@@ -35,7 +37,17 @@ def clearance_png(result: InterferenceResult, max_pairs: int = MAX_PAIRS) -> byt
             ax.plot(x[p.collision_indices], np.zeros(len(p.collision_indices)), "x", color=line.get_color(),
                     ms=4)
     ax.axhline(result.min_clearance_required_mm, color="red", ls="--", lw=1.0,
-               label=f"required {result.min_clearance_required_mm:g} mm")
+               label=f"running clearance required {result.min_clearance_required_mm:g} mm")
+    notes = []
+    for relation, held_to in (("meshing", "backlash band (gear mesh check)"), ("bearing", "no overlap")):
+        group = [p for p in result.pairs if p.relation == relation]
+        if group:
+            worst = min(p.min_clearance_mm for p in group)
+            notes.append(f"not drawn: {len(group)} {relation} pair{'s' * (len(group) > 1)}, smallest gap "
+                         f"{worst:.4g} mm, held to {held_to}")
+    if notes:
+        ax.text(0.01, 0.98, "\n".join(notes), transform=ax.transAxes, fontsize=7, va="top", ha="left",
+                bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "0.7"})
     ax.set_xlabel(f"input ({result.input_unit})")
     ax.set_ylabel("clearance (mm)")
     ax.set_ylim(-0.05 * top, 1.05 * top)

@@ -28,6 +28,11 @@ from fabricate.parts.model import BulgePath, Part
 from fabricate.parts.profiles import offset_path
 from fabricate.planar import transform_points
 
+#: Smallest text in a drawing (mm): ISO 3098 / ASME Y14.2 ask for at least 2.5 mm on printed drawings.
+MIN_DRAWING_TEXT_MM = 2.5
+#: The kinematic drawing's dimension style (its text and arrow sizes).
+DIMSTYLE = "FABRICATE"
+
 #: ACI colours: red for cutting, blue for engraving, grey for the sheet border, others for CAD drawings.
 LAYERS = {"CUT": 1, "ENGRAVE": 5, "SHEET": 8, "LINKS": 7, "JOINTS": 3, "DIMENSIONS": 2, "LABELS": 4}
 
@@ -185,7 +190,11 @@ def kinematic_dxf(mechanism: Any, poses: Mapping[str, np.ndarray]) -> bytes:
         for name in body.points:
             world.setdefault(name, transform_points(poses[body.name], body.point(name)))
     span = max(1.0, float(np.ptp(np.array(list(world.values())), axis=0).max())) if world else 1.0
-    text_h = round(max(1.0, span / 60.0), 3)
+    text_h = round(max(MIN_DRAWING_TEXT_MM, span / 60.0), 3)
+    # the sizes go in a dimension style of their own: LibreCAD and others ignore per-entity overrides
+    doc.dimstyles.new(DIMSTYLE, dxfattribs={"dimtxt": text_h, "dimasz": text_h, "dimdec": 3, "dimlfac": 1.0,
+                                            "dimexo": 0.5 * text_h, "dimexe": 0.5 * text_h,
+                                            "dimgap": 0.3 * text_h, "dimtad": 1})
     drawn: set[tuple[str, str]] = set()
     for body in mechanism.bodies:
         names = [n for n in body.points if n in joint_names] or list(body.points)
@@ -199,8 +208,7 @@ def kinematic_dxf(mechanism: Any, poses: Mapping[str, np.ndarray]) -> bytes:
                     continue
                 drawn.add(key)
                 msp.add_line(tuple(pa), tuple(pb), dxfattribs={"layer": "LINKS"})
-                dim = msp.add_aligned_dim(p1=tuple(pa), p2=tuple(pb), distance=3.0 * text_h,
-                                          override={"dimtxt": text_h, "dimasz": text_h, "dimdec": 3, "dimlfac": 1.0},
+                dim = msp.add_aligned_dim(p1=tuple(pa), p2=tuple(pb), distance=3.0 * text_h, dimstyle=DIMSTYLE,
                                           dxfattribs={"layer": "DIMENSIONS"})
                 dim.render()
     # points at one spot (a compound hinge) get one label and one pair of ordinate dimensions
@@ -219,9 +227,7 @@ def kinematic_dxf(mechanism: Any, poses: Mapping[str, np.ndarray]) -> bytes:
         if is_joint:
             for add, offset in ((msp.add_ordinate_x_dim, (0.0, -4.0 * text_h)),
                                 (msp.add_ordinate_y_dim, (-4.0 * text_h, 0.0))):
-                dim = add(feature_location=tuple(p), offset=offset,
-                          override={"dimtxt": 0.7 * text_h, "dimasz": 0.7 * text_h, "dimdec": 3,
-                                    "dimlfac": 1.0},
+                dim = add(feature_location=tuple(p), offset=offset, dimstyle=DIMSTYLE,
                           dxfattribs={"layer": "DIMENSIONS"})
                 dim.render()
     return document_bytes(doc)

@@ -76,6 +76,8 @@ def pair_gif(pair: Any, frames: int, size_px: int = 384, frame_ms: int = 80) -> 
     """
     from PIL import Image, ImageDraw
 
+    from fabricate.export.previews import label_font
+
     lo, hi = pair.working_range
     xs = np.linspace(lo, hi, int(frames), endpoint=not pair.closed)
     out_a0, out_b0, _, _ = _placed(pair, lo)
@@ -105,6 +107,7 @@ def pair_gif(pair: Any, frames: int, size_px: int = 384, frame_ms: int = 80) -> 
             (cx, cy), = pixels(centre[None, :])
             r = 0.5 * bore * scale
             draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=0, outline=1)
+        draw.text((4, 4), f"gear a {np.degrees(x):.1f} deg", fill=1, font=label_font())
         images.append(image)
     return gif_bytes(images, frame_ms, optimize=False, disposal=1)
 

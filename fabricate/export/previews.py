@@ -31,6 +31,24 @@ def pose_indices(count: int, poses: int) -> list[int]:
     return sorted({int(round(v)) for v in np.linspace(0, count - 1, poses)})
 
 
+def label_font() -> Any:
+    """Pillow's built-in bitmap font: the same pixels on every machine (no system fonts)."""
+    from PIL import ImageFont
+
+    return getattr(ImageFont, "load_default_imagefont", ImageFont.load_default)()
+
+
+def frame_label(value: float, unit: str) -> str:
+    """The text drawn on a GIF frame: its input value."""
+    return f"input {float(value):.1f} {unit}"
+
+
+def part_colours(parts: Sequence[Part]) -> dict[str, int]:
+    """A palette index per part: neighbours in the part list (meshing gears, a link and its spacer) differ,
+    which colouring by layer did not give (a gear pair shares one layer)."""
+    return {part.name: k % len(PALETTE) for k, part in enumerate(parts)}
+
+
 def _shapes(parts: Sequence[Part]) -> list[tuple[Part, np.ndarray, list[tuple[np.ndarray, float]]]]:
     """(part, outline polygon, holes) drawn bottom layer first."""
     ordered = sorted(parts, key=lambda p: (p.z_mm, p.name))
@@ -71,6 +89,7 @@ def assembly_png(parts: Sequence[Part], motion: Any, poses: int = 4, tip_point: 
     plt = pyplot()
 
     shapes = _shapes(parts)
+    part_colour = part_colours(parts)
     indices = pose_indices(len(motion.inputs), poses)
     lo, hi = _extent(shapes, motion, indices)
     fig, axes = plt.subplots(1, len(indices), figsize=(3.2 * len(indices), 3.4), squeeze=False,
@@ -87,7 +106,7 @@ def assembly_png(parts: Sequence[Part], motion: Any, poses: int = 4, tip_point: 
         plates, faces, edges, holes_xy = [], [], [], []
         for part, outline, holes in shapes:
             pose = body_poses.get(part.body, np.zeros(3))
-            colour = np.array(PALETTE[part.layer % len(PALETTE)]) / 255.0
+            colour = np.array(PALETTE[part_colour[part.name]]) / 255.0
             plates.append(transform_points(pose, outline))
             faces.append((*colour, 0.55))
             edges.append(tuple(colour * 0.6))
@@ -133,6 +152,8 @@ def motion_gif(parts: Sequence[Part], motion: Any, frames: int = 24, size_px: in
     from PIL import Image, ImageDraw
 
     shapes = _shapes(parts)
+    part_colour = part_colours(parts)
+    unit = motion.mechanism.input_unit
     indices = pose_indices(len(motion.inputs), frames)
     lo, hi = _extent(shapes, motion, indices)
     scale = size_px / float(max(hi - lo))
@@ -155,13 +176,14 @@ def motion_gif(parts: Sequence[Part], motion: Any, frames: int = 24, size_px: in
         body_poses = motion.poses_at(i)
         for part, outline, holes in shapes:
             pose = body_poses.get(part.body, np.zeros(3))
-            colour = 2 + part.layer % len(PALETTE)
+            colour = 2 + part_colour[part.name]
             draw.polygon(pixels(transform_points(pose, outline)), fill=colour, outline=1)
             for centre, radius in holes:
                 if radius > 0:
                     (cx, cy), = pixels(transform_points(pose, centre)[None, :])
                     r = radius * scale
                     draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=0)
+        draw.text((4, 4), frame_label(motion.inputs[i], unit), fill=1, font=label_font())
         images.append(image)
     sequence = images + images[-2:0:-1]
     return gif_bytes(sequence, frame_ms, optimize=False, disposal=1)

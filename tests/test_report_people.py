@@ -1,0 +1,105 @@
+"""report.md and the pictures for people: interference worst first and by kind of contact, labelled GIF frames,
+distinct part colours, kinematic drawing text of at least 2.5 mm in its dimension style."""
+
+from __future__ import annotations
+
+import io
+import re
+
+import ezdxf
+import numpy as np
+import pytest
+from PIL import Image
+
+from fabricate.export.dxf import DIMSTYLE, MIN_DRAWING_TEXT_MM
+from fabricate.export.previews import part_colours
+from fabricate.pipeline import run_build
+from fabricate.spec import load_design
+
+
+@pytest.fixture(scope="module")
+def five_bar():
+    return run_build(load_design("finger_five_bar_ncg"))
+
+
+def _rows(markdown: str, header_start: str) -> list[list[str]]:
+    lines = markdown.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith(header_start))
+    rows = []
+    for line in lines[start + 2:]:
+        if not line.startswith("|"):
+            break
+        rows.append([c.strip() for c in line.strip("|").split("|")])
+    return rows
+
+
+def test_interference_table_is_worst_first(five_bar):
+    md = five_bar.files["report.md"].decode()
+    rows = _rows(md, "| a | b | contact | smallest gap mm | required mm | margin mm")
+    pairs = five_bar.report["interference"]["pairs"]
+    assert len(rows) == len(pairs)
+    margins = [float(r[5]) for r in rows]
+    assert margins == sorted(margins)
+    # the margin printed is the gap less the requirement of that pair, recomputed from the report
+    expected = sorted(p["min_clearance_mm"] - p["required_mm"] for p in pairs)
+    assert np.allclose(margins, expected, atol=5e-4 * max(1.0, max(map(abs, expected))))
+
+
+def test_summary_separates_moving_clearance_from_gear_mesh_and_bearing(five_bar):
+    md = five_bar.files["report.md"].decode()
+    rows = {r[0]: r for r in _rows(md, "| contact | pairs |")}
+    pairs = five_bar.report["interference"]["pairs"]
+    mesh = [p for p in pairs if p["relation"] == "meshing"]
+    bearing = [p for p in pairs if p["relation"] == "bearing"]
+    assert mesh and bearing
+    # the gear mesh gap (well under the running clearance) is reported with what it is held to
+    assert float(rows["gear teeth in mesh"][2]) == pytest.approx(min(p["min_clearance_mm"] for p in mesh), rel=1e-3)
+    assert min(p["min_clearance_mm"] for p in mesh) < five_bar.report["interference"]["required_clearance_mm"]
+    assert "backlash" in rows["gear teeth in mesh"][4]
+    assert int(rows["a spacer or washer on its parts"][1]) == len(bearing)
+    assert "passes" in rows["a spacer or washer on its parts"][5]
+    moving = [p for p in pairs if p["relation"] == "moving"]
+    assert float(rows["parts moving past each other"][2]) == pytest.approx(
+        min(p["min_clearance_mm"] for p in moving), rel=1e-3)
+    backlash = five_bar.report["interference"]["gear_mesh"][0]["backlash_mm"]
+    assert re.search(r"Gear mesh \w+: backlash \[", md) and f"{backlash[0]:.4g}" in md
+
+
+def _label_box(frame: Image.Image) -> np.ndarray:
+    return np.asarray(frame.convert("L"))[2:14, 2:110]
+
+
+@pytest.mark.parametrize("path", ["previews/motion.gif", "gears/sun_planet_turning.gif"])
+def test_gif_frames_carry_their_input(five_bar, path):
+    gif = Image.open(io.BytesIO(five_bar.files[path]))
+    first = gif.copy()
+    gif.seek(gif.n_frames // 3)
+    later = gif.copy()
+    for frame in (first, later):
+        box = _label_box(frame)
+        assert (box < 128).sum() > 40  # dark text pixels on the white corner
+    assert not np.array_equal(_label_box(first), _label_box(later))  # a different value is written
+
+
+def test_parts_of_a_gear_pair_get_distinct_colours():
+    outcome = run_build(load_design("gear_pair_elliptic"))
+    parts = outcome.partset.parts
+    colours = part_colours(parts)
+    gears = [p.name for p in parts if p.gear]
+    assert len(gears) == 2 and colours[gears[0]] != colours[gears[1]]
+    assert {p.layer for p in parts if p.gear} and len({p.layer for p in parts if p.gear}) == 1  # one layer
+    gif = Image.open(io.BytesIO(outcome.files["previews/motion.gif"])).convert("RGB")
+    used = {tuple(c) for c in np.asarray(gif).reshape(-1, 3)}
+    assert len(used) >= 2 + len(parts)  # background, outline and one fill per part
+
+
+def test_kinematic_drawing_text_is_at_least_2_5_mm_in_its_dimension_style(five_bar):
+    doc = ezdxf.read(io.StringIO(five_bar.files["kinematic.dxf"].decode()))
+    style = doc.dimstyles.get(DIMSTYLE)
+    assert style.dxf.dimtxt >= MIN_DRAWING_TEXT_MM
+    dims = list(doc.modelspace().query("DIMENSION"))
+    assert dims and all(d.dxf.dimstyle == DIMSTYLE for d in dims)
+    # no per-entity size override that a reader such as LibreCAD would ignore
+    assert all(not d.get_xdata("ACAD") for d in dims if d.has_xdata("ACAD"))
+    texts = list(doc.modelspace().query("TEXT"))
+    assert texts and min(t.dxf.height for t in texts) >= MIN_DRAWING_TEXT_MM
