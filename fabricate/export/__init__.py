@@ -9,6 +9,8 @@ Files
 ``parts/<name>.dxf``       DXF of each part's cut path in its own coordinates
 ``print_plate.stl``        every part laid out on the SLA build plate
 ``assembly.3mf``           the assembly at the first pose (one object per part)
+``parts/<name>.step``      B-rep solid of each part on z = 0 (only with the extra ``cad``: OCP)
+``assembly.step``          the assembly at the first pose, one named solid per part (extra ``cad``)
 ``sheet.dxf``              every part nested on the process sheet, labelled on ENGRAVE
 ``kinematic.dxf``          joints, link centre lines and dimensions at the first pose
 ``previews/assembly.png``  the assembly at several poses
@@ -78,6 +80,7 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
         print_plate_stl,
         validate_stl,
     )
+    from fabricate.export.step import step_available, step_files
 
     process = design.process
     spec = design.parts
@@ -89,6 +92,7 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     plate_area = (float(process.build_volume_mm[0]), float(process.build_volume_mm[1]))
     plate = plate_layout(parts, cache, plate_area, spec.plate_spacing_mm)
     sheet = sheet_layout(parts, kerf, plate_area, spec.sheet_margin_mm, spec.sheet_spacing_mm)
+    with_step = step_available()  # optional extra `cad` (OCP); without it no STEP files, "step": None
     for part, on_plate, on_sheet in zip(parts, plate, sheet, strict=True):
         stl_path, dxf_path = f"parts/{part.name}.stl", f"parts/{part.name}.dxf"
         stl = part_stl(part, cache)
@@ -100,6 +104,7 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
         files[dxf_path] = part_dxf(part, kerf)
         entries.append({
             "name": part.name, "process": part.process, "stl": stl_path, "dxf": dxf_path,
+            "step": f"parts/{part.name}.step" if with_step else None,
             "volume_mm3": round(part.volume_mm3(), 4), "stl_volume_mm3": round(mesh_volume(vertices, faces), 4),
             "layer": part.layer,
             "holes": [{"joint": h.joint, "diameter_mm": round(h.diameter_mm, 6),
@@ -114,6 +119,8 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     files["print_plate.stl"] = print_plate_stl(parts, cache, plate, plate_area)
     first = motion.poses_at(0)
     files["assembly.3mf"] = assembly_3mf(parts, cache, first, title=design.name)
+    if with_step:
+        files.update(step_files(parts, first, partset.chord_tolerance_mm, title=design.name))
     files["sheet.dxf"] = sheet_dxf(parts, kerf, sheet, plate_area)
     files["kinematic.dxf"] = kinematic_dxf(mechanism, first)
     if previews:

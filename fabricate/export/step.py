@@ -1,0 +1,575 @@
+"""STEP (ISO 10303-21, AP214) export of parts and the assembly as B-rep solids, through OCP.
+
+Mechanical CAD (SolidWorks, Fusion, Onshape, FreeCAD) wants solids, not meshes: every part becomes a
+planar face bounded by its exact profile (lines, true circular arcs for bulges, full circles for holes,
+slots as inner wires) extruded by its thickness. Gear flanks arrive already polygonised to the chord
+tolerance (short lines), so they stay lines here and the solid's volume is the report's exactly.
+
+This is the only module importing OCP (the optional extra ``cad``: the ``cadquery-ocp-novtk`` wheel). It
+is imported lazily, inside the functions, so the package works without it; :func:`step_available`
+says whether it is there.
+
+Encoders return bytes and are deterministic: OCP writes files only, so each encoder writes into a private
+temporary folder, reads the file back and deletes it; the header's time stamp, author, organisation and
+originating system are set to fixed values (a rebuild gives the same bytes).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import math
+import os
+import re
+import tempfile
+from collections.abc import Iterator, Mapping, Sequence
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from fabricate.errors import GeometryError
+from fabricate.parts.model import BulgePath, Part
+
+#: Fixed header values: STEP's FILE_NAME carries a time stamp and who wrote it; a rebuild must give the
+#: same bytes, so none of it may depend on the clock, the user or the OCCT build.
+HEADER_TIME_STAMP = "2000-01-01T00:00:00"
+HEADER_SYSTEM = "fabricate"
+
+#: Shortest edge kept (mm): a repeated vertex in a profile would make a zero-length edge, which OCCT refuses.
+_MIN_EDGE_MM = 1e-9
+
+
+class StepSolid(NamedTuple):
+    """One solid read back from a STEP file (see :func:`read_step`).
+
+    Attributes
+    ----------
+    name : str
+        Product name of the solid ('' when the file names none).
+    volume_mm3 : float
+        Volume of the solid, mm^3 (from the exact B-rep surfaces).
+    n_cylindrical_faces : int
+        Faces lying on a cylinder that close on themselves around its axis (a full 2π turn): holes. Arc
+        segments of an outline or a slot give partial cylinders, counted in ``n_arc_faces`` instead.
+    valid : bool
+        The shape is one closed solid and OCCT's BRepCheck_Analyzer finds nothing wrong with it.
+    n_arc_faces : int
+        Partial cylindrical faces (outline and slot arcs).
+    bounds : (2, 3) float64 array
+        Tight axis-aligned bounding box (min, max) in mm, in the file's world frame (posed for an assembly).
+    """
+
+    name: str
+    volume_mm3: float
+    n_cylindrical_faces: int
+    valid: bool
+    n_arc_faces: int
+    bounds: np.ndarray
+
+
+@contextlib.contextmanager
+def _quiet_occt() -> Iterator[None]:
+    """OCCT's default messenger prints transfer statistics to stdout; a build writes nothing there
+    (``-q``), so every printer is held at failures only while we read or write, then restored."""
+    from OCP.Message import Message, Message_Fail
+
+    printers = Message.DefaultMessenger_s().Printers()
+    saved = [printers.Value(k) for k in range(1, printers.Length() + 1)]
+    levels = [printer.GetTraceLevel() for printer in saved]
+    for printer in saved:
+        printer.SetTraceLevel(Message_Fail)
+    try:
+        yield
+    finally:
+        for printer, level in zip(saved, levels, strict=True):
+            printer.SetTraceLevel(level)
+
+
+@functools.lru_cache(maxsize=1)
+def step_available() -> bool:
+    """Whether OCP (the optional extra ``cad``) can be imported, so STEP files can be written."""
+    try:
+        import OCP.STEPCAFControl  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+# ---------------------------------------------------------------------------------------------- building
+
+
+def _vertex(point: np.ndarray) -> Any:
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+    from OCP.gp import gp_Pnt
+
+    return BRepBuilderAPI_MakeVertex(gp_Pnt(float(point[0]), float(point[1]), 0.0)).Vertex()
+
+
+def _arc_circle(p0: np.ndarray, p1: np.ndarray, bulge: float) -> Any:
+    """The circle (gp_Circ in z = 0) carrying the arc from ``p0`` to ``p1`` with ``bulge``, oriented so its
+    parameter runs from ``p0`` to ``p1`` along the arc: axis +z for a counter-clockwise (positive) bulge."""
+    from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pnt
+
+    theta = 4.0 * math.atan(bulge)
+    chord_vec = p1 - p0
+    chord = float(np.hypot(*chord_vec))
+    radius = chord / (2.0 * abs(math.sin(theta / 2.0)))
+    # same construction as fabricate.parts.model.arc_points: the centre is left of the chord for a CCW arc
+    normal = np.array([-chord_vec[1], chord_vec[0]]) / chord
+    centre = 0.5 * (p0 + p1) + math.copysign(1.0, theta) * normal * radius * math.cos(theta / 2.0)
+    axis = gp_Dir(0.0, 0.0, 1.0 if theta > 0 else -1.0)
+    start = (p0 - centre) / radius
+    frame = gp_Ax2(gp_Pnt(float(centre[0]), float(centre[1]), 0.0), axis,
+                   gp_Dir(float(start[0]), float(start[1]), 0.0))
+    return gp_Circ(frame, radius)
+
+
+def _path_wire(path: BulgePath, counter_clockwise: bool, what: str) -> Any:
+    """A closed wire of the path's lines and true arcs, turned to the asked orientation.
+
+    Vertices are made once and shared by the edges meeting there, so the wire closes exactly (no
+    tolerance-based vertex matching).
+    """
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+
+    vertices = np.asarray(path.vertices, dtype=np.float64)
+    bulges = np.asarray(path.bulges, dtype=np.float64)
+    if (path.area() > 0) != counter_clockwise:
+        # the reversed path visits the vertices backwards; each arc keeps its circle with the opposite sense
+        vertices = vertices[::-1]
+        bulges = -np.roll(bulges[::-1], -1)
+    n = len(vertices)
+    keep = [i for i in range(n) if float(np.hypot(*(vertices[(i + 1) % n] - vertices[i]))) > _MIN_EDGE_MM]
+    if len(keep) < 2 or (len(keep) == 2 and not np.any(bulges[keep])):
+        raise GeometryError(f"{what}: degenerate profile of {len(keep)} edges")
+    # a dropped (zero-length) segment merges its two vertices: keep the first of each run
+    points = [vertices[i] for i in keep]
+    made = [_vertex(p) for p in points]
+    wire = BRepBuilderAPI_MakeWire()
+    for k, i in enumerate(keep):
+        j = (k + 1) % len(keep)
+        p0, p1, b = points[k], points[j], float(bulges[i])
+        if b != 0.0:
+            edge = BRepBuilderAPI_MakeEdge(_arc_circle(p0, p1, b), made[k], made[j])
+        else:
+            edge = BRepBuilderAPI_MakeEdge(made[k], made[j])
+        if not edge.IsDone():
+            raise GeometryError(f"{what}: edge {i} of the profile could not be made")
+        wire.Add(edge.Edge())
+        if not wire.IsDone():
+            raise GeometryError(f"{what}: edge {i} does not continue the profile")
+    return wire.Wire()
+
+
+def _circle_wire(centre: np.ndarray, diameter_mm: float) -> Any:
+    """A clockwise full-circle wire (an inner boundary of a face lying on +z)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+    from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pnt
+
+    frame = gp_Ax2(gp_Pnt(float(centre[0]), float(centre[1]), 0.0), gp_Dir(0.0, 0.0, -1.0))
+    edge = BRepBuilderAPI_MakeEdge(gp_Circ(frame, 0.5 * float(diameter_mm))).Edge()
+    return BRepBuilderAPI_MakeWire(edge).Wire()
+
+
+def part_shape(part: Part, chord_tolerance_mm: float, z_mm: float = 0.0) -> Any:
+    """The part as an OCP B-rep solid: its profile in z = ``z_mm`` extruded by its thickness along +z.
+
+    Parameters
+    ----------
+    part : Part
+        Outline (lines and arcs, CCW or CW: turned CCW here), holes (full circles) and, for parts that
+        have them, ``slots`` (closed bulge paths cut through the plate); mm in body coordinates.
+    chord_tolerance_mm : float
+        The build's chord tolerance (mm). The B-rep keeps arcs and circles exact, so it does not shape the
+        solid; it bounds the tolerance handed to OCCT's shape fixing (a tenth of it) and names the gear
+        flank accuracy, which was fixed when the flanks were polygonised.
+    z_mm : float
+        Height of the bottom face: 0 for the part's own file, ``part.z_mm`` for an assembly.
+
+    Returns
+    -------
+    OCP.TopoDS.TopoDS_Solid
+
+    Raises
+    ------
+    GeometryError
+        When a face or solid cannot be made, or the result is not a valid closed solid of positive volume.
+    """
+    what = f"part {part.name}: STEP solid"
+    try:
+        return _solid(part, chord_tolerance_mm, z_mm, what)
+    except Exception as exc:
+        # OCCT's exceptions (StdFail_NotDone, Standard_ConstructionError, ...) share no Python base class
+        # but their module; they mean this geometry cannot be made, which the pipeline reports as such
+        if type(exc).__module__.startswith("OCP"):
+            raise GeometryError(f"{what}: {type(exc).__name__} {exc}".rstrip()) from exc
+        raise
+
+
+def _solid(part: Part, chord_tolerance_mm: float, z_mm: float, what: str) -> Any:
+    """:func:`part_shape` without the translation of OCCT's exceptions."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_Transform
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
+    from OCP.gp import gp_Trsf, gp_Vec
+    from OCP.ShapeFix import ShapeFix_Shape
+    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+
+    if not part.thickness_mm > 0:
+        raise GeometryError(f"{what}: thickness {part.thickness_mm} mm")
+    outer = _path_wire(part.outline, True, what)
+    face_maker = BRepBuilderAPI_MakeFace(outer, True)
+    if not face_maker.IsDone():
+        raise GeometryError(f"{what}: the outline is not a planar face")
+    for hole in part.holes:
+        face_maker.Add(_circle_wire(np.asarray(hole.centre, dtype=np.float64), hole.diameter_mm))
+    for slot in getattr(part, "slots", ()):
+        face_maker.Add(_path_wire(slot, False, what))
+    face = face_maker.Face()
+    prism = BRepPrimAPI_MakePrism(face, gp_Vec(0.0, 0.0, float(part.thickness_mm)))
+    if not prism.IsDone():
+        raise GeometryError(f"{what}: the extrusion failed")
+    shape = prism.Shape()
+    if not BRepCheck_Analyzer(shape).IsValid():
+        # only a broken input gets here (e.g. a hole crossing the outline); the fixer may mend tolerances
+        fixer = ShapeFix_Shape(shape)
+        fixer.SetPrecision(0.1 * chord_tolerance_mm)
+        fixer.Perform()
+        shape = fixer.Shape()
+        if not BRepCheck_Analyzer(shape).IsValid():
+            raise GeometryError(f"{what}: not a valid solid (a hole or slot crosses the outline or another?)")
+    explorer = TopExp_Explorer(shape, TopAbs_SOLID)
+    if not explorer.More():
+        raise GeometryError(f"{what}: the extrusion is not a solid")
+    solid = _downcast("Solid", explorer.Current())
+    volume = _volume(solid)
+    if not volume > 0:
+        raise GeometryError(f"{what}: volume {volume} mm^3")
+    if z_mm:
+        lift = gp_Trsf()
+        lift.SetTranslation(gp_Vec(0.0, 0.0, float(z_mm)))
+        solid = _downcast("Solid", BRepBuilderAPI_Transform(solid, lift, True).Shape())
+    return solid
+
+
+def _downcast(kind: str, shape: Any) -> Any:
+    """``TopoDS.Solid`` / ``TopoDS.Face`` of a shape: a namespace function in OCP 8, a static method
+    (``Solid_s``) in OCP 7."""
+    from OCP import TopoDS as topods_module
+
+    caster = topods_module.TopoDS
+    return getattr(caster, kind, None)(shape) if hasattr(caster, kind) else getattr(caster, f"{kind}_s")(shape)
+
+
+def _volume(shape: Any) -> float:
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props)
+    return float(props.Mass())
+
+
+def _pose_location(pose: np.ndarray, z_mm: float) -> Any:
+    """TopLoc_Location of a planar body pose (x mm, y mm, theta rad) lifted to ``z_mm``; the same motion
+    as :func:`fabricate.planar.pose_matrix` applies to the meshes."""
+    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
+    from OCP.TopLoc import TopLoc_Location
+
+    rotate, move = gp_Trsf(), gp_Trsf()
+    rotate.SetRotation(gp_Ax1(gp_Pnt(0.0, 0.0, 0.0), gp_Dir(0.0, 0.0, 1.0)), float(pose[2]))
+    move.SetTranslation(gp_Vec(float(pose[0]), float(pose[1]), float(z_mm)))
+    return TopLoc_Location(move.Multiplied(rotate))
+
+
+# ----------------------------------------------------------------------------------------------- writing
+
+
+def _xcaf_document() -> tuple[Any, Any]:
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.XCAFDoc import XCAFDoc_DocumentTool
+
+    document = TDocStd_Document(TCollection_ExtendedString("XmlXCAF"))
+    return document, XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
+
+
+def _set_name(label: Any, name: str) -> None:
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.TDataStd import TDataStd_Name
+
+    TDataStd_Name.Set_s(label, TCollection_ExtendedString(name))
+
+
+_FILE_NAME = re.compile(rb"FILE_NAME\(.*?\);\s*\n", re.DOTALL)
+
+
+def _write(document: Any, title: str) -> bytes:
+    """The XCAF document as STEP AP214 bytes with a fixed header (see module docstring)."""
+    from OCP.Interface import Interface_Static
+    from OCP.STEPCAFControl import STEPCAFControl_Writer
+    from OCP.STEPControl import STEPControl_AsIs
+
+    # global OCCT settings, set on every call so nothing else in the process can change what we write
+    Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
+    Interface_Static.SetCVal_s("write.step.unit", "MM")
+    Interface_Static.SetCVal_s("write.step.product.name", title)
+    writer = STEPCAFControl_Writer()
+    writer.SetNameMode(True)
+    writer.SetColorMode(False)
+    writer.SetLayerMode(False)
+    folder = tempfile.mkdtemp(prefix="fabricate-step-")
+    path = os.path.join(folder, "out.step")
+    try:
+        with _quiet_occt():
+            if not writer.Transfer(document, STEPControl_AsIs):
+                raise GeometryError(f"{title}: STEP transfer failed")
+            _fix_header(writer.ChangeWriter().Model(), title)
+            status = writer.Write(path)
+        with open(path, "rb") as handle:
+            data = handle.read()
+    except OSError as exc:
+        raise GeometryError(f"{title}: STEP could not be written ({exc})") from exc
+    finally:
+        if os.path.exists(path):
+            os.remove(path)
+        os.rmdir(folder)
+    from OCP.IFSelect import IFSelect_RetDone
+
+    if status != IFSelect_RetDone:
+        raise GeometryError(f"{title}: STEP writer returned {status}")
+    return _fixed_file_name(data, title)
+
+
+def _fix_header(model: Any, title: str) -> None:
+    """Header entities with fixed values (name, time stamp, author, organisation, systems)."""
+    from OCP.APIHeaderSection import APIHeaderSection_MakeHeader
+    from OCP.TCollection import TCollection_HAsciiString
+
+    header = APIHeaderSection_MakeHeader(model)
+    header.SetName(TCollection_HAsciiString(title))
+    header.SetTimeStamp(TCollection_HAsciiString(HEADER_TIME_STAMP))
+    header.SetAuthorValue(1, TCollection_HAsciiString(""))
+    header.SetOrganizationValue(1, TCollection_HAsciiString(""))
+    header.SetPreprocessorVersion(TCollection_HAsciiString(HEADER_SYSTEM))
+    header.SetOriginatingSystem(TCollection_HAsciiString(HEADER_SYSTEM))
+    header.SetAuthorisation(TCollection_HAsciiString(""))
+    header.Apply(model)
+
+
+def _fixed_file_name(data: bytes, title: str) -> bytes:
+    """The FILE_NAME header line rewritten to fixed values, whatever the OCCT version put there (the
+    writer may stamp the time and its own name at write time, after :func:`_fix_header`)."""
+    fixed = (f"FILE_NAME('{_step_string(title)}','{HEADER_TIME_STAMP}',(''),(''),'{HEADER_SYSTEM}',"
+             f"'{HEADER_SYSTEM}','');\n").encode("ascii")
+    data, count = _FILE_NAME.subn(lambda _: fixed, data, count=1)
+    if count != 1:
+        raise GeometryError(f"{title}: the STEP writer wrote no FILE_NAME header")
+    return data
+
+
+def _step_string(text: str) -> str:
+    """Text as a STEP string body: ASCII only (others become '?'), apostrophes doubled."""
+    return text.encode("ascii", "replace").decode("ascii").replace("'", "''")
+
+
+def part_step(part: Part, chord_tolerance_mm: float, shape: Any = None) -> bytes:
+    """STEP AP214 of one part lying on z = 0 in its own (body) coordinates, like its STL; mm.
+
+    Parameters
+    ----------
+    part : Part
+    chord_tolerance_mm : float
+        The build's chord tolerance (see :func:`part_shape`).
+    shape : TopoDS_Solid, optional
+        The part's solid from :func:`part_shape` when the caller has it already (built here otherwise).
+
+    Returns
+    -------
+    bytes
+        One named solid (product name = part name); deterministic.
+    """
+    document, tool = _xcaf_document()
+    label = tool.AddShape(shape if shape is not None else part_shape(part, chord_tolerance_mm), False)
+    _set_name(label, part.name)
+    return _write(document, part.name)
+
+
+def assembly_step(parts: Sequence[Part], poses: Mapping[str, np.ndarray], chord_tolerance_mm: float,
+                  title: str = "assembly", shapes: Mapping[str, Any] | None = None) -> bytes:
+    """STEP AP214 of the assembly at the given body poses: one named solid per part, mm.
+
+    Each part is its flat solid (as in its own file) placed by its body's pose and lifted to its layer
+    height ``z_mm``, the same placement :func:`fabricate.export.stl.assembly_3mf` gives the meshes.
+
+    Parameters
+    ----------
+    parts : sequence of Part
+    poses : Mapping[str, (3,) array]
+        World pose of each body (x mm, y mm, theta rad); a body missing stays at the origin.
+    chord_tolerance_mm : float
+    title : str
+        Name of the assembly product.
+    shapes : Mapping[str, TopoDS_Solid], optional
+        Part name -> its solid from :func:`part_shape` (built here for any part missing).
+
+    Returns
+    -------
+    bytes
+        Deterministic STEP text.
+    """
+    shapes = shapes or {}
+    document, tool = _xcaf_document()
+    assembly = tool.NewShape()
+    _set_name(assembly, title)
+    for part in parts:
+        shape = shapes.get(part.name)
+        label = tool.AddShape(shape if shape is not None else part_shape(part, chord_tolerance_mm), False)
+        _set_name(label, part.name)
+        pose = np.asarray(poses.get(part.body, np.zeros(3)), dtype=np.float64)
+        component = tool.AddComponent(assembly, label, _pose_location(pose, part.z_mm))
+        _set_name(component, part.name)
+    tool.UpdateAssemblies()
+    return _write(document, title)
+
+
+def step_files(parts: Sequence[Part], poses: Mapping[str, np.ndarray], chord_tolerance_mm: float,
+               title: str = "assembly") -> dict[str, bytes]:
+    """Every STEP file of a build, each part's solid made once: ``parts/<name>.step`` per part and
+    ``assembly.step`` at ``poses`` (see :func:`part_step`, :func:`assembly_step`).
+
+    Returns
+    -------
+    dict[str, bytes]
+        Path relative to the output folder -> content.
+    """
+    shapes = {part.name: part_shape(part, chord_tolerance_mm) for part in parts}
+    files = {f"parts/{part.name}.step": part_step(part, chord_tolerance_mm, shapes[part.name]) for part in parts}
+    files["assembly.step"] = assembly_step(parts, poses, chord_tolerance_mm, title, shapes)
+    return files
+
+
+# ----------------------------------------------------------------------------------------------- reading
+
+
+def read_step(data: bytes) -> list[StepSolid]:
+    """Every solid of a STEP file, named and measured, in the file's world frame.
+
+    Parameters
+    ----------
+    data : bytes
+        STEP file content.
+
+    Returns
+    -------
+    list of StepSolid
+        One per solid instance (an assembly's components posed), in file order; each a tuple
+        ``(name, volume_mm3, n_cylindrical_faces, valid, n_arc_faces, bounds)``.
+
+    Raises
+    ------
+    GeometryError
+        When OCP cannot read the data as STEP.
+    """
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPCAFControl import STEPCAFControl_Reader
+
+    document, tool = _xcaf_document()
+    folder = tempfile.mkdtemp(prefix="fabricate-step-")
+    path = os.path.join(folder, "in.step")
+    try:
+        with open(path, "wb") as handle:
+            handle.write(data)
+        reader = STEPCAFControl_Reader()
+        reader.SetNameMode(True)
+        with _quiet_occt():
+            status = reader.ReadFile(path)
+            if status != IFSelect_RetDone:
+                raise GeometryError(f"STEP not readable (reader status {status})")
+            if not reader.Transfer(document):
+                raise GeometryError("STEP read but not transferred to shapes")
+    finally:
+        if os.path.exists(path):
+            os.remove(path)
+        os.rmdir(folder)
+    roots = _label_sequence()
+    tool.GetFreeShapes(roots)
+    out: list[StepSolid] = []
+    for k in range(1, roots.Length() + 1):
+        _collect(tool, roots.Value(k), None, out)
+    return out
+
+
+def _label_sequence() -> Any:
+    """An empty sequence of XCAF labels (``OCP.collections`` in OCP 8, ``OCP.TDF`` in OCP 7)."""
+    try:
+        from OCP.collections import Sequence_TDF_Label
+    except ImportError:
+        from OCP.TDF import TDF_LabelSequence as Sequence_TDF_Label
+    return Sequence_TDF_Label()
+
+
+def _label_name(label: Any) -> str:
+    from OCP.TDataStd import TDataStd_Name
+
+    attribute = TDataStd_Name()
+    if label.FindAttribute(TDataStd_Name.GetID_s(), attribute):
+        return attribute.Get().ToExtString()
+    return ""
+
+
+def _collect(tool: Any, label: Any, location: Any, out: list[StepSolid]) -> None:
+    """Solids under an XCAF label, composing the component locations on the way down."""
+    from OCP.TDF import TDF_Label
+    from OCP.TopLoc import TopLoc_Location
+    from OCP.XCAFDoc import XCAFDoc_ShapeTool
+
+    location = location if location is not None else TopLoc_Location()
+    if XCAFDoc_ShapeTool.IsAssembly_s(label):
+        components = _label_sequence()
+        XCAFDoc_ShapeTool.GetComponents_s(label, components, False)
+        for k in range(1, components.Length() + 1):
+            component = components.Value(k)
+            referred = TDF_Label()
+            XCAFDoc_ShapeTool.GetReferredShape_s(component, referred)
+            placed = location.Multiplied(XCAFDoc_ShapeTool.GetLocation_s(component))
+            _collect(tool, referred, placed, out)
+        return
+    shape = XCAFDoc_ShapeTool.GetShape_s(label).Moved(location)
+    out.extend(_measure(shape, _label_name(label)))
+
+
+def _measure(shape: Any, name: str) -> list[StepSolid]:
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.BRepBndLib import BRepBndLib
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.BRepTools import BRepTools
+    from OCP.GeomAbs import GeomAbs_Cylinder
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+
+    solids = []
+    explorer = TopExp_Explorer(shape, TopAbs_SOLID)
+    while explorer.More():
+        solid = _downcast("Solid", explorer.Current())
+        full = partial = 0
+        faces = TopExp_Explorer(solid, TopAbs_FACE)
+        while faces.More():
+            face = _downcast("Face", faces.Current())
+            if BRepAdaptor_Surface(face).GetType() == GeomAbs_Cylinder:
+                u0, u1, _, _ = BRepTools.UVBounds_s(face)
+                # a hole's wall goes once round its axis; an outline arc covers less than a turn
+                if u1 - u0 > 2.0 * math.pi - 1e-9:
+                    full += 1
+                else:
+                    partial += 1
+            faces.Next()
+        box = Bnd_Box()
+        BRepBndLib.AddOptimal_s(solid, box, False, False)
+        low, high = box.CornerMin(), box.CornerMax()
+        solids.append(StepSolid(name, _volume(solid), full, bool(BRepCheck_Analyzer(solid).IsValid()), partial,
+                                np.array([[low.X(), low.Y(), low.Z()], [high.X(), high.Y(), high.Z()]])))
+        explorer.Next()
+    return solids
