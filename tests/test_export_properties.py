@@ -1,0 +1,175 @@
+"""Exporters against closed forms and independent readers, on hand-made parts (no synthesis, fast).
+
+Written to kill mutants of ``fabricate/export`` (see ``tests/benchmarks/mutation_report.md``): the cut
+path's outline grows and its slot shrinks by exactly kerf / 2, holes shrink by the kerf, nested parts keep
+the spacing and the margin, and an STL is the part's prism.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+
+import ezdxf
+import numpy as np
+import pytest
+import shapely
+import trimesh
+from ezdxf import path as dxf_path
+
+from fabricate.export.dxf import part_dxf, sheet_dxf, sheet_layout
+from fabricate.export.stl import (
+    SolidCache,
+    mesh_problems,
+    part_stl,
+    placed_flat_mesh,
+    plate_layout,
+    plate_stl,
+    validate_stl,
+)
+from fabricate.parts.build import SlottedPart
+from fabricate.parts.model import BulgePath, Hole
+from tests.interference_fixtures import slot_outline, slot_part
+
+KERF = 0.2
+WIDTH = 8.0  # link width
+LENGTH = 30.0  # hole to hole
+HOLE = 3.2  # finished hole diameter
+SLOT_L, SLOT_W = 10.0, 3.0  # guide slot: centre-to-centre length and width
+
+
+def stadium_area(length: float, width: float) -> float:
+    return width * length + math.pi * (width / 2) ** 2
+
+
+def slotted_link() -> SlottedPart:
+    """A rounded link with two pin holes and a stadium slot between them."""
+    slot = BulgePath(slot_outline(SLOT_L, SLOT_W).vertices + [10.0, 0.0], np.array([0.0, 1.0, 0.0, 1.0]))
+    holes = (Hole("A", np.array([0.0, 0.0]), HOLE, 3.0), Hole("B", np.array([LENGTH, 0.0]), HOLE, 3.0))
+    return SlottedPart("rod", "rod", slot_outline(LENGTH, WIDTH), holes, 3.0, 0.0, 0, "laser", slots=(slot,))
+
+
+def read(data: bytes):
+    return ezdxf.read(io.StringIO(data.decode("utf-8"))).modelspace()
+
+
+def contour(entity, flatten_mm: float = 1e-4) -> shapely.Polygon:
+    """ezdxf's own flattening (its arcs are cubic Beziers: within ~3e-4 r of the true arc)."""
+    return shapely.Polygon([(v.x, v.y) for v in dxf_path.make_path(entity).flattening(flatten_mm)])
+
+
+def exact_area(entity) -> float:
+    """Area of a closed LWPOLYLINE in closed form: the vertex polygon plus, for each bulge b over a chord
+    c, the circular segment R^2 / 2 (theta - sin theta) with theta = 4 atan(b), R = c / (2 sin(theta / 2))."""
+    pts = np.array(entity.get_points("xyb"))
+    xy, bulges = pts[:, :2], pts[:, 2]
+    nxt = np.roll(xy, -1, axis=0)
+    area = 0.5 * float(np.sum(xy[:, 0] * nxt[:, 1] - nxt[:, 0] * xy[:, 1]))
+    for p0, p1, b in zip(xy, nxt, bulges, strict=True):
+        if b != 0.0:
+            theta = 4.0 * math.atan(abs(b))
+            radius = math.hypot(*(p1 - p0)) / (2.0 * math.sin(theta / 2.0))
+            area += math.copysign(0.5 * radius * radius * (theta - math.sin(theta)), b)
+    return area
+
+
+@pytest.mark.parametrize("kerf", [0.0, KERF])
+def test_cut_path_is_offset_by_half_the_kerf(kerf):
+    """Closed forms: the outline is a stadium of width w + kerf, the slot one of width w_slot - kerf, the
+    holes circles of diameter d - kerf, all at their modelled centres (read back through ezdxf)."""
+    part = slotted_link()
+    msp = read(part_dxf(part, kerf))
+    entities = sorted(msp.query('LWPOLYLINE[layer=="CUT"]'), key=lambda e: -abs(exact_area(e)))
+    assert len(entities) == 2
+    assert exact_area(entities[0]) == pytest.approx(stadium_area(LENGTH, WIDTH + kerf), rel=1e-12)
+    assert abs(exact_area(entities[1])) == pytest.approx(stadium_area(SLOT_L, SLOT_W - kerf), rel=1e-12)
+    outline, slot = (contour(e) for e in entities)
+    assert outline.bounds == pytest.approx((-(WIDTH + kerf) / 2, -(WIDTH + kerf) / 2,
+                                            LENGTH + (WIDTH + kerf) / 2, (WIDTH + kerf) / 2), abs=2e-3)
+    assert slot.bounds == pytest.approx((10.0 - (SLOT_W - kerf) / 2, -(SLOT_W - kerf) / 2,
+                                         10.0 + SLOT_L + (SLOT_W - kerf) / 2, (SLOT_W - kerf) / 2), abs=2e-3)
+    circles = sorted(msp.query('CIRCLE[layer=="CUT"]'), key=lambda e: e.dxf.center.x)
+    assert [2 * c.dxf.radius for c in circles] == pytest.approx([HOLE - kerf, HOLE - kerf], abs=1e-9)
+    np.testing.assert_allclose([(c.dxf.center.x, c.dxf.center.y) for c in circles], [(0.0, 0.0), (LENGTH, 0.0)],
+                               atol=1e-12)
+    # the engraved label sits inside the plate, clear of the holes and the slot
+    (text,) = msp.query('TEXT[layer=="ENGRAVE"]')
+    spot = shapely.Point(text.dxf.align_point.x, text.dxf.align_point.y)
+    plate = outline.difference(slot)
+    for c in circles:
+        plate = plate.difference(shapely.Point(c.dxf.center.x, c.dxf.center.y).buffer(c.dxf.radius))
+    assert plate.contains(spot)
+    assert 0.3 <= text.dxf.height <= 5.0
+
+
+def links(n: int = 7) -> list:
+    return [slot_part(f"link{k}", f"link{k}", ("A", "B"), 20.0 + 6.0 * k, width=6.0 + k, pin=3.0,
+                      clearance=0.1, process="laser") for k in range(n)]
+
+
+@pytest.mark.parametrize(("sheet", "margin", "spacing"), [((120.0, 60.0), 5.0, 2.0), ((90.0, 50.0), 3.0, 4.0)])
+def test_nested_sheets_keep_spacing_and_margin(sheet, margin, spacing):
+    """Every part is cut once; on each sheet the cut outlines are at least spacing + kerf apart (the
+    kerf is cut away on both sides) and at least the margin inside the sheet, less the 0.05 mm chord of
+    the polygons the nesting packs (measured on ezdxf's own flattening of the written DXF)."""
+    parts = links()
+    layout = sheet_layout(parts, KERF, sheet, margin, spacing)
+    assert len(layout) == len(parts)
+    border = shapely.box(0.0, 0.0, *sheet)
+    seen = 0
+    for s in range(max(p.sheet for p in layout) + 1):
+        msp = read(sheet_dxf(parts, KERF, layout, sheet, s))
+        polys = [contour(e, 1e-3) for e in msp.query('LWPOLYLINE[layer=="CUT"]')]
+        seen += len(polys)
+        assert polys, f"sheet {s} is empty"
+        for i, a in enumerate(polys):
+            assert border.exterior.distance(a) >= margin - 0.05 and border.contains(a)
+            for b in polys[i + 1:]:
+                assert a.distance(b) >= spacing + KERF - 0.1
+        # every hole lies inside its own part's outline
+        for c in msp.query('CIRCLE[layer=="CUT"]'):
+            centre = shapely.Point(c.dxf.center.x, c.dxf.center.y)
+            assert sum(p.contains(centre.buffer(c.dxf.radius)) for p in polys) == 1
+    assert seen == len(parts)
+    # the shelves are used: the packing is not needlessly sparse (each sheet but the last is used)
+    total = sum(shapely.Polygon(p.outline.polygon(0.05)).area for p in parts)
+    assert max(p.sheet for p in layout) + 1 <= math.ceil(4 * total / (sheet[0] * sheet[1])) + 1
+
+
+def test_part_stl_is_the_prism_of_the_profile():
+    """Volume of the STL read back by trimesh = (stadium - holes) x thickness within the chord error,
+    bottom on z = 0, top at the thickness, footprint = the stadium's extent."""
+    part = slot_part("crank", "crank", ("O", "A"), 15.0, width=6.0, pin=2.0, clearance=0.25, z=7.0)
+    tol = 0.002
+    data = part_stl(part, SolidCache(tol))
+    mesh = trimesh.load(io.BytesIO(data), file_type="stl")
+    holes = 2 * math.pi * (2.5 / 2) ** 2
+    exact = (stadium_area(15.0, 6.0) - holes) * 3.0
+    perimeter = 2 * 15.0 + math.pi * 6.0 + 2 * math.pi * 2.5
+    assert abs(mesh.volume - exact) <= tol * perimeter * 3.0
+    assert mesh.volume < exact  # inscribed polygons: never more than the exact solid
+    assert validate_stl(data) == []
+    np.testing.assert_allclose(mesh.bounds, [[-3.0, -3.0, 0.0], [18.0, 3.0, 3.0]], atol=tol)
+
+
+def test_plate_keeps_parts_apart_and_inside():
+    """Placed on the build plate the parts' footprints do not overlap, keep the spacing and stay inside the
+    plate; the plate STL holds every part's volume."""
+    parts = [slot_part(f"p{k}", f"p{k}", ("A", "B"), 15.0 + 5 * k, width=6.0) for k in range(5)]
+    cache = SolidCache(0.005)
+    area, spacing = (60.0, 40.0), 3.0
+    layout = plate_layout(parts, cache, area, spacing)
+    meshes = [placed_flat_mesh(p, cache, pl) for p, pl in zip(parts, layout, strict=True)]
+    by_sheet: dict[int, list] = {}
+    for (vertices, _faces), pl in zip(meshes, layout, strict=True):
+        footprint = shapely.MultiPoint(vertices[:, :2]).convex_hull
+        assert shapely.box(0, 0, *area).contains(footprint)
+        assert shapely.box(0, 0, *area).exterior.distance(footprint) >= spacing - 0.05
+        by_sheet.setdefault(pl.sheet, []).append(footprint)
+    for footprints in by_sheet.values():
+        for i, a in enumerate(footprints):
+            for b in footprints[i + 1:]:
+                assert a.distance(b) >= spacing - 0.1  # boxes of polygons inscribed at a 0.05 mm chord
+    plate = trimesh.load(io.BytesIO(plate_stl(meshes)), file_type="stl")
+    assert plate.volume == pytest.approx(sum(p.volume_mm3() for p in parts), rel=1e-3)
+    assert mesh_problems(plate) == []
