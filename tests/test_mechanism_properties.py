@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from fabricate.errors import LockupError
-from fabricate.mechanism import Body, Driver, Mechanism, Revolute
+from fabricate.mechanism import Body, Driver, LinearLaw, Mechanism, Revolute
+from tests.conftest import make_four_bar
 
 
 def parallelogram(start_deg: float, end_deg: float, crank: float = 20.0, ground: float = 40.0) -> Mechanism:
@@ -63,3 +64,83 @@ def test_sweep_through_change_point_is_reported(start, end):
     first = change_points[(change_points - start) * np.sign(end - start) > 0]
     first = first[np.argmin(np.abs(first - start))]
     assert abs(info.value.input_value - first) <= abs(end - start) / 24 + 1e-6  # input in degrees
+
+
+def test_linear_law_and_its_derivatives_on_integer_input():
+    """y = 0.5 x - 2, y' = 0.5, y'' = 0, also for an integer array (no truncation to int)."""
+    law = LinearLaw(0.5, -2.0)
+    x = np.array([0, 1, 3])
+    np.testing.assert_array_equal(law(x), [-2.0, -1.5, -0.5])
+    np.testing.assert_array_equal(law(x, 1), [0.5, 0.5, 0.5])
+    np.testing.assert_array_equal(law(x, 2), [0.0, 0.0, 0.0])
+    assert law(x, 1).dtype == np.float64 and law(x, 2).dtype == np.float64
+
+
+def test_lookups_name_what_is_missing():
+    mech = make_four_bar()
+    with pytest.raises(KeyError, match="nobody"):
+        mech.body("nobody")
+    with pytest.raises(KeyError, match="Z9"):
+        mech.point_owner("Z9")
+    assert mech.point_names() == ("O", "D", "A", "B")
+    assert mech.degrees_of_freedom() == 1  # 3 (4 - 1) - 2 * 4
+    assert Body("b", {"P": (1, 2)}).point("P").dtype == np.float64
+
+
+def test_solve_anywhere_matches_the_sweep():
+    """solve(s) follows the first pose's branch to s: equal to the sweep there, at the start, at the end
+    and far from the start (300 deg: a plain Newton from the assembly guess would not get there)."""
+    mech = make_four_bar()
+    motion = mech.sweep(np.array([60.0, 180.0, 360.0, 420.0]))
+    for i, s in enumerate(motion.inputs):
+        pose = mech.solve(float(s))
+        for name in mech.body_names:
+            np.testing.assert_allclose(pose[name], motion.pose(name)[i], atol=1e-9)
+
+
+def test_sweep_default_count_cache_and_read_only_results():
+    mech = make_four_bar()
+    assert len(mech.sweep().inputs) == 361  # documented default
+    first = mech.sweep(5)
+    counts = [len(mech.sweep(n).inputs) for n in range(6, 17)]  # more sweeps than the cache holds
+    assert counts == list(range(6, 17))
+    again = mech.sweep(5)
+    assert len(again.inputs) == 5
+    np.testing.assert_array_equal(again.q, first.q)
+    assert mech.sweep(9) is mech.sweep(9)  # the same motion object is shared, so it must be read-only
+    motion = mech.sweep(9)
+    for array in (motion.inputs, motion.q):
+        with pytest.raises(ValueError):
+            array[0] = 0.0
+
+
+def test_velocity_shapes_and_ground():
+    mech = make_four_bar()
+    motion = mech.sweep(7)
+    v = mech.velocity(motion.poses_at(3), float(motion.inputs[3]))
+    assert set(v) == set(mech.body_names)
+    assert all(np.shape(v[name]) == (3,) for name in v)
+    np.testing.assert_array_equal(v["ground"], np.zeros(3))
+    assert motion.pose("ground").shape == (7, 3) and not motion.pose("ground").any()
+    # the crank turns at the input rate (input in degrees)
+    assert v["crank"][2] == pytest.approx(math.pi / 180.0, rel=1e-9)
+
+
+def test_relative_angle_is_the_difference_of_body_angles():
+    motion = make_four_bar().sweep(13)
+    np.testing.assert_allclose(motion.relative_angle("coupler", "crank"),
+                               motion.pose("coupler")[:, 2] - motion.pose("crank")[:, 2], atol=0)
+    np.testing.assert_allclose(motion.relative_angle("crank", "ground"), np.radians(motion.inputs), atol=1e-9)
+
+
+def test_joints_declared_with_ground_second_give_the_same_motion():
+    """Revolutes may name the ground as their second body: the motion must not depend on the order."""
+    mech = make_four_bar()
+    flipped = Mechanism(
+        name="four_bar_flipped", bodies=mech.bodies, ground="ground",
+        joints=(Revolute("O", "crank", "ground"), Revolute("A", "coupler", "crank"),
+                Revolute("B", "rocker", "coupler"), Revolute("D", "rocker", "ground")),
+        gears=(), drivers=mech.drivers, input_range=mech.input_range, assembly=mech.assembly)
+    a, b = mech.sweep(37), flipped.sweep(37)
+    for name in ("crank", "coupler", "rocker"):
+        np.testing.assert_allclose(b.pose(name), a.pose(name), atol=1e-9)
