@@ -88,3 +88,74 @@ def test_spur_transmission_error_is_the_larger_flank_error():
     np.testing.assert_allclose((mesh.free_plus[ok] + mesh.free_minus[ok]) * r, backlash, atol=1e-3)
     # the errors of the two flanks differ: the max/min choice matters for this pair
     assert np.mean(np.abs(np.abs(mesh.free_plus[ok] - lag) - np.abs(mesh.free_minus[ok] - lag)) > 0) > 0.5
+
+
+# -- outline helpers, each against its definition -------------------------------------------------
+def test_flank_index_counts_half_pitches_from_the_origin():
+    from fabricate.gears.teeth import flank_index
+
+    p, origin = 2.0, 0.3
+    # flank k sits at origin - p/4 + k p/2 on the pitch line (left flank of tooth 0 is 0)
+    k = np.arange(-5, 6)
+    u = origin - p / 4 + k * p / 2
+    np.testing.assert_array_equal(flank_index(u, p, origin), k)
+    np.testing.assert_array_equal(flank_index(u + 0.2 * p, p, origin), k)  # rounds to the nearest
+    np.testing.assert_array_equal(flank_index(u - 0.2 * p, p, origin), k)
+    out = flank_index(np.array([np.nan, np.inf]), p, origin)
+    assert out.dtype == np.int64 and np.all(out < -(2**61))
+
+
+def test_largest_polygon_of_collections():
+    from fabricate.gears.teeth import _largest_polygon
+
+    small, big = shapely.box(0, 0, 1, 1), shapely.box(5, 5, 8, 8)
+    assert _largest_polygon(big) is big
+    assert _largest_polygon(shapely.MultiPolygon([small, big])).equals(big)
+    mixed = shapely.GeometryCollection([LineString([(0, 0), (9, 9)]), small, shapely.MultiPolygon([big])])
+    assert _largest_polygon(mixed).equals(big)
+    with pytest.raises(ValueError):
+        _largest_polygon(shapely.GeometryCollection([LineString([(0, 0), (1, 1)])]))
+
+
+def test_clean_ring_drops_closing_and_repeated_vertices():
+    from fabricate.gears.teeth import _clean_ring
+
+    square = np.array([[0, 0], [1, 0], [1, 0], [1, 1], [0, 1], [0, 0]], dtype=float)
+    np.testing.assert_array_equal(_clean_ring(square), [[0, 0], [1, 0], [1, 1], [0, 1]])
+    np.testing.assert_array_equal(_clean_ring(square[:-1]), [[0, 0], [1, 0], [1, 1], [0, 1]])
+    near = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0, 1e-12]], dtype=float)  # last repeats the first
+    assert len(_clean_ring(near)) == 4
+
+
+@pytest.mark.parametrize("tol", [1e-3, 0.02, 0.2])
+def test_simplify_ring_keeps_every_dropped_vertex_within_the_tolerance(tol):
+    from fabricate.gears.teeth import simplify_ring
+
+    t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    r = 10 + 0.8 * np.sin(7 * t) + 0.05 * np.sin(53 * t)
+    ring = np.column_stack([r * np.cos(t), r * np.sin(t)])
+    out = simplify_ring(ring, tol)
+    assert 3 < len(out) < len(ring)
+    # a subset of the input, in order
+    idx = [int(np.flatnonzero(np.all(ring == v, axis=1))[0]) for v in out]
+    assert idx == sorted(idx) and idx[0] == 0
+    dist = shapely.distance(shapely.points(ring), shapely.LinearRing(out))
+    assert dist.max() <= tol * (1 + 1e-9)
+    assert dist.max() > 0.3 * tol  # not needlessly dense
+    if tol < 0.01:
+        assert len(out) > 100
+
+
+@pytest.mark.parametrize(("radius", "tol"), [(2.0, 0.005), (0.5, 0.2), (20.0, 1e-4)])
+def test_circle_points_chord_error(radius, tol):
+    from fabricate.gears.teeth import circle_points
+
+    pts = circle_points(radius, tol, start=0.3)
+    n = len(pts)
+    assert n >= 16
+    np.testing.assert_allclose(np.hypot(*pts.T), radius, rtol=1e-12)
+    sagitta = radius * (1 - np.cos(np.pi / n))
+    assert sagitta <= tol * (1 + 1e-9)
+    assert n == 16 or radius * (1 - np.cos(np.pi / (n - 1))) > tol  # the fewest points that do it
+    assert Polygon(pts).exterior.is_ccw
+    assert np.arctan2(pts[0, 1], pts[0, 0]) == pytest.approx(0.3)
