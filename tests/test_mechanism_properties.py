@@ -144,3 +144,53 @@ def test_joints_declared_with_ground_second_give_the_same_motion():
     a, b = mech.sweep(37), flipped.sweep(37)
     for name in ("crank", "coupler", "rocker"):
         np.testing.assert_allclose(b.pose(name), a.pose(name), atol=1e-9)
+
+
+def test_off_axis_joint_points_follow_the_closed_form():
+    """Joint points off their body's x axis (a ternary coupler, a bent rocker): the solver must rotate local
+    points by the full rotation (both the sin and cos terms). Closed form: Freudenstein for the rocker,
+    then the coupler point from the rigid triangle A-B-P."""
+    from tests.test_mechanism import freudenstein_rocker
+
+    crank, coupler, rocker, ground = 15.0, 40.0, 30.0, 40.0
+    beta, gamma = 0.5, -0.7  # B's direction in the coupler frame, B's direction in the rocker frame
+    p_local = np.array([12.0, 9.0])  # a coupler point off the A-B line
+    base = make_four_bar(crank, coupler, rocker, ground, start_deg=60.0, end_deg=300.0)
+    b_c = coupler * np.array([math.cos(beta), math.sin(beta)])
+    b_r = rocker * np.array([math.cos(gamma), math.sin(gamma)])
+    c0, r0 = base.assembly["coupler"], base.assembly["rocker"]
+    mech = Mechanism(
+        name="bent_four_bar",
+        bodies=(base.body("ground"), base.body("crank"),
+                Body("coupler", {"A": (0.0, 0.0), "B": tuple(b_c), "P": tuple(p_local)}),
+                Body("rocker", {"D": (0.0, 0.0), "B": tuple(b_r)})),
+        ground="ground", joints=base.joints, gears=(), drivers=base.drivers, input_range=base.input_range,
+        assembly={"crank": base.assembly["crank"], "coupler": (c0[0], c0[1], c0[2] - beta),
+                  "rocker": (r0[0], r0[1], r0[2] - gamma)})
+    motion = mech.sweep(49)
+    theta = np.radians(motion.inputs)
+    phi = freudenstein_rocker(crank, coupler, rocker, ground, theta)
+    b_world = np.column_stack([ground + rocker * np.cos(phi), rocker * np.sin(phi)])
+    np.testing.assert_allclose(motion.point("B", "rocker"), b_world, atol=1e-9)
+    np.testing.assert_allclose(motion.point("B", "coupler"), b_world, atol=1e-9)
+    a_world = crank * np.column_stack([np.cos(theta), np.sin(theta)])
+    np.testing.assert_allclose(motion.point("A", "coupler"), a_world, atol=1e-9)
+    # P from the triangle: A + R(angle of AB - beta) p_local
+    ang = np.arctan2(*(b_world - a_world)[:, ::-1].T) - beta
+    p_world = a_world + np.column_stack([np.cos(ang) * p_local[0] - np.sin(ang) * p_local[1],
+                                         np.sin(ang) * p_local[0] + np.cos(ang) * p_local[1]])
+    np.testing.assert_allclose(motion.point("P"), p_world, atol=1e-9)
+
+
+def test_millimetre_sized_linkage_follows_the_closed_form():
+    """A linkage far smaller than 1 mm (0.2 mm crank): the branch guard scales with the mechanism, so
+    ordinary steps are accepted and the result is Freudenstein's."""
+    from tests.test_mechanism import freudenstein_rocker
+
+    k = 0.02
+    mech = make_four_bar(15 * k, 40 * k, 30 * k, 40 * k, start_deg=60.0, end_deg=420.0)
+    motion = mech.sweep(25)
+    theta = np.radians(motion.inputs)
+    phi = freudenstein_rocker(15 * k, 40 * k, 30 * k, 40 * k, theta)
+    np.testing.assert_allclose(motion.point("B", "rocker"),
+                               np.column_stack([40 * k + 30 * k * np.cos(phi), 30 * k * np.sin(phi)]), atol=1e-10)
