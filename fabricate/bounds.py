@@ -36,18 +36,18 @@ MAX_SPRING_RATE = 1.0e4
 #: ``process.chord_tolerance_mm``: the polygonisation sagitta; vertex counts grow as 1/sqrt(tol).
 MIN_CHORD_TOLERANCE_MM = 0.001
 #: ``checks.sweep_poses``: poses of the swept motion and the interference check.
-MAX_SWEEP_POSES = 10000
+MAX_SWEEP_POSES = 5000
 #: ``gears.mesh_steps``: poses of the gear mesh check.
 MAX_MESH_STEPS = 7200
 #: ``gears.teeth`` / ``gear_pair.teeth`` and the teeth a module gives: teeth of one gear (cost grows
 #: faster than linearly: 200 + 200 teeth built in 15 s, 400 + 400 in 98 s).
 MAX_TEETH = 200
 #: ``gears.mesh_steps`` × (z_a + z_b): the mesh check's work (7200 steps of a 30 + 30 pair: ~15 s).
-MAX_MESH_STEP_TEETH = 450_000
+MAX_MESH_STEP_TEETH = 250_000
 #: Measured seconds per step and tooth of the mesh check (for the estimate in messages).
 MESH_SECONDS_PER_TOOTH_STEP = 3.5e-5
 #: ``synthesis.kappa_samples`` (five-bar): samples of the hinge curves (a Python loop per sample).
-MAX_KAPPA_SAMPLES = 10000
+MAX_KAPPA_SAMPLES = 5000
 #: ``synthesis.curve_step_mm`` (five-bar): smallest refinement step of the hinge curves.
 MIN_CURVE_STEP_MM = 0.01
 #: ``region.step_mm`` (Watt six-bar): the x sampling of the Burmester curves, per box.
