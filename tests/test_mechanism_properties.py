@@ -109,6 +109,7 @@ def test_sweep_default_count_cache_and_read_only_results():
     np.testing.assert_array_equal(again.q, first.q)
     assert mech.sweep(9) is mech.sweep(9)  # the same motion object is shared, so it must be read-only
     motion = mech.sweep(9)
+    assert mech.sweep([60, 90, 120]).inputs.dtype == np.float64  # integer inputs are degrees, not ints
     for array in (motion.inputs, motion.q):
         with pytest.raises(ValueError):
             array[0] = 0.0
