@@ -1,0 +1,104 @@
+"""Part profiles and sizes against closed forms and shapely on raw coordinates.
+
+Written to kill mutants of ``fabricate/parts`` (see ``tests/benchmarks/mutation_report.md``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+
+from fabricate.parts.build import derive_sizes
+from fabricate.parts.model import BulgePath
+from fabricate.parts.profiles import circle_hull, circle_path, fuse_polygons, offset_path
+from fabricate.parts.spec import PartsSpec
+from fabricate.planar import polygon_area
+
+
+def test_sizes_closed_forms(sla_process, laser_process):
+    """hole = pin + 2 c + compensation; wall = max(min wall, pin / 2) (laser: >= sheet thickness);
+    boss = hole / 2 + wall; mount hole = screw + 2 c + compensation, its boss + wall; hub >= hole + 2 walls."""
+    for process in (sla_process, laser_process):
+        pin, c, comp = process.pin_diameter_mm, process.running_clearance_mm, process.hole_compensation_mm
+        wall = max(process.min_wall_mm, 0.5 * pin)
+        if process.name == "laser":
+            wall = max(wall, process.thickness_mm)
+        s = derive_sizes(process, PartsSpec(mounting_hole_mm=4.0), {})
+        assert s.pin_mm == pin
+        assert s.hole_mm == pytest.approx(pin + 2 * c + comp, abs=1e-12)
+        assert s.boss_radius_mm == pytest.approx((pin + 2 * c + comp) / 2 + wall, abs=1e-12)
+        assert s.mount_hole_mm == pytest.approx(4.0 + 2 * c + comp, abs=1e-12)
+        assert s.mount_boss_radius_mm == pytest.approx((4.0 + 2 * c + comp) / 2 + wall, abs=1e-12)
+        assert s.hub_mm == pytest.approx(max(2 * s.boss_radius_mm, s.hole_mm + 2 * process.min_wall_mm), abs=1e-12)
+        # an explicit boss wall and hub win (the hub still at least hole + 2 min walls)
+        t = derive_sizes(process, PartsSpec(boss_wall_mm=5.0, hub_diameter_mm=30.0), {})
+        wall_t = max(5.0, process.thickness_mm) if process.name == "laser" else 5.0
+        assert t.boss_radius_mm == pytest.approx(s.hole_mm / 2 + wall_t, abs=1e-12)
+        assert t.hub_mm == pytest.approx(30.0, abs=1e-12)
+        tiny = derive_sizes(process, PartsSpec(hub_diameter_mm=0.5), {})
+        assert tiny.hub_mm == pytest.approx(s.hole_mm + 2 * process.min_wall_mm, abs=1e-12)
+        geared = derive_sizes(process, PartsSpec(), {}, gear_hub_mm=25.0)
+        assert geared.hub_mm == pytest.approx(25.0, abs=1e-12)
+
+
+def test_circle_path_is_the_circle():
+    path = circle_path(np.array([3.0, -2.0]), 4.0)
+    assert path.area() == pytest.approx(math.pi * 16.0, rel=1e-12)
+    poly = path.polygon(1e-4)
+    np.testing.assert_allclose(np.hypot(*(poly - [3.0, -2.0]).T), 4.0, rtol=1e-12)
+    assert polygon_area(poly) > 0
+
+
+def test_hull_of_nested_and_coincident_circles():
+    """A circle inside another adds nothing; two coincident circles are one; three circles in a row are
+    the stadium of the outer two (closed forms)."""
+    inner = circle_hull(np.array([[0.0, 0.0], [1.0, 0.5]]), np.array([5.0, 2.0]))
+    assert inner.area() == pytest.approx(math.pi * 25.0, rel=1e-12)
+    same = circle_hull(np.array([[2.0, 2.0], [2.0, 2.0]]), np.array([3.0, 3.0]))
+    assert same.area() == pytest.approx(math.pi * 9.0, rel=1e-12)
+    row = circle_hull(np.array([[0.0, 0.0], [10.0, 0.0], [20.0, 0.0]]), 2.0)
+    assert row.area() == pytest.approx(20.0 * 4.0 + math.pi * 4.0, rel=1e-9)
+    # unequal radii: area of the exact hull of two circles (closed form with the tangent angle)
+    r1, r2, d = 4.0, 2.0, 12.0
+    pear = circle_hull(np.array([[0.0, 0.0], [d, 0.0]]), np.array([r1, r2]))
+    a = math.asin((r1 - r2) / d)
+    expected = (r1 + r2) * d * math.cos(a) + (math.pi + 2 * a) * r1 ** 2 / 2 + (math.pi - 2 * a) * r2 ** 2 / 2
+    assert pear.area() == pytest.approx(expected, rel=1e-9)
+    assert polygon_area(pear.vertices) > 0  # counter-clockwise
+    with pytest.raises(Exception, match="positive radius"):
+        circle_hull(np.array([[0.0, 0.0]]), 0.0)
+
+
+def test_offset_of_a_polyline_is_the_minkowski_sum():
+    """A concave L (polyline): grown by d its area is shapely's buffer of the raw vertices, and shrinking
+    gives the erosion; both counter-clockwise and starting at the lowest-leftmost vertex."""
+    ell = BulgePath.polyline(np.array([[0, 0], [10, 0], [10, 3], [3, 3], [3, 10], [0, 10]], dtype=float))
+    raw = shapely.Polygon(ell.vertices)
+    for d in (0.4, -0.4):
+        out = offset_path(ell, d)
+        expected = raw.buffer(d, quad_segs=256, join_style="round")
+        assert shapely.Polygon(out.vertices).area == pytest.approx(expected.area, abs=2e-3 * abs(d) * raw.length)
+        assert shapely.Polygon(out.vertices).symmetric_difference(expected).area < 1e-2
+        assert polygon_area(out.vertices) > 0
+        first = out.vertices[0]
+        assert tuple(first) == min(map(tuple, out.vertices))
+    assert offset_path(ell, 0.0) is ell
+    with pytest.raises(Exception, match="splits or removes"):
+        offset_path(ell, -2.0)  # the 3 mm arms vanish
+
+
+def test_fuse_fills_enclosed_gaps_and_drops_collinear_points():
+    """A ring of four bars around an empty square: the fused plate is the outer square (gap filled), with
+    no vertex in the middle of a straight edge."""
+    base = BulgePath.polyline(np.array([[0, 0], [10, 0], [10, 2], [0, 2]], dtype=float))
+    bars = [np.array([[8, 0], [10, 0], [10, 10], [8, 10]], dtype=float),
+            np.array([[0, 8], [10, 8], [10, 10], [0, 10]], dtype=float),
+            np.array([[0, 0], [2, 0], [2, 10], [0, 10]], dtype=float)]
+    fused = fuse_polygons(base, bars, 0.01)
+    assert shapely.Polygon(fused.vertices).area == pytest.approx(100.0, abs=1e-9)
+    assert len(fused.vertices) == 4
+    assert polygon_area(fused.vertices) > 0
+    np.testing.assert_array_equal(fused.vertices[0], [0.0, 0.0])
