@@ -39,6 +39,7 @@ from fabricate.export.step import (  # noqa: E402
     part_step,
     read_step,
     step_available,
+    step_problems,
 )
 from fabricate.export.stl import read_3mf  # noqa: E402
 from fabricate.parts.model import BulgePath, Hole, Part  # noqa: E402
@@ -172,6 +173,16 @@ def test_assembly_bytes_do_not_depend_on_what_was_written_before() -> None:
     first = assembly_step(parts, poses, 0.005, title="two")
     assert b"NEXT_ASSEMBLY_USAGE_OCCURRENCE('1','plate'" in first
     assert assembly_step(parts, poses, 0.005, title="two") == first
+
+
+def test_step_problems_names_a_wrong_volume_and_hole_count() -> None:
+    part = _plate()
+    data = part_step(part, 0.005)
+    assert step_problems(data, {"plate": (part.volume_mm3(), 2)}) == []
+    problems = step_problems(data, {"plate": (part.volume_mm3() * 1.001, 3)})
+    assert len(problems) == 2 and "volume" in problems[0] and "3" in problems[1]
+    assert "differ" in step_problems(data, {"other": (1.0, 0)})[0]
+    assert step_problems(b"ISO-10303-21;\nnot step") != []
 
 
 # ---------------------------------------------------------------------------------------- determinism

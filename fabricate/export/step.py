@@ -590,3 +590,43 @@ def _measure(shape: Any, name: str) -> list[StepSolid]:
                                 np.array([[low.X(), low.Y(), low.Z()], [high.X(), high.Y(), high.Z()]])))
         explorer.Next()
     return solids
+
+
+def step_problems(data: bytes, expected: Mapping[str, tuple[float, int]] | None = None,
+                  rel_tol: float = 1e-6) -> list[str]:
+    """What is wrong with a STEP file against what the report says it holds (empty: nothing found).
+
+    Parameters
+    ----------
+    data : bytes
+        A part's or the assembly's STEP file.
+    expected : Mapping[str, (float, int)], optional
+        Part name -> (volume mm^3, number of holes), in file order: one entry for a part file, every
+        part for ``assembly.step``. Without it only readability and validity are checked.
+    rel_tol : float
+        Relative volume tolerance.
+
+    Returns
+    -------
+    list of str
+        One sentence per problem, e.g. ``"solid ground: volume 812.5 mm^3, the report says 810.0"``.
+    """
+    try:
+        solids = read_step(data)
+    except GeometryError as exc:
+        return [str(exc)]
+    problems = [f"solid {s.name or '?'}: not a valid solid" for s in solids if not s.valid]
+    if not solids:
+        problems.append("no solid")
+    if expected is None:
+        return problems
+    names = [s.name for s in solids]
+    if names != list(expected):
+        return problems + [f"solids {names} differ from the report's parts {list(expected)}"]
+    for solid in solids:
+        volume, holes = expected[solid.name]
+        if not abs(solid.volume_mm3 - volume) <= rel_tol * abs(volume):
+            problems.append(f"solid {solid.name}: volume {solid.volume_mm3:.4f} mm^3, the report says {volume:.4f}")
+        if solid.n_cylindrical_faces != holes:
+            problems.append(f"solid {solid.name}: {solid.n_cylindrical_faces} hole cylinders, the report says {holes}")
+    return problems
