@@ -22,9 +22,7 @@ from fabricate.export.stl import (
     SolidCache,
     mesh_problems,
     part_stl,
-    placed_flat_mesh,
     plate_layout,
-    plate_stl,
     validate_stl,
 )
 from fabricate.parts.build import SlottedPart
@@ -154,12 +152,15 @@ def test_part_stl_is_the_prism_of_the_profile():
 
 def test_plate_keeps_parts_apart_and_inside():
     """Placed on the build plate the parts' footprints do not overlap, keep the spacing and stay inside the
-    plate; the plate STL holds every part's volume."""
+    plate; each placed mesh keeps its part's volume (rigid placement)."""
     parts = [slot_part(f"p{k}", f"p{k}", ("A", "B"), 15.0 + 5 * k, width=6.0) for k in range(5)]
     cache = SolidCache(0.005)
     area, spacing = (60.0, 40.0), 3.0
     layout = plate_layout(parts, cache, area, spacing)
-    meshes = [placed_flat_mesh(p, cache, pl) for p, pl in zip(parts, layout, strict=True)]
+    meshes = []
+    for p, pl in zip(parts, layout, strict=True):
+        vertices, faces = cache.flat_mesh(p)
+        meshes.append((np.column_stack([pl.apply(vertices[:, :2]), vertices[:, 2]]), faces))
     by_sheet: dict[int, list] = {}
     for (vertices, _faces), pl in zip(meshes, layout, strict=True):
         footprint = shapely.MultiPoint(vertices[:, :2]).convex_hull
@@ -170,6 +171,7 @@ def test_plate_keeps_parts_apart_and_inside():
         for i, a in enumerate(footprints):
             for b in footprints[i + 1:]:
                 assert a.distance(b) >= spacing - 0.1  # boxes of polygons inscribed at a 0.05 mm chord
-    plate = trimesh.load(io.BytesIO(plate_stl(meshes)), file_type="stl")
-    assert plate.volume == pytest.approx(sum(p.volume_mm3() for p in parts), rel=1e-3)
-    assert mesh_problems(plate) == []
+    for p, (vertices, faces) in zip(parts, meshes, strict=True):
+        placed = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+        assert mesh_problems(placed) == []
+        assert placed.volume == pytest.approx(p.volume_mm3(), rel=1e-3)

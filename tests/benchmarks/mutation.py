@@ -195,10 +195,13 @@ def run_module(key: str, max_children: int) -> dict:
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
     names = sorted(selected)
     if names:
-        subprocess.run(["nice", "-n", "10", mutmut_exe(), "run", "--max-children", str(max_children), *names],
-                       cwd=work, env=env, check=False, stdout=subprocess.DEVNULL)
+        with open(work / "mutmut-run.log", "w") as log:  # mutmut's own output, for when a run fails
+            subprocess.run(["nice", "-n", "10", mutmut_exe(), "run", "--max-children", str(max_children), *names],
+                           cwd=work, env=env, check=False, stdout=log, stderr=subprocess.STDOUT)
     meta_path = work / "mutants" / (MODULES[key][0] + ".meta")
     codes = json.loads(meta_path.read_text())["exit_code_by_key"] if meta_path.exists() else {}
+    if names and all(codes.get(n) is None for n in names):
+        raise SystemExit(f"{key}: mutmut ran no mutant; see {work / 'mutmut-run.log'}")
     table = load_equivalents()
     rows = []
     for name in names:
@@ -263,6 +266,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--report", action="store_true", help="only rewrite the report from saved results")
     parser.add_argument("--max-children", type=int, default=1, help="parallel mutants (default 1 core)")
     args = parser.parse_args(argv)
+    HERE.mkdir(parents=True, exist_ok=True)
     results = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
     keys = list(MODULES) if args.all else args.modules
     unknown = [k for k in keys if k not in MODULES]
