@@ -70,6 +70,32 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "synthesis/kinematic_mapping": ("fabricate/synthesis/kinematic_mapping.py", ["tests/test_five_bar.py"]),
 }
 
+#: The six hand-made mutants of issue 15 and the tests that must kill them (``--examples`` checks it).
+EXAMPLES = [
+    ("branch-change check in the sweep disabled", "fabricate/mechanism.py",
+     "if sign0 != 0.0 and sign != 0.0 and sign != sign0:", "if False:",
+     ["tests/test_mechanism_properties.py::test_sweep_through_change_point_is_reported"]),
+    ("sector hub radius min -> max", "fabricate/gears/teeth.py",
+     "hub = Polygon(circle_points(min(hub_radius_mm,", "hub = Polygon(circle_points(max(hub_radius_mm,",
+     ["tests/test_gears_properties.py::test_sector_hub_is_the_hub_asked_for"]),
+    ("transmission error takes the smaller flank error", "fabricate/gears/mesh.py",
+     "te = np.where(np.abs(err_plus) >= np.abs(err_minus), err_plus, err_minus)",
+     "te = np.where(np.abs(err_plus) <= np.abs(err_minus), err_plus, err_minus)",
+     ["tests/test_gears_properties.py::test_spur_transmission_error_is_the_larger_flank_error"]),
+    ("clearance verdict slack x10", "fabricate/checks/interference.py",
+     "and p.min_clearance_mm < p.required_mm - self.tolerance_mm]",
+     "and p.min_clearance_mm < p.required_mm - 10 * self.tolerance_mm]",
+     ["tests/test_checks_properties.py::test_clearance_just_under_the_requirement_fails"]),
+    ("slot kerf offset with the wrong sign", "fabricate/export/dxf.py",
+     "slots = [offset_path(s, -half)", "slots = [offset_path(s, half)",
+     ["tests/test_export_properties.py::test_cut_path_is_offset_by_half_the_kerf",
+      "tests/test_export.py::test_part_dxf_round_trip[slider_crank-laser]"]),
+    ("cut hole diameter not shrunk by the kerf (was read from the model by the old round-trip test)",
+     "fabricate/export/dxf.py", "h.diameter_mm - kerf_mm)", "h.diameter_mm)",
+     ["tests/test_export_properties.py::test_cut_path_is_offset_by_half_the_kerf",
+      "tests/test_export.py::test_part_dxf_round_trip[four_bar-laser]"]),
+]
+
 STATUS = {1: "killed", 3: "killed", 0: "survived", 5: "no tests", 33: "no tests", 34: "skipped",
           36: "timeout", -24: "timeout", 24: "timeout", 152: "timeout", 255: "timeout", None: "not checked"}
 
@@ -246,6 +272,14 @@ def write_report(results: dict) -> str:
     missing = [k for k in MODULES if k not in results]
     if missing:
         lines += ["", "Not run yet: " + ", ".join(missing) + "."]
+    examples = HERE / "examples.md"
+    if examples.exists():
+        lines += ["", "## The six mutants of issue 15", "",
+                  "Checked with `python tests/benchmarks/mutation.py --examples` (each applied to a scratch "
+                  "copy, its tests run):", "", examples.read_text().rstrip()]
+    notes = HERE / "notes.md"
+    if notes.exists():
+        lines += ["", notes.read_text().rstrip()]
     lines += ["", "## Equivalent mutants", ""]
     for key, res in results.items():
         for r in res["mutants"]:
@@ -259,13 +293,45 @@ def write_report(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def check_examples() -> list[str]:
+    """Apply each hand-made mutant of ``EXAMPLES`` to a scratch copy and run its tests: all must fail."""
+    lines = []
+    for title, source, old, new, tests in EXAMPLES:
+        work = WORK / "examples"
+        if work.exists():
+            shutil.rmtree(work)
+        work.mkdir(parents=True)
+        for name in ("fabricate", "tests", "templates"):
+            shutil.copytree(ROOT / name, work / name, ignore=shutil.ignore_patterns("__pycache__"))
+        text = (work / source).read_text()
+        if text.count(old) != 1:
+            lines.append(f"| {title} | `{source}` | the original line is not there (code changed?) | - |")
+            continue
+        (work / source).write_text(text.replace(old, new))
+        env = dict(os.environ, PYTHONPATH=str(work), PYTHONDONTWRITEBYTECODE="1")
+        run = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *tests], cwd=work,
+                             env=env, capture_output=True, text=True, check=False)
+        verdict = "killed" if run.returncode == 1 else f"NOT killed (pytest exit {run.returncode})"
+        names = ", ".join(f"`{t}`" for t in tests)
+        lines.append(f"| {title} | `{source}` | {names} | {verdict} |")
+        print(lines[-1], flush=True)
+    shutil.rmtree(WORK / "examples", ignore_errors=True)
+    return lines
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("modules", nargs="*", help=f"some of: {', '.join(MODULES)}")
     parser.add_argument("--all", action="store_true", help="every listed module")
     parser.add_argument("--report", action="store_true", help="only rewrite the report from saved results")
     parser.add_argument("--max-children", type=int, default=1, help="parallel mutants (default 1 core)")
+    parser.add_argument("--examples", action="store_true", help="check that the issue's six mutants are killed")
     args = parser.parse_args(argv)
+    if args.examples:
+        table = check_examples()
+        (HERE / "examples.md").write_text("| mutant | file | killing tests | verdict |\n|---|---|---|---|\n"
+                                          + "\n".join(table) + "\n")
+        return 0 if all("| killed |" in row for row in table) else 1
     HERE.mkdir(parents=True, exist_ok=True)
     results = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
     keys = list(MODULES) if args.all else args.modules
