@@ -241,6 +241,35 @@ def run_module(key: str, max_children: int) -> dict:
             "string_only_skipped": strings, "mutants": rows}
 
 
+def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
+    """Run the survivors of a saved result again in its work copy, with the current tests (after adding a
+    killing test): the mutants are the same as long as the module's source has not changed."""
+    source, tests = MODULES[key]
+    work = WORK / key.replace("/", "_")
+    if (ROOT / source).read_text() != (work / source).read_text():
+        raise SystemExit(f"{key}: {source} changed since the full run; run the module again")
+    for target in (work / "tests", work / "mutants" / "tests"):
+        shutil.rmtree(target, ignore_errors=True)
+        shutil.copytree(ROOT / "tests", target, ignore=shutil.ignore_patterns("__pycache__", ".hypothesis"))
+    (work / "mutants" / "mutmut-stats.json").unlink(missing_ok=True)  # new tests: map them again
+    names = [r["name"] for r in result["mutants"] if r["status"] in ("survived", "no tests")]
+    if names:
+        with open(work / "mutmut-rerun.log", "w") as log:
+            subprocess.run(["nice", "-n", "10", mutmut_exe(), "run", "--max-children", str(max_children), *names],
+                           cwd=work, check=False, stdout=log, stderr=subprocess.STDOUT)
+    codes = json.loads((work / "mutants" / (source + ".meta")).read_text())["exit_code_by_key"]
+    table = load_equivalents()
+    for r in result["mutants"]:
+        if r["name"] in names:
+            r["status"] = STATUS.get(codes.get(r["name"]), "suspicious")
+        if r["status"] != "killed":
+            reason = equivalent_reason(key, r["function"], r["old"], r["new"], table)
+            if reason:
+                r["status"], r["reason"] = "equivalent", reason
+    result["tests"] = tests
+    return result
+
+
 def summarise(result: dict) -> dict:
     count = {}
     for r in result["mutants"]:
@@ -326,6 +355,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--report", action="store_true", help="only rewrite the report from saved results")
     parser.add_argument("--max-children", type=int, default=1, help="parallel mutants (default 1 core)")
     parser.add_argument("--examples", action="store_true", help="check that the issue's six mutants are killed")
+    parser.add_argument("--survivors", action="store_true",
+                        help="re-run only the saved survivors of MODULE(s) with the current tests")
     args = parser.parse_args(argv)
     if args.examples:
         table = check_examples()
@@ -340,7 +371,10 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"unknown module(s) {unknown}; choose from {list(MODULES)}")
     if not args.report:
         for key in keys:
-            results[key] = run_module(key, args.max_children)
+            if args.survivors:
+                results[key] = rerun_survivors(key, results[key], args.max_children)
+            else:
+                results[key] = run_module(key, args.max_children)
             s = summarise(results[key])
             print(f"{key}: {s['killed']}/{s['run'] - s['equivalent']} killed ({100 * s['rate']:.1f}%), "
                   f"{s['survived']} survived, {s['no_tests']} without tests, {s['equivalent']} equivalent",
