@@ -358,6 +358,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--survivors", action="store_true",
                         help="re-run only the saved survivors of MODULE(s) with the current tests")
     args = parser.parse_args(argv)
+    HERE.mkdir(parents=True, exist_ok=True)
     if args.examples:
         table = check_examples()
         (HERE / "examples.md").write_text("| mutant | file | killing tests | verdict |\n|---|---|---|---|\n"
