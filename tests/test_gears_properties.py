@@ -159,3 +159,58 @@ def test_circle_points_chord_error(radius, tol):
     assert n == 16 or radius * (1 - np.cos(np.pi / (n - 1))) > tol  # the fewest points that do it
     assert Polygon(pts).exterior.is_ccw
     assert np.arctan2(pts[0, 1], pts[0, 0]) == pytest.approx(0.3)
+
+
+# -- the gear-mesh check of an assembled motion ---------------------------------------------------
+def fake_motion(x_a: np.ndarray, x_b: np.ndarray):
+    """The three things check_gear_mesh reads from a Motion: relative angles, inputs, the input unit."""
+    from types import SimpleNamespace
+
+    angles = {"gear_a": x_a, "gear_b": x_b, "carrier": np.zeros_like(x_a)}
+    return SimpleNamespace(relative_angle=lambda body, ref: angles[body] - angles[ref],
+                           inputs=np.degrees(x_a), mechanism=SimpleNamespace(input_unit="deg"))
+
+
+def test_gear_mesh_check_of_a_motion_on_the_law():
+    """Spur pair driven exactly by its law: no failure, backlash = the designed 0.1 mm (closed form), the TE
+    the larger flank error against the closed-form designed play at the motion's own angles."""
+    from dataclasses import replace
+
+    from fabricate.checks.gear_mesh import check_gear_mesh
+
+    pair = replace(spur_pair(), carrier="carrier")
+    x = np.linspace(0.2, 1.4, 61)
+    result = check_gear_mesh(pair, fake_motion(x, np.asarray(pair.law(x))))
+    assert result.failures == ()
+    assert result.law_error_rad < 1e-12
+    assert result.steps == 61 and result.steps_without_contact == 0
+    assert result.backlash_mm == pytest.approx((0.1, 0.1), abs=1e-3)
+    lo, hi = result.backlash_allowed_mm
+    assert lo < 0.1 < hi
+    assert result.x_a_range_deg == pytest.approx((np.degrees(0.2), np.degrees(1.4)))
+    assert result.interference_area_mm2 == 0.0
+    lag = 0.1 / (2 * 12.0)  # backlash / (2 r), r = 12 mm
+    from fabricate.gears.mesh import mesh_check
+
+    own = mesh_check(pair, x_a_values=x)
+    err = np.maximum(np.abs(own.free_plus - lag), np.abs(own.free_minus - lag))
+    assert result.transmission_error_deg == pytest.approx(np.degrees(np.nanmax(err)), rel=1e-9)
+
+
+def test_gear_mesh_check_catches_a_motion_off_the_law_and_out_of_range():
+    from dataclasses import replace
+
+    from fabricate.checks.gear_mesh import check_gear_mesh
+
+    pair = replace(spur_pair(), carrier="carrier")
+    x = np.linspace(0.2, 1.4, 31)
+    off = check_gear_mesh(pair, fake_motion(x, np.asarray(pair.law(x)) + np.radians(0.5)))
+    assert off.law_error_rad == pytest.approx(np.radians(0.5), rel=1e-9)
+    assert any("departs from the gear law" in f for f in off.failures)
+    sector = replace(sector_pair(), carrier="carrier")
+    lo, hi = sector.working_range
+    x = np.linspace(lo, hi + 0.2, 31)  # 11 deg past the cut range
+    out = check_gear_mesh(sector, fake_motion(x, np.asarray(sector.law(x))))
+    assert any("outside the cut range" in f for f in out.failures)
+    inside = check_gear_mesh(sector, fake_motion(x[x <= hi], np.asarray(sector.law(x[x <= hi]))))
+    assert not any("outside the cut range" in f for f in inside.failures)
