@@ -196,3 +196,57 @@ def test_plate_keeps_parts_apart_and_inside():
         placed = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
         assert mesh_problems(placed) == []
         assert placed.volume == pytest.approx(p.volume_mm3(), rel=1e-3)
+
+
+def test_kinematic_drawing_of_a_bent_four_bar():
+    """The kinematic DXF at one pose: a LINKS line and an aligned dimension of the link's true length for
+    each pair of joints of a body, a JOINTS circle and a label with the world coordinates at each joint, two
+    ordinate dimensions per joint; units mm; the measurements read back equal the closed-form lengths."""
+    from fabricate.export.dxf import kinematic_dxf
+    from tests.conftest import make_four_bar
+
+    mech = make_four_bar()
+    poses = mech.sweep(5).poses_at(2)  # crank at 240 deg
+    msp = read(kinematic_dxf(mech, poses))
+    th = math.radians(240.0)
+    a = np.array([15 * math.cos(th), 15 * math.sin(th)])
+    b = np.array(transform(poses["rocker"], (30.0, 0.0)))
+    world = {"O": np.zeros(2), "D": np.array([40.0, 0.0]), "A": a, "B": b}
+    assert math.hypot(*(b - a)) == pytest.approx(40.0, abs=1e-9)
+    lines = set()
+    for e in msp.query('LINE[layer=="LINKS"]'):
+        ends = ((e.dxf.start.x, e.dxf.start.y), (e.dxf.end.x, e.dxf.end.y))
+        lines.add(tuple(sorted(k for end in ends for k, p in world.items() if np.allclose(p, end, atol=1e-9))))
+    assert lines == {("D", "O"), ("A", "O"), ("A", "B"), ("B", "D")}
+    aligned = sorted(round(d.get_measurement(), 6) for d in msp.query("DIMENSION")
+                     if d.dimtype in (0, 1))  # linear (ezdxf writes the aligned ones rotated)
+    assert aligned == [15.0, 30.0, 40.0, 40.0]
+    joints = msp.query('CIRCLE[layer=="JOINTS"]')
+    assert len(joints) == 4
+    for name, p in world.items():
+        assert any(np.allclose((c.dxf.center.x, c.dxf.center.y), p, atol=1e-9) for c in joints), name
+    labels = [t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]')]
+    assert f"A ({a[0]:.3f}, {a[1]:.3f})" in labels and "D (40.000, 0.000)" in labels
+    ordinates = [d for d in msp.query("DIMENSION") if d.dimtype == 6]
+    assert len(ordinates) == 8
+    # an ordinate measurement is the feature point relative to the origin: its x for an x-ordinate
+    measured = sorted(round(abs(d.get_measurement().x if d.dxf.dimtype & 64 else d.get_measurement().y), 6)
+                      for d in ordinates)
+    expected = sorted(round(abs(v), 6) for p in world.values() for v in p)
+    assert measured == pytest.approx(expected, abs=1e-6)
+
+
+def transform(pose, local):
+    x, y, th = pose
+    return (x + math.cos(th) * local[0] - math.sin(th) * local[1], y + math.sin(th) * local[0] + math.cos(th) * local[1])
+
+
+def test_read_dxf_reports_unreadable_input_and_cut_diameters():
+    from fabricate.export.dxf import audit_problems, read_dxf
+
+    part = slotted_link()
+    problems, diameters = read_dxf(part_dxf(part, KERF))
+    assert problems == [] and audit_problems(part_dxf(part, KERF)) == []
+    assert diameters == pytest.approx([HOLE - KERF, HOLE - KERF], abs=1e-9)
+    assert read_dxf(b"\xff\xfe not text")[0][0].startswith("not UTF-8")
+    assert read_dxf(b"0\nSECTION\n2\nNONSENSE\n")[0]  # something is reported
