@@ -237,8 +237,10 @@ def test_kinematic_drawing_of_a_bent_four_bar():
 
 
 def transform(pose, local):
+    """A body point in the world: rotate by theta, then translate (written out here)."""
     x, y, th = pose
-    return (x + math.cos(th) * local[0] - math.sin(th) * local[1], y + math.sin(th) * local[0] + math.cos(th) * local[1])
+    c, s = math.cos(th), math.sin(th)
+    return (x + c * local[0] - s * local[1], y + s * local[0] + c * local[1])
 
 
 def test_read_dxf_reports_unreadable_input_and_cut_diameters():
