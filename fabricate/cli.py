@@ -70,6 +70,8 @@ def _summary(report: dict, out: Path | None, failures: list[str] | None = None) 
     print(f"{report['design']['name']}: checks {'passed' if not failures else 'FAILED'}{where}")
     for failure in failures:
         print(f"  - {failure}")
+    for note in report.get("notes", []):
+        print(f"  note: {note}")
 
 
 def _build(args: argparse.Namespace) -> int:

@@ -106,7 +106,7 @@ def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     """Synthesis only: report.json with design, mechanism and synthesis, plus the method's plots."""
     result, report, motion, failures = _synthesis_stage(design, progress, "synth")
     progress("plots")
-    files = {f"plots/{name}": data for name, data in sorted(result.figures().items())}
+    files = synthesis_plots(result)
     report["checks"] = {"passed": not failures, "failures": failures}
     return _finish(design, report, files, exit_code=1 if failures else 0, synthesis=result, motion=motion)
 
@@ -156,7 +156,8 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
                   progress: Progress, stage: list[str]) -> BuildOutcome:
     """Gears, parts, exports, checks and pictures; ``stage[0]`` names the stage running (for failures)."""
     from fabricate.checks import run_checks
-    from fabricate.export import export_all, export_previews
+    from fabricate.export import STEP_SKIPPED, export_all, export_previews, export_step
+    from fabricate.export.step import step_available
     from fabricate.gears import build_gear_pairs
     from fabricate.parts.build import build_parts
 
@@ -172,11 +173,13 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
     enter("parts")
     partset = build_parts(design, mechanism, motion, gear_pairs, result.parts)
     # pictures take as long as everything else: draw them in a forked child on the second core
-    pictures = Background([result.figures, lambda: gear_pictures(gear_pairs),
-                           lambda: export_previews(design, partset, motion)])
+    pictures = Background([lambda: synthesis_plots(result), lambda: gear_pictures(gear_pairs),
+                           lambda: export_previews(design, partset, motion),
+                           lambda: export_step(design, partset, motion)])
+    report["notes"] = [] if step_available() else [STEP_SKIPPED]
     try:
         enter("exports")
-        exported, parts_report = export_all(design, partset, mechanism, motion, previews=False)
+        exported, parts_report = export_all(design, partset, mechanism, motion, previews=False, step=False)
         files.update(exported)
         report["parts"] = parts_report
         report["bom"] = list(getattr(partset, "bom", []))
@@ -195,6 +198,11 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
         pictures.cancel()
     return _finish(design, report, files, exit_code=0 if not failures else 1, synthesis=result, motion=motion,
                    partset=partset, gear_pairs=gear_pairs, checks=checks)
+
+
+def synthesis_plots(result: SynthesisResult) -> dict[str, bytes]:
+    """The synthesis method's figures, under ``plots/`` (the same paths for ``synth`` and ``build``)."""
+    return {f"plots/{name}": data for name, data in sorted(result.figures().items())}
 
 
 def gear_pictures(gear_pairs: list[Any]) -> dict[str, bytes]:

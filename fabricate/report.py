@@ -67,6 +67,8 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
         out.append(f"- {failure}")
     if checks.get("failures"):
         out.append("")
+    for note in report.get("notes", []):
+        out += [f"Note: {note}", ""]
     mech = report.get("mechanism", {})
     if mech.get("joints"):
         out += ["## Mechanism (first pose)", ""]

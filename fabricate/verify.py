@@ -74,22 +74,48 @@ def _manifest(report: Mapping[str, Any]) -> tuple[dict[str, dict[str, Any]], lis
 
 
 def _expected_by_file(report: Mapping[str, Any]) -> dict[str, Any]:
-    """What the report says each geometry file holds: volumes, holes, object names."""
+    """What the report says each geometry file holds: volumes, hole diameters, object names and volumes.
+
+    Drawings hold the finished holes, cut files the kerf-compensated ones; a plate or sheet holds every
+    copy of every part the report places on it.
+    """
     parts = [p for p in report.get("parts", []) if isinstance(p, dict)]
     expected: dict[str, Any] = {}
-    volumes = []
+    plates: dict[int, list[tuple[str, float]]] = {}
+    sheets: dict[int, list[float]] = {}
     for part in parts:
         volume = part.get("stl_volume_mm3")
+        holes = [h for h in part.get("holes", []) if isinstance(h, dict)]
+        finished = sorted(float(h.get("diameter_mm", 0.0)) for h in holes)
+        cut = sorted(float(h.get("cut_diameter_mm", h.get("diameter_mm", 0.0))) for h in holes)
         if isinstance(part.get("stl"), str) and isinstance(volume, (int, float)):
             expected[part["stl"]] = float(volume)
-            volumes.append(float(volume))
         if isinstance(part.get("dxf"), str):
-            expected[part["dxf"]] = sorted(float(h.get("cut_diameter_mm", h.get("diameter_mm", 0.0)))
-                                           for h in part.get("holes", []))
+            expected[part["dxf"]] = finished
+        if isinstance(part.get("cut_dxf"), str):
+            expected[part["cut_dxf"]] = cut
+        copies = int(part.get("copies", 1) or 1)
+        for key, target in (("plate", plates), ("sheet", sheets)):
+            indices = part.get(key, {}).get("index", []) if isinstance(part.get(key), dict) else []
+            for k, number in enumerate(indices if isinstance(indices, list) else []):
+                name = part["name"] if copies == 1 else f"{part['name']} ({k + 1} of {copies})"
+                if key == "plate":
+                    target.setdefault(number, []).append((name, float(volume or 0.0)))
+                else:
+                    target.setdefault(number, []).extend(cut)
+    for number, items in plates.items():
+        expected[f"plates/plate_{number}.stl"] = sum(v for _, v in items)
+        expected[f"plates/plate_{number}.3mf"] = dict(items)
+    for number, diameters in sheets.items():
+        expected[f"cut/sheet_{number}.dxf"] = sorted(diameters)
     if parts:
-        expected["print_plate.stl"] = sum(volumes)
         expected["assembly.3mf"] = {p.get("name"): p.get("stl_volume_mm3") for p in parts}
-        expected["sheet.dxf"] = sorted(d for p in parts for d in expected.get(p.get("dxf"), []))
+        # a STEP solid is exact: the profile's area times the thickness, one cylinder per hole
+        solids = {p.get("name"): (float(p.get("volume_mm3") or 0.0), len(p.get("holes", []))) for p in parts}
+        for part in parts:
+            if isinstance(part.get("step"), str):
+                expected[part["step"]] = {part.get("name"): solids[part.get("name")]}
+        expected["assembly.step"] = solids
     return expected
 
 
@@ -121,6 +147,20 @@ def content_problems(rel: str, data: bytes, expected: Any) -> list[str]:
                 image.load()
         except Exception as exc:  # noqa: BLE001 - Pillow raises many types for a broken image
             return [f"not a readable image ({type(exc).__name__}: {exc})"]
+        return []
+    if suffix == ".step":
+        from fabricate.export.step import step_available, step_problems
+
+        return step_problems(data, expected) if step_available() else []
+    if suffix == ".svg":
+        import xml.etree.ElementTree as ET
+
+        try:
+            root = ET.fromstring(data)
+        except ET.ParseError as exc:
+            return [f"not readable SVG ({exc})"]
+        if not root.tag.endswith("svg") or not str(root.get("width", "")).endswith("mm"):
+            return ["not an SVG sized in millimetres"]
         return []
     if suffix in (".csv", ".md", ".json", ".txt", ".toml"):
         try:
@@ -206,7 +246,16 @@ def rebuild_problems(directory: Path, report: Mapping[str, Any],
     outcome = runner(design, progress)
     on_disk = {str(m.get("path")) for m in report.get("manifest", []) if isinstance(m, dict)} | {REPORT}
     problems = []
-    for rel in sorted(set(outcome.files) | on_disk):
+    skipped: set[str] = set()
+    from fabricate.export.step import step_available
+
+    if not step_available() and any(rel.endswith(".step") for rel in on_disk):
+        # without OCP a rebuild makes no STEP files and its report says so: compare everything else
+        skipped = {rel for rel in on_disk if rel.endswith(".step")} | {REPORT}
+        outcome.report.setdefault("notes", []).append(
+            f"{len(skipped) - 1} STEP files and report.json not compared with a rebuild: OCP is not installed "
+            "(pip install 'fabricate[cad]'); their hashes were checked")
+    for rel in sorted((set(outcome.files) | on_disk) - skipped):
         path = directory / rel
         if rel not in outcome.files:
             problems.append(f"{rel}: a rebuild of the embedded template does not write it")

@@ -43,6 +43,11 @@ def test_admesh_reads_every_part_whole_without_repair(template, tmp_path):
             assert stats[key] == 0, (part["name"], key, stats[key])
         # admesh sums float32 facets: 1e-5 relative of the mesh volume the report gives
         assert stats["Volume"] == pytest.approx(part["stl_volume_mm3"], rel=1e-5)
-    plate = _admesh(tmp_path / "out" / "print_plate.stl")
-    assert plate["Number of parts"] == len(parts)
-    assert plate["Volume"] == pytest.approx(sum(p["stl_volume_mm3"] for p in parts), rel=1e-5)
+    # every plate: one admesh part per copy on it, together every copy of every part, nothing repaired
+    copies = parts[0]["copies"]
+    plates = sorted((tmp_path / "out" / "plates").glob("plate_*.stl"))
+    stats = [_admesh(plate) for plate in plates]
+    assert sum(s["Number of parts"] for s in stats) == copies * len(parts)
+    assert all(s["Edges fixed"] == 0 and s["Facets added"] == 0 for s in stats)
+    assert sum(s["Volume"] for s in stats) == pytest.approx(copies * sum(p["stl_volume_mm3"] for p in parts),
+                                                             rel=1e-5)

@@ -34,8 +34,9 @@ from fabricate.export.stl import (
     SolidCache,
     assembly_3mf,
     part_stl,
+    placed_flat_mesh,
     plate_layout,
-    print_plate_stl,
+    plate_stl,
     validate_stl,
 )
 from fabricate.parts.build import build_parts
@@ -172,22 +173,43 @@ def test_stl_round_trip(name):
 
 
 @pytest.mark.parametrize("name", CASES)
-def test_print_plate(name):
+def test_plates_hold_every_copy_inside_the_build_area(name):
     c = case(name)
-    data = c.files["print_plate.stl"]
-    assert validate_stl(data) == []
-    mesh = trimesh.load(io.BytesIO(data), file_type="stl")
-    total = sum(p.volume_mm3() for p in c.partset.parts)
-    bound = sum(c.partset.chord_tolerance_mm * perimeter_mm(p) * p.thickness_mm for p in c.partset.parts)
-    assert abs(mesh.volume - total) <= bound + 1e-5 * total
-    assert len(mesh.split(only_watertight=True)) == len(c.partset.parts)
+    plates = sorted(k for k in c.files if k.startswith("plates/") and k.endswith(".stl"))
+    if c.process.name == "laser":  # a laser build cuts sheets instead
+        assert not any(k.startswith("plates/") for k in c.files)
+        return
+    parts = list(c.partset.parts)
+    copies = c.partset.copies
     width, depth = c.process.build_volume_mm[:2]
-    if all(e["plate"]["fits"] and e["plate"]["index"] == 0 for e in c.entries):
-        assert mesh.bounds[0][0] >= -1e-6 and mesh.bounds[0][1] >= -1e-6
-        assert mesh.bounds[1][0] <= width + 1e-6 and mesh.bounds[1][1] <= depth + 1e-6
-    # no two parts overlap on the plate
-    footprints = [shapely.MultiPoint(b.vertices[:, :2]).convex_hull for b in mesh.split(only_watertight=True)]
-    assert sum(f.area for f in footprints) == pytest.approx(shapely.union_all(footprints).area, rel=1e-9)
+    margin = c.design.parts.plate_spacing_mm
+    all_fit = all(e["plate"]["fits"] for e in c.entries)
+    shells, volume = 0, 0.0
+    for rel in plates:
+        data = c.files[rel]
+        assert validate_stl(data) == []
+        mesh = trimesh.load(io.BytesIO(data), file_type="stl")
+        bodies = mesh.split(only_watertight=True)
+        shells += len(bodies)
+        volume += mesh.volume
+        assert mesh.bounds[0][2] == pytest.approx(0.0, abs=1e-6)  # laid flat
+        if all_fit:
+            assert mesh.bounds[0][0] >= margin - 1e-6 and mesh.bounds[0][1] >= margin - 1e-6
+            assert mesh.bounds[1][0] <= width - margin + 1e-6 and mesh.bounds[1][1] <= depth - margin + 1e-6
+        # no two parts overlap on the plate
+        footprints = [shapely.MultiPoint(b.vertices[:, :2]).convex_hull for b in bodies]
+        assert sum(f.area for f in footprints) == pytest.approx(shapely.union_all(footprints).area, rel=1e-9)
+        # its 3MF twin: unit millimetre, one named object per part on the plate
+        with zipfile.ZipFile(io.BytesIO(c.files[rel[:-4] + ".3mf"])) as archive:
+            root = ET.fromstring(archive.read("3D/3dmodel.model"))
+        ns = {"m": "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"}
+        assert root.get("unit") == "millimeter"
+        names = [o.get("name") for o in root.findall(".//m:object", ns)]
+        assert len(names) == len(bodies) == len(set(names))
+    assert shells == copies * len(parts)  # every copy of every part is printed
+    total = copies * sum(p.volume_mm3() for p in parts)
+    bound = copies * sum(c.partset.chord_tolerance_mm * perimeter_mm(p) * p.thickness_mm for p in parts)
+    assert abs(volume - total) <= bound + 1e-5 * total
 
 
 @pytest.mark.parametrize("name", CASES)
@@ -260,7 +282,7 @@ def test_part_dxf_round_trip(name):
     c = case(name)
     kerf = c.process.kerf_mm
     for part in c.partset.parts:
-        data = c.files[f"parts/{part.name}.dxf"]
+        data = c.files[f"cut/{part.name}.dxf" if c.process.name == "laser" else f"drawings/{part.name}.dxf"]
         doc = read_dxf(data)
         assert doc.layers.get("CUT").color == 1
         assert audit_problems(data) == []
@@ -293,7 +315,7 @@ def test_binary_link_dxf_is_exact_rounded_slot():
     """Closed form: a 15 mm crank cut on the laser is a stadium of radius boss + kerf / 2."""
     c = case("four_bar-laser")
     crank = c.partset.part("crank")
-    doc = read_dxf(c.files["parts/crank.dxf"])
+    doc = read_dxf(c.files["cut/crank.dxf"])
     (outline,) = doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')
     r = 0.5 * (3.0 + 0.2) + 3.0 + 0.1  # hole/2 + web (= sheet thickness) + kerf/2
     bulges = sorted(b for *_, b in outline.get_points("xyb"))
@@ -305,29 +327,56 @@ def test_binary_link_dxf_is_exact_rounded_slot():
 
 
 @pytest.mark.parametrize("name", CASES)
-def test_sheet_dxf_nests_without_overlap(name):
+def test_cut_sheets_nest_every_copy_without_overlap(name):
     c = case(name)
-    data = c.files["sheet.dxf"]
-    assert audit_problems(data) == []
-    msp = read_dxf(data).modelspace()
-    contours = contour_polygons(msp, flatten_mm=1e-3)
-    # outer contours are those not inside another one
-    outers = [p for p in contours if not any(q is not p and q.contains(p) for q in contours)]
-    assert len(outers) == len(c.partset.parts)
-    for i, a in enumerate(outers):
-        for b in outers[i + 1:]:
-            assert not a.intersects(b)
-    sheets = [shapely.Polygon(np.array(e.get_points("xy"))) for e in msp.query('LWPOLYLINE[layer=="SHEET"]')]
-    for outer in outers:
-        assert any(s.contains(outer) for s in sheets)
-    assert len(msp.query('TEXT[layer=="ENGRAVE"]')) == len(c.partset.parts)
-    assert sorted(t.dxf.text for t in msp.query("TEXT")) == sorted(p.name for p in c.partset.parts)
+    sheets = sorted(k for k in c.files if k.startswith("cut/sheet_") and k.endswith(".dxf"))
+    if c.process.name != "laser":  # nothing is cut for a printed build
+        assert not any(k.startswith("cut/") for k in c.files)
+        return
+    parts = list(c.partset.parts)
+    outers_total, names = 0, []
+    for rel in sheets:
+        data = c.files[rel]
+        assert audit_problems(data) == []
+        assert c.files[rel[:-4] + ".svg"].startswith(b"<?xml")
+        msp = read_dxf(data).modelspace()
+        contours = contour_polygons(msp, flatten_mm=1e-3)
+        # outer contours are those not inside another one
+        outers = [p for p in contours if not any(q is not p and q.contains(p) for q in contours)]
+        outers_total += len(outers)
+        for i, a in enumerate(outers):
+            for b in outers[i + 1:]:
+                assert not a.intersects(b)
+        (border,) = [shapely.Polygon(np.array(e.get_points("xy")))
+                     for e in msp.query('LWPOLYLINE[layer=="SHEET"]')]
+        assert border.bounds == (0.0, 0.0, *c.process.build_volume_mm[:2])  # the process's sheet size
+        for outer in outers:
+            assert border.contains(outer)
+        names += [t.dxf.text for t in msp.query('TEXT[layer=="ENGRAVE"]')]
+    assert outers_total == c.partset.copies * len(parts)  # every copy of every part is cut
+    assert sorted(names) == sorted(p.name for p in parts for _ in range(c.partset.copies))
+
+
+@pytest.mark.parametrize("name", [n for n in CASES if n.endswith("-laser")])
+def test_drawings_are_at_the_finished_size(name):
+    """drawings/ is for CAD: the part as it is once cut (no kerf), unlike cut/."""
+    c = case(name)
+    kerf = c.process.kerf_mm
+    assert kerf > 0
+    for part in c.partset.parts:
+        msp = read_dxf(c.files[f"drawings/{part.name}.dxf"]).modelspace()
+        circles = msp.query('CIRCLE[layer=="CUT"]')
+        for circle, hole in zip(circles, part.holes, strict=True):
+            assert 2 * circle.dxf.radius == pytest.approx(expected_cut_diameter(hole, c) + kerf, abs=1e-6)
+        outline = msp.query('LWPOLYLINE[layer=="CUT"]')[0]
+        expected, slack = offset_area(part.outline.vertices, part.outline.bulges, 0.0)
+        assert abs(lwpolyline_area(outline) - expected) <= slack
 
 
 @pytest.mark.parametrize("name", CASES)
 def test_kinematic_dxf(name):
     c = case(name)
-    data = c.files["kinematic.dxf"]
+    data = c.files["drawings/kinematic.dxf"]
     assert audit_problems(data) == []
     msp = read_dxf(data).modelspace()
     first = c.motion.poses_at(0)
@@ -391,14 +440,22 @@ def test_encoders_are_pure_functions_of_their_input():
     c = case("geared_four_bar-laser")
     parts = list(c.partset.parts)
     cache = SolidCache(c.partset.chord_tolerance_mm)
+    kerf = c.process.kerf_mm
     assert part_stl(parts[0], cache) == c.files[f"parts/{parts[0].name}.stl"]
-    assert part_dxf(parts[0], c.process.kerf_mm) == c.files[f"parts/{parts[0].name}.dxf"]
-    layout = sheet_layout(parts, c.process.kerf_mm, c.process.build_volume_mm[:2], 5.0, 3.0)
-    assert sheet_dxf(parts, c.process.kerf_mm, layout, c.process.build_volume_mm[:2]) == c.files["sheet.dxf"]
-    plate = plate_layout(parts, cache, c.process.build_volume_mm[:2], 4.0)
-    assert print_plate_stl(parts, cache, plate, c.process.build_volume_mm[:2]) == c.files["print_plate.stl"]
+    assert part_dxf(parts[0], kerf) == c.files[f"cut/{parts[0].name}.dxf"]
+    assert part_dxf(parts[0], 0.0) == c.files[f"drawings/{parts[0].name}.dxf"]
+    area = c.process.build_volume_mm[:2]
+    layout = sheet_layout(parts, kerf, area, c.design.parts.sheet_margin_mm, c.design.parts.sheet_spacing_mm)
+    assert sheet_dxf(parts, kerf, layout, area, 0) == c.files["cut/sheet_1.dxf"]
     assert assembly_3mf(parts, cache, c.motion.poses_at(0), c.design.name) == c.files["assembly.3mf"]
-    assert kinematic_dxf(c.mechanism, c.motion.poses_at(0)) == c.files["kinematic.dxf"]
+    assert kinematic_dxf(c.mechanism, c.motion.poses_at(0)) == c.files["drawings/kinematic.dxf"]
+    sla = case("geared_four_bar-sla")
+    sla_parts = [p for p in sla.partset.parts for _ in range(sla.partset.copies)]
+    cache = SolidCache(sla.partset.chord_tolerance_mm)
+    plate = plate_layout(sla_parts, cache, sla.process.build_volume_mm[:2], sla.design.parts.plate_spacing_mm)
+    assert {pl.sheet for pl in plate} == {0}
+    meshes = [placed_flat_mesh(p, cache, pl) for p, pl in zip(sla_parts, plate, strict=True)]
+    assert plate_stl(meshes) == sla.files["plates/plate_1.stl"]
 
 
 def test_validate_stl_finds_problems():
@@ -434,7 +491,7 @@ def test_openscad_imports_every_dxf(name, tmp_path):
         target = tmp_path / f"f{k}.dxf"
         target.write_bytes(data)
         names[target.name] = rel
-        layer = "JOINTS" if rel == "kinematic.dxf" else "CUT"
+        layer = "JOINTS" if rel.endswith("kinematic.dxf") else "CUT"
         imports.append(f'translate([{1000 * k}, 0]) import("{target}", layer="{layer}");')
     # one OpenSCAD run per case (its start-up dominates); messages name the file they concern
     scad = tmp_path / "all.scad"
@@ -448,7 +505,7 @@ def test_openscad_imports_every_dxf(name, tmp_path):
             continue
         rel = next((names[n] for n in names if n in line), "?")
         # OpenSCAD cannot draw dimensions and texts: it says so and skips them (kinematic drawing only)
-        assert rel == "kinematic.dxf" and "Unsupported DXF Entity" in line, line
+        assert rel.endswith("kinematic.dxf") and "Unsupported DXF Entity" in line, line
     # every file produced geometry: something in each 1000 mm slot along x
     xs = [v[0] for e in ezdxf.readfile(out).modelspace() if e.dxftype() in ("LWPOLYLINE", "POLYLINE", "LINE")
           for v in (e.get_points("xy") if e.dxftype() == "LWPOLYLINE" else
@@ -487,6 +544,18 @@ def test_prusaslicer_reports_manifold_without_repair(name, tmp_path):
     assert run.returncode == 0, run.stderr
     assert run.stdout.count("[assembly.3mf]") == len(c.partset.parts)
     assert run.stdout.count("manifold = yes") == len(c.partset.parts)
+    # every plate's 3MF: one manifold object per copy of a part on it, together every copy of every part
+    plates = sorted(k for k in c.files if k.startswith("plates/") and k.endswith(".3mf"))
+    targets = []
+    for k, rel in enumerate(plates):
+        targets.append(tmp_path / f"plate{k}.3mf")
+        targets[-1].write_bytes(c.files[rel])
+    if targets:
+        run = subprocess.run(["prusa-slicer", "--info", *map(str, targets)], capture_output=True, text=True,
+                             timeout=300)
+        assert run.returncode == 0, run.stderr
+        objects = sum(run.stdout.count(f"[{t.name}]") for t in targets)
+        assert objects == run.stdout.count("manifold = yes") == c.partset.copies * len(c.partset.parts)
 
 
 ENCODE_IN_CHILD = """

@@ -94,7 +94,7 @@ def test_parts_of_a_gear_pair_get_distinct_colours():
 
 
 def test_kinematic_drawing_text_is_at_least_2_5_mm_in_its_dimension_style(five_bar):
-    doc = ezdxf.read(io.StringIO(five_bar.files["kinematic.dxf"].decode()))
+    doc = ezdxf.read(io.StringIO(five_bar.files["drawings/kinematic.dxf"].decode()))
     style = doc.dimstyles.get(DIMSTYLE)
     assert style.dxf.dimtxt >= MIN_DRAWING_TEXT_MM
     dims = list(doc.modelspace().query("DIMENSION"))

@@ -31,7 +31,7 @@ def built(tmp_path_factory) -> Path:
     return out
 
 
-_REBUILDS: dict[tuple[str, str], object] = {}
+_REBUILDS: dict[tuple[str, str, bool], object] = {}
 
 
 @pytest.fixture(autouse=True)
@@ -43,7 +43,9 @@ def _one_rebuild_per_template(monkeypatch):
     real = pipeline.run_build
 
     def cached(design, progress=lambda _m: None):
-        key = (Path(design.template).name, design.template_text)
+        from fabricate.export.step import step_available
+
+        key = (Path(design.template).name, design.template_text, step_available())
         if key not in _REBUILDS:
             _REBUILDS[key] = real(design, progress)
         return _REBUILDS[key]
@@ -76,19 +78,19 @@ def test_an_untouched_output_passes(copy, capsys):
 
 
 def _dxf_hole_radius_x3(d: Path) -> str:
-    path = d / "parts" / "carrier.dxf"
+    path = d / "drawings" / "carrier.dxf"
     doc = ezdxf.read(io.StringIO(path.read_text()))
     circle = doc.modelspace().query('CIRCLE[layer=="CUT"]').first
     circle.dxf.radius *= 3.0
     stream = io.StringIO()
     doc.write(stream)
     path.write_text(stream.getvalue())
-    return "parts/carrier.dxf: cut holes"
+    return "drawings/carrier.dxf: cut holes"
 
 
 def _dxf_garbage(d: Path) -> str:
-    (d / "sheet.dxf").write_text("garbage")
-    return "sheet.dxf: not a readable DXF"
+    (d / "drawings" / "kinematic.dxf").write_text("garbage")
+    return "drawings/kinematic.dxf: not a readable DXF"
 
 
 def _stl_scaled(d: Path) -> str:
@@ -101,9 +103,9 @@ def _stl_scaled(d: Path) -> str:
 
 
 def _stl_truncated(d: Path) -> str:
-    path = d / "print_plate.stl"
+    path = d / "plates" / "plate_1.stl"
     path.write_bytes(path.read_bytes()[:-37])
-    return "print_plate.stl: truncated"
+    return "plates/plate_1.stl: truncated"
 
 
 def _3mf_corrupt(d: Path) -> str:
@@ -229,3 +231,67 @@ def test_manifest_sizes_and_hashes_are_those_on_disk(built):
         mesh = trimesh.load(built / part["stl"])
         assert mesh.volume == pytest.approx(part["stl_volume_mm3"], rel=1e-6)
         assert np.isclose(part["stl_volume_mm3"], part["volume_mm3"], rtol=1e-3)
+
+
+@pytest.fixture(scope="module")
+def laser_built(tmp_path_factory) -> Path:
+    """The same pair made on the laser: cut/ files (DXF and SVG, kerf-compensated) instead of plates."""
+    src = tmp_path_factory.mktemp("laser_src") / "pair_laser.toml"
+    text = (TEMPLATE_DIR / f"{FAST}.toml").read_text().replace('profile = "sla"', 'profile = "laser"', 1)
+    assert 'profile = "laser"' in text
+    src.write_text(text)
+    out = tmp_path_factory.mktemp("laser") / "out"
+    outcome = run_build(load_design(src))
+    write_output(outcome.files, out)
+    return out
+
+
+def _laser_copy(laser_built: Path, tmp_path: Path) -> Path:
+    target = tmp_path / "laser"
+    shutil.copytree(laser_built, target)
+    return target
+
+
+def test_a_laser_output_passes_and_its_cut_files_are_verified(laser_built, tmp_path, capsys):
+    copy = _laser_copy(laser_built, tmp_path)
+    assert (copy / "cut" / "sheet_1.svg").is_file() and not (copy / "plates").exists()
+    code, out = _check(copy, capsys)
+    assert "cut/" not in out, out  # whatever the design's own verdict, no cut file is flagged
+    (copy / "cut" / "sheet_1.svg").write_text("<svg")
+    path = copy / "cut" / "gear_a.dxf"
+    doc = ezdxf.read(io.StringIO(path.read_text()))
+    doc.modelspace().query('CIRCLE[layer=="CUT"]').first.dxf.radius += 0.1  # a kerf applied twice
+    stream = io.StringIO()
+    doc.write(stream)
+    path.write_text(stream.getvalue())
+    code, out = _check(copy, capsys)
+    assert code == 1
+    assert "cut/sheet_1.svg: not readable SVG" in out and "cut/gear_a.dxf: cut holes" in out
+
+
+def test_a_tampered_step_solid_is_named(copy, capsys):
+    pytest.importorskip("OCP")
+    path = copy / "parts" / "gear_a.step"
+    text = path.read_text()
+    # move one Cartesian point of the solid: still a STEP file, no longer the reported solid
+    marker = "CARTESIAN_POINT('',("
+    start = text.index(marker, len(text) // 2) + len(marker)
+    end = text.index(",", start)
+    path.write_text(text[:start] + str(float(text[start:end]) + 5.0) + text[end:])
+    code, out = _check(copy, capsys)
+    assert code == 1
+    assert "parts/gear_a.step: contents differ from the manifest" in out
+    assert "parts/gear_a.step: differs from a rebuild" in out
+
+
+def test_without_ocp_a_build_says_step_was_skipped(tmp_path, monkeypatch, capsys):
+    import fabricate.export.step as step
+
+    monkeypatch.setattr(step, "step_available", lambda: False)
+    assert main(["build", FAST, "-o", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert out.count("STEP skipped") == 1 and "fabricate[cad]" in out
+    report = _report(tmp_path / "out")
+    assert not any(f.endswith(".step") for f in report["files"])
+    assert all(p["step"] is None for p in report["parts"])
+    assert "STEP skipped" in (tmp_path / "out" / "report.md").read_text()

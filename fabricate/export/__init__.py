@@ -38,8 +38,8 @@ def _bom_csv(rows: list[dict[str, Any]]) -> bytes:
     return buffer.getvalue().encode("utf-8")
 
 
-def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews: bool = True
-               ) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
+def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews: bool = True,
+               step: bool = True) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
     """Every export of a part set.
 
     Parameters
@@ -53,6 +53,9 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
         The sweep; its first pose is the assembly pose.
     previews : bool
         Include the preview pictures (the pipeline draws them separately, see :func:`export_previews`).
+    step : bool
+        Include the STEP files when OCP is installed (the pipeline makes them separately, see
+        :func:`export_step`); the report names their paths either way.
 
     Returns
     -------
@@ -71,40 +74,63 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
         When a written STL does not read back as a closed solid (a bug, never a design finding).
     """
     from fabricate.export.dxf import kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
+    from fabricate.export.step import step_available
     from fabricate.export.stl import (
         SolidCache,
         assembly_3mf,
         mesh_volume,
+        model_3mf,
         part_stl,
+        placed_flat_mesh,
         plate_layout,
-        print_plate_stl,
+        plate_stl,
         validate_stl,
     )
-    from fabricate.export.step import step_available, step_files
+    from fabricate.export.svg import part_svg, sheet_svg
 
     process = design.process
     spec = design.parts
     parts = list(partset.parts)
+    copies = max(1, int(getattr(partset, "copies", 1) or 1))
+    laser = is_laser(process)
     kerf = process.kerf_mm
+    min_text = float(getattr(process, "min_text_mm", 0.0))
     cache = SolidCache(partset.chord_tolerance_mm)
     files: dict[str, bytes] = {}
     entries: list[dict[str, Any]] = []
-    plate_area = (float(process.build_volume_mm[0]), float(process.build_volume_mm[1]))
-    plate = plate_layout(parts, cache, plate_area, spec.plate_spacing_mm)
-    sheet = sheet_layout(parts, kerf, plate_area, spec.sheet_margin_mm, spec.sheet_spacing_mm)
+    area = (float(process.build_volume_mm[0]), float(process.build_volume_mm[1]))
+    # every copy of every part is made: a three-finger gripper prints or cuts three finger sets
+    made = [part for part in parts for _ in range(copies)]
+    if laser:
+        margin = spec.sheet_margin_mm
+        placements = sheet_layout(made, kerf, area, margin, spec.sheet_spacing_mm)
+    else:
+        margin = spec.plate_spacing_mm
+        placements = plate_layout(made, cache, area, margin)
+    where: dict[str, list[Any]] = {}
+    for part, placement in zip(made, placements, strict=True):
+        where.setdefault(part.name, []).append(placement)
     with_step = step_available()  # optional extra `cad` (OCP); without it no STEP files, "step": None
-    for part, on_plate, on_sheet in zip(parts, plate, sheet, strict=True):
-        stl_path, dxf_path = f"parts/{part.name}.stl", f"parts/{part.name}.dxf"
+    for part in parts:
+        stl_path, dxf_path = f"parts/{part.name}.stl", f"drawings/{part.name}.dxf"
         stl = part_stl(part, cache)
         problems = validate_stl(stl)
         vertices, faces = cache.flat_mesh(part)
         if problems:
             raise GeometryError(f"part {part.name}: STL {', '.join(problems)}")
         files[stl_path] = stl
-        files[dxf_path] = part_dxf(part, kerf)
+        files[dxf_path] = part_dxf(part, 0.0)  # finished size, for CAD
+        cut_dxf = cut_svg = None
+        if laser:
+            cut_dxf, cut_svg = f"cut/{part.name}.dxf", f"cut/{part.name}.svg"
+            files[cut_dxf] = part_dxf(part, kerf)
+            files[cut_svg] = part_svg(part, kerf, min_text_mm=min_text)
+        placed = where[part.name]
         entries.append({
             "name": part.name, "process": part.process, "stl": stl_path, "dxf": dxf_path,
+            "cut_dxf": cut_dxf, "cut_svg": cut_svg,
             "step": f"parts/{part.name}.step" if with_step else None,
+            "copies": copies,
             "volume_mm3": round(part.volume_mm3(), 4), "stl_volume_mm3": round(mesh_volume(vertices, faces), 4),
             "layer": part.layer,
             "holes": [{"joint": h.joint, "diameter_mm": round(h.diameter_mm, 6),
@@ -112,21 +138,55 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
             "role": part.role, "body": part.body, "thickness_mm": part.thickness_mm,
             "z_mm": round(part.z_mm, 6), "area_mm2": round(part.area_mm2(), 4), "gear": part.gear,
             "slots": len(getattr(part, "slots", ())), "stl_problems": problems,
-            "plate": {"index": on_plate.sheet, "fits": fits(on_plate, plate_area, spec.plate_spacing_mm)},
-            "sheet": {"index": on_sheet.sheet, "fits": fits(on_sheet, plate_area, spec.sheet_margin_mm)},
+            ("sheet" if laser else "plate"): {"index": [pl.sheet + 1 for pl in placed],
+                                              "fits": all(fits(pl, area, margin) for pl in placed)},
             "warnings": [w for w in getattr(partset, "warnings", ()) if w.startswith(f"part {part.name}:")],
         })
-    files["print_plate.stl"] = print_plate_stl(parts, cache, plate, plate_area)
+    for number in sorted({pl.sheet for pl in placements}):
+        on_it = [(part, pl, k) for k, (part, pl) in enumerate(zip(made, placements, strict=True))
+                 if pl.sheet == number]
+        if laser:
+            sheet_parts, sheet_places = [part for part, _, _ in on_it], [pl for _, pl, _ in on_it]
+            files[f"cut/sheet_{number + 1}.dxf"] = sheet_dxf(sheet_parts, kerf, sheet_places, area, number)
+            files[f"cut/sheet_{number + 1}.svg"] = sheet_svg(sheet_parts, kerf, sheet_places, area, number,
+                                                             title=f"{design.name} sheet", min_text_mm=min_text)
+        else:
+            meshes = [placed_flat_mesh(part, cache, pl) for part, pl, _ in on_it]
+            names = [_copy_name(part.name, k % copies, copies) for part, _, k in on_it]
+            files[f"plates/plate_{number + 1}.stl"] = plate_stl(meshes)
+            files[f"plates/plate_{number + 1}.3mf"] = model_3mf(
+                [(name, *mesh) for name, mesh in zip(names, meshes, strict=True)], f"{design.name} plate {number + 1}")
     first = motion.poses_at(0)
     files["assembly.3mf"] = assembly_3mf(parts, cache, first, title=design.name)
-    if with_step:
-        files.update(step_files(parts, first, partset.chord_tolerance_mm, title=design.name))
-    files["sheet.dxf"] = sheet_dxf(parts, kerf, sheet, plate_area)
-    files["kinematic.dxf"] = kinematic_dxf(mechanism, first)
+    if with_step and step:
+        files.update(export_step(design, partset, motion))
+    files["drawings/kinematic.dxf"] = kinematic_dxf(mechanism, first)
     if previews:
         files.update(export_previews(design, partset, motion))
     files["bom.csv"] = _bom_csv(list(partset.bom))
     return files, entries
+
+
+def is_laser(process: Any) -> bool:
+    """Whether a process cuts sheets (kerf-compensated cut files, nested sheets) rather than prints."""
+    return process.name == "laser"
+
+
+def _copy_name(name: str, index: int, copies: int) -> str:
+    return name if copies == 1 else f"{name} ({index + 1} of {copies})"
+
+
+def export_step(design: Any, partset: Any, motion: Any) -> dict[str, bytes]:
+    """``parts/NAME.step`` and ``assembly.step`` (B-rep solids, first pose); empty without OCP."""
+    from fabricate.export.step import step_available, step_files
+
+    if not step_available():
+        return {}
+    return step_files(list(partset.parts), motion.poses_at(0), partset.chord_tolerance_mm, title=design.name)
+
+
+#: What a build says when the optional ``cad`` extra is missing.
+STEP_SKIPPED = "STEP skipped: OCP is not installed (pip install 'fabricate[cad]' for parts/*.step and assembly.step)"
 
 
 def export_previews(design: Any, partset: Any, motion: Any) -> dict[str, bytes]:

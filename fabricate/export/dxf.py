@@ -156,20 +156,15 @@ def sheet_layout(parts: Sequence[Part], kerf_mm: float, sheet_mm: tuple[float, f
 
 
 def sheet_dxf(parts: Sequence[Part], kerf_mm: float, placements: Sequence[Placement],
-              sheet_mm: tuple[float, float]) -> bytes:
-    """All parts nested on sheets; every further sheet is drawn to the right of the previous one."""
+              sheet_mm: tuple[float, float], sheet: int = 0) -> bytes:
+    """Sheet number ``sheet``: its border (layer SHEET, not plotted) and the parts placed on it."""
     doc = new_document(("CUT", "ENGRAVE", "SHEET"))
     msp = doc.modelspace()
-    sheets = 1 + max((p.sheet for p in placements), default=0)
-    pitch = sheet_mm[0] + 20.0
-    for k in range(sheets):
-        x0 = k * pitch
-        msp.add_lwpolyline([(x0, 0.0), (x0 + sheet_mm[0], 0.0), (x0 + sheet_mm[0], sheet_mm[1]),
-                            (x0, sheet_mm[1])], format="xy", close=True, dxfattribs={"layer": "SHEET"})
+    msp.add_lwpolyline([(0.0, 0.0), (sheet_mm[0], 0.0), (sheet_mm[0], sheet_mm[1]), (0.0, sheet_mm[1])],
+                       format="xy", close=True, dxfattribs={"layer": "SHEET"})
     for part, placement in zip(parts, placements, strict=True):
-        shifted = Placement(placement.angle, placement.offset + np.array([placement.sheet * pitch, 0.0]),
-                            placement.sheet, placement.size)
-        add_part(msp, part, kerf_mm, shifted)
+        if placement.sheet == sheet:
+            add_part(msp, part, kerf_mm, placement)
     return document_bytes(doc)
 
 

@@ -168,26 +168,29 @@ def read_3mf(data: bytes) -> tuple[dict[str, trimesh.Trimesh], list[str]]:
 
 def plate_layout(parts: Sequence[Part], cache: SolidCache, build_area_mm: tuple[float, float],
                  spacing_mm: float) -> list[Placement]:
-    """Placements of parts on the SLA build plate (x, y of the build volume)."""
-    outlines = [p.outline.polygon(max(cache.tol, 0.05)) for p in parts]
+    """Placements of parts on the SLA build plate (x, y of the build volume).
+
+    Parts are measured by the vertices of the meshes that are printed, so a placement's box is the
+    printed part's box (a coarser outline could leave the mesh a sagitta outside the margin).
+    """
+    outlines = [cache.flat_mesh(p)[0][:, :2] for p in parts]
     return shelf_pack(outlines, build_area_mm, margin_mm=spacing_mm, spacing_mm=spacing_mm)
 
 
-def print_plate_stl(parts: Sequence[Part], cache: SolidCache, placements: Sequence[Placement],
-                    build_area_mm: tuple[float, float]) -> bytes:
-    """One STL with every part lying flat on the plate; further plates continue to the right.
-
-    Each part keeps its own closed shells, so the plate is watertight when each part is.
-    """
+def plate_stl(meshes: Sequence[tuple[np.ndarray, np.ndarray]]) -> bytes:
+    """One STL of several closed meshes (vertices (n, 3) mm, triangles (m, 3)): each keeps its own shell."""
     vertices_all, faces_all, base = [], [], 0
-    for part, place in zip(parts, placements, strict=True):
-        vertices, faces = cache.flat_mesh(part)
-        xy = place.apply(vertices[:, :2])
-        xy[:, 0] += place.sheet * (build_area_mm[0] + 10.0)
-        vertices_all.append(np.column_stack([xy, vertices[:, 2]]))
+    for vertices, faces in meshes:
+        vertices_all.append(vertices)
         faces_all.append(faces + base)
         base += len(vertices)
     return stl_bytes(np.concatenate(vertices_all), np.concatenate(faces_all))
+
+
+def placed_flat_mesh(part: Part, cache: SolidCache, place: Placement) -> tuple[np.ndarray, np.ndarray]:
+    """The part lying flat (z from 0) moved by its plate placement: vertices (n, 3) mm, triangles (m, 3)."""
+    vertices, faces = cache.flat_mesh(part)
+    return np.column_stack([place.apply(vertices[:, :2]), vertices[:, 2]]), faces
 
 
 def assembly_3mf(parts: Sequence[Part], cache: SolidCache, poses: Mapping[str, np.ndarray],
@@ -203,20 +206,29 @@ def assembly_3mf(parts: Sequence[Part], cache: SolidCache, poses: Mapping[str, n
     title : str
         Model title metadata.
     """
-    objects, items = [], []
-    for k, part in enumerate(parts, start=1):
+    objects = []
+    for part in parts:
         solid = posed(cache.solid(part), np.asarray(poses.get(part.body, np.zeros(3)), dtype=np.float64))
-        vertices, faces = mesh_arrays(solid)
+        objects.append((part.name, *mesh_arrays(solid)))
+    return model_3mf(objects, title)
+
+
+def model_3mf(objects: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str) -> bytes:
+    """3MF (core spec, unit millimetre) of named meshes ``(name, vertices (n, 3) mm, triangles (m, 3))``,
+    one object and one build item each, ids in the given order; fixed zip dates, so equal input gives equal
+    bytes."""
+    resources, items = [], []
+    for k, (name, vertices, faces) in enumerate(objects, start=1):
         vert_xml = "".join(f'<vertex x="{x:.6f}" y="{y:.6f}" z="{z:.6f}"/>' for x, y, z in vertices)
         tri_xml = "".join(f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in faces)
-        objects.append(f'<object id="{k}" name="{_xml_escape(part.name)}" type="model"><mesh>'
-                       f"<vertices>{vert_xml}</vertices><triangles>{tri_xml}</triangles></mesh></object>")
+        resources.append(f'<object id="{k}" name="{_xml_escape(name)}" type="model"><mesh>'
+                         f"<vertices>{vert_xml}</vertices><triangles>{tri_xml}</triangles></mesh></object>")
         items.append(f'<item objectid="{k}"/>')
     model = ('<?xml version="1.0" encoding="UTF-8"?>\n'
              '<model unit="millimeter" xml:lang="en-US" '
              'xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02">'
              f'<metadata name="Title">{_xml_escape(title)}</metadata>'
-             f'<resources>{"".join(objects)}</resources><build>{"".join(items)}</build></model>')
+             f'<resources>{"".join(resources)}</resources><build>{"".join(items)}</build></model>')
     content_types = ('<?xml version="1.0" encoding="UTF-8"?>\n'
                      '<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">'
                      '<Default Extension="rels" '

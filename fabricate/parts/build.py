@@ -400,7 +400,9 @@ def _check_pin_webs(parts: Sequence[Part], process: ProcessSpec) -> None:
                 if distance < 1e-9:
                     continue  # one pin through two joint names (merged coincident pins)
                 web = distance - 0.5 * (a.diameter_mm + b.diameter_mm)
-                if web < process.min_wall_mm:
+                # a wall thinner than the process likes is a printability finding (exit 1, named by the
+                # printability check); only holes that meet make the part impossible to build
+                if web <= 0.0:
                     largest = (distance - process.min_wall_mm - 2.0 * process.running_clearance_mm
                                - process.hole_compensation_mm)
                     limit = (f"at most {math.floor(largest * 100) / 100:g} mm" if largest >= process.min_pin_mm
