@@ -7,6 +7,7 @@ the spacing and the margin, and an STL is the part's prism.
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 
@@ -252,3 +253,77 @@ def test_read_dxf_reports_unreadable_input_and_cut_diameters():
     assert diameters == pytest.approx([HOLE - KERF, HOLE - KERF], abs=1e-9)
     assert read_dxf(b"\xff\xfe not text")[0][0].startswith("not UTF-8")
     assert read_dxf(b"0\nSECTION\n2\nNONSENSE\n")[0]  # something is reported
+
+
+def test_cut_files_are_metric_with_fixed_layer_colours():
+    """A cut DXF is in millimetres ($INSUNITS 4, $MEASUREMENT 1 metric, $LUNITS 2 decimal), with the layer
+    colours laser software keys on (CUT red 1, ENGRAVE blue 5) and no dimension styles; a sheet border layer
+    is not plotted; the kinematic drawing carries the dimension styles it uses."""
+    from ezdxf import units
+
+    from fabricate.export.dxf import document_bytes, kinematic_dxf, new_document
+    from tests.conftest import make_four_bar
+
+    doc = ezdxf.read(io.StringIO(part_dxf(slotted_link(), KERF).decode("utf-8")))
+    assert doc.units == units.MM and doc.header["$MEASUREMENT"] == 1 and doc.header["$LUNITS"] == 2
+    assert doc.dxfversion == "AC1024"  # R2010
+    assert doc.layers.get("CUT").color == 1 and doc.layers.get("ENGRAVE").color == 5
+    assert doc.layers.get("CUT").dxf.plot == 1
+    assert "EZDXF" not in {s.dxf.name.upper() for s in doc.dimstyles}
+    sheet = ezdxf.read(io.StringIO(document_bytes(new_document(("CUT", "ENGRAVE", "SHEET"))).decode("utf-8")))
+    assert sheet.layers.get("SHEET").dxf.plot == 0 and sheet.layers.get("SHEET").color == 8
+    mech = make_four_bar()
+    drawing = ezdxf.read(io.StringIO(kinematic_dxf(mech, mech.sweep(3).poses_at(0)).decode("utf-8")))
+    assert "EZDXF" in {s.dxf.name.upper() for s in drawing.dimstyles}
+    assert drawing.units == units.MM
+
+
+def plate_region(part) -> shapely.Geometry:
+    """The plate (outline less holes and slots), from the raw paths and hole records."""
+    plate = raw_polygon(part.outline)
+    for h in part.holes:
+        plate = plate.difference(shapely.Point(h.centre).buffer(h.diameter_mm / 2, quad_segs=64))
+    for s in getattr(part, "slots", ()):
+        plate = plate.difference(raw_polygon(s))
+    return plate
+
+
+def label_of(part):
+    (text,) = read(part_dxf(part, 0.0)).query('TEXT[layer=="ENGRAVE"]')
+    return shapely.Point(text.dxf.align_point.x, text.dxf.align_point.y), text.dxf.height, text.dxf.text
+
+
+@pytest.mark.parametrize("name", ["rod", "a_much_longer_part_name"])
+def test_label_sits_at_the_roomiest_spot_and_fits(name):
+    """The engraved label is centred near the plate's most inward point (within 5 % of the largest inscribed
+    circle found here on a 0.05 mm grid) and its text box (0.9 h per character by h) stays clear of every
+    edge, hole and slot."""
+    part = dataclasses.replace(slotted_link(), name=name)
+    plate = plate_region(part)
+    spot, height, text = label_of(part)
+    assert text == name
+    room = plate.boundary.distance(spot)
+    assert plate.contains(spot)
+    x0, y0, x1, y1 = plate.bounds
+    grid = shapely.points(np.stack(np.meshgrid(np.arange(x0, x1, 0.05), np.arange(y0, y1, 0.05)), -1).reshape(-1, 2))
+    inside = grid[shapely.contains(plate, grid)]
+    best = float(np.max(shapely.distance(plate.boundary, inside)))
+    assert room >= 0.95 * best
+    half_w, half_h = 0.45 * height * len(text), 0.5 * height
+    assert math.hypot(half_w, half_h) <= room + 1e-9
+    assert height >= 0.3 and (height == 5.0 or height >= 0.5 * min(0.8 * room, 1.6 * room / (0.9 * len(text))))
+
+
+def test_label_goes_on_the_larger_piece_or_falls_back():
+    """A slot across the whole plate splits it: the label goes on the larger piece. A plate eaten by its hole
+    gets the outline's vertex centroid and a 1 mm text."""
+    outline = slot_outline(40.0, 8.0)
+    across = BulgePath(np.array([[9.0, -6.0], [11.0, -6.0], [11.0, 6.0], [9.0, 6.0]]), np.zeros(4))
+    split = SlottedPart("split", "split", outline, (), 3.0, 0.0, 0, "laser", slots=(across,))
+    spot, _, _ = label_of(split)
+    assert spot.x > 11.0  # the 29 mm piece, not the 9 mm one
+    eaten = SlottedPart("eaten", "eaten", slot_outline(2.0, 2.0), (Hole("A", np.array([1.0, 0.0]), 10.0, 3.0),),
+                        3.0, 0.0, 0, "laser")
+    spot, height, _ = label_of(eaten)
+    assert (spot.x, spot.y) == pytest.approx(tuple(np.mean(eaten.outline.vertices, axis=0)))
+    assert height == 1.0
