@@ -24,6 +24,7 @@ import argparse
 import io
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -154,11 +155,14 @@ def _tokens(text: str) -> list[tuple[int, str]]:
         return []
 
 
+_STRING = re.compile(r"""[rbfuRBFU]{0,2}("([^"\\\n]|\\.)*"|'([^'\\\n]|\\.)*')""")
+
+
 def is_string_only(old: str, new: str) -> bool:
     """The mutant changes string literals only (or swaps one for None): message / name text."""
     a, b = _tokens(old), _tokens(new)
-    if not a or not b:
-        return False
+    if not a or not b:  # a fragment of a longer statement: compare with the literals blanked out
+        return old != new and _STRING.sub('""', old) == _STRING.sub('""', new)
     if len(a) == len(b):
         diffs = [(x, y) for x, y in zip(a, b, strict=True) if x != y]
         return bool(diffs) and all(x[0] == tokenize.STRING and y[0] == tokenize.STRING for x, y in diffs) \
@@ -253,6 +257,7 @@ def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
         shutil.rmtree(target, ignore_errors=True)
         shutil.copytree(ROOT / "tests", target, ignore=shutil.ignore_patterns("__pycache__", ".hypothesis"))
     (work / "mutants" / "mutmut-stats.json").unlink(missing_ok=True)  # new tests: map them again
+    result = drop_string_only(result)
     names = [r["name"] for r in result["mutants"] if r["status"] in ("survived", "no tests")]
     if names:
         with open(work / "mutmut-rerun.log", "w") as log:
@@ -268,6 +273,14 @@ def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
             if reason:
                 r["status"], r["reason"] = "equivalent", reason
     result["tests"] = tests
+    return result
+
+
+def drop_string_only(result: dict) -> dict:
+    """Move rows the (current) string-only filter excludes out of the run set."""
+    keep = [r for r in result["mutants"] if not is_string_only(r["old"], r["new"])]
+    result["string_only_skipped"] += len(result["mutants"]) - len(keep)
+    result["mutants"] = keep
     return result
 
 
@@ -384,7 +397,8 @@ def main(argv: list[str] | None = None) -> int:
             RESULTS.write_text(json.dumps(results, indent=1) + "\n")
     else:
         table = load_equivalents()
-        for key, res in results.items():  # re-apply the equivalents table
+        for key, res in results.items():  # re-apply the string filter and the equivalents table
+            drop_string_only(res)
             for r in res["mutants"]:
                 if r["status"] in ("survived", "equivalent", "no tests"):
                     reason = equivalent_reason(key, r["function"], r["old"], r["new"], table)
