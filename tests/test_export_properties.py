@@ -327,3 +327,35 @@ def test_label_goes_on_the_larger_piece_or_falls_back():
     spot, height, _ = label_of(eaten)
     assert (spot.x, spot.y) == pytest.approx(tuple(np.mean(eaten.outline.vertices, axis=0)))
     assert height == 1.0
+
+
+def test_sheet_dxf_draws_the_first_sheet_with_its_placed_parts():
+    """Sheet 0 of the cut file: its SHEET border is the sheet's rectangle (not plotted) and every part placed
+    on it is cut where the layout put it: outline area = the stadium grown by kerf / 2 (closed form), centred
+    on the placed centre of the part's outline, its holes placed likewise."""
+    from fabricate.export.dxf import sheet_dxf
+
+    parts = links()
+    sheet = (120.0, 60.0)
+    layout = sheet_layout(parts, KERF, sheet, 5.0, 2.0)
+    doc = ezdxf.read(io.StringIO(sheet_dxf(parts, KERF, layout, sheet).decode("utf-8")))
+    msp = doc.modelspace()
+    borders = [np.array(e.get_points("xy")) for e in msp.query('LWPOLYLINE[layer=="SHEET"]')]
+    assert any(np.allclose(sorted(map(tuple, b)), [(0.0, 0.0), (0.0, 60.0), (120.0, 0.0), (120.0, 60.0)])
+               for b in borders)
+    assert doc.layers.get("SHEET").dxf.plot == 0
+    outlines = [(exact_area(e), contour(e, 1e-3).centroid) for e in msp.query('LWPOLYLINE[layer=="CUT"]')]
+    circles = [(c.dxf.center.x, c.dxf.center.y, 2 * c.dxf.radius) for c in msp.query('CIRCLE[layer=="CUT"]')]
+    on_first = [(p, pl) for p, pl in zip(parts, layout, strict=True) if pl.sheet == 0]
+    assert on_first
+    for part, placement in on_first:
+        length = float(np.hypot(*part.holes[1].centre))
+        width = 2 * float(np.max(np.abs(part.outline.vertices[:, 1])))
+        area = stadium_area(length, width + KERF)
+        centre = placement.apply(np.array([[length / 2, 0.0]]))[0]
+        assert any(a == pytest.approx(area, rel=1e-9) and c.distance(shapely.Point(centre)) < 1e-3
+                   for a, c in outlines), part.name
+        for hole in part.holes:
+            x, y = placement.apply(np.asarray(hole.centre)[None, :])[0]
+            assert any(abs(cx - x) < 1e-9 and abs(cy - y) < 1e-9 and d == pytest.approx(hole.diameter_mm - KERF)
+                       for cx, cy, d in circles)
