@@ -195,3 +195,25 @@ def test_millimetre_sized_linkage_follows_the_closed_form():
     phi = freudenstein_rocker(15 * k, 40 * k, 30 * k, 40 * k, theta)
     np.testing.assert_allclose(motion.point("B", "rocker"),
                                np.column_stack([40 * k + 30 * k * np.cos(phi), 30 * k * np.sin(phi)]), atol=1e-10)
+
+
+def test_gear_train_counts_the_coupling_and_follows_the_ratio():
+    """Two gears on the ground coupled by a law: Gruebler 3 (3 - 1) - 2 * 2 - 1 = 1 degree of freedom, and
+    the driven gear turns at the law's ratio (closed form theta_b = -0.5 theta_a)."""
+    from fabricate.mechanism import GearCoupling
+
+    mech = Mechanism(
+        name="gear_train",
+        bodies=(Body("ground", {"A": (0.0, 0.0), "B": (30.0, 0.0)}), Body("ga", {"A": (0.0, 0.0)}),
+                Body("gb", {"B": (0.0, 0.0)})),
+        ground="ground",
+        joints=(Revolute("A", "ground", "ga"), Revolute("B", "ground", "gb")),
+        gears=(GearCoupling("pair", "ground", "ga", "gb", LinearLaw(-0.5), "A", "B"),),
+        drivers=(Driver("angle", "ga", "ground"),),
+        input_range=(0.0, 90.0),
+        assembly={"ga": (0.0, 0.0, 0.0), "gb": (30.0, 0.0, 0.0)},
+    )
+    assert mech.degrees_of_freedom() == 1
+    motion = mech.sweep(7)
+    np.testing.assert_allclose(motion.pose("gb")[:, 2], -0.5 * np.radians(motion.inputs), atol=1e-9)
+    np.testing.assert_allclose(motion.point("B", "gb"), [[30.0, 0.0]] * 7, atol=1e-9)
