@@ -55,6 +55,10 @@ def _parser() -> argparse.ArgumentParser:
     c = sub.add_parser("check", help="verify an output folder (files, contents, rebuild) or check a template")
     c.add_argument("target", help="template, or a folder written by 'fabricate build'")
     c.add_argument("-q", "--quiet", action="store_true")
+    for cmd in (b, s, c):
+        cmd.add_argument("--process", metavar="sla|laser|PATH",
+                         help="make it with this process profile instead of the template's (the template's "
+                              "pin diameter is kept)")
     sub.add_parser("list", help="templates shipped")
     i = sub.add_parser("init", help="write an editable copy of a shipped template into the current folder")
     i.add_argument("name", help="name of the new design (writes NAME.toml)")
@@ -79,7 +83,7 @@ def _build(args: argparse.Namespace) -> int:
     from fabricate.pipeline import run_build, run_synth
     from fabricate.spec import load_design
 
-    design = load_design(args.template)
+    design = load_design(args.template, args.process)
     stage = args.command
     default = Path("outputs") / (design.name if stage == "build" else f"{design.name}-synth")
     protect = [design.template]
@@ -98,10 +102,13 @@ def _check(args: argparse.Namespace) -> int:
 
     target = Path(args.target)
     if not target.is_dir():
-        outcome = run_build(load_design(args.target), _progress(args.quiet))
+        outcome = run_build(load_design(args.target, args.process), _progress(args.quiet))
         _summary(outcome.report, None)
         return outcome.exit_code
     from fabricate.verify import verify_output
+
+    if args.process:
+        raise SpecError("--process", "a folder is checked with the process it was built with (see its report)")
 
     problems, report = verify_output(target, _progress(args.quiet))
     if report is None:

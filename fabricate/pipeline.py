@@ -58,9 +58,13 @@ def _quiet(_: str) -> None:
 def design_section(design: DesignSpec, stage: str) -> dict[str, Any]:
     # the template's file name only: a folder in the report would make its bytes depend on where the
     # build ran (the template itself is embedded as template_text)
-    return {"name": design.name, "kind": design.kind, "template": Path(design.template).name,
-            "fabricate_version": __version__, "description": design.description,
-            "process": design.process.name, "stage": stage}
+    section = {"name": design.name, "kind": design.kind, "template": Path(design.template).name,
+               "fabricate_version": __version__, "description": design.description,
+               "process": design.process.name, "stage": stage}
+    if design.process_override is not None:  # --process: check rebuilds with the same profile
+        section["process_override"] = {"source": design.process_override.source,
+                                       "text": design.process_override.text}
+    return section
 
 
 def mechanism_section(mechanism: Mechanism, motion: Motion) -> dict[str, Any]:
@@ -156,9 +160,10 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
                   progress: Progress, stage: list[str]) -> BuildOutcome:
     """Gears, parts, exports, checks and pictures; ``stage[0]`` names the stage running (for failures)."""
     from fabricate.checks import run_checks
-    from fabricate.export import STEP_SKIPPED, export_all, export_previews, export_step
+    from fabricate.export import STEP_SKIPPED, assembly_csv, export_all, export_previews, export_step
     from fabricate.export.step import step_available
     from fabricate.gears import build_gear_pairs
+    from fabricate.parts.assembly import assembly_steps, pin_stacks, stacks_report
     from fabricate.parts.build import build_parts
 
     def enter(name: str) -> None:
@@ -183,6 +188,9 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
         files.update(exported)
         report["parts"] = parts_report
         report["bom"] = list(getattr(partset, "bom", []))
+        stacks = pin_stacks(partset)
+        report["assembly"] = {"pins": stacks_report(stacks), "steps": assembly_steps(stacks, partset.copies)}
+        files["assembly.csv"] = assembly_csv(stacks)
         enter("checks")
         checks = run_checks(design, partset, mechanism, motion, gear_pairs)
         report["interference"] = checks.interference

@@ -99,6 +99,10 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
                       [[p.get("name"), p.get("process"), p.get("layer"), p.get("volume_mm3"),
                         ", ".join(f"{h['joint']}: {h['diameter_mm']:.3f}" for h in p.get("holes", [])),
                         p.get("stl"), p.get("dxf")] for p in parts]) + [""]
+    assembly = report.get("assembly", {})
+    if assembly.get("steps"):
+        out += ["## Assembly", "", "Each pin's stack from bottom to top (also in `assembly.csv`):", ""]
+        out += list(assembly["steps"]) + [""]
     bom = report.get("bom", [])
     if bom:
         out += ["## Bill of materials", ""]

@@ -318,6 +318,17 @@ class ProcessSpec:
         SLA build volume (x, y, z) or laser sheet (x, y, thickness).
     pin_diameter_mm : float
         Nominal pin diameter used at joints.
+    chord_tolerance_mm : float
+        Polygonisation sagitta for meshes.
+    material : str
+        What parts are made of (BOM); ``density_g_cm3`` its density (part masses).
+    min_text_mm : float
+        Smallest label the process engraves or embosses legibly; smaller labels are left out.
+    arcs : str
+        ``"bulge"`` (exact LWPOLYLINE arcs) or ``"segments"`` (arcs as lines within the chord tolerance,
+        for OpenSCAD and older laser software that ignore bulges).
+    cut_colour, engrave_colour : str
+        SVG stroke colours ("#rrggbb") of the two operations.
     """
 
     name: str
@@ -332,26 +343,74 @@ class ProcessSpec:
     build_volume_mm: tuple[float, float, float]
     pin_diameter_mm: float
     chord_tolerance_mm: float
+    material: str = ""
+    density_g_cm3: float = 1.2
+    min_text_mm: float = 1.0
+    arcs: str = "bulge"
+    cut_colour: str = "#ff0000"
+    engrave_colour: str = "#0000ff"
 
 
-def parse_process(table: Table) -> ProcessSpec:
-    """Read ``[process]``: a profile name plus overrides of the profile's fields."""
+@dataclass(frozen=True)
+class ProcessOverride:
+    """A process chosen on the command line (``--process laser|sla|PATH``) instead of the template's.
+
+    Attributes
+    ----------
+    source : str
+        ``"sla"``, ``"laser"`` or the profile file's name.
+    text : str
+        The profile's TOML text (embedded in report.json so ``check`` rebuilds with it).
+    """
+
+    source: str
+    text: str
+
+
+def process_override(name_or_path: str) -> ProcessOverride:
+    """Resolve ``--process``: a shipped profile name or a profile file."""
+    if name_or_path in ("sla", "laser"):
+        return ProcessOverride(name_or_path, read_text(TEMPLATE_DIR / f"process_{name_or_path}.toml"))
+    path = Path(name_or_path)
+    if not path.is_file():
+        raise SpecError("--process", f"expected sla, laser or a process profile file, got \"{name_or_path}\"")
+    return ProcessOverride(path.name, read_text(path))
+
+
+#: Fields a template keeps when --process replaces its profile: which dowel pins the design uses is a
+#: choice of the design, everything else (clearances, kerf, sheet, thickness) belongs to the process.
+DESIGN_PROCESS_FIELDS = ("pin_diameter_mm",)
+
+
+def parse_process(table: Table, override: ProcessOverride | None = None) -> ProcessSpec:
+    """Read ``[process]``: a profile name plus overrides of the profile's fields.
+
+    With ``override`` (``--process``) the profile is the override's and of the template's own fields only
+    :data:`DESIGN_PROCESS_FIELDS` are kept.
+    """
     from fabricate.bounds import MIN_CHORD_TOLERANCE_MM
 
     profile = table.string("profile", "sla", choices=("sla", "laser"))
-    base_path = TEMPLATE_DIR / f"process_{profile}.toml"
-    base = read_toml(base_path) if base_path.is_file() else {}
+    if override is None:
+        base_path = TEMPLATE_DIR / f"process_{profile}.toml"
+        base = read_toml(base_path) if base_path.is_file() else {}
+        path = table.path or "process"
+    else:
+        base = parse_toml(override.text, override.source)
+        path = f"--process {override.source}"
     merged = dict(base)
     for key in table.data:
         if key != "profile":
-            merged[key] = table.data[key]
             table._used.add(key)
-    t = Table(merged, table.path or "process")
+            if override is None or key in DESIGN_PROCESS_FIELDS:
+                merged[key] = table.data[key]
+    t = Table(merged, path)
+    method = t.string("method", profile if override is None else _MISSING, choices=("sla", "laser"))
     # every length is bounded (bounds.MAX_LENGTH_MM and tighter where the process makes sense): a
     # huge pin or wall turns into geometry no kernel can build; the chord tolerance's lower bound
     # caps the vertex count of every polygonised arc (memory and time grow as 1/sqrt(tolerance))
     spec = ProcessSpec(
-        name=profile,
+        name=method,
         running_clearance_mm=t.number("running_clearance_mm", min=0.0, max=5.0),
         hole_compensation_mm=t.number("hole_compensation_mm", 0.0, min=-2.0, max=2.0),
         min_wall_mm=t.number("min_wall_mm", positive=True, max=50.0),
@@ -363,12 +422,25 @@ def parse_process(table: Table) -> ProcessSpec:
         build_volume_mm=tuple(t.array("build_volume_mm", shape=(3,), positive=True, max=10000.0).tolist()),
         pin_diameter_mm=t.number("pin_diameter_mm", positive=True, max=50.0),
         chord_tolerance_mm=t.number("chord_tolerance_mm", 0.005, min=MIN_CHORD_TOLERANCE_MM, max=1.0),
+        material=t.string("material", ""),
+        density_g_cm3=t.number("density_g_cm3", 1.2, positive=True, max=25.0),
+        min_text_mm=t.number("min_text_mm", 1.0, min=0.0, max=20.0),
+        arcs=t.string("arcs", "bulge", choices=("bulge", "segments")),
+        cut_colour=_colour(t, "cut_colour", "#ff0000"),
+        engrave_colour=_colour(t, "engrave_colour", "#0000ff"),
     )
     t.finish()
     if spec.pin_diameter_mm < spec.min_pin_mm:
         raise SpecError(t.field("pin_diameter_mm"),
                         f"pin {spec.pin_diameter_mm:g} mm is below the process minimum {spec.min_pin_mm:g} mm")
     return spec
+
+
+def _colour(t: Table, key: str, default: str) -> str:
+    value = t.string(key, default)
+    if not (len(value) == 7 and value[0] == "#" and all(c in "0123456789abcdefABCDEF" for c in value[1:])):
+        raise SpecError(t.field(key), f'expected a colour "#rrggbb", got "{value}"')
+    return value.lower()
 
 
 @dataclass(frozen=True)
@@ -402,6 +474,8 @@ class DesignSpec:
         Where it was read from.
     template_text : str
         The template exactly as validated (embedded in report.json so a build can be re-made from it).
+    process_override : ProcessOverride or None
+        The ``--process`` profile that replaced the template's, if any.
     process : ProcessSpec
     checks : ChecksSpec
     gears : fabricate.gears.spec.GearSpec
@@ -422,25 +496,27 @@ class DesignSpec:
     parts: Any
     method: Any
     template_text: str = ""
+    process_override: ProcessOverride | None = None
 
 
-def load_design(path: str | Path) -> DesignSpec:
+def load_design(path: str | Path, process: str | ProcessOverride | None = None) -> DesignSpec:
     """Load and validate a template file (a path, or a shipped template's name) into a :class:`DesignSpec`.
+
+    ``process`` (``--process``: ``"sla"``, ``"laser"``, a profile file or a :class:`ProcessOverride`)
+    replaces the template's process profile.
 
     Raises
     ------
     SpecError
         On the first invalid field, naming its path.
     """
-    from fabricate.bounds import preflight
-
     path = find_template(path)
-    design = design_from_text(read_text(path), path)
-    preflight(design)  # counts whose product drives memory or time (each field alone is already bounded)
-    return design
+    if isinstance(process, str):
+        process = process_override(process)
+    return design_from_text(read_text(path), path, process)
 
 
-def design_from_text(text: str, path: str | Path) -> DesignSpec:
+def design_from_text(text: str, path: str | Path, process: ProcessOverride | None = None) -> DesignSpec:
     """Validate a template given as text; ``path`` is where it came from (its file name goes in reports).
 
     ``fabricate check DIR`` rebuilds from the text embedded in a report with this, so the verdict depends
@@ -461,16 +537,22 @@ def design_from_text(text: str, path: str | Path) -> DesignSpec:
     kind = design.string("kind", choices=tuple(sorted(KINDS)))
     description = design.string("description", "")
     design.finish()
-    process = parse_process(root.table("process", {}))
+    process_spec = parse_process(root.table("process", {}), process)
     checks = parse_checks(root.table("checks", {}))
     gears = parse_gear_spec(root.table("gears", {}))
     parts = parse_parts_spec(root.table("parts", {}))
     method = KINDS[kind].parse_spec(root)
     root.finish()
     bore = getattr(gears, "bore_mm", None)
-    if bore is not None and abs(bore - process.pin_diameter_mm) > 1e-9:
+    if bore is not None and abs(bore - process_spec.pin_diameter_mm) > 1e-9:
         # every joint, gear axes included, turns on a pin of the process diameter
-        raise SpecError("gears.bore_mm", f"{bore:g} mm differs from the pin diameter {process.pin_diameter_mm:g} mm "
+        pin = process_spec.pin_diameter_mm
+        raise SpecError("gears.bore_mm", f"{bore:g} mm differs from the pin diameter {pin:g} mm "
                                          "the gears turn on; set process.pin_diameter_mm to it or leave bore_mm out")
-    return DesignSpec(name=name, kind=kind, description=description, template=path, process=process,
-                      checks=checks, gears=gears, parts=parts, method=method, template_text=text)
+    spec = DesignSpec(name=name, kind=kind, description=description, template=path, process=process_spec,
+                      checks=checks, gears=gears, parts=parts, method=method, template_text=text,
+                      process_override=process)
+    from fabricate.bounds import preflight
+
+    preflight(spec)  # counts whose product drives memory or time (each field alone is already bounded)
+    return spec

@@ -232,14 +232,18 @@ def rebuild_problems(directory: Path, report: Mapping[str, Any],
         The fresh report (its check failures are the design's own), None when nothing could be rebuilt.
     """
     from fabricate.pipeline import run_build, run_synth
-    from fabricate.spec import design_from_text
+    from fabricate.spec import ProcessOverride, design_from_text
 
     text = report.get("template_text")
     design_info = report.get("design", {})
     if not isinstance(text, str) or not text:
         return [f"{REPORT}: no embedded template (template_text) to rebuild from"], None
+    override = design_info.get("process_override")
     try:
-        design = design_from_text(text, str(design_info.get("template") or "template.toml"))
+        process = None
+        if isinstance(override, dict):
+            process = ProcessOverride(str(override.get("source")), str(override.get("text")))
+        design = design_from_text(text, str(design_info.get("template") or "template.toml"), process)
     except SpecError as exc:
         return [f"{REPORT}: the embedded template is not valid: {exc}"], None
     runner = run_synth if design_info.get("stage") == "synth" else run_build

@@ -38,6 +38,19 @@ def _bom_csv(rows: list[dict[str, Any]]) -> bytes:
     return buffer.getvalue().encode("utf-8")
 
 
+def assembly_csv(stacks: list[Any]) -> bytes:
+    """assembly.csv: one row per item on a pin, bottom to top (pin, position, item, kind, z in mm)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(["pin", "position", "item", "kind", "z_bottom_mm", "z_top_mm", "pin_diameter_mm",
+                     "pin_length_mm"])
+    for stack in stacks:
+        for k, item in enumerate(stack.items, start=1):
+            writer.writerow([stack.pin, k, item.item, item.kind, f"{item.z_mm[0]:.3f}", f"{item.z_mm[1]:.3f}",
+                             f"{stack.diameter_mm:g}", f"{stack.length_mm:.3f}"])
+    return buffer.getvalue().encode("utf-8")
+
+
 def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews: bool = True,
                step: bool = True) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
     """Every export of a part set.
@@ -73,7 +86,7 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     GeometryError
         When a written STL does not read back as a closed solid (a bug, never a design finding).
     """
-    from fabricate.export.dxf import kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
+    from fabricate.export.dxf import DxfStyle, kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
     from fabricate.export.step import step_available
     from fabricate.export.stl import (
         SolidCache,
@@ -95,6 +108,10 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     laser = is_laser(process)
     kerf = process.kerf_mm
     min_text = float(getattr(process, "min_text_mm", 0.0))
+    arcs = getattr(process, "arcs", "bulge")
+    drawing = DxfStyle(arcs, partset.chord_tolerance_mm)  # for CAD: every label
+    cutting = DxfStyle(arcs, partset.chord_tolerance_mm, min_text)  # only labels the process can engrave
+    colours = (getattr(process, "cut_colour", "#ff0000"), getattr(process, "engrave_colour", "#0000ff"))
     cache = SolidCache(partset.chord_tolerance_mm)
     files: dict[str, bytes] = {}
     entries: list[dict[str, Any]] = []
@@ -119,12 +136,12 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
         if problems:
             raise GeometryError(f"part {part.name}: STL {', '.join(problems)}")
         files[stl_path] = stl
-        files[dxf_path] = part_dxf(part, 0.0)  # finished size, for CAD
+        files[dxf_path] = part_dxf(part, 0.0, drawing)  # finished size, for CAD
         cut_dxf = cut_svg = None
         if laser:
             cut_dxf, cut_svg = f"cut/{part.name}.dxf", f"cut/{part.name}.svg"
-            files[cut_dxf] = part_dxf(part, kerf)
-            files[cut_svg] = part_svg(part, kerf, min_text_mm=min_text)
+            files[cut_dxf] = part_dxf(part, kerf, cutting)
+            files[cut_svg] = part_svg(part, kerf, min_text_mm=min_text, colours=colours)
         placed = where[part.name]
         entries.append({
             "name": part.name, "process": part.process, "stl": stl_path, "dxf": dxf_path,
@@ -147,9 +164,10 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
                  if pl.sheet == number]
         if laser:
             sheet_parts, sheet_places = [part for part, _, _ in on_it], [pl for _, pl, _ in on_it]
-            files[f"cut/sheet_{number + 1}.dxf"] = sheet_dxf(sheet_parts, kerf, sheet_places, area, number)
+            files[f"cut/sheet_{number + 1}.dxf"] = sheet_dxf(sheet_parts, kerf, sheet_places, area, number, cutting)
             files[f"cut/sheet_{number + 1}.svg"] = sheet_svg(sheet_parts, kerf, sheet_places, area, number,
-                                                             title=f"{design.name} sheet", min_text_mm=min_text)
+                                                             title=f"{design.name} sheet", min_text_mm=min_text,
+                                                             colours=colours)
         else:
             meshes = [placed_flat_mesh(part, cache, pl) for part, pl, _ in on_it]
             names = [_copy_name(part.name, k % copies, copies) for part, _, k in on_it]

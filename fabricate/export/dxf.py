@@ -15,6 +15,7 @@ import contextlib
 import io
 from collections import OrderedDict
 from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import ezdxf
@@ -111,8 +112,31 @@ def _label_spot(part: Part, text: str) -> tuple[np.ndarray, float]:
     return np.array([spot.x, spot.y]), float(np.clip(round(height, 3), 0.3, 5.0))
 
 
+@dataclass(frozen=True)
+class DxfStyle:
+    """How a process wants its DXF: exact bulge arcs or line segments, and its smallest label.
+
+    Attributes
+    ----------
+    arcs : str
+        ``"bulge"``: arcs as LWPOLYLINE bulges (exact). ``"segments"``: arcs as straight segments whose
+        sagitta is at most ``chord_tolerance_mm``, for readers that ignore bulges (OpenSCAD, older laser
+        software). Holes stay CIRCLEs either way (every reader draws those).
+    chord_tolerance_mm : float
+    min_text_mm : float
+        Labels that would be smaller are left out (0 keeps every label).
+    """
+
+    arcs: str = "bulge"
+    chord_tolerance_mm: float = 0.005
+    min_text_mm: float = 0.0
+
+
+EXACT = DxfStyle()
+
+
 def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None = None,
-             label: str | None = None) -> None:
+             label: str | None = None, style: DxfStyle = EXACT) -> None:
     """Draw a part's cut path (CUT) and its label (ENGRAVE) into a modelspace.
 
     Parameters
@@ -121,6 +145,8 @@ def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None =
         Rotation and offset onto a sheet; None keeps the part's own coordinates.
     label : str, optional
         Text engraved at the roomiest inside point (default: the part name).
+    style : DxfStyle
+        Arcs as bulges or segments, and the smallest label drawn.
     """
     outline, holes, slots = cut_geometry(part, kerf_mm)
 
@@ -128,6 +154,8 @@ def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None =
         return placement.apply(points) if placement is not None else np.asarray(points, dtype=np.float64)
 
     for path in [outline] + slots:
+        if style.arcs == "segments":
+            path = BulgePath.polyline(path.polygon(style.chord_tolerance_mm))
         xy = place(path.vertices)
         msp.add_lwpolyline([(float(x), float(y), float(b)) for (x, y), b in zip(xy, path.bulges, strict=True)],
                            format="xyb", close=True, dxfattribs={"layer": "CUT"})
@@ -136,15 +164,17 @@ def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None =
         msp.add_circle((float(c[0]), float(c[1])), float(diameter) / 2.0, dxfattribs={"layer": "CUT"})
     label = label if label is not None else part.name
     spot, height = _label_spot(part, label)
+    if height < style.min_text_mm:  # the process cannot engrave it legibly
+        return
     spot = place(spot[None, :])[0]
     text = msp.add_text(label, height=height, dxfattribs={"layer": "ENGRAVE"})
     text.set_placement((float(spot[0]), float(spot[1])), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
 
 
-def part_dxf(part: Part, kerf_mm: float) -> bytes:
+def part_dxf(part: Part, kerf_mm: float, style: DxfStyle = EXACT) -> bytes:
     """DXF of one part in its own (body) coordinates."""
     doc = new_document()
-    add_part(doc.modelspace(), part, kerf_mm)
+    add_part(doc.modelspace(), part, kerf_mm, style=style)
     return document_bytes(doc)
 
 
@@ -156,7 +186,7 @@ def sheet_layout(parts: Sequence[Part], kerf_mm: float, sheet_mm: tuple[float, f
 
 
 def sheet_dxf(parts: Sequence[Part], kerf_mm: float, placements: Sequence[Placement],
-              sheet_mm: tuple[float, float], sheet: int = 0) -> bytes:
+              sheet_mm: tuple[float, float], sheet: int = 0, style: DxfStyle = EXACT) -> bytes:
     """Sheet number ``sheet``: its border (layer SHEET, not plotted) and the parts placed on it."""
     doc = new_document(("CUT", "ENGRAVE", "SHEET"))
     msp = doc.modelspace()
@@ -164,7 +194,7 @@ def sheet_dxf(parts: Sequence[Part], kerf_mm: float, placements: Sequence[Placem
                        format="xy", close=True, dxfattribs={"layer": "SHEET"})
     for part, placement in zip(parts, placements, strict=True):
         if placement.sheet == sheet:
-            add_part(msp, part, kerf_mm, placement)
+            add_part(msp, part, kerf_mm, placement, style=style)
     return document_bytes(doc)
 
 
