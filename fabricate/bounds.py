@@ -42,8 +42,14 @@ MAX_MESH_STEPS = 7200
 #: ``gears.teeth`` / ``gear_pair.teeth`` and the teeth a module gives: teeth of one gear (cost grows
 #: faster than linearly: 200 + 200 teeth built in 15 s, 400 + 400 in 98 s).
 MAX_TEETH = 200
-#: ``gears.mesh_steps`` × (z_a + z_b): the mesh check's work (7200 steps of a 30 + 30 pair: ~15 s).
-MAX_MESH_STEP_TEETH = 250_000
+#: ``gears.mesh_steps`` × (z_a + z_b): the mesh check's work (7200 steps of a 30 + 30 pair took ~15 s;
+#: 200 + 200 teeth at the least 720 steps must stay valid).
+MAX_MESH_STEP_TEETH = 300_000
+#: Gear pair kind: ``checks.sweep_poses`` × (z_a + z_b) (posing, layering and the interference sweep of
+#: the toothed outlines; 5000 poses × 400 teeth spent 70 s in the parts stage alone).
+MAX_POSE_TEETH = 150_000
+#: Gear pair kind: ``parts.gif_frames`` × (z_a + z_b) (each frame draws both toothed outlines).
+MAX_FRAME_TEETH = 12_000
 #: Measured seconds per step and tooth of the mesh check (for the estimate in messages).
 MESH_SECONDS_PER_TOOTH_STEP = 3.5e-5
 #: ``synthesis.kappa_samples`` (five-bar): samples of the hinge curves (a Python loop per sample).
@@ -59,8 +65,9 @@ MAX_REGION_WORK = 8.0e6
 REGION_MB_PER_WORK = 1.0e-4
 #: ``region.statics_samples`` (Watt six-bar).
 MAX_STATICS_SAMPLES = 2001
-#: ``selection.refine_seeds`` (Watt six-bar): least-squares refinements started.
-MAX_REFINE_SEEDS = 100000
+#: ``selection.refine_seeds`` (Watt six-bar): least-squares refinements started (100000 took 17 s
+#: of synthesis; the worst Watt template at 100000 used 45 s of CPU in all).
+MAX_REFINE_SEEDS = 10000
 #: ``push_rod.samples`` (underactuated): stroke samples of the closing motion.
 MAX_STROKE_SAMPLES = 2001
 #: ``optimisation.path_samples`` (compliant gripper).
@@ -79,7 +86,8 @@ def preflight(design: Any) -> None:
     Products of counts that the field bounds alone do not cap:
 
     - compliant gripper: the optimisation grid (points per axis and in all);
-    - Watt six-bar: the solution region's d samples × d0 samples × statics samples.
+    - Watt six-bar: the solution region's d samples × d0 samples × statics samples;
+    - gear pair: sweep poses and GIF frames × teeth.
 
     (The gear mesh check's steps × teeth is refused where the tooth counts are known, in
     :mod:`fabricate.gears.pair`.)
@@ -115,6 +123,8 @@ def preflight(design: Any) -> None:
                             f"{method.path_samples} path samples = {work:.3g}, over the bound of "
                             f"{MAX_SPRING_TABLE:.0e}; at most {int(MAX_SPRING_TABLE // triples)} path samples "
                             "with these axes, or larger steps on k1, k2, phi01")
+    if design.kind == "gear_pair":
+        _gear_pair_work(design)
     if design.kind == "watt_six_bar":
         counts = [int((box[1] - box[0]) / method.step_mm + 1e-9) + 1 for box in (method.box("d"), method.box("d0"))]
         work = float(counts[0] * counts[1] * method.statics_samples)
@@ -127,6 +137,20 @@ def preflight(design: Any) -> None:
                             f"= {work:.3g}, over the bound of {MAX_REGION_WORK:.0e} (about "
                             f"{REGION_MB_PER_WORK * work / 1024:.1f} GB estimated against "
                             f"{MEMORY_BUDGET_MB / 1024:.0f} GB); {fix}")
+
+
+def _gear_pair_work(design: Any) -> None:
+    """Poses and picture frames × teeth of a standalone gear pair (its outlines dominate every stage)."""
+    teeth = design.gears.teeth or getattr(design.method, "teeth", None)
+    # without tooth counts the module decides them after synthesis: assume the most teeth allowed
+    total = sum(teeth) if teeth else 2 * MAX_TEETH
+    for field, count, bound, what in (
+            ("checks.sweep_poses", design.checks.sweep_poses, MAX_POSE_TEETH, "poses"),
+            ("parts.gif_frames", design.parts.gif_frames, MAX_FRAME_TEETH, "GIF frames")):
+        if count * total > bound:
+            raise SpecError(field, f"{count} {what} × {total} teeth = {count * total}, over the bound of {bound} "
+                                   f"(every pose moves both toothed outlines); at most {max(1, bound // total)} "
+                                   f"{what} with {total} teeth")
 
 
 _GRID_FIELDS = {"alpha": "alpha_deg", "c": "c_mm", "k1": "k1_Nmm_per_deg", "k2": "k2_Nmm_per_deg",

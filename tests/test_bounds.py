@@ -136,3 +136,11 @@ def test_compliant_grid_axis_over_the_bound_names_the_axis(tmp_path: Path, capsy
     path = _template(tmp_path, "gripper_compliant.toml", [(r"^phi01_deg = \[0.0, 180.0, 2.0\]",
                                                            "phi01_deg = [0.0, 180.0, 1e-300]")])
     _assert_refused(path, "optimisation.phi01_deg", tmp_path, capsys)
+
+
+def test_gear_pair_poses_times_teeth_over_the_bound_names_sweep_poses(tmp_path: Path, capsys) -> None:
+    # 200 + 200 teeth are allowed, and so are 5000 poses, but not both: refused by the preflight estimate
+    path = _template(tmp_path, GEARS, [(r"^teeth = \[30, 30\]", "teeth = [200, 200]")],
+                     extra=f"\n[checks]\nsweep_poses = {bounds.MAX_SWEEP_POSES}\n")
+    err = _assert_refused(path, "checks.sweep_poses", tmp_path, capsys)
+    assert f"at most {bounds.MAX_POSE_TEETH // 400}" in err

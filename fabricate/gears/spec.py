@@ -24,15 +24,17 @@ Keys (all optional)
                          circle).
 ``compare_methods``      bool, default true. Also build the other method and report the largest deviation
                          between the two outlines in µm.
-``spare_teeth``          int >= 1, default 1. Extra engagements beyond each end of a sector's range.
+``spare_teeth``          int in [1, 20], default 1. Extra engagements beyond each end of a sector's range.
 ``mesh_steps``           int in [720, 7200], default 720. Poses of the mesh check over the working range
                          (time grows with steps × outline vertices; the bound keeps the check within
-                         the resource budget of :mod:`fabricate.bounds`).
+                         the resource budget of :mod:`fabricate.bounds`). Also steps × (z_a + z_b) <=
+                         300000, checked when the tooth counts are known (an error names the largest
+                         number of steps).
 ``closed``               bool. Absent: as the design kind says (sector for a finger, closed for a gear pair).
-``teeth``                [z_a, z_b], integers in [3, 400]. Tooth counts of a closed pair (with the centre distance
+``teeth``                [z_a, z_b], integers in [3, 200]. Tooth counts of a closed pair (with the centre distance
                          they fix the module, unless ``module_mm`` is given, which then fixes the
                          centre distance).
-``min_teeth``            int in [3, 400], default 8. Fewest teeth a closed gear may have (a check).
+``min_teeth``            int in [3, 200], default 8. Fewest teeth a closed gear may have (a check).
 ``bore_mm``              float in (0, 50]. Bore of each gear on its axis. Absent: the process pin diameter.
 ``hub_diameter_mm``      float > 0. Hub around the bore. Absent: the parts layer decides.
 

@@ -13,13 +13,13 @@ Keys (all optional)
 ``hub_diameter_mm``      float > 0. Hub of a gear fused to its body. Absent: ``[gears] hub_diameter_mm``
                          or the boss diameter.
 ``pad_radius_mm``        float > 0. Fingertip pad radius; overrides the synthesis hint.
-``mounting_holes``       int >= 0, default 2. Mounting holes on the ground part.
+``mounting_holes``       int in [0, 16], default 2. Mounting holes on the ground part.
 ``mounting_hole_mm``     float > 0, default 3.0. Nominal diameter of a mounting screw.
 ``plate_spacing_mm``     float >= 0, default 4.0. Gap between parts on the SLA print plate.
 ``sheet_margin_mm``      float >= 0, default 5.0. Margin at the sheet edge for the laser nesting.
 ``sheet_spacing_mm``     float >= 0, default 3.0. Gap between nested parts on the sheet.
-``preview_poses``        int >= 1, default 4. Poses drawn in the assembly preview PNG.
-``gif_frames``           int >= 2, default 24. Frames of the motion GIF.
+``preview_poses``        int in [1, 24], default 4. Poses drawn in the assembly preview PNG.
+``gif_frames``           int in [2, 360], default 24. Frames of the motion GIF.
 
 Example
 -------

@@ -47,14 +47,17 @@ WORST: dict[str, tuple[str, dict[tuple[str, str], Any]]] = {
     "five_bar_ncg": ("finger_five_bar_ncg.toml", {
         ("synthesis", "kappa_samples"): bounds.MAX_KAPPA_SAMPLES,
         ("synthesis", "curve_step_mm"): bounds.MIN_CURVE_STEP_MM,
-        # spare_teeth = 20 makes the sectors span a full turn (refused, naming gears.<pair>.closed);
-        # 16 gives 76 teeth in all: mesh steps at the steps × teeth bound
-        ("gears", "spare_teeth"): 16,
-        ("gears", "mesh_steps"): bounds.MAX_MESH_STEP_TEETH // 76,
+        # spare_teeth 16 and 20 make the sectors span a full turn (refused, naming gears.<pair>.closed);
+        # 10 gives 52-53 teeth in all: mesh steps at the steps × teeth bound (with a little margin)
+        ("gears", "spare_teeth"): 10,
+        ("gears", "mesh_steps"): bounds.MAX_MESH_STEP_TEETH // 54,
     }),
     "gear_pair": ("gear_pair_elliptic.toml", {
         ("gears", "teeth"): [bounds.MAX_TEETH, bounds.MAX_TEETH],
         ("gears", "mesh_steps"): max(720, bounds.MAX_MESH_STEP_TEETH // (2 * bounds.MAX_TEETH)),
+        # poses and GIF frames at their products with the teeth (preflight)
+        ("checks", "sweep_poses"): bounds.MAX_POSE_TEETH // (2 * bounds.MAX_TEETH),
+        ("parts", "gif_frames"): bounds.MAX_FRAME_TEETH // (2 * bounds.MAX_TEETH),
     }),
     "watt_six_bar": ("finger_watt_six_bar.toml", {
         # 201 x 101 region samples at the shipped 0.2 mm step: statics samples up to the region bound
