@@ -359,3 +359,54 @@ def test_sheet_dxf_draws_the_first_sheet_with_its_placed_parts():
             x, y = placement.apply(np.asarray(hole.centre)[None, :])[0]
             assert any(abs(cx - x) < 1e-9 and abs(cy - y) < 1e-9 and d == pytest.approx(hole.diameter_mm - KERF)
                        for cx, cy, d in circles)
+
+
+def test_kinematic_drawing_rules_for_ternary_links_free_points_and_hinges():
+    """Links are drawn between the joints of a body (a ternary link: all three sides), between all its points
+    when it has no joint, never twice and never at zero length (a compound hinge); joints and free points
+    get circles of 0.6 and 0.3 text heights; the text height is span / 60 (at least 2.5 mm), the dimension
+    style sized from it."""
+    from types import SimpleNamespace
+
+    from fabricate.export.dxf import kinematic_dxf
+    from fabricate.mechanism import Body
+
+    bodies = (Body("base", {"O": (0.0, 0.0), "D": (40.0, 0.0), "Q": (20.0, 10.0)}),
+              Body("tri", {"A": (0.0, 0.0), "B": (30.0, 0.0), "C": (10.0, 15.0)}),
+              Body("pad", {"T1": (0.0, 0.0), "T2": (5.0, 0.0)}),
+              Body("hinge", {"O": (0.0, 0.0), "O2": (0.0, 0.0)}),
+              Body("again", {"D": (0.0, 0.0), "O": (-40.0, 0.0)}))
+    joints = [SimpleNamespace(name=n) for n in ("O", "D", "A", "B", "C", "O2")]
+    poses = {"base": np.zeros(3), "tri": np.array([200.0, 0.0, 0.0]), "pad": np.array([0.0, 30.0, 0.0]),
+             "hinge": np.zeros(3), "again": np.array([40.0, 0.0, 0.0])}
+    doc = ezdxf.read(io.StringIO(kinematic_dxf(SimpleNamespace(bodies=bodies, joints=joints), poses).decode()))
+    msp = doc.modelspace()
+    text_h = round(230.0 / 60.0, 3)  # span: x from 0 to 230
+    lengths = sorted(round(math.hypot(e.dxf.end.x - e.dxf.start.x, e.dxf.end.y - e.dxf.start.y), 6)
+                     for e in msp.query('LINE[layer=="LINKS"]'))
+    assert lengths == sorted(round(v, 6) for v in (40.0, 30.0, math.hypot(10, 15), math.hypot(20, 15), 5.0))
+    dims = msp.query("DIMENSION")
+    assert all(d.dxf.layer == "DIMENSIONS" for d in dims)
+    assert sorted(round(d.get_measurement(), 6) for d in dims if d.dimtype in (0, 1)) == lengths
+    style = doc.dimstyles.get("FABRICATE")
+    assert style.dxf.dimtxt == pytest.approx(text_h) and style.dxf.dimasz == pytest.approx(text_h)
+    assert style.dxf.dimexo == pytest.approx(0.5 * text_h) and style.dxf.dimexe == pytest.approx(0.5 * text_h)
+    assert style.dxf.dimgap == pytest.approx(0.3 * text_h) and style.dxf.dimtad == 1 and style.dxf.dimdec == 3
+    assert {round(t.dxf.height, 6) for t in msp.query("TEXT")} == {text_h}
+    radii = {(c.dxf.layer, round(c.dxf.radius, 6)) for c in msp.query("CIRCLE")}
+    assert radii == {("JOINTS", round(0.6 * text_h, 6)), ("LABELS", round(0.3 * text_h, 6))}
+    assert len(msp.query('CIRCLE[layer=="JOINTS"]')) == 5  # O and O2 share one spot
+    assert len(msp.query('CIRCLE[layer=="LABELS"]')) == 3  # Q, T1, T2
+    assert "O, O2 (0.000, 0.000)" in [t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]')]
+    assert {layer.dxf.name for layer in doc.layers} >= {"LINKS", "JOINTS", "DIMENSIONS", "LABELS"}
+
+
+def test_sheet_dxf_border_is_closed_and_parts_match_placements():
+    from fabricate.export.dxf import sheet_dxf
+
+    parts = links(3)
+    layout = sheet_layout(parts, KERF, (120.0, 60.0), 5.0, 2.0)
+    msp = read(sheet_dxf(parts, KERF, layout, (120.0, 60.0)))
+    assert all(e.closed for e in msp.query('LWPOLYLINE[layer=="SHEET"]'))
+    with pytest.raises(ValueError):
+        sheet_dxf(parts, KERF, layout[:-1], (120.0, 60.0))
