@@ -373,21 +373,28 @@ def test_kinematic_drawing_rules_for_ternary_links_free_points_and_hinges():
 
     bodies = (Body("base", {"O": (0.0, 0.0), "D": (40.0, 0.0), "Q": (20.0, 10.0)}),
               Body("tri", {"A": (0.0, 0.0), "B": (30.0, 0.0), "C": (10.0, 15.0)}),
-              Body("pad", {"T1": (0.0, 0.0), "T2": (5.0, 0.0)}),
-              Body("hinge", {"O": (0.0, 0.0), "O2": (0.0, 0.0)}),
+              Body("pad", {"T1": (0.0, 0.0), "T2": (0.5, 0.0)}),
+              Body("hinge", {"O": (0.0, 0.0), "O2": (0.0, 0.0), "E": (0.0, -20.0)}),
               Body("again", {"D": (0.0, 0.0), "O": (-40.0, 0.0)}))
-    joints = [SimpleNamespace(name=n) for n in ("O", "D", "A", "B", "C", "O2")]
-    poses = {"base": np.zeros(3), "tri": np.array([200.0, 0.0, 0.0]), "pad": np.array([0.0, 30.0, 0.0]),
+    joints = [SimpleNamespace(name=n) for n in ("O", "D", "A", "B", "C", "O2", "E")]
+    poses = {"base": np.zeros(3), "tri": np.array([200.0, 0.0, 0.0]), "pad": np.array([0.0, -30.0, 0.0]),
              "hinge": np.zeros(3), "again": np.array([40.0, 0.0, 0.0])}
     doc = ezdxf.read(io.StringIO(kinematic_dxf(SimpleNamespace(bodies=bodies, joints=joints), poses).decode()))
     msp = doc.modelspace()
-    text_h = round(230.0 / 60.0, 3)  # span: x from 0 to 230
+    text_h = round(230.0 / 60.0, 3)  # span: the larger extent, x from 0 to 230 (y: -30 to 15)
     lengths = sorted(round(math.hypot(e.dxf.end.x - e.dxf.start.x, e.dxf.end.y - e.dxf.start.y), 6)
                      for e in msp.query('LINE[layer=="LINKS"]'))
-    assert lengths == sorted(round(v, 6) for v in (40.0, 30.0, math.hypot(10, 15), math.hypot(20, 15), 5.0))
+    # O-D once (two bodies have it), A-B-C all sides, T1-T2 (no joints: its own points), O-E and O2-E (not O-O2)
+    assert lengths == sorted(round(v, 6) for v in (40.0, 30.0, math.hypot(10, 15), math.hypot(20, 15), 0.5,
+                                                   20.0, 20.0))
     dims = msp.query("DIMENSION")
     assert all(d.dxf.layer == "DIMENSIONS" for d in dims)
-    assert sorted(round(d.get_measurement(), 6) for d in dims if d.dimtype in (0, 1)) == lengths
+    linear = [d for d in dims if d.dimtype in (0, 1)]
+    assert sorted(round(d.get_measurement(), 6) for d in linear) == lengths
+    for d in linear:  # the dimension line stands 3 text heights off the link
+        p2, p3, p = (np.array([v.x, v.y]) for v in (d.dxf.defpoint2, d.dxf.defpoint3, d.dxf.defpoint))
+        u = (p3 - p2) / np.hypot(*(p3 - p2))
+        assert abs(u[0] * (p - p2)[1] - u[1] * (p - p2)[0]) == pytest.approx(3 * text_h, abs=1e-6)
     style = doc.dimstyles.get("FABRICATE")
     assert style.dxf.dimtxt == pytest.approx(text_h) and style.dxf.dimasz == pytest.approx(text_h)
     assert style.dxf.dimexo == pytest.approx(0.5 * text_h) and style.dxf.dimexe == pytest.approx(0.5 * text_h)
@@ -395,7 +402,7 @@ def test_kinematic_drawing_rules_for_ternary_links_free_points_and_hinges():
     assert {round(t.dxf.height, 6) for t in msp.query("TEXT")} == {text_h}
     radii = {(c.dxf.layer, round(c.dxf.radius, 6)) for c in msp.query("CIRCLE")}
     assert radii == {("JOINTS", round(0.6 * text_h, 6)), ("LABELS", round(0.3 * text_h, 6))}
-    assert len(msp.query('CIRCLE[layer=="JOINTS"]')) == 5  # O and O2 share one spot
+    assert len(msp.query('CIRCLE[layer=="JOINTS"]')) == 6  # O and O2 share one spot
     assert len(msp.query('CIRCLE[layer=="LABELS"]')) == 3  # Q, T1, T2
     assert "O, O2 (0.000, 0.000)" in [t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]')]
     assert {layer.dxf.name for layer in doc.layers} >= {"LINKS", "JOINTS", "DIMENSIONS", "LABELS"}
