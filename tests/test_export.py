@@ -308,7 +308,14 @@ def test_part_dxf_round_trip(name):
         keys = [tuple(np.round(np.array(e.get_points("xyb")).ravel(), 6)) for e in outlines]
         keys += [(round(e.dxf.center.x, 6), round(e.dxf.center.y, 6), round(e.dxf.radius, 6)) for e in circles]
         assert len(set(keys)) == len(keys)
-        assert len(msp.query('TEXT[layer=="ENGRAVE"]')) == 1
+        # the drawing keeps its label; a cut file only one the process can engrave legibly
+        drawn = read_dxf(c.files[f"drawings/{part.name}.dxf"]).modelspace().query('TEXT[layer=="ENGRAVE"]')
+        assert len(drawn) == 1
+        cut_labels = msp.query('TEXT[layer=="ENGRAVE"]')
+        if c.process.name == "laser":
+            assert len(cut_labels) == (drawn[0].dxf.height >= c.process.min_text_mm)
+        else:
+            assert len(cut_labels) == 1
 
 
 def test_binary_link_dxf_is_exact_rounded_slot():
@@ -354,7 +361,11 @@ def test_cut_sheets_nest_every_copy_without_overlap(name):
             assert border.contains(outer)
         names += [t.dxf.text for t in msp.query('TEXT[layer=="ENGRAVE"]')]
     assert outers_total == c.partset.copies * len(parts)  # every copy of every part is cut
-    assert sorted(names) == sorted(p.name for p in parts for _ in range(c.partset.copies))
+    # every copy is labelled where the process can engrave the label legibly (heights from the drawings)
+    legible = [p.name for p in parts for _ in range(c.partset.copies)
+               if read_dxf(c.files[f"drawings/{p.name}.dxf"]).modelspace().query("TEXT")[0].dxf.height
+               >= c.process.min_text_mm]
+    assert sorted(names) == sorted(legible)
 
 
 @pytest.mark.parametrize("name", [n for n in CASES if n.endswith("-laser")])
