@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -425,15 +426,26 @@ def test_compound_hinge_shares_one_pin_and_hole():
     assert sum(s.length_mm for s in on_compound) + 3 * t == pytest.approx(compound.length_mm)
 
 
-def test_overlapping_holes_are_reported(four_bar, sla_process):
-    """A 15 mm pin on a 15 mm crank: its two holes (15.7 mm) run into each other; the part set says so."""
+def test_overlapping_holes_name_the_pin_and_the_largest_that_fits(four_bar, sla_process):
+    """A 15 mm pin on a 15 mm crank: its two holes (15.7 mm) run into each other and would cut the link in
+    two, so the build refuses naming the pin field and the largest pin that leaves the process's wall;
+    that pin builds, with the wall the process asks for."""
     import dataclasses
 
+    from fabricate.errors import SpecError
+
     fat = dataclasses.replace(sla_process, pin_diameter_mm=15.0)
-    partset = build_parts(design_for(fat), four_bar, four_bar.sweep(11), [], {})
-    assert any(w.startswith("part crank: holes O and A overlap by 0.700 mm") for w in partset.warnings)
-    plain = build_parts(design_for(sla_process), four_bar, four_bar.sweep(11), [], {})
-    assert plain.warnings == ()
+    with pytest.raises(SpecError, match=r"process.pin_diameter_mm: 15 mm pins: holes O and A of part crank") as info:
+        build_parts(design_for(fat), four_bar, four_bar.sweep(11), [], {})
+    largest = float(re.search(r"at most ([\d.]+) mm", str(info.value)).group(1))
+    # closed form: centre distance 15 - wall - 2 x clearance - compensation
+    assert largest == pytest.approx(15.0 - 0.8 - 2 * 0.25 - 0.2, abs=0.01)
+    fits = build_parts(design_for(dataclasses.replace(sla_process, pin_diameter_mm=largest)), four_bar,
+                       four_bar.sweep(11), [], {})
+    crank = fits.part("crank")
+    (o, a) = crank.holes[:2]
+    assert np.hypot(*(o.centre - a.centre)) - 0.5 * (o.diameter_mm + a.diameter_mm) >= 0.8 - 1e-9
+    assert fits.warnings == ()
 
 
 def test_pad_segment_is_the_circular_segment():

@@ -27,14 +27,22 @@ from typing import Any
 from fabricate.errors import GeometryError
 from fabricate.export.layout import fits
 
+#: bom.csv's leading columns; any other key of the report's BOM rows follows, sorted by name.
+BOM_COLUMNS = ("item", "kind", "qty", "process", "material", "thickness_mm", "volume_mm3", "mass_g",
+               "diameter_mm", "length_mm", "inner_diameter_mm", "outer_diameter_mm", "rate_Nmm_per_deg",
+               "preload_deg", "legs_mm", "shared", "joints", "description")
+
 
 def _bom_csv(rows: list[dict[str, Any]]) -> bytes:
+    """bom.csv: every column of the report's BOM (empty where a row has no such value)."""
+    present = {k for row in rows for k in row}
+    columns = [c for c in BOM_COLUMNS if c in present] + sorted(present - set(BOM_COLUMNS))
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(["item", "kind", "qty", "joints", "description"])
+    writer.writerow(columns)
     for row in rows:
-        writer.writerow([row.get("item", ""), row.get("kind", ""), row.get("qty", 0),
-                         " ".join(row.get("joints", [])), row.get("description", "")])
+        writer.writerow([" ".join(map(str, row[c])) if isinstance(row.get(c), list)
+                         else ("" if row.get(c) is None else row[c]) for c in columns])
     return buffer.getvalue().encode("utf-8")
 
 

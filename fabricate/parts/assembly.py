@@ -48,15 +48,21 @@ def _joints(pin_name: str) -> set[str]:
 def pin_stacks(partset: Any) -> list[PinStack]:
     """The stack on every pin of a part set, bottom to top, in the part set's pin order.
 
-    A body part is on a pin when the pin passes through its body and the part has a hole at one of the
-    pin's joints; spacers and washers come from the part set (one between each pair of joined layers).
+    A body part is on a pin when the pin joins its body (through a hole at one of the pin's joints, or in
+    the part's slot for a slider); spacers and washers come from the part set (one between each pair of
+    joined layers).
     """
     stacks = []
     for pin in partset.pins:
         joints = _joints(pin.joint)
-        items = [StackItem(part.name, "part", (round(part.z_mm, 6), round(part.z_mm + part.thickness_mm, 6)))
-                 for part in partset.parts
-                 if part.role != "spacer" and part.body in pin.bodies and any(h.joint in joints for h in part.holes)]
+        items = []
+        for part in partset.parts:
+            if part.role == "spacer" or part.body not in pin.bodies:
+                continue
+            # a pin through a body passes its hole, or rides in its slot (a slider's guide)
+            on_hole = any(h.joint in joints for h in part.holes)
+            name = part.name if on_hole or not getattr(part, "slots", ()) else f"{part.name} (in its slot)"
+            items.append(StackItem(name, "part", (round(part.z_mm, 6), round(part.z_mm + part.thickness_mm, 6))))
         printed = {round(part.z_mm, 6): part.name for part in partset.parts
                    if part.role == "spacer" and any(h.joint in joints for h in part.holes)}
         for spacer in partset.spacers:

@@ -142,7 +142,9 @@ def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Map
                      "description": "steel dowel pin, cut to the stack; retain with adhesive or clips"})
     for sp in spacers:
         kind = "washer" if sp.washer else "spacer"
-        made = "printed with the parts" if (not sp.washer and process == "sla") else "purchased"
+        if not sp.washer and process == "sla":
+            continue  # printed with the parts: a part row of its own (see part_rows)
+        made = "purchased"
         rows.append({"item": f"{kind} {sp.inner_diameter_mm:g}/{sp.outer_diameter_mm:g} x {sp.length_mm:.2f} mm",
                      "kind": kind, "inner_diameter_mm": round(sp.inner_diameter_mm, 4),
                      "outer_diameter_mm": round(sp.outer_diameter_mm, 4), "length_mm": round(sp.length_mm, 4),
@@ -152,6 +154,9 @@ def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Map
         rows.append({"item": f"screw M{mounting_mm:g}", "kind": "screw", "qty": mounting * copies,
                      "joints": [], "description": "mounting screw for the ground part"})
     for spring in hints.get("springs", ()) or ():
+        rate = spring.get("rate_Nmm_per_deg")
+        if isinstance(rate, (int, float)) and rate <= 0.0:
+            continue  # a zero rate means no spring there (the compliant optimum has k1 = 0)
         rows.append({"item": f"torsion spring at {spring.get('joint', '?')}", "kind": "spring",
                      "qty": copies, "joints": [str(spring.get("joint", ""))],
                      "rate_Nmm_per_deg": spring.get("rate_Nmm_per_deg"),
@@ -166,4 +171,21 @@ def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Map
         rows.append({"item": str(item.get("item", "item")), "kind": "purchased",
                      "qty": int(item.get("qty", 1)), "joints": [],
                      "description": str(item.get("note", "")), "shared": True})
+    return rows
+
+
+def part_rows(parts: Sequence[Any], process: Any, copies: int = 1) -> list[dict[str, Any]]:
+    """One BOM row per printed or cut part: process, material, quantity (all copies), volume and mass.
+
+    Mass is the exact volume (profile area x thickness, mm^3) times the profile's density (g/cm^3).
+    """
+    kind = "cut part" if process.name == "laser" else "printed part"
+    rows = []
+    for part in parts:
+        volume = float(part.volume_mm3())
+        rows.append({"item": part.name, "kind": kind, "qty": copies, "process": process.name,
+                     "material": process.material, "thickness_mm": round(float(part.thickness_mm), 4),
+                     "volume_mm3": round(volume, 4), "mass_g": round(volume * process.density_g_cm3 / 1000.0, 6),
+                     "joints": sorted({h.joint for h in part.holes}),
+                     "description": f"{part.role} part, {process.material or process.name}"})
     return rows

@@ -43,7 +43,7 @@ import shapely
 
 from fabricate.errors import GeometryError, SpecError
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
-from fabricate.parts.bom import Pin, Spacer, bill_of_materials, pins_and_spacers
+from fabricate.parts.bom import Pin, Spacer, bill_of_materials, part_rows, pins_and_spacers
 from fabricate.parts.layers import assign_layers, conflict_graph, layer_z, order_layers, pin_crossings
 from fabricate.parts.model import BulgePath, Hole, Part, circle_polygon
 from fabricate.parts.profiles import circle_hull, fuse_polygons
@@ -378,8 +378,9 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
         raise GeometryError(f"part names collide after sanitising: {sorted(names)}")
     copies = int(hints.get("copies", 1) or 1)
     mounting = sum(1 for h in holes[ground] if h.joint.startswith("mount_"))
-    bom = bill_of_materials(pins, spacers, hints, process.name, copies, mounting=mounting,
-                            mounting_mm=parts_spec.mounting_hole_mm)
+    bom = part_rows(parts, process, copies) + bill_of_materials(pins, spacers, hints, process.name, copies,
+                                                                 mounting=mounting,
+                                                                 mounting_mm=parts_spec.mounting_hole_mm)
     return PartSet(parts=tuple(parts), bom=bom, pins=tuple(pins), spacers=tuple(spacers), layers=layers,
                    process=process.name, chord_tolerance_mm=tol, thickness_mm=thickness, layer_gap_mm=gap,
                    kerf_mm=process.kerf_mm, copies=copies, hints=hints, warnings=tuple(warnings))

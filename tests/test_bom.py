@@ -1,0 +1,99 @@
+"""The bill of materials a maker orders from: every printed or cut part with its mass, springs only where
+they exist, bom.csv carrying every column; and the assembly stacks that say what goes where on each pin."""
+
+from __future__ import annotations
+
+import csv
+import io
+
+import pytest
+import shapely
+
+from fabricate.pipeline import run_build
+from fabricate.spec import load_design
+
+
+@pytest.fixture(scope="module")
+def gripper():
+    return run_build(load_design("gripper_compliant"))
+
+
+@pytest.fixture(scope="module")
+def five_bar_laser():
+    return run_build(load_design("finger_five_bar_ncg", "laser"))
+
+
+def test_every_part_is_in_the_bom_with_its_mass(gripper, five_bar_laser):
+    for outcome, kind in ((gripper, "printed part"), (five_bar_laser, "cut part")):
+        process = load_design(outcome.report["design"]["template"].removesuffix(".toml"),
+                              "laser" if kind == "cut part" else None).process
+        rows = {r["item"]: r for r in outcome.report["bom"] if r["kind"] == kind}
+        assert set(rows) == {p.name for p in outcome.partset.parts}
+        for part in outcome.partset.parts:
+            row = rows[part.name]
+            assert row["qty"] == outcome.partset.copies and row["process"] == process.name
+            assert row["material"] == process.material and process.material
+            # independent of the BOM code: the profile area (shapely, from the polygon) x thickness x density
+            rings = part.polygons(1e-6)  # inscribed: loses at most 1e-6 mm x perimeter of area
+            area = shapely.Polygon(rings[0], rings[1:]).area
+            mass = area * part.thickness_mm * process.density_g_cm3 / 1000
+            assert row["mass_g"] == pytest.approx(mass, rel=1e-5, abs=1e-6)
+    assert gripper.partset.copies == 3  # three fingers: three of every part
+
+
+def test_springs_only_where_the_rate_is_above_zero(gripper):
+    springs = [r for r in gripper.report["bom"] if r["kind"] == "spring"]
+    rates = {s["joint"]: s["rate_Nmm_per_deg"] for s in gripper.partset.hints["springs"]}
+    assert min(rates.values()) == 0.0 < max(rates.values())  # the optimum's k1 = 0: no spring at that hinge
+    assert {s["joints"][0] for s in springs} == {j for j, k in rates.items() if k > 0}
+    assert all(s["rate_Nmm_per_deg"] > 0 and s["qty"] == 3 for s in springs)
+
+
+def test_bom_csv_carries_every_column_of_the_report(gripper):
+    rows = list(csv.DictReader(io.StringIO(gripper.files["bom.csv"].decode())))
+    bom = gripper.report["bom"]
+    assert len(rows) == len(bom)
+    assert set(rows[0]) == {k for r in bom for k in r}
+    for row, entry in zip(rows, bom, strict=True):
+        for key, value in entry.items():
+            if isinstance(value, list):
+                assert row[key] == " ".join(map(str, value))
+            elif isinstance(value, float):
+                assert float(row[key]) == pytest.approx(value, rel=1e-12)
+            else:
+                assert row[key] == str(value)
+
+
+def test_printed_spacers_are_parts_not_hardware(gripper):
+    bom = gripper.report["bom"]
+    spacer_parts = [p.name for p in gripper.partset.parts if p.role == "spacer"]
+    assert spacer_parts and all(any(r["item"] == n and r["kind"] == "printed part" for r in bom)
+                                for n in spacer_parts)
+    assert not any(r["kind"] == "spacer" for r in bom)  # no second count of the same spacers
+
+
+@pytest.mark.parametrize("which", ["gripper", "five_bar_laser"])
+def test_each_pin_stack_fills_its_pin_exactly(which, request):
+    outcome = request.getfixturevalue(which)
+    stacks = outcome.report["assembly"]["pins"]
+    assert {s["pin"] for s in stacks} == {p.joint for p in outcome.partset.pins}
+    by_name = {p.name: p for p in outcome.partset.parts}
+    for stack in stacks:
+        items = stack["stack"]
+        # bottom to top without a gap or an overlap, from the pin's bottom to its top
+        assert items[0]["z_mm"][0] == pytest.approx(stack["z_mm"], abs=1e-9)
+        assert items[-1]["z_mm"][1] == pytest.approx(stack["z_mm"] + stack["length_mm"], abs=1e-9)
+        for below, above in zip(items, items[1:], strict=False):
+            assert above["z_mm"][0] == pytest.approx(below["z_mm"][1], abs=1e-9)
+        for item in items:
+            if item["kind"] == "part":
+                part = by_name[item["item"].removesuffix(" (in its slot)")]  # a real part, at its own height
+                assert item["z_mm"] == pytest.approx([part.z_mm, part.z_mm + part.thickness_mm], abs=1e-9)
+                on_hole = bool({h.joint for h in part.holes} & set(stack["pin"].split("+")))
+                assert on_hole != item["item"].endswith("(in its slot)")  # a hole, or else its slot
+                assert on_hole or part.slots
+    csv_rows = list(csv.DictReader(io.StringIO(outcome.files["assembly.csv"].decode())))
+    assert len(csv_rows) == sum(len(s["stack"]) for s in stacks)
+    steps = outcome.report["assembly"]["steps"]
+    assert len(steps) == len(stacks) + (outcome.partset.copies > 1)
+    assert "## Assembly" in outcome.files["report.md"].decode()
