@@ -293,7 +293,7 @@ def label_of(part):
     return shapely.Point(text.dxf.align_point.x, text.dxf.align_point.y), text.dxf.height, text.dxf.text
 
 
-@pytest.mark.parametrize("name", ["rod", "a_much_longer_part_name"])
+@pytest.mark.parametrize("name", ["A", "rod", "a_much_longer_part_name"])
 def test_label_sits_at_the_roomiest_spot_and_fits(name):
     """The engraved label is centred near the plate's most inward point (within 5 % of the largest inscribed
     circle found here on a 0.05 mm grid) and its text box (0.9 h per character by h) stays clear of every
@@ -312,6 +312,22 @@ def test_label_sits_at_the_roomiest_spot_and_fits(name):
     half_w, half_h = 0.45 * height * len(text), 0.5 * height
     assert math.hypot(half_w, half_h) <= room + 1e-9
     assert height >= 0.3 and (height == 5.0 or height >= 0.5 * min(0.8 * room, 1.6 * room / (0.9 * len(text))))
+    assert height == round(height, 3)  # millimetres to 3 decimals
+
+
+def test_label_text_is_centred_capped_and_can_be_named():
+    """The label is middle-centred on its spot, never taller than 5 mm however roomy the plate, and an
+    explicit label (a copy number on a sheet) replaces the part name."""
+    from fabricate.export.dxf import add_part, new_document
+
+    big = SlottedPart("B", "B", slot_outline(60.0, 40.0), (), 3.0, 0.0, 0, "laser")
+    spot, height, _ = label_of(big)
+    assert height == 5.0
+    (text,) = read(part_dxf(big, 0.0)).query('TEXT[layer=="ENGRAVE"]')
+    assert (text.dxf.halign, text.dxf.valign) == (1, 2)  # MIDDLE_CENTER
+    doc = new_document()
+    add_part(doc.modelspace(), slotted_link(), KERF, label="rod #2")
+    assert [t.dxf.text for t in doc.modelspace().query("TEXT")] == ["rod #2"]
 
 
 def test_label_goes_on_the_larger_piece_or_falls_back():
