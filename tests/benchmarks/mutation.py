@@ -212,9 +212,30 @@ def equivalent_reason(key: str, function: str, old: str, new: str, table: list[d
     return None
 
 
-def run_module(key: str, max_children: int) -> dict:
-    work = prepare(key)
-    diffs = in_process_mutants(work)
+def saved_diffs(work: Path) -> dict[str, str]:
+    """{name: diff} of the mutants already generated in a work copy (no generation, no run)."""
+    code = (
+        "import json, sys\n"
+        "from mutmut.__main__ import collect_source_file_mutation_data\n"
+        "from mutmut.mutation.diff_apply import get_diff_for_mutant\n"
+        "mutants, _ = collect_source_file_mutation_data(mutant_names=())\n"
+        "json.dump({name: get_diff_for_mutant(name) for _d, name, _r in mutants}, sys.stdout)\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], cwd=work, capture_output=True, text=True, check=False)
+    if run.returncode != 0:
+        raise SystemExit(f"cannot read the mutants of {work}:\n{run.stderr[-3000:]}")
+    return json.loads(run.stdout[run.stdout.index("{"):])
+
+
+def run_module(key: str, max_children: int, collect_only: bool = False) -> dict:
+    """Generate and run one module's mutants; with ``collect_only`` read what an earlier (possibly
+    interrupted) run of the same work copy left: mutants it did not reach are "not checked"."""
+    work = WORK / key.replace("/", "_")
+    if collect_only:
+        diffs = saved_diffs(work)
+    else:
+        work = prepare(key)
+        diffs = in_process_mutants(work)
     selected = {}
     strings = 0
     for name, diff in diffs.items():
@@ -225,7 +246,7 @@ def run_module(key: str, max_children: int) -> dict:
         selected[name] = (old, new)
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
     names = sorted(selected)
-    if names:
+    if names and not collect_only:
         with open(work / "mutmut-run.log", "w") as log:  # mutmut's own output, for when a run fails
             subprocess.run(["nice", "-n", "10", mutmut_exe(), "run", "--max-children", str(max_children), *names],
                            cwd=work, env=env, check=False, stdout=log, stderr=subprocess.STDOUT)
@@ -239,7 +260,7 @@ def run_module(key: str, max_children: int) -> dict:
         status = STATUS.get(codes.get(name), "suspicious")
         old, new = selected[name]
         fn = function_of(name)
-        reason = equivalent_reason(key, fn, old, new, table) if status != "killed" else None
+        reason = equivalent_reason(key, fn, old, new, table) if status not in ("killed", "not checked") else None
         rows.append({"name": name, "function": fn, "status": "equivalent" if reason else status,
                      "old": old.strip(), "new": new.strip(), "reason": reason})
     return {"module": key, "source": MODULES[key][0], "tests": MODULES[key][1], "generated": len(diffs),
@@ -288,13 +309,13 @@ def summarise(result: dict) -> dict:
     count = {}
     for r in result["mutants"]:
         count[r["status"]] = count.get(r["status"], 0) + 1
-    run = len(result["mutants"])
+    run = len(result["mutants"]) - count.get("not checked", 0)
     eq = count.get("equivalent", 0)
     killed = count.get("killed", 0) + count.get("timeout", 0)
     rate = killed / (run - eq) if run > eq else float("nan")
     return {"run": run, "killed": killed, "survived": count.get("survived", 0), "no_tests": count.get("no tests", 0),
             "equivalent": eq, "other": run - killed - eq - count.get("survived", 0) - count.get("no tests", 0),
-            "rate": rate}
+            "not_checked": count.get("not checked", 0), "rate": rate}
 
 
 def write_report(results: dict) -> str:
@@ -304,14 +325,15 @@ def write_report(results: dict) -> str:
              "not run. Kill rate = (killed + timeout) / (run - equivalent); survivors without a covering test "
              "count as survivors.", "",
              "| module | generated | string-only (not run) | run | killed | survived | no tests | equivalent "
-             "| kill rate |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "| kill rate | not reached |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for key in MODULES:
         if key not in results:
             continue
         res = results[key]
         s = summarise(res)
         lines.append(f"| {key} | {res['generated']} | {res['string_only_skipped']} | {s['run']} | {s['killed']} "
-                     f"| {s['survived']} | {s['no_tests']} | {s['equivalent']} | {100 * s['rate']:.1f}% |")
+                     f"| {s['survived']} | {s['no_tests']} | {s['equivalent']} | {100 * s['rate']:.1f}% "
+                     f"| {s['not_checked']} |")
     missing = [k for k in MODULES if k not in results]
     if missing:
         lines += ["", "Not run yet: " + ", ".join(missing) + "."]
@@ -369,6 +391,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--report", action="store_true", help="only rewrite the report from saved results")
     parser.add_argument("--max-children", type=int, default=1, help="parallel mutants (default 1 core)")
     parser.add_argument("--examples", action="store_true", help="check that the issue's six mutants are killed")
+    parser.add_argument("--collect", action="store_true",
+                        help="read the results an earlier (interrupted) run of MODULE(s) left, without running")
     parser.add_argument("--survivors", action="store_true",
                         help="re-run only the saved survivors of MODULE(s) with the current tests")
     args = parser.parse_args(argv)
@@ -388,6 +412,8 @@ def main(argv: list[str] | None = None) -> int:
         for key in keys:
             if args.survivors:
                 results[key] = rerun_survivors(key, results[key], args.max_children)
+            elif args.collect:
+                results[key] = run_module(key, args.max_children, collect_only=True)
             else:
                 results[key] = run_module(key, args.max_children)
             s = summarise(results[key])
