@@ -97,3 +97,18 @@ def test_each_pin_stack_fills_its_pin_exactly(which, request):
     steps = outcome.report["assembly"]["steps"]
     assert len(steps) == len(stacks) + (outcome.partset.copies > 1)
     assert "## Assembly" in outcome.files["report.md"].decode()
+
+
+def test_exploded_picture_shows_every_part(gripper):
+    import numpy as np
+    from PIL import Image
+
+    from fabricate.export.previews import PALETTE, part_colours
+
+    image = np.asarray(Image.open(io.BytesIO(gripper.files["previews/exploded.png"])).convert("RGB")).astype(float)
+    colours = part_colours(gripper.partset.parts)
+    for part in gripper.partset.parts:
+        # each part's face is drawn in its own colour at alpha 0.75 over white
+        rgb = 0.75 * np.array(PALETTE[colours[part.name]], dtype=float) + 0.25 * 255.0
+        close = np.all(np.abs(image - rgb) <= 3.0, axis=2)
+        assert close.sum() > 20, part.name

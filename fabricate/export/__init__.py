@@ -217,10 +217,12 @@ STEP_SKIPPED = "STEP skipped: OCP is not installed (pip install 'fabricate[cad]'
 
 def export_previews(design: Any, partset: Any, motion: Any) -> dict[str, bytes]:
     """The assembly at several poses (PNG) and its motion (GIF), keyed by relative path."""
-    from fabricate.export.previews import assembly_png, motion_gif
+    from fabricate.export.previews import assembly_png, exploded_png, motion_gif
+    from fabricate.parts.assembly import pin_stacks
 
     parts = list(partset.parts)
     spec = design.parts
     tip = partset.hints.get("tip_point") if hasattr(partset, "hints") else None
     return {"previews/assembly.png": assembly_png(parts, motion, spec.preview_poses, tip, title=design.name),
+            "previews/exploded.png": exploded_png(parts, motion.poses_at(0), pin_stacks(partset), title=design.name),
             "previews/motion.gif": motion_gif(parts, motion, spec.gif_frames)}
