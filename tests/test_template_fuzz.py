@@ -127,7 +127,7 @@ def mutated(draw: st.DrawFn) -> str:
     return _toml(data)
 
 
-@settings(max_examples=40, deadline=None, derandomize=True,
+@settings(max_examples=30, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(text=mutated())
 def test_mutated_templates_exit_with_a_code_and_no_traceback(text: str, tmp_path_factory, capsys) -> None:
