@@ -33,17 +33,19 @@ MAX_FORCE_N = 1.0e5
 #: Largest spring rate, N·mm/deg.
 MAX_SPRING_RATE = 1.0e4
 
-#: ``process.chord_tolerance_mm``: the polygonisation sagitta; vertex counts grow as 1/sqrt(tol).
-MIN_CHORD_TOLERANCE_MM = 0.001
+#: ``process.chord_tolerance_mm``: the polygonisation sagitta; vertex counts grow as 1/sqrt(tol), and the
+#: STEP export's shape fixing works to a tenth of it (100-tooth gears at 0.001 mm: 65 s of STEP alone).
+MIN_CHORD_TOLERANCE_MM = 0.002
 #: ``checks.sweep_poses``: poses of the swept motion and the interference check.
 MAX_SWEEP_POSES = 5000
 #: ``gears.mesh_steps``: poses of the gear mesh check.
 MAX_MESH_STEPS = 7200
 #: ``gears.teeth`` / ``gear_pair.teeth`` and the teeth a module gives: teeth of one gear (cost grows
-#: faster than linearly: 200 + 200 teeth built in 15 s, 400 + 400 in 98 s).
-MAX_TEETH = 200
+#: faster than linearly: 200 + 200 teeth built in 15 s, 400 + 400 in 98 s; the STEP export of a
+#: 200 + 200 pair at the finest chord tolerance took minutes).
+MAX_TEETH = 100
 #: ``gears.mesh_steps`` × (z_a + z_b): the mesh check's work (7200 steps of a 30 + 30 pair took ~15 s;
-#: 200 + 200 teeth at the least 720 steps must stay valid).
+#: 100 + 100 teeth at 1500 steps, 30 + 30 at 5000).
 MAX_MESH_STEP_TEETH = 300_000
 #: Gear pair kind: ``checks.sweep_poses`` × (z_a + z_b) (posing, layering and the interference sweep of
 #: the toothed outlines; 5000 poses × 400 teeth spent 70 s in the parts stage alone).

@@ -68,7 +68,7 @@ def test_chord_tolerance_below_its_bound_names_the_field(tmp_path: Path, capsys)
 
 
 def test_teeth_over_the_bound_names_the_field(tmp_path: Path, capsys) -> None:
-    path = _template(tmp_path, GEARS, [(r"^teeth = \[30, 30\]", "teeth = [2000, 2000]")])
+    path = _template(tmp_path, GEARS, [(r"^teeth = \[30, 30\]", "teeth = [2000, 2000]")])  # from the issue
     _assert_refused(path, "gears.teeth[0]", tmp_path, capsys)
 
 
@@ -127,7 +127,8 @@ def test_count_at_its_bound_validates_and_past_it_is_refused(name: str, pattern:
 def test_teeth_times_mesh_steps_over_the_bound_names_mesh_steps(tmp_path: Path, capsys) -> None:
     # each field is within its own bound; their product is not (refused before any tooth is cut)
     steps = f'method = "exact"\nmesh_steps = {bounds.MAX_MESH_STEPS}'
-    path = _template(tmp_path, GEARS, [(r"^teeth = \[30, 30\]", "teeth = [200, 200]"), (r'^method = "exact"', steps)])
+    teeth = f"teeth = [{bounds.MAX_TEETH}, {bounds.MAX_TEETH}]"
+    path = _template(tmp_path, GEARS, [(r"^teeth = \[30, 30\]", teeth), (r'^method = "exact"', steps)])
     err = _assert_refused(path, "gears.mesh_steps", tmp_path, capsys)
     assert "at most" in err
 
@@ -139,8 +140,9 @@ def test_compliant_grid_axis_over_the_bound_names_the_axis(tmp_path: Path, capsy
 
 
 def test_gear_pair_poses_times_teeth_over_the_bound_names_sweep_poses(tmp_path: Path, capsys) -> None:
-    # 200 + 200 teeth are allowed, and so are 5000 poses, but not both: refused by the preflight estimate
-    path = _template(tmp_path, GEARS, [(r"^teeth = \[30, 30\]", "teeth = [200, 200]")],
+    # the most teeth are allowed, and so are the most poses, but not both: refused by the preflight estimate
+    teeth = f"teeth = [{bounds.MAX_TEETH}, {bounds.MAX_TEETH}]"
+    path = _template(tmp_path, GEARS, [(r"^teeth = \[30, 30\]", teeth)],
                      extra=f"\n[checks]\nsweep_poses = {bounds.MAX_SWEEP_POSES}\n")
     err = _assert_refused(path, "checks.sweep_poses", tmp_path, capsys)
-    assert f"at most {bounds.MAX_POSE_TEETH // 400}" in err
+    assert f"at most {bounds.MAX_POSE_TEETH // (2 * bounds.MAX_TEETH)}" in err

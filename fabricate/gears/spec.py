@@ -31,10 +31,10 @@ Keys (all optional)
                          300000, checked when the tooth counts are known (an error names the largest
                          number of steps).
 ``closed``               bool. Absent: as the design kind says (sector for a finger, closed for a gear pair).
-``teeth``                [z_a, z_b], integers in [3, 200]. Tooth counts of a closed pair (with the centre distance
+``teeth``                [z_a, z_b], integers in [3, 100]. Tooth counts of a closed pair (with the centre distance
                          they fix the module, unless ``module_mm`` is given, which then fixes the
                          centre distance).
-``min_teeth``            int in [3, 200], default 8. Fewest teeth a closed gear may have (a check).
+``min_teeth``            int in [3, 100], default 8. Fewest teeth a closed gear may have (a check).
 ``bore_mm``              float in (0, 50]. Bore of each gear on its axis. Absent: the process pin diameter.
 ``hub_diameter_mm``      float > 0. Hub around the bore. Absent: the parts layer decides.
 
