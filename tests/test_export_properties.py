@@ -388,21 +388,24 @@ def test_kinematic_drawing_rules_for_ternary_links_free_points_and_hinges():
     from fabricate.mechanism import Body
 
     bodies = (Body("base", {"O": (0.0, 0.0), "D": (40.0, 0.0), "Q": (20.0, 10.0)}),
-              Body("tri", {"A": (0.0, 0.0), "B": (30.0, 0.0), "C": (10.0, 15.0)}),
+              Body("tri", {"A": (0.0, 0.0), "B": (30.0, 0.0), "C": (10.0, 15.0), "F": (30.0, 15.0),
+                           "R": (5.0, 5.0)}),
               Body("pad", {"T1": (0.0, 0.0), "T2": (0.5, 0.0)}),
               Body("hinge", {"O": (0.0, 0.0), "O2": (0.0, 0.0), "E": (0.0, -20.0)}),
-              Body("again", {"D": (0.0, 0.0), "O": (-40.0, 0.0)}))
-    joints = [SimpleNamespace(name=n) for n in ("O", "D", "A", "B", "C", "O2", "E")]
+              Body("again", {"D": (0.0, 0.0), "O": (-40.0, 0.0)}),
+              Body("hinge2", {"H1": (0.0, 0.0), "H2": (0.0, 0.0), "N": (0.0, 0.2)}))
+    joints = [SimpleNamespace(name=n) for n in ("O", "D", "A", "B", "C", "F", "O2", "E", "H1", "H2")]
     poses = {"base": np.zeros(3), "tri": np.array([200.0, 0.0, 0.0]), "pad": np.array([0.0, -30.0, 0.0]),
-             "hinge": np.zeros(3), "again": np.array([40.0, 0.0, 0.0])}
+             "hinge": np.zeros(3), "again": np.array([40.0, 0.0, 0.0]), "hinge2": np.array([10.0, -10.0, 0.0])}
     doc = ezdxf.read(io.StringIO(kinematic_dxf(SimpleNamespace(bodies=bodies, joints=joints), poses).decode()))
     msp = doc.modelspace()
     text_h = round(230.0 / 60.0, 3)  # span: the larger extent, x from 0 to 230 (y: -30 to 15)
     lengths = sorted(round(math.hypot(e.dxf.end.x - e.dxf.start.x, e.dxf.end.y - e.dxf.start.y), 6)
                      for e in msp.query('LINE[layer=="LINKS"]'))
-    # O-D once (two bodies have it), A-B-C all sides, T1-T2 (no joints: its own points), O-E and O2-E (not O-O2)
-    assert lengths == sorted(round(v, 6) for v in (40.0, 30.0, math.hypot(10, 15), math.hypot(20, 15), 0.5,
-                                                   20.0, 20.0))
+    # O-D once (two bodies have it), all six pairs of the quaternary link A-B-C-F (not its free point R),
+    # T1-T2 (no joints: its own points), O-E and O2-E (not O-O2), nothing for H1-H2 (one spot)
+    quad = (30.0, math.hypot(10, 15), math.hypot(30, 15), math.hypot(20, 15), 15.0, 20.0)  # AB AC AF BC BF CF
+    assert lengths == sorted(round(v, 6) for v in (40.0, *quad, 0.5, 20.0, 20.0))
     dims = msp.query("DIMENSION")
     assert all(d.dxf.layer == "DIMENSIONS" for d in dims)
     linear = [d for d in dims if d.dimtype in (0, 1)]
@@ -418,10 +421,43 @@ def test_kinematic_drawing_rules_for_ternary_links_free_points_and_hinges():
     assert {round(t.dxf.height, 6) for t in msp.query("TEXT")} == {text_h}
     radii = {(c.dxf.layer, round(c.dxf.radius, 6)) for c in msp.query("CIRCLE")}
     assert radii == {("JOINTS", round(0.6 * text_h, 6)), ("LABELS", round(0.3 * text_h, 6))}
-    assert len(msp.query('CIRCLE[layer=="JOINTS"]')) == 6  # O and O2 share one spot
-    assert len(msp.query('CIRCLE[layer=="LABELS"]')) == 3  # Q, T1, T2
-    assert "O, O2 (0.000, 0.000)" in [t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]')]
+    assert len(msp.query('CIRCLE[layer=="JOINTS"]')) == 8  # O and O2 share one spot, H1 and H2 another
+    assert len(msp.query('CIRCLE[layer=="LABELS"]')) == 5  # Q, R, T1, T2, N
+    labels = {t.dxf.text: t for t in msp.query('TEXT[layer=="LABELS"]')}
+    assert "O, O2 (0.000, 0.000)" in labels and "H1, H2 (10.000, -10.000)" in labels
+    assert "N (10.000, -9.800)" in labels  # 0.2 mm away: a spot of its own
+    d_label = labels["D (40.000, 0.000)"]
+    assert (d_label.dxf.halign, d_label.dxf.valign) == (0, 1)  # BOTTOM_LEFT
+    np.testing.assert_allclose([d_label.dxf.align_point.x, d_label.dxf.align_point.y], [40 + text_h, text_h])
+    assert style.dxf.dimlfac == 1.0
+    for d in (d for d in dims if d.dimtype == 6):  # ordinate leaders run 4 text heights down / left
+        p2, p3 = np.array([d.dxf.defpoint2.x, d.dxf.defpoint2.y]), np.array([d.dxf.defpoint3.x, d.dxf.defpoint3.y])
+        expected = [0.0, -4 * text_h] if d.dxf.dimtype & 64 else [-4 * text_h, 0.0]
+        np.testing.assert_allclose(p3 - p2, expected, atol=1e-9)
     assert {layer.dxf.name for layer in doc.layers} >= {"LINKS", "JOINTS", "DIMENSIONS", "LABELS"}
+
+
+def test_segment_style_and_minimum_text():
+    """A process that wants line segments gets an outline without bulges whose vertices lie on the exact
+    kerf-offset stadium and whose chords stay within its tolerance; labels under its minimum height go."""
+    from fabricate.export.dxf import DxfStyle, sheet_dxf
+
+    part = slotted_link()
+    style = DxfStyle(arcs="segments", chord_tolerance_mm=0.01, min_text_mm=50.0)
+    msp = read(part_dxf(part, KERF, style))
+    outline = max(msp.query('LWPOLYLINE[layer=="CUT"]'), key=lambda e: len(e))
+    pts = np.array(outline.get_points("xyb"))
+    assert not pts[:, 2].any()
+    r = (WIDTH + KERF) / 2
+    # distance of each vertex from the stadium's spine (the segment between the hole centres) is r
+    t = np.clip(pts[:, 0] / LENGTH, 0.0, 1.0)
+    np.testing.assert_allclose(np.hypot(pts[:, 0] - t * LENGTH, pts[:, 1]), r, atol=1e-9)
+    assert exact_area(outline) >= stadium_area(LENGTH, WIDTH + KERF) - 2 * 0.01 * (2 * LENGTH + 2 * math.pi * r)
+    assert len(msp.query("TEXT")) == 0
+    layout = sheet_layout([part], KERF, (120.0, 60.0), 5.0, 2.0)
+    sheet = read(sheet_dxf([part], KERF, layout, (120.0, 60.0), 0, style))
+    assert not any(np.array(e.get_points("xyb"))[:, 2].any() for e in sheet.query('LWPOLYLINE[layer=="CUT"]'))
+    assert len(sheet.query("TEXT")) == 0
 
 
 def test_sheet_dxf_border_is_closed_and_parts_match_placements():
