@@ -51,3 +51,37 @@ def test_admesh_reads_every_part_whole_without_repair(template, tmp_path):
     assert all(s["Edges fixed"] == 0 and s["Facets added"] == 0 for s in stats)
     assert sum(s["Volume"] for s in stats) == pytest.approx(copies * sum(p["stl_volume_mm3"] for p in parts),
                                                              rel=1e-5)
+
+
+@pytest.mark.skipif(shutil.which("librecad") is None or shutil.which("pdftoppm") is None,
+                    reason="LibreCAD or poppler-utils not installed")
+def test_librecad_draws_dimension_text_at_least_2_5_mm(tmp_path):
+    """LibreCAD sizes dimension text by the drawing's header and dimension style, not by per-entity
+    overrides: its PDF, printed at 1:1 and rasterised at 10 px/mm, shows dimension digits >= 2.5 mm."""
+    import os
+
+    import numpy as np
+    from PIL import Image
+    from scipy import ndimage
+
+    from fabricate.export.dxf import MIN_DRAWING_TEXT_MM
+
+    outcome = run_build(load_design("finger_five_bar_ncg"))
+    dxf = tmp_path / "kinematic.dxf"
+    dxf.write_bytes(outcome.files["drawings/kinematic.dxf"])
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "XDG_RUNTIME_DIR": str(tmp_path)}
+    run = subprocess.run(["librecad", "dxf2pdf", "-s", "1", "-c", str(dxf.name)], cwd=tmp_path, env=env,
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0 and (tmp_path / "kinematic.pdf").is_file(), run.stderr
+    subprocess.run(["pdftoppm", "-r", "254", "-png", "kinematic.pdf", "page"], cwd=tmp_path, check=True,
+                   timeout=120)
+    image = np.asarray(Image.open(next(tmp_path.glob("page*.png"))).convert("RGB")).astype(int)
+    # layer DIMENSIONS is ACI 2 (yellow): its small connected blobs are the dimension digits
+    yellow = (image[:, :, 0] > 180) & (image[:, :, 1] > 180) & (image[:, :, 2] < 120)
+    labels, count = ndimage.label(yellow, structure=np.ones((3, 3)))
+    sizes = np.array([(s[0].stop - s[0].start, s[1].stop - s[1].start) for s in ndimage.find_objects(labels)])
+    px_per_mm = 254 / 25.4
+    glyphs = sizes[(sizes[:, 0] < 10 * px_per_mm) & (sizes[:, 1] < 1.2 * sizes[:, 0]) & (sizes[:, 0] > 3)]
+    assert len(glyphs) >= 10  # the link lengths' and ordinates' digits
+    # digit height is the font's cap height, ~0.9-1.0 of the text height
+    assert np.median(glyphs[:, 0]) / px_per_mm >= 0.9 * MIN_DRAWING_TEXT_MM

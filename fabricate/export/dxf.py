@@ -216,10 +216,13 @@ def kinematic_dxf(mechanism: Any, poses: Mapping[str, np.ndarray]) -> bytes:
             world.setdefault(name, transform_points(poses[body.name], body.point(name)))
     span = max(1.0, float(np.ptp(np.array(list(world.values())), axis=0).max())) if world else 1.0
     text_h = round(max(MIN_DRAWING_TEXT_MM, span / 60.0), 3)
-    # the sizes go in a dimension style of their own: LibreCAD and others ignore per-entity overrides
-    doc.dimstyles.new(DIMSTYLE, dxfattribs={"dimtxt": text_h, "dimasz": text_h, "dimdec": 3, "dimlfac": 1.0,
-                                            "dimexo": 0.5 * text_h, "dimexe": 0.5 * text_h,
-                                            "dimgap": 0.3 * text_h, "dimtad": 1})
+    # the sizes go in a dimension style of their own (readers ignore per-entity overrides) and in the
+    # drawing's header variables, which LibreCAD sizes every dimension by
+    sizes = {"dimtxt": text_h, "dimasz": text_h, "dimdec": 3, "dimlfac": 1.0, "dimexo": 0.5 * text_h,
+             "dimexe": 0.5 * text_h, "dimgap": 0.3 * text_h, "dimtad": 1}
+    doc.dimstyles.new(DIMSTYLE, dxfattribs=dict(sizes))  # ezdxf adds its name to the dict it is given
+    for key, value in sizes.items():
+        doc.header[f"${key.upper()}"] = value
     drawn: set[tuple[str, str]] = set()
     for body in mechanism.bodies:
         names = [n for n in body.points if n in joint_names] or list(body.points)
