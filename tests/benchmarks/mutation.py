@@ -273,7 +273,10 @@ def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
     source, tests = MODULES[key]
     work = WORK / key.replace("/", "_")
     if (ROOT / source).read_text() != (work / source).read_text():
-        raise SystemExit(f"{key}: {source} changed since the full run; run the module again")
+        # the mutants are those of the work copy's source: the new tests are run against that version
+        print(f"{key}: {source} changed since the full run; re-running the survivors of the version that "
+              "was measured (run the module again to measure the current one)", flush=True)
+        result["note"] = "survivors re-run against the source version of the full run"
     for target in (work / "tests", work / "mutants" / "tests"):
         shutil.rmtree(target, ignore_errors=True)
         shutil.copytree(ROOT / "tests", target, ignore=shutil.ignore_patterns("__pycache__", ".hypothesis"))
