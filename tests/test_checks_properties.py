@@ -115,10 +115,6 @@ def test_overlap_areas_and_clearance_match_shapely():
     assert far.sum() == 1 and np.all(got[far] > 5.0)  # beyond the search length: a lower bound only
 
 
-@pytest.mark.xfail(strict=True, raises=shapely.errors.GEOSException,
-                   reason="bug in fabricate.checks.distance._clipped_distance: when the bounding boxes are exactly "
-                          "2 x search apart the clip window is degenerate (lo == hi) and GEOS raises; the guard "
-                          "should be `if np.any(lo >= hi): return math.inf`")
 def test_clearance_when_the_search_windows_just_touch():
     """Boxes 10 mm apart on both axes with a 5 mm search length: farther than the search, so +inf."""
     a = Outline([np.array([[0, 0], [20, 0], [20, 20], [0, 20]], dtype=float)])

@@ -174,7 +174,9 @@ def _clipped_distance(a: Outline, poly_b: shapely.Polygon, bounds_b: np.ndarray,
     """Distance of ``a`` and ``poly_b`` if at most ``search`` (exact), else a value > ``search``."""
     lo = np.maximum(a.bounds[:2], bounds_b[:2]) - search
     hi = np.minimum(a.bounds[2:], bounds_b[2:]) + search
-    if np.any(lo > hi):
+    # boxes 2 x search apart or more on an axis: the parts are farther apart than search (which is > 0);
+    # lo == hi would also hand GEOS a degenerate clip window, which it refuses
+    if np.any(lo >= hi):
         return math.inf
     clip_a = shapely.clip_by_rect(a.polygon, lo[0], lo[1], hi[0], hi[1])
     if clip_a.is_empty:
