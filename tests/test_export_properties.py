@@ -395,11 +395,11 @@ def test_kinematic_drawing_rules_for_ternary_links_free_points_and_hinges():
               Body("again", {"D": (0.0, 0.0), "O": (-40.0, 0.0)}),
               Body("hinge2", {"H1": (0.0, 0.0), "H2": (0.0, 0.0), "N": (0.0, 0.2)}))
     joints = [SimpleNamespace(name=n) for n in ("O", "D", "A", "B", "C", "F", "O2", "E", "H1", "H2")]
-    poses = {"base": np.zeros(3), "tri": np.array([200.0, 0.0, 0.0]), "pad": np.array([0.0, -30.0, 0.0]),
+    poses = {"base": np.zeros(3), "tri": np.array([200.0, 0.0, 0.0]), "pad": np.array([-20.0, -30.0, 0.0]),
              "hinge": np.zeros(3), "again": np.array([40.0, 0.0, 0.0]), "hinge2": np.array([10.0, -10.0, 0.0])}
     doc = ezdxf.read(io.StringIO(kinematic_dxf(SimpleNamespace(bodies=bodies, joints=joints), poses).decode()))
     msp = doc.modelspace()
-    text_h = round(230.0 / 60.0, 3)  # span: the larger extent, x from 0 to 230 (y: -30 to 15)
+    text_h = round(250.0 / 60.0, 3)  # span: the larger extent, x from -20 to 230 (y: -30 to 15)
     lengths = sorted(round(math.hypot(e.dxf.end.x - e.dxf.start.x, e.dxf.end.y - e.dxf.start.y), 6)
                      for e in msp.query('LINE[layer=="LINKS"]'))
     # O-D once (two bodies have it), all six pairs of the quaternary link A-B-C-F (not its free point R),
@@ -430,6 +430,7 @@ def test_kinematic_drawing_rules_for_ternary_links_free_points_and_hinges():
     assert (d_label.dxf.halign, d_label.dxf.valign) == (0, 1)  # BOTTOM_LEFT
     np.testing.assert_allclose([d_label.dxf.align_point.x, d_label.dxf.align_point.y], [40 + text_h, text_h])
     assert style.dxf.dimlfac == 1.0
+    assert all(d.dxf.dimstyle == "FABRICATE" for d in dims)
     for d in (d for d in dims if d.dimtype == 6):  # ordinate leaders run 4 text heights down / left
         p2, p3 = np.array([d.dxf.defpoint2.x, d.dxf.defpoint2.y]), np.array([d.dxf.defpoint3.x, d.dxf.defpoint3.y])
         expected = [0.0, -4 * text_h] if d.dxf.dimtype & 64 else [-4 * text_h, 0.0]
@@ -458,6 +459,10 @@ def test_segment_style_and_minimum_text():
     sheet = read(sheet_dxf([part], KERF, layout, (120.0, 60.0), 0, style))
     assert not any(np.array(e.get_points("xyb"))[:, 2].any() for e in sheet.query('LWPOLYLINE[layer=="CUT"]'))
     assert len(sheet.query("TEXT")) == 0
+    # a label exactly at the process minimum is kept
+    (text,) = read(part_dxf(part, KERF)).query("TEXT")
+    at_minimum = DxfStyle(min_text_mm=text.dxf.height)
+    assert len(read(part_dxf(part, KERF, at_minimum)).query("TEXT")) == 1
 
 
 def test_sheet_dxf_border_is_closed_and_parts_match_placements():
