@@ -8,7 +8,6 @@ text. Each mutation must end in ``main([...])`` returning 0, 1 or 2, with no "Tr
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from pathlib import Path
@@ -19,41 +18,11 @@ from hypothesis import strategies as st
 
 from fabricate.cli import main
 from fabricate.spec import parse_toml, shipped_templates
+from tests.toml_writer import toml_text
 
 TEMPLATES = {p.name: p.read_text(encoding="utf-8") for p in shipped_templates()}
 #: A build that validates can still take the whole pipeline (a few seconds to ~20 s on two cores).
 MAX_SECONDS = 120.0
-
-
-def _value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, float) and not math.isfinite(v):
-        return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
-    if isinstance(v, (int, float)):
-        return repr(v)
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, list):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    return "{" + ", ".join(f"{json.dumps(k)} = {_value(x)}" for k, x in v.items()) + "}"
-
-
-def _toml(data: dict[str, Any]) -> str:
-    lines: list[str] = []
-
-    def table(prefix: str, d: dict[str, Any]) -> None:
-        if prefix:
-            lines.append(f"[{prefix}]")
-        for k, v in d.items():
-            if not isinstance(v, dict):
-                lines.append(f"{json.dumps(k)} = {_value(v)}")
-        for k, v in d.items():
-            if isinstance(v, dict):
-                table(f"{prefix}.{json.dumps(k)}" if prefix else json.dumps(k), v)
-
-    table("", data)
-    return "\n".join(lines) + "\n"
 
 
 def _leaves(d: dict[str, Any], prefix: tuple = ()) -> list[tuple]:
@@ -124,7 +93,7 @@ def mutated(draw: st.DrawFn) -> str:
             _set(data, path, int(scaled) if isinstance(current, int) and abs(scaled) < 2**63 else scaled)
         else:
             _set(data, path, draw(st.sampled_from(SPECIALS)))
-    return _toml(data)
+    return toml_text(data)
 
 
 @settings(max_examples=30, deadline=None, derandomize=True,

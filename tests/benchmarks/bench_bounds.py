@@ -13,15 +13,17 @@ Run: ``python tests/benchmarks/bench_bounds.py [kind ...]`` (not part of the tes
 from __future__ import annotations
 
 import json
-import math
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 from typing import Any
 
-from fabricate import bounds
-from fabricate.spec import TEMPLATE_DIR, parse_toml
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository: tests/ helpers
+
+from fabricate import bounds  # noqa: E402
+from fabricate.spec import TEMPLATE_DIR, parse_toml  # noqa: E402
+from tests.toml_writer import toml_text  # noqa: E402
 
 #: Wrapper run in its own process: times one build and reads its peak RSS (kB on Linux).
 WRAPPER = """
@@ -74,40 +76,6 @@ WORST: dict[str, tuple[str, dict[tuple[str, str], Any]]] = {
         ("drive", "fingers"): 12,
     }),
 }
-
-
-def _value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, float) and not math.isfinite(v):
-        return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
-    if isinstance(v, (int, float)):
-        return repr(v)
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, list):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{json.dumps(k)} = {_value(x)}" for k, x in v.items()) + "}"
-    raise TypeError(type(v))
-
-
-def toml_text(data: dict[str, Any]) -> str:
-    """A TOML document of nested tables (enough for templates: scalars, lists, tables)."""
-    lines: list[str] = []
-
-    def table(prefix: str, d: dict[str, Any]) -> None:
-        if prefix:
-            lines.append(f"[{prefix}]")
-        for k, v in d.items():
-            if not isinstance(v, dict):
-                lines.append(f"{json.dumps(k)} = {_value(v)}")
-        for k, v in d.items():
-            if isinstance(v, dict):
-                table(f"{prefix}.{json.dumps(k)}" if prefix else json.dumps(k), v)
-
-    table("", data)
-    return "\n".join(lines) + "\n"
 
 
 def worst_template(kind: str) -> str:
