@@ -232,19 +232,64 @@ def test_concurrent_writers_are_serialised(tmp_path):
     assert _siblings(tmp_path) == ["out"]  # no temporary, old or lock file left
 
 
+CTRL_C_CHILD = """
+import pathlib, sys, time
+import fabricate.pipeline as pipeline
+real = pipeline._build_stages
+def held(*args, **kwargs):  # the build is inside its stages (parts, exports) when Ctrl-C comes
+    pathlib.Path(sys.argv[1]).touch()
+    time.sleep(120)
+    return real(*args, **kwargs)
+pipeline._build_stages = held
+from fabricate.cli import main
+sys.exit(main(["build", "gear_pair_elliptic", "-o", sys.argv[2]]))
+"""
+
+
 def test_ctrl_c_exits_130_with_one_line_and_the_previous_output_intact(tmp_path):
     out = tmp_path / "out"
     write_output(fake_output("a"), out)
-    child = subprocess.Popen([sys.executable, "-m", "fabricate", "build", "finger_five_bar_ncg", "-o", str(out)],
+    marker = tmp_path / "inside"
+    child = subprocess.Popen([sys.executable, "-c", CTRL_C_CHILD, str(marker), str(out)],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(2.5)  # inside synthesis or later (a build takes several seconds)
+    deadline = time.monotonic() + 120
+    while not marker.exists():  # wait until the build is under way: no race with a fast machine
+        assert child.poll() is None and time.monotonic() < deadline, child.communicate()
+        time.sleep(0.05)
     child.send_signal(signal.SIGINT)
     stdout, stderr = child.communicate(timeout=60)
     assert child.returncode == 130, (stdout, stderr)
     assert "Traceback" not in stderr and len(stderr.strip().splitlines()) == 1
     assert "interrupted" in stderr
     assert _tree(out) == fake_output("a")
-    assert _siblings(tmp_path) == ["out"]
+    assert sorted(_siblings(tmp_path)) == ["inside", "out"]
+
+
+def test_ctrl_c_during_the_ocp_import_stays_a_ctrl_c(monkeypatch):
+    """pybind11 turns an exception in a module's init into ImportError; a KeyboardInterrupt behind one must
+    not read as "OCP is not installed"."""
+    import builtins
+
+    import fabricate.export.step as step
+
+    real_import = builtins.__import__
+
+    def interrupted(name, *args, **kwargs):
+        if name.startswith("OCP"):
+            try:
+                raise KeyboardInterrupt
+            except KeyboardInterrupt as exc:
+                raise ImportError("initialization failed") from exc
+        return real_import(name, *args, **kwargs)
+
+    step.step_available.cache_clear()
+    monkeypatch.setattr(builtins, "__import__", interrupted)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            step.step_available()
+    finally:
+        monkeypatch.undo()
+        step.step_available.cache_clear()
 
 
 def test_check_output_dir_accepts_new_and_empty_folders(tmp_path):

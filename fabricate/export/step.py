@@ -94,7 +94,14 @@ def step_available() -> bool:
     """Whether OCP (the optional extra ``cad``) can be imported, so STEP files can be written."""
     try:
         import OCP.STEPCAFControl  # noqa: F401
-    except ImportError:
+    except ImportError as exc:
+        # pybind11 reports any exception during a module's init as an ImportError: a Ctrl-C that lands in
+        # this (slow) import must stay a Ctrl-C, not become "OCP is not installed" (and be cached as such)
+        cause = exc.__cause__ or exc.__context__
+        while cause is not None:
+            if isinstance(cause, KeyboardInterrupt):
+                raise cause from None
+            cause = cause.__cause__ or cause.__context__
         return False
     return True
 
