@@ -122,7 +122,7 @@ def _kernel_failures() -> tuple[type[BaseException], ...]:
 
     from fabricate.errors import GeometryError
 
-    return (GeometryError, np.linalg.LinAlgError, shapely.errors.GEOSException, shapely.errors.ShapelyError,
+    return (GeometryError, np.linalg.LinAlgError, shapely.errors.ShapelyError,  # GEOSException is one
             FloatingPointError, OverflowError, ZeroDivisionError, ValueError)
 
 

@@ -25,6 +25,7 @@ from pathlib import Path, PurePosixPath
 from typing import Any
 
 from fabricate.errors import SpecError
+from fabricate.export import copy_name
 from fabricate.output import REPORT, foreign_entries
 
 #: Relative tolerance of a mesh volume against the report (the report rounds to 1e-4 mm^3; meshes carry
@@ -98,7 +99,7 @@ def _expected_by_file(report: Mapping[str, Any]) -> dict[str, Any]:
         for key, target in (("plate", plates), ("sheet", sheets)):
             indices = part.get(key, {}).get("index", []) if isinstance(part.get(key), dict) else []
             for k, number in enumerate(indices if isinstance(indices, list) else []):
-                name = part["name"] if copies == 1 else f"{part['name']} ({k + 1} of {copies})"
+                name = copy_name(part["name"], k, copies)
                 if key == "plate":
                     target.setdefault(number, []).append((name, float(volume or 0.0)))
                 else:

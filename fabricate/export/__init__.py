@@ -113,7 +113,7 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     spec = design.parts
     parts = list(partset.parts)
     copies = max(1, int(getattr(partset, "copies", 1) or 1))
-    laser = is_laser(process)
+    laser = process.name == "laser"  # cut sheets, else print plates
     kerf = process.kerf_mm
     min_text = float(getattr(process, "min_text_mm", 0.0))
     arcs = getattr(process, "arcs", "bulge")
@@ -178,7 +178,7 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
                                                              colours=colours)
         else:
             meshes = [placed_flat_mesh(part, cache, pl) for part, pl, _ in on_it]
-            names = [_copy_name(part.name, k % copies, copies) for part, _, k in on_it]
+            names = [copy_name(part.name, k % copies, copies) for part, _, k in on_it]
             files[f"plates/plate_{number + 1}.stl"] = plate_stl(meshes)
             files[f"plates/plate_{number + 1}.3mf"] = model_3mf(
                 [(name, *mesh) for name, mesh in zip(names, meshes, strict=True)], f"{design.name} plate {number + 1}")
@@ -193,12 +193,8 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     return files, entries
 
 
-def is_laser(process: Any) -> bool:
-    """Whether a process cuts sheets (kerf-compensated cut files, nested sheets) rather than prints."""
-    return process.name == "laser"
-
-
-def _copy_name(name: str, index: int, copies: int) -> str:
+def copy_name(name: str, index: int, copies: int) -> str:
+    """How a plate's 3MF names copy ``index`` (from 0) of a part made ``copies`` times."""
     return name if copies == 1 else f"{name} ({index + 1} of {copies})"
 
 
