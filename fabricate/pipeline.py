@@ -165,6 +165,8 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
     from fabricate.gears import build_gear_pairs
     from fabricate.parts.assembly import assembly_steps, pin_stacks, stacks_report
     from fabricate.parts.build import build_parts
+    from fabricate.strength.check import run_strength
+    from fabricate.strength.plots import strength_plot
 
     def enter(name: str) -> None:
         stage[0] = name
@@ -197,8 +199,14 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
         failures = list(checks.failures)
         for pair in gear_pairs:
             failures += [f"gear {pair.name}: {text}" for text in pair.failures()]
+        enter("strength")
+        strength = run_strength(design, partset, mechanism, motion, gear_pairs, result.parts)
+        report["strength"] = strength.report()
+        failures += strength.failures()
         report["checks"] = {"passed": not failures, "failures": failures}
         enter("plots")
+        if strength.findings:
+            files["plots/strength.png"] = strength_plot(strength, mechanism.input_unit)
         for name, data in sorted(checks.figures().items()):
             files[f"plots/{name}"] = data
         files.update(pictures.result())

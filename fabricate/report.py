@@ -111,6 +111,9 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
     inter = report.get("interference", {})
     if inter:
         out += interference_markdown(inter)
+    strength = report.get("strength", {})
+    if strength:
+        out += strength_markdown(strength)
     if images:
         out += ["## Pictures", ""]
         out += [f"![{path}]({path})" for path in images] + [""]
@@ -181,3 +184,19 @@ def interference_markdown(inter: Mapping[str, Any]) -> list[str]:
                         p.get("required_mm"), margin(p)[1], p.get("at_input", p.get("input_deg")), p.get("ok")]
                        for p in sorted(pairs, key=margin)]) + [""]
     return out
+
+
+def strength_markdown(strength: Mapping[str, Any]) -> list[str]:
+    """report.md's strength section: the loads, then one row per part and pin, weakest first."""
+    verdict = "passed" if strength.get("passed") else "FAILED"
+    out = ["## Strength", "",
+           f"Every part and pin at the design load over the whole motion: {verdict} (safety factor = allowable / "
+           f"stress, required {_fmt(strength.get('required_safety_factor'))}).", ""]
+    loads = strength.get("loads") or ["no load stated ([load] in the template)"]
+    out += ["Loads: " + "; ".join(loads) + ".", ""]
+    rows = sorted(strength.get("parts", []), key=lambda p: p.get("min_safety_factor", 0.0))
+    out += _table(["part", "safety factor", "governing feature", "load", "at input", "stress MPa", "allowable MPa"],
+                  [[p.get("name"), p.get("min_safety_factor"), p.get("feature"), p.get("input"), p.get("pose_input"),
+                    p.get("stress_MPa"), p.get("allowable_MPa")] for p in rows]) + [""]
+    out += [f"- {note}" for note in strength.get("notes", [])]
+    return out + ([""] if strength.get("notes") else [])

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -349,6 +349,16 @@ class ProcessSpec:
     arcs: str = "bulge"
     cut_colour: str = "#ff0000"
     engrave_colour: str = "#0000ff"
+    materials: Mapping[str, Any] = field(default_factory=dict, compare=False)
+    pin_material: str = ""
+
+    def part_material(self) -> Any:
+        """The :class:`~fabricate.strength.spec.Material` of the parts (None if the profile has none)."""
+        return self.materials.get(self.material)
+
+    def pin_material_spec(self) -> Any:
+        """The :class:`~fabricate.strength.spec.Material` of the dowel pins (None if not given)."""
+        return self.materials.get(self.pin_material)
 
 
 @dataclass(frozen=True)
@@ -406,6 +416,15 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
                 merged[key] = table.data[key]
     t = Table(merged, path)
     method = t.string("method", profile if override is None else _MISSING, choices=("sla", "laser"))
+    from fabricate.strength.spec import parse_materials, pick_material
+
+    materials = parse_materials(t.table("materials", {}))
+    material = t.string("material", "")
+    pin_material = t.string("pin_material", "")
+    density = 1.2
+    if materials:
+        density = pick_material(materials, material, t.field("material")).density_g_cm3
+        pick_material(materials, pin_material, t.field("pin_material"))
     # every length is bounded (bounds.MAX_LENGTH_MM and tighter where the process makes sense): a
     # huge pin or wall turns into geometry no kernel can build; the chord tolerance's lower bound
     # caps the vertex count of every polygonised arc (memory and time grow as 1/sqrt(tolerance))
@@ -422,12 +441,14 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
         build_volume_mm=tuple(t.array("build_volume_mm", shape=(3,), positive=True, max=10000.0).tolist()),
         pin_diameter_mm=t.number("pin_diameter_mm", positive=True, max=50.0),
         chord_tolerance_mm=t.number("chord_tolerance_mm", 0.005, min=MIN_CHORD_TOLERANCE_MM, max=1.0),
-        material=t.string("material", ""),
-        density_g_cm3=t.number("density_g_cm3", 1.2, positive=True, max=25.0),
+        material=material,
+        density_g_cm3=t.number("density_g_cm3", density, positive=True, max=25.0),
         min_text_mm=t.number("min_text_mm", 1.0, min=0.0, max=20.0),
         arcs=t.string("arcs", "bulge", choices=("bulge", "segments")),
         cut_colour=_colour(t, "cut_colour", "#ff0000"),
         engrave_colour=_colour(t, "engrave_colour", "#0000ff"),
+        materials=materials,
+        pin_material=pin_material,
     )
     t.finish()
     if spec.pin_diameter_mm < spec.min_pin_mm:
@@ -449,6 +470,7 @@ class ChecksSpec:
 
     sweep_poses: int = 360
     min_clearance_mm: float | None = None  # None: the process's running clearance
+    min_safety_factor: float = 2.0  # every part's strength: allowable stress / stress at the design load
 
 
 def parse_checks(table: Table) -> ChecksSpec:
@@ -458,6 +480,7 @@ def parse_checks(table: Table) -> ChecksSpec:
     spec = ChecksSpec(
         sweep_poses=table.integer("sweep_poses", 360, min=2, max=MAX_SWEEP_POSES),
         min_clearance_mm=table.number("min_clearance_mm", None, min=0.0, max=50.0),
+        min_safety_factor=table.number("min_safety_factor", 2.0, min=1.0, max=20.0),
     )
     table.finish()
     return spec
@@ -497,6 +520,7 @@ class DesignSpec:
     method: Any
     template_text: str = ""
     process_override: ProcessOverride | None = None
+    load: Any = None
 
 
 def load_design(path: str | Path, process: str | ProcessOverride | None = None) -> DesignSpec:
@@ -541,6 +565,9 @@ def design_from_text(text: str, path: str | Path, process: ProcessOverride | Non
     checks = parse_checks(root.table("checks", {}))
     gears = parse_gear_spec(root.table("gears", {}))
     parts = parse_parts_spec(root.table("parts", {}))
+    from fabricate.strength.spec import parse_load
+
+    load = parse_load(root.table("load", {}))
     method = KINDS[kind].parse_spec(root)
     root.finish()
     bore = getattr(gears, "bore_mm", None)
@@ -551,7 +578,7 @@ def design_from_text(text: str, path: str | Path, process: ProcessOverride | Non
                                          "the gears turn on; set process.pin_diameter_mm to it or leave bore_mm out")
     spec = DesignSpec(name=name, kind=kind, description=description, template=path, process=process_spec,
                       checks=checks, gears=gears, parts=parts, method=method, template_text=text,
-                      process_override=process)
+                      process_override=process, load=load)
     from fabricate.bounds import preflight
 
     preflight(spec)  # counts whose product drives memory or time (each field alone is already bounded)

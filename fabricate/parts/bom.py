@@ -184,8 +184,14 @@ def part_rows(parts: Sequence[Any], process: Any, copies: int = 1) -> list[dict[
     for part in parts:
         volume = float(part.volume_mm3())
         rows.append({"item": part.name, "kind": kind, "qty": copies, "process": process.name,
-                     "material": process.material, "thickness_mm": round(float(part.thickness_mm), 4),
+                     "material": _material_name(process), "thickness_mm": round(float(part.thickness_mm), 4),
                      "volume_mm3": round(volume, 4), "mass_g": round(volume * process.density_g_cm3 / 1000.0, 6),
                      "joints": sorted({h.joint for h in part.holes}),
-                     "description": f"{part.role} part, {process.material or process.name}"})
+                     "description": f"{part.role} part, {_material_name(process) or process.name}"})
     return rows
+
+
+def _material_name(process: Any) -> str:
+    """The part material for people: the profile material's name, else its key."""
+    material = process.part_material() if hasattr(process, "part_material") else None
+    return material.name if material is not None else process.material

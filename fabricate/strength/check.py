@@ -1,0 +1,510 @@
+"""The strength check: every part and pin at its design load, over the whole motion.
+
+Loads (:func:`design_loads`) come from the template's ``[load]`` and the synthesis' springs; the joint
+reactions, gear torques and driver efforts at every pose from :func:`~fabricate.strength.statics.solve_statics`.
+Each part then gets the closed-form models of :mod:`fabricate.strength.models`, each with its governing
+pose:
+
+- pins: shear (single or double, from the real stack on the pin) and bending (the stack's plate
+  thicknesses and gaps);
+- holes: bearing, tear-out (edge distance along the load, measured on the part's outline) and the
+  net section across a pin-loaded hole (with its stress concentration);
+- links: tension and in-plane bending at and between the holes, on sections cut from the part's real
+  outline (free body: every load on one side of the cut), with the open-hole concentration at a hole;
+- gears: Lewis root bending with the form factor of the equivalent spur gear of the sharpest pitch-curve
+  curvature, and Hertz contact at the pitch point, from the transmitted torque.
+
+Safety factor = allowable / stress; a part below ``[checks] min_safety_factor`` fails the build with the
+part, the feature, the load that governs and what would fix it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import shapely
+
+from fabricate.errors import GeometryError
+from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
+from fabricate.planar import rotation
+from fabricate.strength import models
+from fabricate.strength.section import cut_section
+from fabricate.strength.statics import BodyTorque, DriverEffort, PointForce, Statics, solve_statics
+
+#: Directions at which each hole's edge distance is measured (interpolated between them).
+_EDGE_DIRECTIONS = 72
+
+
+@dataclass
+class Finding:
+    """The governing stress of one feature of one part."""
+
+    part: str
+    feature: str
+    kind: str  # pin, hole, link, gear
+    stress_MPa: float
+    allowable_MPa: float
+    pose: int
+    load: str
+    fix: str
+    curve: np.ndarray | None = None  # stress (MPa) at every pose, for the plot
+
+    @property
+    def safety_factor(self) -> float:
+        return models.safety_factor(self.allowable_MPa, self.stress_MPa)
+
+
+@dataclass(frozen=True)
+class Loads:
+    """Applied loads over the motion and what they are, for people."""
+
+    forces: tuple[PointForce, ...]
+    torques: tuple[BodyTorque, ...]
+    efforts: tuple[DriverEffort, ...]
+    described: tuple[str, ...]
+
+
+@dataclass
+class StrengthResult:
+    """Findings, the statics they come from and the report section."""
+
+    findings: list[Finding]
+    statics: Statics | None
+    min_safety_factor: float
+    inputs: np.ndarray
+    curves: dict[str, np.ndarray] = field(default_factory=dict)
+    loads: tuple[str, ...] = ()
+    notes: list[str] = field(default_factory=list)
+
+    def per_part(self) -> dict[str, Finding]:
+        worst: dict[str, Finding] = {}
+        for f in self.findings:
+            if f.part not in worst or f.safety_factor < worst[f.part].safety_factor:
+                worst[f.part] = f
+        return worst
+
+    @property
+    def passed(self) -> bool:
+        return all(f.safety_factor >= self.min_safety_factor for f in self.findings)
+
+    def failures(self) -> list[str]:
+        out = []
+        for name, f in sorted(self.per_part().items(), key=lambda kv: kv[1].safety_factor):
+            if f.safety_factor >= self.min_safety_factor:
+                continue
+            out.append(f"strength: part {name}, {f.feature}: {f.stress_MPa:.1f} MPa under {f.load} at input "
+                       f"{self.inputs[f.pose]:.4g} gives a safety factor {f.safety_factor:.2f} < "
+                       f"{self.min_safety_factor:g} (allowable {f.allowable_MPa:g} MPa); {f.fix}")
+        return out
+
+    def report(self) -> dict[str, Any]:
+        parts = []
+        for name, f in sorted(self.per_part().items()):
+            parts.append({"name": name, "min_safety_factor": _round(f.safety_factor), "feature": f.feature,
+                          "input": f.load, "pose_input": _round(float(self.inputs[f.pose])),
+                          "stress_MPa": _round(f.stress_MPa), "allowable_MPa": _round(f.allowable_MPa),
+                          "fix": f.fix})
+        return {"passed": self.passed, "required_safety_factor": self.min_safety_factor,
+                "loads": list(self.loads), "parts": parts, "notes": list(self.notes)}
+
+
+def _round(x: float) -> float:
+    return float(f"{x:.6g}") if math.isfinite(x) else x
+
+
+# -- loads -----------------------------------------------------------------------------------------
+
+def _unit_rows(v: np.ndarray) -> np.ndarray:
+    """Rows of ``v`` (n, 2) scaled to unit length; a zero row takes its nearest non-zero neighbour."""
+    norm = np.hypot(v[:, 0], v[:, 1])
+    ok = norm > 1e-12 * max(1.0, float(norm.max(initial=0.0)))
+    if not ok.any():
+        raise GeometryError("strength: the tip point does not move, so the tip load has no direction")
+    good = np.flatnonzero(ok)
+    nearest = good[np.clip(np.searchsorted(good, np.arange(len(v))), 0, len(good) - 1)]
+    src = np.where(ok, np.arange(len(v)), nearest)
+    return v[src] / norm[src][:, None]
+
+
+def _joint_between(mechanism: Mechanism, a: str, b: str) -> Revolute | None:
+    for j in mechanism.joints:
+        if isinstance(j, Revolute) and {j.body_a, j.body_b} == {a, b}:
+            return j
+    return None
+
+
+def design_loads(design: Any, mechanism: Mechanism, motion: Motion, hints: Mapping[str, Any]) -> Loads:
+    """The template's ``[load]`` and the synthesis' springs as loads over the motion."""
+    load = design.load
+    forces: list[PointForce] = []
+    torques: list[BodyTorque] = []
+    efforts: list[DriverEffort] = []
+    said: list[str] = []
+    n = len(motion.inputs)
+    if load.tip_force_N > 0.0:
+        point = load.tip_point or hints.get("tip_point")
+        if not point or point not in mechanism.point_names():
+            raise GeometryError(f"strength: load.tip_point {point!r} is not a named point of the mechanism")
+        owners = [b for b, pad in (hints.get("pads") or {}).items() if pad.get("point") == point]
+        body = owners[0] if owners else mechanism.point_owner(point)
+        path = motion.point(point, body)
+        velocity = np.gradient(path, motion.inputs, axis=0)
+        forces.append(PointForce(body, mechanism.body(body).point(point),
+                                 -load.tip_force_N * _unit_rows(velocity), name=f"tip force at {point}"))
+        said.append(f"tip force {load.tip_force_N:g} N at {point}, opposing its motion")
+    if load.springs:
+        for spring in hints.get("springs", ()) or ():
+            rate = float(spring.get("rate_Nmm_per_deg") or 0.0)
+            joint = next((j for j in mechanism.joints if j.name == spring.get("joint")), None)
+            if rate <= 0.0 or not isinstance(joint, Revolute):
+                continue
+            rel = np.degrees(motion.relative_angle(joint.body_b, joint.body_a))
+            sense = 1.0 if rel[-1] >= rel[0] else -1.0
+            deflection = float(spring.get("preload_deg") or 0.0) + sense * (rel - rel[0])
+            # a return spring resists the closing: the torque on body_b is against its relative turn
+            torques.append(BodyTorque(joint.body_b, joint.body_a, -sense * rate * np.maximum(deflection, 0.0),
+                                      joint=joint.name))
+            said.append(f"spring at {joint.name}, {rate:g} N·mm/° from {float(spring.get('preload_deg') or 0):g}° "
+                        f"preload (up to {rate * float(np.max(deflection)):.0f} N·mm)")
+    if (load.input_force_N or load.input_torque_Nmm) and mechanism.drivers:
+        driver = mechanism.drivers[0]
+        value = load.input_force_N if driver.kind == "slide" else load.input_torque_Nmm
+        if value == 0.0:
+            field_name = "input_torque_Nmm" if driver.kind == "angle" else "input_force_N"
+            raise GeometryError(f"strength: the first driver is a{'n angle' if driver.kind == 'angle' else ' slide'}; "
+                                f"give load.{field_name}")
+        # the actuator pushes the way the motion goes
+        if driver.law is not None:
+            slope = np.asarray(driver.law(motion.inputs, 1), dtype=np.float64)
+        else:
+            slope = np.ones(n)
+        sign = np.sign(np.where(slope == 0.0, 1.0, slope)) * np.sign(motion.inputs[-1] - motion.inputs[0] or 1.0)
+        efforts.append(DriverEffort(0, value * sign))
+        unit = "N" if driver.kind == "slide" else "N·mm"
+        said.append(f"actuator {value:g} {unit} on the input")
+    return Loads(tuple(forces), tuple(torques), tuple(efforts), tuple(said))
+
+
+# -- the check ---------------------------------------------------------------------------------------
+
+def _on_body_local(force: np.ndarray, pose: np.ndarray) -> np.ndarray:
+    """World forces (n, 2) in a body's frame."""
+    return np.einsum("nji,nj->ni", rotation(pose[:, 2]), force)
+
+
+def _edge_distances(rings: list[np.ndarray], centre: np.ndarray, radius: float) -> np.ndarray:
+    """Distance (mm) from a hole's centre to the part's boundary along each of the test directions."""
+    polygon = shapely.Polygon(rings[0], rings[1:])
+    boundary = polygon.boundary
+    span = float(np.ptp(rings[0], axis=0).max()) * 2.0 + 10.0
+    out = np.empty(_EDGE_DIRECTIONS)
+    for k in range(_EDGE_DIRECTIONS):
+        a = 2.0 * math.pi * k / _EDGE_DIRECTIONS
+        u = np.array([math.cos(a), math.sin(a)])
+        ray = shapely.LineString([centre + (radius + 1e-6) * u, centre + span * u])
+        hit = ray.intersection(boundary)
+        pts = shapely.get_coordinates(hit)
+        out[k] = float(np.min(np.hypot(*(pts - centre).T))) if len(pts) else span
+    return out
+
+
+def _edge_along(edges: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    ang = np.mod(np.arctan2(directions[:, 1], directions[:, 0]), 2.0 * math.pi)
+    pos = ang / (2.0 * math.pi) * _EDGE_DIRECTIONS
+    k0 = np.floor(pos).astype(int) % _EDGE_DIRECTIONS
+    k1 = (k0 + 1) % _EDGE_DIRECTIONS
+    # the least of the two neighbours: never optimistic between measured directions
+    return np.minimum(edges[k0], edges[k1])
+
+
+def body_loads(mechanism: Mechanism, motion: Motion, statics: Statics, loads: Loads
+               ) -> tuple[dict[str, list[tuple[np.ndarray, np.ndarray, str]]], dict[str, list[tuple[np.ndarray, str]]]]:
+    """Every load each body receives over the motion, in equilibrium body by body.
+
+    Returns
+    -------
+    point_loads : dict body -> list of (local point (2,) mm, world force (n, 2) N, joint name or '')
+        Joint reactions, applied forces, slide-driver and slider forces.
+    couples : dict body -> list of (torque (n,) N·mm, joint it acts at or '')
+        Springs and angle-driver efforts.
+    """
+    revolutes = {j.name: j for j in mechanism.joints if isinstance(j, Revolute)}
+    # forces each body receives: at its joints (pins), applied forces and couples, driver efforts
+    body_point_loads: dict[str, list[tuple[np.ndarray, np.ndarray, str]]] = {}  # body -> (local point, world F, at)
+    body_couples: dict[str, list[tuple[np.ndarray, str]]] = {}  # body -> (torque (n,), at joint)
+    for name, j in revolutes.items():
+        f = statics.joint_forces[name]
+        body_point_loads.setdefault(j.body_a, []).append((mechanism.body(j.body_a).point(name), f, name))
+        body_point_loads.setdefault(j.body_b, []).append((mechanism.body(j.body_b).point(name), -f, name))
+    for pf in loads.forces:
+        body_point_loads.setdefault(pf.body, []).append((np.asarray(pf.local), np.asarray(pf.force), ""))
+    for t in loads.torques:
+        body_couples.setdefault(t.body, []).append((np.asarray(t.torque), t.joint))
+        body_couples.setdefault(t.reaction, []).append((-np.asarray(t.torque), t.joint))
+    carried_all = statics.driver_efforts.copy()
+    for e in loads.efforts:
+        carried_all[:, e.index] += e.effort  # the actuator's known effort plus the multiplier's remainder
+    for k, d in enumerate(mechanism.drivers):
+        carried = carried_all[:, k]  # torque (angle) or force (slide) the driver puts on its body
+        if d.kind == "angle":
+            j = _joint_between(mechanism, d.body, d.reference)
+            body_couples.setdefault(d.body, []).append((carried, j.name if j else ""))
+            body_couples.setdefault(d.reference, []).append((-carried, j.name if j else ""))
+        else:
+            slider = next(s for s in mechanism.joints if isinstance(s, Slider) and s.name == d.joint)
+            axis = np.asarray(slider.axis, dtype=np.float64) / math.hypot(*slider.axis)
+            u = np.einsum("nij,j->ni", rotation(motion.pose(d.reference)[:, 2]), axis)
+            body_point_loads.setdefault(d.body, []).append(
+                (mechanism.body(d.body).point(d.joint), carried[:, None] * u, d.joint))
+            body_point_loads.setdefault(d.reference, []).append(
+                (mechanism.body(d.reference).point(d.joint), -carried[:, None] * u, d.joint))
+    for s in (j for j in mechanism.joints if isinstance(j, Slider)):
+        normal_local = np.array([-s.axis[1], s.axis[0]], dtype=np.float64) / math.hypot(*s.axis)
+        nw = np.einsum("nij,j->ni", rotation(motion.pose(s.body_a)[:, 2]), normal_local)
+        fn = statics.slider_forces[s.name][:, None] * nw
+        body_point_loads.setdefault(s.body_b, []).append((mechanism.body(s.body_b).point(s.name), fn, s.name))
+        body_point_loads.setdefault(s.body_a, []).append((mechanism.body(s.body_a).point(s.name), -fn, s.name))
+        lock = statics.slider_torques[s.name]
+        body_couples.setdefault(s.body_b, []).append((lock, s.name))
+        body_couples.setdefault(s.body_a, []).append((-lock, s.name))
+    for g in mechanism.gears:
+        # the coupling acts as torques (the tooth force's push on the axes is added at the pins)
+        lam = statics.gear_torques[g.name]
+        slope = np.asarray(g.law(motion.relative_angle(g.gear_a, g.carrier), 1), dtype=np.float64)
+        for body, coef, at in ((g.gear_b, 1.0, g.axis_b), (g.gear_a, -slope, g.axis_a),
+                               (g.carrier, slope - 1.0, g.axis_a)):
+            body_couples.setdefault(body, []).append((coef * lam, at))
+    return body_point_loads, body_couples
+
+
+def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion, gear_pairs: list[Any],
+                 hints: Mapping[str, Any]) -> StrengthResult:
+    """Every part and pin at the design load over ``motion``; see the module docstring."""
+    required = float(design.checks.min_safety_factor)
+    material = design.process.part_material()
+    pin_material = design.process.pin_material_spec()
+    result = StrengthResult([], None, required, np.asarray(motion.inputs))
+    if material is None or pin_material is None:
+        result.notes.append("no material data in the process profile: strength not checked")
+        return result
+    loads = design_loads(design, mechanism, motion, hints)
+    result.loads = loads.described
+    if not loads.described:
+        result.notes.append("the template states no [load]: strength checked at zero load")
+    statics = solve_statics(mechanism, motion, loads.forces, loads.torques, loads.efforts)
+    result.statics = statics
+    chord = partset.chord_tolerance_mm
+    parts = [p for p in partset.parts if p.role != "spacer"]
+    revolutes = {j.name: j for j in mechanism.joints if isinstance(j, Revolute)}
+    load_name = "; ".join(loads.described) or "no load"
+
+    body_point_loads, body_couples = body_loads(mechanism, motion, statics, loads)
+
+    # -- pins --------------------------------------------------------------------------------------
+    for pin in partset.pins:
+        joints = [j for j in pin.joint.split("+") if j in revolutes]
+        if not joints:
+            continue
+        force = np.zeros((len(motion.inputs), 2))
+        for j in joints:
+            force = force + statics.joint_forces[j] if len(joints) == 1 else np.maximum(
+                force, np.abs(statics.joint_forces[j]))
+        mag = np.hypot(force[:, 0], force[:, 1])
+        i = int(np.argmax(mag))
+        on_pin = sorted((p for p in parts if any(h.joint in joints for h in p.holes)), key=lambda p: p.z_mm)
+        if len(on_pin) < 2:
+            continue
+        body_a = revolutes[joints[0]].body_a
+        pairs = zip(on_pin, on_pin[1:], strict=False)
+        planes = sum(1 for lo, hi in pairs if (lo.body == body_a) != (hi.body == body_a))
+        planes = max(planes, 1)
+        d = float(pin.diameter_mm)
+        tau = np.asarray(models.pin_shear_stress(mag, d, planes), dtype=np.float64)
+        result.findings.append(Finding(f"pin {pin.joint}", f"pin shear ({'double' if planes >= 2 else 'single'})",
+                                       "pin", float(tau[i]), pin_material.shear_MPa, i,
+                                       f"{mag[i]:.1f} N at {pin.joint}", "a thicker pin (process.pin_diameter_mm)",
+                                       tau))
+        if planes >= 2 and len(on_pin) >= 3:
+            mid = on_pin[1]
+            outer = min(on_pin[0].thickness_mm, on_pin[2].thickness_mm)
+            gap = max(0.0, mid.z_mm - (on_pin[0].z_mm + on_pin[0].thickness_mm))
+            moment = models.pin_bending_moment_double_shear(mag, mid.thickness_mm, outer, gap)
+        else:
+            lo, hi = on_pin[0], on_pin[-1]
+            gap = max(0.0, hi.z_mm - (lo.z_mm + lo.thickness_mm))
+            moment = models.pin_bending_moment_single_shear(mag, lo.thickness_mm, hi.thickness_mm, gap)
+        sigma = np.asarray(models.pin_bending_stress(moment, d), dtype=np.float64)
+        result.findings.append(Finding(f"pin {pin.joint}", "pin bending", "pin", float(sigma[i]),
+                                       pin_material.flexural_MPa, i, f"{mag[i]:.1f} N at {pin.joint}",
+                                       "a thicker pin or a smaller layer gap", sigma))
+
+    # -- parts: holes and sections ---------------------------------------------------------------------
+    for part in parts:
+        share = sum(1 for p in parts if p.body == part.body) or 1
+        rings = part.polygons(chord)
+        pose = motion.pose(part.body)
+        t = part.thickness_mm
+        loads_local = []  # (local point, local force (n, 2), at joint)
+        for local, f, at in body_point_loads.get(part.body, []):
+            if at and at in revolutes and not any(h.joint == at for h in part.holes):
+                continue
+            loads_local.append((np.asarray(local, dtype=np.float64), _on_body_local(np.asarray(f) / share, pose), at))
+        couples = [(np.asarray(c) / share, at) for c, at in body_couples.get(part.body, [])]
+        holes = [h for h in part.holes if h.joint in revolutes]
+        for h in holes:
+            f = sum((lf for lp, lf, at in loads_local if at == h.joint), np.zeros((len(motion.inputs), 2)))
+            mag = np.hypot(f[:, 0], f[:, 1])
+            if not np.any(mag > 0):
+                continue
+            i = int(np.argmax(mag))
+            pin_d = h.pin_diameter_mm or h.diameter_mm
+            bearing = np.asarray(models.bearing_stress(mag, pin_d, t), dtype=np.float64)
+            result.findings.append(Finding(part.name, f"hole {h.joint} bearing", "hole", float(bearing[i]),
+                                           material.compressive_MPa, i, f"{mag[i]:.1f} N at {h.joint}",
+                                           "a thicker plate (process.thickness_mm) or a larger pin", bearing))
+            edges = _edge_distances(rings, h.centre, 0.5 * h.diameter_mm)
+            unit = f / np.maximum(mag, 1e-300)[:, None]
+            e = _edge_along(edges, unit)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                tear = np.array([models.tearout_stress(mag[k], e[k], h.diameter_mm, t)
+                                 if e[k] > 0.5 * h.diameter_mm else math.inf for k in range(len(mag))])
+            k = int(np.argmax(tear))
+            result.findings.append(Finding(part.name, f"hole {h.joint} tear-out", "hole", float(tear[k]),
+                                           material.shear_MPa, k,
+                                           f"{mag[k]:.1f} N at {h.joint} (edge {e[k]:.2f} mm)",
+                                           "more material round the hole (parts.boss_wall_mm / link_width_mm)",
+                                           tear))
+            # the net section across a pin-loaded hole, square to the load
+            worst = (0.0, 0, 0.0)
+            for k in np.unique([i, int(np.argmax(tear))]):
+                u = unit[k]
+                try:
+                    sec = cut_section(rings, h.centre, np.array([-u[1], u[0]]), t)
+                except GeometryError:
+                    continue
+                kt = models.hole_stress_concentration(h.diameter_mm, sec.width_mm + h.diameter_mm, True)
+                s = kt * mag[k] / sec.area_mm2
+                if s > worst[0]:
+                    worst = (s, int(k), kt)
+            if worst[0] > 0:
+                k = worst[1]
+                result.findings.append(Finding(part.name, f"net section at hole {h.joint} (Kt {worst[2]:.2f})",
+                                               "link", worst[0], material.tensile_MPa, k,
+                                               f"{mag[k]:.1f} N at {h.joint}",
+                                               "a wider link (parts.link_width_mm) or a thicker plate"))
+        # sections at and between every pair of holes: free body on one side of the cut
+        for a_idx in range(len(holes)):
+            for b_idx in range(a_idx + 1, len(holes)):
+                ha, hb = holes[a_idx], holes[b_idx]
+                axis = hb.centre - ha.centre
+                length = float(np.hypot(*axis))
+                if length < 1e-9:
+                    continue
+                u = axis / length
+                for station in (0.0, 0.25, 0.5, 0.75, 1.0):
+                    point = ha.centre + station * axis
+                    try:
+                        sec = cut_section(rings, point, np.array([-u[1], u[0]]), t)
+                    except GeometryError:
+                        continue
+                    finding = _section_finding(part, sec, point, u, station, ha, hb, loads_local, couples,
+                                               material, load_name)
+                    if finding is not None:
+                        result.findings.append(finding)
+
+    # -- gears -------------------------------------------------------------------------------------
+    for pair in gear_pairs:
+        if pair.coupling not in statics.gear_torques:
+            continue
+        _gear_findings(result, pair, statics.gear_torques[pair.coupling], mechanism, motion, parts, material)
+    result.curves = {"inputs": np.asarray(motion.inputs)}
+    for name, f in statics.joint_forces.items():
+        result.curves[f"joint {name} (N)"] = np.hypot(f[:, 0], f[:, 1])
+    return result
+
+
+def _section_finding(part, sec, point, u, station, ha, hb, loads_local, couples, material, load_name):
+    """Tension + bending on one cut of a part (``u`` the link axis, the cut square to it)."""
+    n = next(iter(lf for _, lf, _ in loads_local)).shape[0] if loads_local else 0
+    if n == 0:
+        return None
+    force = np.zeros((n, 2))
+    moment = np.zeros(n)
+    c = sec.centroid_mm
+    for lp, lf, at in loads_local:
+        side = float(np.dot(lp - point, u))
+        # the cut through a hole's centre puts that hole's own load on the far side
+        if side < -1e-9 or (abs(side) <= 1e-9 and at and at == ha.joint and station == 1.0):
+            force += lf
+            arm = lp - c
+            moment += arm[0] * lf[:, 1] - arm[1] * lf[:, 0]
+    for torque, at in couples:
+        spot = ha.centre if at == ha.joint else hb.centre if at == hb.joint else None
+        if spot is None:
+            continue
+        side = float(np.dot(spot - point, u))
+        if side < -1e-9 or (abs(side) <= 1e-9 and station == 0.0):
+            moment += torque
+    axial = force @ u
+    at_hole = station in (0.0, 1.0)
+    hole = ha if station == 0.0 else hb
+    kt = models.hole_stress_concentration(hole.diameter_mm, sec.width_mm + hole.diameter_mm, False) if at_hole else 1.0
+    stress = np.array([models.net_section_stress(axial[k], moment[k], sec, kt) for k in range(n)])
+    k = int(np.argmax(stress))
+    where = f"at hole {hole.joint}" if at_hole else f"between {ha.joint} and {hb.joint} ({station:.2f})"
+    allowable = material.flexural_MPa if abs(moment[k]) * sec.extreme_fibre_mm / sec.inertia_mm4 > abs(
+        axial[k]) / sec.area_mm2 else material.tensile_MPa
+    return Finding(part.name, f"section {where}: N {axial[k]:.1f} N, M {moment[k]:.0f} N·mm"
+                   + (f" (Kt {kt:.2f})" if at_hole else ""), "link", float(stress[k]), allowable, k, load_name,
+                   "a wider link (parts.link_width_mm) or a thicker plate (process.thickness_mm)", stress)
+
+
+def _gear_findings(result, pair, torque_b, mechanism, motion, parts, material) -> None:
+    """Lewis bending and Hertz contact of one gear pair under the statics' torque."""
+    xa = motion.relative_angle(pair.body_a, pair.carrier)
+    ratio = np.abs(np.asarray(pair.law(xa, 1), dtype=np.float64))
+    a = pair.center_distance_mm
+    r_b = a / (1.0 + ratio)  # pitch radius of gear b at the contact (external pair: r_a + r_b = a)
+    ft = np.abs(torque_b) / np.maximum(r_b, 1e-9)
+    i = int(np.argmax(ft))
+    face = min((p.thickness_mm for p in parts if p.gear == pair.name), default=None)
+    if face is None:
+        return
+    phi = math.radians(float(getattr(pair, "pressure_angle_deg", 20.0)))
+    rho = [_min_curvature_radius(pair.pitch_a), _min_curvature_radius(pair.pitch_b)]
+    for gear, radius in (("a", rho[0]), ("b", rho[1])):
+        teeth = 2.0 * radius / pair.module if math.isfinite(radius) and radius > 0 else math.inf
+        y = models.lewis_form_factor(teeth)
+        sigma = models.lewis_bending_stress(ft[i], pair.module, face, y)
+        body = pair.body_a if gear == "a" else pair.body_b
+        name = next((p.name for p in parts if p.body == body and p.gear == pair.name), body)
+        result.findings.append(Finding(name, f"gear {pair.name} tooth root (Lewis, Y {y:.3f}, z_eq {teeth:.1f})",
+                                       "gear", sigma, material.flexural_MPa, i, f"{ft[i]:.1f} N tangential",
+                                       "a larger module (gears.module) or a thicker plate"))
+    fn = ft[i] / math.cos(phi)
+    r1, r2 = models.involute_contact_radii(abs(rho[0]) if math.isfinite(rho[0]) else 1e9,
+                                           abs(rho[1]) if math.isfinite(rho[1]) else 1e9, phi)
+    hertz = models.hertz_line_contact_stress(fn, face, r1, r2, material.modulus_MPa, material.poisson,
+                                             material.modulus_MPa, material.poisson)
+    name = next((p.name for p in parts if p.gear == pair.name), pair.name)
+    result.findings.append(Finding(name, f"gear {pair.name} tooth contact (Hertz)", "gear", hertz,
+                                   material.compressive_MPa, i, f"{fn:.1f} N normal",
+                                   "a larger module or a thicker plate"))
+
+
+def _min_curvature_radius(points: np.ndarray) -> float:
+    """Smallest convex radius of curvature (mm) along a closed or open pitch polyline (three-point circles)."""
+    p = np.asarray(points, dtype=np.float64)
+    if len(p) < 3:
+        return math.inf
+    a, b, c = p[:-2], p[1:-1], p[2:]
+    ab, bc, ca = np.hypot(*(b - a).T), np.hypot(*(c - b).T), np.hypot(*(a - c).T)
+    cross = (b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        radius = ab * bc * ca / (2.0 * cross)  # signed: positive where the curve turns left (convex, CCW)
+    convex = radius[np.isfinite(radius) & (radius > 0)]
+    return float(convex.min()) if len(convex) else math.inf

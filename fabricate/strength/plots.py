@@ -1,0 +1,38 @@
+"""Stress over the motion: each part's governing stress as a fraction of its allowable (matplotlib only here)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fabricate.plotting import png_bytes, pyplot
+from fabricate.strength.check import StrengthResult
+
+#: Parts drawn: the most loaded ones (the rest are in report.md's table).
+MAX_PARTS = 12
+
+
+def strength_plot(result: StrengthResult, input_unit: str, max_parts: int = MAX_PARTS) -> bytes:
+    """PNG of stress / allowable against the input for the most loaded parts and pins.
+
+    A part's curve is its governing feature's stress at every pose divided by that feature's allowable;
+    the red line is 1 / required safety factor (above it the part fails the check). Deterministic bytes.
+    """
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(10.0, 4.5), dpi=100)
+    worst = sorted(result.per_part().values(), key=lambda f: f.safety_factor)[:max_parts]
+    x = result.inputs
+    for f in worst:
+        if f.curve is None or len(f.curve) != len(x):
+            continue
+        ax.plot(x, np.asarray(f.curve) / f.allowable_MPa, lw=1.3, label=f"{f.part}: {f.feature}"[:70])
+    ax.axhline(1.0 / result.min_safety_factor, color="red", ls="--", lw=1.0,
+               label=f"limit (safety factor {result.min_safety_factor:g})")
+    ax.set_xlabel(f"input ({input_unit})")
+    ax.set_ylabel("stress / allowable")
+    ax.set_title("Strength over the motion: governing stress of each part")
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    # fixed margins (tight_layout would draw the figure twice)
+    fig.subplots_adjust(left=0.07, right=0.7, bottom=0.11, top=0.92)
+    return png_bytes(fig)

@@ -1,0 +1,111 @@
+"""Materials (from the process profile) and the design load (the template's ``[load]`` table).
+
+Process profiles carry ``[materials.<key>]`` tables; the profile's ``material`` names the part material
+and ``pin_material`` the dowel pins (a template may pick another of the profile's materials with
+``[process] material = "<key>"``). Every number's source is a comment in the profile.
+
+``[load]`` (every key optional; the default is no external load, which fails nothing):
+
+``tip_force_N``        float in [0, 10000]. Force at the tip point, opposing the tip's motion at every
+                       pose (the object resisting the finger: a grasp or a press).
+``tip_point``          str. Named point it acts on (default the synthesis' tip point).
+``input_force_N``      float in [0, 100000]. Known force of a slide driver's actuator (the push rod),
+                       acting to advance the motion.
+``input_torque_Nmm``   float in [0, 1e7]. Known torque of an angle driver's actuator.
+``springs``            bool, default true. The synthesis' springs load the joints (rate × deflection).
+``source``             str. Where the numbers come from (also a comment next to each).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fabricate.errors import SpecError
+
+
+@dataclass(frozen=True)
+class Material:
+    """Strength data of one material (MPa = N/mm²).
+
+    Attributes
+    ----------
+    key, name : str
+        Profile key and a description for people (the BOM's material).
+    tensile_MPa, flexural_MPa, compressive_MPa, shear_MPa : float
+        Ultimate strengths: tension governs net sections, flexure in-plane bending and tooth roots,
+        compression bearing and contact, shear pins and tear-out.
+    modulus_MPa, poisson : float
+        Elastic constants (Hertz contact).
+    density_g_cm3 : float
+    """
+
+    key: str
+    name: str
+    tensile_MPa: float
+    flexural_MPa: float
+    compressive_MPa: float
+    shear_MPa: float
+    modulus_MPa: float
+    poisson: float
+    density_g_cm3: float
+
+
+def parse_materials(table) -> dict[str, Material]:
+    """Read a profile's ``[materials]`` table (``{}`` when absent) into ``{key: Material}``."""
+    out = {}
+    for key in sorted(table.data):
+        t = table.table(key)
+        out[key] = Material(
+            key=key, name=t.string("name", key.replace("_", " ")),
+            tensile_MPa=t.number("tensile_MPa", positive=True, max=1e5),
+            flexural_MPa=t.number("flexural_MPa", positive=True, max=1e5),
+            compressive_MPa=t.number("compressive_MPa", positive=True, max=1e5),
+            shear_MPa=t.number("shear_MPa", positive=True, max=1e5),
+            modulus_MPa=t.number("modulus_MPa", positive=True, max=1e7),
+            poisson=t.number("poisson", min=0.0, max=0.5),
+            density_g_cm3=t.number("density_g_cm3", positive=True, max=25.0),
+        )
+        t.finish()
+    return out
+
+
+@dataclass(frozen=True)
+class LoadSpec:
+    """Validated ``[load]``: see the module docstring. Forces in N, torques in N·mm."""
+
+    tip_force_N: float = 0.0
+    tip_point: str | None = None
+    input_force_N: float = 0.0
+    input_torque_Nmm: float = 0.0
+    springs: bool = True
+    source: str = ""
+
+    @property
+    def stated(self) -> bool:
+        """Whether the template states any load at all."""
+        return bool(self.tip_force_N or self.input_force_N or self.input_torque_Nmm or self.springs)
+
+
+def parse_load(table) -> LoadSpec:
+    """Read ``[load]`` (``{}`` when absent)."""
+    spec = LoadSpec(
+        tip_force_N=table.number("tip_force_N", 0.0, min=0.0, max=10000.0),
+        tip_point=table.string("tip_point", None),
+        input_force_N=table.number("input_force_N", 0.0, min=0.0, max=100000.0),
+        input_torque_Nmm=table.number("input_torque_Nmm", 0.0, min=0.0, max=1e7),
+        springs=table.boolean("springs", True),
+        source=table.string("source", ""),
+    )
+    table.finish()
+    if spec.input_force_N and spec.input_torque_Nmm:
+        raise SpecError(table.field("input_torque_Nmm"), "give input_force_N (a slide) or input_torque_Nmm "
+                                                         "(an angle), not both")
+    return spec
+
+
+def pick_material(materials: dict[str, Material], key: str, field: str) -> Material:
+    """The profile's material ``key``; a SpecError naming ``field`` if the profile has none such."""
+    if key not in materials:
+        known = ", ".join(sorted(materials)) or "none"
+        raise SpecError(field, f"unknown material \"{key}\" (this process profile has: {known})")
+    return materials[key]
