@@ -298,13 +298,15 @@ def hole_stress_concentration(hole_diameter_mm: float, width_mm: float, pin_load
 
     The coefficients are quoted from that chart as we know it and could not be re-read from a public
     copy (see the tests' data file); they reproduce the chart's shape (about 5.5 at d/w = 0.2, 2.5 at
-    0.5, 2.0 at 0.75). Outside the fitted range the choice is conservative: below d/w = 0.15 the peak is
-    held at the same multiple of the bearing stress ``F / (d t)`` as at 0.15 (an infinitely wide plate's
-    peak scales with the bearing stress, so Kt_n grows as ``(w - d)/d``); above 0.75 the value at 0.75 is
-    kept (the fit falls further). With ``pin_clearance`` (default; printed joints run with clearance)
-    the factor is raised by :data:`PIN_CLEARANCE_FACTOR` = 1.5, the upper end of Frocht & Hill's
-    "increase Kt 35 to 50 percent when clearance exists" (Shigley, *Mechanical Engineering Design*,
-    Fig. A-15-12).
+    0.5, 2.0 at 0.75), and they lie 7 to 18 % above a plane-stress FE of the same lug with the pin load
+    idealised as a cosine pressure (``tests/benchmarks/bench_strength_fe.py``), as expected: a real
+    pin's contact is narrower than the cosine spread. Outside the fitted range the choice is
+    conservative: below d/w = 0.15 the peak is held at the same multiple of the bearing stress
+    ``F / (d t)`` as at 0.15 (an infinitely wide plate's peak scales with the bearing stress, so Kt_n
+    grows as ``(w - d)/d``); above 0.75 the value at 0.75 is kept (the fit falls further). With
+    ``pin_clearance`` (default; printed joints run with clearance) the factor is raised by
+    :data:`PIN_CLEARANCE_FACTOR` = 1.5, the upper end of Frocht & Hill's "increase Kt 35 to 50 percent
+    when clearance exists" (Shigley, *Mechanical Engineering Design*, Fig. A-15-12).
 
     Parameters
     ----------
