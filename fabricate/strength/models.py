@@ -60,9 +60,10 @@ def pin_shear_stress(force_N: ArrayLike, pin_diameter_mm: ArrayLike, shear_plane
     """Average shear stress of a pin: ``tau = F / (n * pi * d^2 / 4)``.
 
     Assumes the load divides equally between the ``n`` shear planes (``n = 1`` lap joint, ``n = 2``
-    clevis) and the shear is uniform over each circular section (the average shear stress of Hibbeler,
-    *Mechanics of Materials*, Sec. 1.5; Beer & Johnston Sec. 1.2). The peak transverse shear of a solid
-    round pin is 4/3 of this; static pin design uses the average.
+    clevis) and the shear is uniform over each circular section: the average shear stress of the
+    mechanics-of-materials texts (Hibbeler, *Mechanics of Materials*, ch. 1; checked against his
+    Problems 1-49 and 1-61). The peak transverse shear of a solid round pin is 4/3 of this; static pin
+    design uses the average.
 
     Parameters
     ----------
@@ -91,9 +92,9 @@ def pin_bending_moment_double_shear(force_N: ArrayLike, inner_thickness_mm: Arra
 
     The pin is a beam through two outer plates (each ``a`` thick) and a middle plate (``b`` thick) with
     a gap ``g`` either side of the middle plate. Each plate bears on the pin uniformly over its thickness
-    (the usual clevis-pin model, e.g. Shigley's *Mechanical Engineering Design* and Roloff/Matek's
-    "pin loose in both parts" case): the outer plates push ``F/2`` each, the middle plate pulls ``F``.
-    The moment peaks at mid-span::
+    (the usual textbook clevis-pin model, pin loose in all three plates): the outer plates push ``F/2``
+    each, the middle plate pulls ``F``. The moment peaks at mid-span (the tests check it against the
+    beam statics of these loads)::
 
         M = F/2 * (a/2 + g + b/2) - F/2 * b/4 = F/2 * (a/2 + g + b/4)
 
@@ -186,8 +187,8 @@ def pin_bending_stress(moment_Nmm: ArrayLike, pin_diameter_mm: ArrayLike) -> Arr
 def bearing_stress(force_N: ArrayLike, pin_diameter_mm: ArrayLike, thickness_mm: ArrayLike) -> ArrayLike:
     """Average bearing (contact) stress of a pin on a plate: ``sigma = F / (d t)``.
 
-    The load spread over the projected area of the pin in the hole (Hibbeler Sec. 1.6; Beer &
-    Johnston Sec. 1.2).
+    The load spread over the projected area of the pin in the hole (Hibbeler, *Mechanics of
+    Materials*, ch. 1; checked against Gere's Solution 1.8-14).
 
     Parameters
     ----------
@@ -358,8 +359,10 @@ def net_section_stress(axial_N: float, moment_Nmm: float, section: Section, kt: 
     extreme fibre. The two add at the worse fibre (conservative when the worse fibre is not the one of
     the axial sign). The stress concentration factor multiplies both because SLA resin and PMMA are
     brittle: the notch peak, not the nominal stress, starts the crack (no yielding redistributes it).
-    Using one Kt for both terms is conservative when ``kt`` is the tension factor: a hole's bending Kt
-    is smaller than its tension Kt (Peterson Chart 4.75 versus 4.1).
+    Using one Kt for both terms is conservative when ``kt`` is the tension factor: a central hole's
+    in-plane bending Kt (on ``I_net = t (w^3 - d^3) / 12``, which is what :func:`cut_section` gives) is at
+    most 2 and 1.0 below d/w = 0.5, its tension Kt at least 2 (Mott, *Machine Elements in Mechanical
+    Design*, Figs. A18-4 and A18-5).
 
     Parameters
     ----------
@@ -444,7 +447,7 @@ def lewis_bending_stress(tangential_force_N: ArrayLike, module_mm: ArrayLike, fa
 
     The tooth is a cantilever of uniform strength (a parabola inscribed in the tooth) loaded at the tip
     by the whole tangential load, one tooth pair in contact, root fillet stress concentration not
-    included (W. Lewis 1892; Shigley Eq. 14-2 in SI form with ``P = 1/m``). No velocity factor: the
+    included (W. Lewis 1892; Shigley ch. 14 in SI form with ``P = 25.4 / m``). No velocity factor: the
     mechanisms here are quasi-static; multiply the force by ``Kv`` for running gears.
 
     Parameters
@@ -480,9 +483,9 @@ def hertz_line_contact_stress(normal_force_N: ArrayLike, face_width_mm: ArrayLik
         p_max = sqrt( F (1/rho1 + 1/rho2) / (pi b ((1 - nu1^2)/E1 + (1 - nu2^2)/E2)) )
 
     Elastic, frictionless, the contact half-width small against the radii, load uniform along the face
-    width ``b`` (Hertz 1881; Shigley Eqs. 3-73/3-74 with ``d = 2 rho``; for spur gears at the pitch point
-    Shigley Eq. 14-14 with ``F = W_t / cos(phi)``). A concave surface has a negative radius (it must be
-    larger in magnitude than the convex one); a flat has ``inf``.
+    width ``b`` (Hertz 1881; Shigley's cylinder-contact equations with ``d = 2 rho``; for spur gears at
+    the pitch point Shigley Eq. 14-14 with ``F = W_t / cos(phi)``). A concave surface has a negative
+    radius (it must be larger in magnitude than the convex one); a flat has ``inf``.
 
     Parameters
     ----------
@@ -560,7 +563,7 @@ def torsion_spring_stress(torque_Nmm: ArrayLike, wire_diameter_mm: ArrayLike, co
     """Bending stress at the inside of the coil of a helical torsion spring: ``sigma = Ki 32 M / (pi d^3)``.
 
     The wire of a torsion spring is in bending; its curvature raises the stress at the inner fibre by
-    ``Ki = (4 C^2 - C - 1) / (4 C (C - 1))`` (Wahl's curved-beam factor, Shigley Eqs. 10-43/10-44),
+    ``Ki = (4 C^2 - C - 1) / (4 C (C - 1))`` (Wahl's curved-beam factor, Shigley Eq. 10-43),
     ``C = D/d`` the spring index (mean coil diameter over wire diameter).
 
     Parameters
