@@ -379,6 +379,8 @@ def test_cut_section_missing_the_part_or_degenerate_input():
         cut_section([ring], [10.0, 4.0], [1.0, -1.0], 3.0)
     with pytest.raises(ValueError):
         cut_section([ring], [5.0, 2.0], [0.0, 0.0], 3.0)
+    with pytest.raises(GeometryError):  # a self-intersecting outline
+        cut_section([np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])], [0.5, 0.2], [0.0, 1.0], 1.0)
     with pytest.raises(ValueError):
         cut_section([ring], [5.0, 2.0], [0.0, 1.0], 0.0)
 
