@@ -474,3 +474,117 @@ def test_sheet_dxf_border_is_closed_and_parts_match_placements():
     assert all(e.closed for e in msp.query('LWPOLYLINE[layer=="SHEET"]'))
     with pytest.raises(ValueError):
         sheet_dxf(parts, KERF, layout[:-1], (120.0, 60.0))
+
+
+# -- STL and 3MF encoders against meshes written here ------------------------------------------------
+def box_mesh(size=(2.0, 3.0, 4.0), origin=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+    """A closed box, outward (counter-clockwise seen from outside) triangles: volume = the product of sizes."""
+    sx, sy, sz = size
+    v = np.array([[x, y, z] for z in (0, sz) for y in (0, sy) for x in (0, sx)], dtype=float) + origin
+    faces = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+                      [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
+    return v, faces
+
+
+def test_stl_of_a_box_reads_back_with_its_volume_and_findings():
+    """The 2 x 3 x 4 box: 12 triangles, 84 + 50 x 12 bytes, volume 24 mm^3; and each defect is named: a
+    missing face (not watertight), a flipped face (inconsistent winding), all faces flipped (negative
+    volume), a wrong expected volume (beyond the relative tolerance only), short or truncated bytes."""
+    from fabricate.export.stl import mesh_volume, stl_bytes
+
+    v, f = box_mesh()
+    data = stl_bytes(v, f)
+    assert len(data) == 84 + 50 * 12 and int.from_bytes(data[80:84], "little") == 12
+    assert mesh_volume(v, f) == pytest.approx(24.0, rel=1e-12)
+    assert validate_stl(data) == []
+    assert validate_stl(data, 24.0 * 1.0009) == []  # within 1e-3
+    assert validate_stl(data, 24.0 * 1.0011) == ["volume 24 mm^3 differs from 24.0264 mm^3"]
+    assert validate_stl(data, 25.0, rel_tol=0.05) == []
+    assert "not watertight" in validate_stl(stl_bytes(v, f[1:]))
+    flipped = f.copy()
+    flipped[0] = flipped[0, ::-1]
+    assert "inconsistent winding" in validate_stl(stl_bytes(v, flipped))
+    assert validate_stl(stl_bytes(v, f[:, ::-1])) == ["volume -24 mm^3 is not positive"]
+    assert validate_stl(data[:83]) == ["not a binary STL (83 bytes, shorter than its 84-byte header)"]
+    assert validate_stl(data[:-50]) == [f"truncated or not a binary STL: {len(data) - 50} bytes, its header "
+                                        f"announces 12 triangles ({len(data)} bytes)"]
+    assert validate_stl(bytes(80) + (0).to_bytes(4, "little")) == ["no triangles"]
+
+
+def test_plate_stl_keeps_each_shell():
+    """Two boxes in one STL: 24 triangles, the volume of both (each keeps its own vertices), the extent of
+    both."""
+    from fabricate.export.stl import plate_stl
+
+    a = box_mesh()
+    b = box_mesh((1.0, 1.0, 1.0), origin=(10.0, 0.0, 0.0))
+    data = plate_stl([a, b])
+    assert validate_stl(data, 25.0, rel_tol=1e-9) == []
+    mesh = trimesh.load(io.BytesIO(data), file_type="stl")
+    assert len(mesh.faces) == 24
+    np.testing.assert_allclose(mesh.bounds, [[0.0, 0.0, 0.0], [11.0, 3.0, 4.0]], atol=1e-6)
+
+
+def test_3mf_round_trip_names_vertices_and_findings():
+    """Two named objects (one name with XML specials) come back with their names, vertices (6 decimals)
+    and triangles; the bytes are deterministic; a foreign unit, a repeated name, a bad index, an unreadable
+    number and a non-zip are each reported."""
+    import zipfile
+
+    from fabricate.export.stl import model_3mf, read_3mf
+
+    box = box_mesh()
+    small = box_mesh((1.0, 1.0, 1.0), origin=(0.1234567, -5.0, 2.0))
+    data = model_3mf([('a&b <"x">', *box), ("small", *small)], "T & <t>")
+    assert data == model_3mf([('a&b <"x">', *box), ("small", *small)], "T & <t>")
+    objects, problems = read_3mf(data)
+    assert problems == []
+    assert list(objects) == ['a&b <"x">', "small"]
+    np.testing.assert_allclose(objects["small"].vertices, small[0], atol=5e-7)
+    np.testing.assert_array_equal(objects["small"].faces, small[1])
+    assert objects['a&b <"x">'].volume == pytest.approx(24.0, rel=1e-12)
+    with zipfile.ZipFile(io.BytesIO(data)) as z:
+        assert z.namelist() == ["[Content_Types].xml", "_rels/.rels", "3D/3dmodel.model"]
+        assert all(i.date_time == (1980, 1, 1, 0, 0, 0) for i in z.infolist())
+        text = z.read("3D/3dmodel.model").decode()
+    assert '<metadata name="Title">T &amp; &lt;t&gt;</metadata>' in text
+    assert '<item objectid="1"/><item objectid="2"/>' in text
+
+    def rewrite(model: str) -> bytes:
+        buf = io.BytesIO()
+        with zipfile.ZipFile(buf, "w") as z:
+            z.writestr("3D/3dmodel.model", model)
+        return buf.getvalue()
+
+    assert read_3mf(rewrite(text.replace('unit="millimeter"', 'unit="inch"')))[1] == ["unit is inch, not millimeter"]
+    twice = model_3mf([("same", *box), ("same", *small)], "t")
+    assert read_3mf(twice)[1] == ["object name same appears twice"]
+    bad = text.replace('v3="1"/>', 'v3="99"/>', 1)
+    assert read_3mf(rewrite(bad))[1] == ['object a&b <"x">: no triangles or triangle indices outside its vertices']
+    assert "unreadable mesh" in read_3mf(rewrite(text.replace('x="2.000000"', 'x="two"', 1)))[1][0]
+    objects, problems = read_3mf(b"not a zip")
+    assert objects == {} and problems[0].startswith("not a readable 3MF package (BadZipFile")
+
+
+def test_assembly_3mf_places_each_part_at_its_body_pose():
+    """A 15 mm link posed at (10, 5, 90 deg): its object spans x in [10 - 3, 10 + 3], y in [5 - 3, 5 + 18] (the
+    stadium turned a quarter), same volume; a part whose body has no pose stays where it is."""
+    from fabricate.export.layout import Placement
+    from fabricate.export.stl import assembly_3mf, placed_flat_mesh, read_3mf
+
+    link = slot_part("link", "crank", ("O", "A"), 15.0, width=6.0, z=2.0)
+    other = slot_part("other", "ground", ("P", "Q"), 10.0, width=6.0)
+    cache = SolidCache(0.002)
+    objects, problems = read_3mf(assembly_3mf([link, other], cache, {"crank": np.array([10.0, 5.0, np.pi / 2])}))
+    assert problems == [] and list(objects) == ["link", "other"]
+    np.testing.assert_allclose(objects["link"].bounds, [[7.0, 2.0, 2.0], [13.0, 23.0, 5.0]], atol=0.003)
+    np.testing.assert_allclose(objects["other"].bounds, [[-3.0, -3.0, 0.0], [13.0, 3.0, 3.0]], atol=0.003)
+    assert objects["link"].volume == pytest.approx(link.volume_mm3(), rel=1e-3)
+    place = Placement(angle=np.pi, offset=np.array([50.0, 20.0]), sheet=0, size=np.array([21.0, 6.0]))
+    vertices, faces = placed_flat_mesh(link, cache, place)
+    flat_v, flat_f = cache.flat_mesh(link)
+    np.testing.assert_array_equal(faces, flat_f)
+    np.testing.assert_allclose(vertices[:, :2], np.column_stack([50.0 - flat_v[:, 0], 20.0 - flat_v[:, 1]]), atol=1e-9)
+    np.testing.assert_array_equal(vertices[:, 2], flat_v[:, 2])
+    assert flat_v[:, 2].min() == pytest.approx(0.0, abs=1e-9)  # lying on the plate, not at z = 2
+    assert cache.solid(link) is cache.solid(link)

@@ -214,3 +214,332 @@ def test_gear_mesh_check_catches_a_motion_off_the_law_and_out_of_range():
     assert any("outside the cut range" in f for f in out.failures)
     inside = check_gear_mesh(sector, fake_motion(x[x <= hi], np.asarray(sector.law(x[x <= hi]))))
     assert not any("outside the cut range" in f for f in inside.failures)
+
+
+# -- ratio laws: formulas, samples, the elliptic family, the ratio check -----------------------------
+def test_formula_constants_are_pi_and_e_at_every_angle():
+    """``pi`` and ``e`` are the constants, not a function of x: pi + e x and its slope e (closed form), also
+    at x = 0 (a constant must not divide by x) and for the complex step (slope exactly e)."""
+    from fabricate.gears.law import compile_formula
+
+    x = np.array([-2.0, 0.0, 0.5, 3.0])
+    np.testing.assert_allclose(compile_formula("pi + e*x")(x), np.pi + np.e * x, rtol=1e-15)
+    np.testing.assert_allclose(compile_formula("pi")(x), np.full(4, np.pi), rtol=1e-15)
+    law = FormulaLaw("2.5*x + pi", sign=1.0)
+    np.testing.assert_allclose(law(x), 2.5 * x + np.pi, rtol=1e-15)
+    np.testing.assert_allclose(law(x, 1), np.full(4, 2.5), rtol=1e-15)
+    np.testing.assert_allclose(FormulaLaw("e*x", sign=1.0)(x, 1), np.full(4, np.e), rtol=1e-15)
+    np.testing.assert_allclose(compile_formula("+x - -2")(x), x + 2.0, rtol=1e-15)  # unary plus and minus
+    # an integer angle array is read as float (numpy refuses integers to negative integer powers)
+    np.testing.assert_allclose(FormulaLaw("x**x", sign=1.0)(np.array([-1, 1, 2])), [-1.0, 1.0, 4.0], rtol=1e-15)
+
+
+def test_law_derivative_falls_back_to_central_differences():
+    """A law that gives only its value and slope (nu >= 2 raises), and one that gives only its value:
+    x_b = -(x + 0.1 sin x), so law'' = 0.1 sin x and law''' = 0.1 cos x (closed form); the central
+    differences (h = 1e-4) are within 1e-7 of it."""
+    from fabricate.gears.law import law_derivative
+
+    def partial(x, nu=0):
+        if nu == 0:
+            return -(x + 0.1 * np.sin(x))
+        if nu == 1:
+            return -(1.0 + 0.1 * np.cos(x))
+        raise ValueError("no higher derivatives")
+
+    def value_only(x, nu=0):
+        if nu:
+            raise TypeError("only the value")
+        return -(x + 0.1 * np.sin(x))
+
+    x = np.linspace(-1.0, 2.0, 7)
+    np.testing.assert_allclose(law_derivative(partial, x, 1), -(1.0 + 0.1 * np.cos(x)), atol=1e-15)
+    np.testing.assert_allclose(law_derivative(partial, x, 2), 0.1 * np.sin(x), atol=1e-8)
+    np.testing.assert_allclose(law_derivative(partial, x, 3), 0.1 * np.cos(x), atol=1e-7)
+    np.testing.assert_allclose(law_derivative(value_only, x, 1), -(1.0 + 0.1 * np.cos(x)), atol=1e-8)
+    np.testing.assert_allclose(law_derivative(value_only, x, 2), 0.1 * np.sin(x), atol=1e-6)
+
+
+@pytest.mark.parametrize(("text", "words"), [("x +* 2", "invalid formula"), ("x + tau", "unknown name 'tau'"),
+                                             ("gamma(x)", "'gamma' is not allowed"),
+                                             ("sin(x, x)", "takes one argument"), ("x < 1", "unsupported expression")])
+def test_formula_errors_name_the_field(text, words):
+    from fabricate.errors import SpecError
+    from fabricate.gears.law import compile_formula
+
+    with pytest.raises(SpecError, match=words) as info:
+        compile_formula(text, "gear_pair.law")
+    assert info.value.path == "gear_pair.law"
+    assert str(info.value).startswith("gear_pair.law: ")
+
+
+@pytest.mark.parametrize("e", [1.0, 1.5, -0.1])
+def test_elliptic_law_rejects_eccentricity_outside_0_1(e):
+    """An ellipse needs 0 <= e < 1 (e = 1 is a parabola: the pitch radius A (1 - e) would be zero)."""
+    from fabricate.errors import SpecError
+    from fabricate.gears.law import elliptic_law
+
+    with pytest.raises(SpecError, match="0 <= e < 1") as info:
+        elliptic_law(e)
+    assert info.value.path == "gear_pair.eccentricity"
+
+
+def test_samples_law_through_three_samples_is_the_parabola():
+    """Three samples are enough: the not-a-knot cubic through three points is the parabola through them
+    (closed form x_b = -x_a - 0.1 x_a^2 here)."""
+    from fabricate.gears.law import samples_law
+
+    xa = np.array([0.0, 0.5, 1.5])
+    law = samples_law(xa, -xa - 0.1 * xa**2)
+    x = np.linspace(0.0, 1.5, 7)
+    np.testing.assert_allclose(law(x), -x - 0.1 * x**2, atol=1e-12)
+    np.testing.assert_allclose(law(x, 1), -1.0 - 0.2 * x, atol=1e-12)
+
+
+@pytest.mark.parametrize(("xa", "xb", "words"), [
+    ([0.0, 1.0], [0.0, -1.0], "at least 3 samples"),
+    ([0.0, 1.0, 2.0], [0.0, np.nan, -2.0], "finite"),
+    ([0.0, np.inf, 2.0], [0.0, -1.0, -2.0], "finite"),
+    ([0.0, 2.0, 1.0], [0.0, -1.0, -2.0], "increase strictly"),
+    ([0.0, 1.0, 1.0, 2.0], [0.0, -1.0, -1.0, -2.0], "increase strictly"),
+])
+def test_samples_law_rejects_bad_samples_naming_the_field(xa, xb, words):
+    from fabricate.errors import SpecError
+    from fabricate.gears.law import samples_law
+
+    with pytest.raises(SpecError, match=words) as info:
+        samples_law(np.array(xa), np.array(xb), "gear_pair.law_samples_deg")
+    assert info.value.path == "gear_pair.law_samples_deg"
+
+
+def test_check_ratio_names_the_first_angle_where_the_law_fails():
+    """-sqrt(1 - x) is real up to x = 1 rad: the error names the first grid angle past 1 rad (not the first
+    angle of the grid)."""
+    from fabricate.errors import SpecError
+    from fabricate.gears.law import check_ratio
+
+    x = np.linspace(0.0, 2.0, 41)  # step 0.05 rad
+    with pytest.raises(SpecError, match="not finite") as info:
+        check_ratio(FormulaLaw("sqrt(1 - x)"), x, "gear_pair.law")
+    assert info.value.path == "gear_pair.law"
+    assert f"x_a = {np.degrees(x[x > 1.0][0]):.3f} deg" in str(info.value)
+
+
+def test_check_ratio_rejects_a_zero_ratio():
+    """A driven gear that stands still (law = const, ratio exactly 0) is not a gear pair."""
+    from fabricate.errors import SpecError
+    from fabricate.gears.law import check_ratio
+
+    with pytest.raises(SpecError, match=r"ratio -?0 <= 0"):
+        check_ratio(FormulaLaw("0.5"), np.linspace(0.0, 1.0, 5))
+    ok = check_ratio(FormulaLaw("0.5*x"), np.linspace(0.0, 1.0, 5))  # control: ratio 0.5 everywhere
+    np.testing.assert_allclose(ok, 0.5, rtol=1e-15)
+
+
+def test_check_ratio_names_the_angle_of_the_most_negative_ratio():
+    """x_b = -(x + 2 cos x): ratio 1 - 2 sin x, most negative at the grid angle nearest pi/2 (not at the
+    start of the grid); the error gives that ratio and angle and names the field."""
+    from fabricate.errors import SpecError
+    from fabricate.gears.law import check_ratio
+
+    x = np.linspace(0.0, 3.0, 31)
+    ratio = 1.0 - 2.0 * np.sin(x)
+    worst = x[np.abs(x - np.pi / 2).argmin()]
+    with pytest.raises(SpecError) as info:
+        check_ratio(FormulaLaw("x + 2*cos(x)"), x, "gear_pair.law")
+    assert info.value.path == "gear_pair.law"
+    assert f"ratio {ratio.min():.4g} <= 0 at x_a = {np.degrees(worst):.3f} deg" in str(info.value)
+
+
+# -- pitch curves against closed forms -------------------------------------------------------------
+def test_constant_ratio_pitch_curves_are_the_two_circles():
+    """x_b = -x_a / 2 on a 30 mm centre distance: pitch circles r_a = 10, r_b = 20 mm (a i / (1 + i), a / (1 + i),
+    i = 0.5); arc length s = r_a (x - x_ref); perimeters 2 pi r; frames of a circle (tangent, outward radial
+    normal, curvature 1 / r); gear a at polar angle -x, gear b at pi - law(x)."""
+    from fabricate.gears.pitch import PitchCurves
+
+    law = FormulaLaw("0.5*x")
+    pitch = PitchCurves(law, 30.0, (0.0, 2 * np.pi), x_ref=0.3, periods=(2 * np.pi, 4 * np.pi), intervals=64)
+    x = np.array([0.1, 0.3, 1.0, 2.5, 6.0])
+    np.testing.assert_allclose(pitch.ratio(x), 0.5, rtol=1e-12)
+    np.testing.assert_allclose(pitch.speed(x), 10.0, rtol=1e-12)
+    np.testing.assert_allclose(pitch.s_of_x(x), 10.0 * (x - 0.3), atol=1e-9)
+    s = np.array([-3.0, 0.0, 7.0, 50.0])
+    np.testing.assert_allclose(pitch.x_of_s(s), 0.3 + s / 10.0, atol=1e-9)
+    assert pitch.perimeter_a == pytest.approx(20 * np.pi, rel=1e-12)
+    assert pitch.perimeter_b == pytest.approx(40 * np.pi, rel=1e-12)
+    np.testing.assert_allclose(pitch.wrap(np.array([-1.0, 70.0, 130.0]), "a"), np.mod([-1.0, 70.0, 130.0], 20 * np.pi))
+    np.testing.assert_allclose(pitch.wrap(np.array([-1.0, 70.0, 130.0]), "b"), np.mod([-1.0, 70.0, 130.0], 40 * np.pi))
+    np.testing.assert_allclose(pitch.curve(x, "a"), 10.0 * np.column_stack([np.cos(x), -np.sin(x)]), atol=1e-12)
+    np.testing.assert_allclose(pitch.curve(x, "b"), -20.0 * np.column_stack([np.cos(x / 2), np.sin(x / 2)]), atol=1e-12)
+    r, dr, ddr, th, dth = pitch.radii(x, "b")
+    np.testing.assert_allclose([r, dr, ddr], [np.full(5, 20.0), np.zeros(5), np.zeros(5)], atol=1e-9)
+    np.testing.assert_allclose(th, np.pi + x / 2, atol=1e-12)
+    np.testing.assert_allclose(dth, 0.5, rtol=1e-12)
+    fa = pitch.frames(10.0 * (x - 0.3), "a")  # at the arc lengths of x
+    np.testing.assert_allclose(fa.point, 10.0 * np.column_stack([np.cos(x), -np.sin(x)]), atol=1e-8)
+    np.testing.assert_allclose(fa.tangent, np.column_stack([-np.sin(x), -np.cos(x)]), atol=1e-9)
+    np.testing.assert_allclose(fa.normal, np.column_stack([np.cos(x), -np.sin(x)]), atol=1e-9)
+    np.testing.assert_allclose(fa.curvature, 0.1, rtol=1e-9)
+    fb = pitch.frames(10.0 * (x - 0.3), "b")
+    np.testing.assert_allclose(fb.tangent, np.column_stack([np.sin(x / 2), -np.cos(x / 2)]), atol=1e-9)
+    np.testing.assert_allclose(fb.normal, -np.column_stack([np.cos(x / 2), np.sin(x / 2)]), atol=1e-9)
+    np.testing.assert_allclose(fb.curvature, 0.05, rtol=1e-9)
+    # closed gears repeat after their own perimeter: one turn later on a, 40 pi mm later on b
+    np.testing.assert_allclose(pitch.frames(10.0 * (x - 0.3) + 20 * np.pi, "a").point, fa.point, atol=1e-8)
+    np.testing.assert_allclose(pitch.frames(10.0 * (x - 0.3) + 40 * np.pi, "b").point, fb.point, atol=1e-8)
+    # by default arc length counts from x = 0
+    default = PitchCurves(law, 30.0, (0.0, 2 * np.pi), intervals=64)
+    np.testing.assert_allclose(default.s_of_x(np.array([0.0, 1.0])), [0.0, 10.0], atol=1e-9)
+
+
+def test_elliptic_pitch_curve_radius_derivatives_arc_length_and_curvature():
+    """The 1:1 elliptic pair (e = 0.3, a = 30 mm): gear a is the ellipse r = p / (1 + e cos x) about its focus
+    (p = A (1 - e^2), A = a / 2) at polar angle -x, gear b the same rolled: r_b = a - r_a. Radius derivatives
+    against the closed form, arc length against quadrature of sqrt(r^2 + r'^2), curvature against the polar
+    formula (r^2 + 2 r'^2 - r r'') / (r^2 + r'^2)^1.5, perimeter against 4 A E(e^2)."""
+    from scipy.integrate import quad
+    from scipy.special import ellipe
+
+    from fabricate.gears.law import elliptic_law
+    from fabricate.gears.pitch import PitchCurves
+
+    e, a = 0.3, 30.0
+    big_a = a / 2
+    p = big_a * (1 - e * e)
+    pitch = PitchCurves(elliptic_law(e), a, (0.0, 2 * np.pi), x_ref=0.5, periods=(2 * np.pi, 2 * np.pi), intervals=256)
+    x = np.array([0.0, 0.7, 2.0, 3.5, 5.9])
+    d = 1 + e * np.cos(x)
+    r = p / d
+    dr = p * e * np.sin(x) / d**2
+    ddr = p * e * np.cos(x) / d**2 + 2 * p * e**2 * np.sin(x) ** 2 / d**3
+    ra, dra, ddra, tha, dtha = pitch.radii(x, "a")
+    np.testing.assert_allclose(ra, r, rtol=1e-12)
+    np.testing.assert_allclose(dra, dr, atol=1e-9)
+    np.testing.assert_allclose(ddra, ddr, rtol=1e-5)  # law''' by central differences (h = 1e-3)
+    np.testing.assert_allclose(tha, -x, atol=0)
+    np.testing.assert_allclose(dtha, -1.0, atol=0)
+    rb, drb, ddrb, _, _ = pitch.radii(x, "b")
+    np.testing.assert_allclose([rb, drb, ddrb], [a - r, -dr, -ddr], rtol=1e-5, atol=1e-9)
+    np.testing.assert_allclose(pitch.speed(x), np.hypot(r, dr), rtol=1e-8)  # law'' by central differences
+    for xi in (0.0, 2.0, 5.9):
+        want = quad(lambda t: np.hypot(p / (1 + e * np.cos(t)), p * e * np.sin(t) / (1 + e * np.cos(t)) ** 2),
+                    0.5, xi, epsabs=1e-12, epsrel=1e-12)[0]
+        assert pitch.s_of_x(np.array([xi]))[0] == pytest.approx(want, abs=1e-7)  # speed within 1e-8
+    assert pitch.perimeter_a == pytest.approx(4 * big_a * ellipe(e * e), rel=1e-10)
+    kappa = (r**2 + 2 * dr**2 - r * ddr) / (r**2 + dr**2) ** 1.5
+    np.testing.assert_allclose(pitch.frames_at_x(x, "a").curvature, kappa, rtol=1e-6)
+    # the two frames at one contact: tangents opposite in the world (rolling), points a apart
+    s = pitch.s_of_x(x)
+    np.testing.assert_allclose(pitch.x_of_s(s), x, atol=1e-12)
+    np.testing.assert_allclose(np.hypot(*pitch.frames(s, "a").point.T) + np.hypot(*pitch.frames(s, "b").point.T),
+                               a, atol=1e-9)
+
+
+# -- gear checks without booleans: curvature, undercut, feasibility, contact ratio, pressure angle --------
+class _Curvatures:
+    """Stands in for PitchCurves where only the curvature of each gear's pitch curve is read."""
+
+    def __init__(self, a, b):
+        self.k = {"a": np.asarray(a, dtype=float), "b": np.asarray(b, dtype=float)}
+
+    def frames_at_x(self, x, gear):
+        from types import SimpleNamespace
+
+        return SimpleNamespace(curvature=self.k[gear])
+
+
+def test_curvature_summary_of_convex_and_concave_stretches():
+    """Smallest convex radius = 1 / largest positive curvature, smallest concave radius = 1 / largest negative
+    curvature magnitude, inf where there is none."""
+    from fabricate.gears.checks import curvature_summary
+
+    out = curvature_summary(_Curvatures([0.1, 0.2, -0.05, -0.25], [0.05, 0.04]), np.zeros(2))
+    assert out == {"min_radius_of_curvature_a_mm": pytest.approx(5.0), "min_curvature_a_per_mm": -0.25,
+                   "min_concave_radius_a_mm": pytest.approx(4.0),
+                   "min_radius_of_curvature_b_mm": pytest.approx(20.0), "min_curvature_b_per_mm": 0.04,
+                   "min_concave_radius_b_mm": np.inf}
+    flat = curvature_summary(_Curvatures([0.0, -0.1], [0.0, 0.0]), np.zeros(2))
+    assert flat["min_radius_of_curvature_a_mm"] == np.inf and flat["min_concave_radius_a_mm"] == pytest.approx(10.0)
+    assert flat["min_radius_of_curvature_b_mm"] == np.inf and flat["min_concave_radius_b_mm"] == np.inf
+
+
+def test_undercut_limit_is_the_classical_one():
+    """Standard rack (h_f = 1.25 m, rho_f = 0.38 m, 20 deg): straight flank depth 1.25 - 0.38 (1 - sin 20) = 1.0 m,
+    limit 1.0 m / sin^2(20 deg) = 8.55 m (z_min = 17.1 teeth)."""
+    from fabricate.gears.checks import undercut_limit_mm
+    from fabricate.gears.spec import GearSpec
+
+    s = np.sin(np.radians(20.0))
+    for m in (0.5, 1.0, 2.0):
+        assert undercut_limit_mm(m, GearSpec()) == pytest.approx((1.25 - 0.38 * (1 - s)) * m / s**2, rel=1e-12)
+    spec = GearSpec(pressure_angle_deg=25.0, dedendum=1.2, root_fillet=0.3)
+    s25 = np.sin(np.radians(25.0))
+    assert undercut_limit_mm(1.5, spec) == pytest.approx((1.2 - 0.3 * (1 - s25)) * 1.5 / s25**2, rel=1e-12)
+
+
+def test_feasibility_limits_at_their_boundaries():
+    """Module limit 2 rho / min_teeth (rho = 8 mm, 8 teeth: 2 mm) and concave radius limit 2 h_f m (1 mm module:
+    2.5 mm): just inside passes, just outside raises naming the field and the largest module."""
+    from fabricate.errors import SpecError
+    from fabricate.gears.checks import check_feasible
+    from fabricate.gears.spec import GearSpec
+
+    spec = GearSpec()
+
+    def curv(rho_a, rho_b, concave_a=np.inf, concave_b=np.inf):
+        return {"min_radius_of_curvature_a_mm": rho_a, "min_radius_of_curvature_b_mm": rho_b,
+                "min_concave_radius_a_mm": concave_a, "min_concave_radius_b_mm": concave_b}
+
+    check_feasible(curv(8.0, 30.0), 2.0, spec)  # exactly 8 teeth on the osculating circle
+    check_feasible(curv(30.0, 8.0), 1.999, spec)
+    with pytest.raises(SpecError, match=r"needs module <= 2 mm") as info:
+        check_feasible(curv(30.0, 8.0), 2.001, spec, "gear_pair.module_mm")
+    assert info.value.path == "gear_pair.module_mm"
+    assert "holds 7.996 teeth" not in str(info.value) and "holds 8.0 teeth (min_teeth = 8)" in str(info.value)
+    check_feasible(curv(30.0, 30.0, 2.5, 9.0), 1.0, spec)  # concave radius exactly 2 h_f m
+    with pytest.raises(SpecError, match=r"concave with radius 2.49 mm; needs module <= 0.996 mm") as info:
+        check_feasible(curv(30.0, 30.0, 9.0, 2.49), 1.0, spec)
+    assert info.value.path == "gears.module_mm"
+
+
+def test_contact_ratio_of_spur_gears_and_of_the_rack_limit():
+    """Pitch circles 10 and 20 mm, module 1: the spur contact ratio
+    (sqrt(r_a1^2 - r_b1^2) + sqrt(r_a2^2 - r_b2^2) - a sin alpha) / (pi m cos alpha); a flat or concave curve
+    counts as a rack (addendum / sin alpha)."""
+    from fabricate.gears.checks import local_contact_ratio
+    from fabricate.gears.spec import GearSpec
+
+    alpha = np.radians(20.0)
+    m, ha = 1.0, 1.0
+
+    def path(r):
+        return np.sqrt((r + ha) ** 2 - (r * np.cos(alpha)) ** 2)
+
+    spur = (path(10.0) + path(20.0) - 30.0 * np.sin(alpha)) / (np.pi * m * np.cos(alpha))
+    got = local_contact_ratio(_Curvatures([0.1, 0.1], [0.05, 0.05]), np.zeros(2), m, GearSpec())
+    np.testing.assert_allclose(got, spur, rtol=1e-12)
+    rack = ha / np.sin(alpha)
+    got = local_contact_ratio(_Curvatures([0.0, -0.2], [0.05, 1e-10]), np.zeros(2), m, GearSpec())
+    want = [(rack + path(20.0) - 20.0 * np.sin(alpha)), 2 * rack]
+    np.testing.assert_allclose(got, np.array(want) / (np.pi * m * np.cos(alpha)), rtol=1e-12)
+
+
+def test_working_pressure_angles_of_the_elliptic_pair():
+    """The ellipse's pitch tangent leans by mu = atan(e sin x / (1 + e cos x)) from the perpendicular to the
+    line of centres (the polar tangent angle of r = p / (1 + e cos x)): the flanks work at 20 deg -/+ mu, the
+    driving flank at 20 - mu (ranges over x); for circles (e = 0) both at exactly 20 deg."""
+    from fabricate.gears.checks import pressure_angle_range_deg
+    from fabricate.gears.law import elliptic_law
+    from fabricate.gears.pitch import PitchCurves
+    from fabricate.gears.spec import GearSpec
+
+    x = np.array([0.0, 0.8, 2.0, 4.0])
+    for e in (0.0, 0.3):
+        pitch = PitchCurves(elliptic_law(e), 30.0, (0.0, 2 * np.pi), intervals=16)
+        mu = np.degrees(np.arctan(e * np.sin(x) / (1 + e * np.cos(x))))
+        out = pressure_angle_range_deg(pitch, x, GearSpec())
+        drive, coast = np.abs(20.0 - mu), np.abs(20.0 + mu)
+        # law'' by central differences: 1e-6 deg
+        assert out["drive_flank_deg"] == pytest.approx([drive.min(), drive.max()], abs=1e-6)
+        assert out["coast_flank_deg"] == pytest.approx([coast.min(), coast.max()], abs=1e-6)
