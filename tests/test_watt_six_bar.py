@@ -63,7 +63,7 @@ def _template_root(path: Path = TEMPLATE, edit=None) -> Table:
     if edit is not None:
         edit(data)
     root = Table(data)
-    for generic in ("design", "process", "checks", "gears", "parts"):
+    for generic in ("design", "process", "checks", "gears", "parts", "load"):
         if root.has(generic):
             root.table(generic)
     return root

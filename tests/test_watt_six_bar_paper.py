@@ -257,7 +257,7 @@ def test_circuit_defects_agree_with_an_independent_branch_test(theta, key):
 
 def test_fitted_angles_select_an_exact_region_point_next_to_mechanism_1():
     root = Table(read_toml(TEMPLATE_DIR / "finger_watt_six_bar.toml"))
-    for generic in ("design", "process", "checks", "gears", "parts"):
+    for generic in ("design", "process", "checks", "gears", "parts", "load"):
         if root.has(generic):
             root.table(generic)
     spec = wsb.parse_spec(root)

@@ -418,6 +418,9 @@ def _sweep_pair(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, pose_a: np
                 tol: float) -> PairResult:
     n = len(pose_a)
     z_gap = max(a.z0, b.z0) - min(a.z1, b.z1)
+    if abs(z_gap) < 1e-9:
+        # flush faces (layer heights are sums of thicknesses and gaps: 12.6 may come out 12.600000000000001)
+        z_gap = 0.0
     stacked = z_gap >= 0.0
     rel = RelativePoses.between(pose_a, pose_b)
     # broad phase: bounding circles; a pose whose circles are farther apart than the search length

@@ -60,12 +60,17 @@ class Finding:
 
 @dataclass(frozen=True)
 class Loads:
-    """Applied loads over the motion and what they are, for people."""
+    """Applied loads over the motion and what they are, for people.
+
+    ``reaction``: with a known actuator effort, the object's resistance at the tip, a unit direction per
+    pose whose magnitude the statics solve.
+    """
 
     forces: tuple[PointForce, ...]
     torques: tuple[BodyTorque, ...]
     efforts: tuple[DriverEffort, ...]
     described: tuple[str, ...]
+    reaction: PointForce | None = None
 
 
 @dataclass
@@ -145,17 +150,46 @@ def design_loads(design: Any, mechanism: Mechanism, motion: Motion, hints: Mappi
     efforts: list[DriverEffort] = []
     said: list[str] = []
     n = len(motion.inputs)
-    if load.tip_force_N > 0.0:
+    reaction = None
+    actuated = bool(load.input_force_N or load.input_torque_Nmm)
+    if load.tip_force_N > 0.0 or actuated:
         point = load.tip_point or hints.get("tip_point")
         if not point or point not in mechanism.point_names():
             raise GeometryError(f"strength: load.tip_point {point!r} is not a named point of the mechanism")
         owners = [b for b, pad in (hints.get("pads") or {}).items() if pad.get("point") == point]
         body = owners[0] if owners else mechanism.point_owner(point)
         path = motion.point(point, body)
-        velocity = np.gradient(path, motion.inputs, axis=0)
-        forces.append(PointForce(body, mechanism.body(body).point(point),
-                                 -load.tip_force_N * _unit_rows(velocity), name=f"tip force at {point}"))
-        said.append(f"tip force {load.tip_force_N:g} N at {point}, opposing its motion")
+        if load.object_centre:
+            centre = load.object_centre
+            if centre not in mechanism.body(mechanism.ground).points:
+                raise GeometryError(f"strength: load.object_centre {centre!r} is not a named point of the "
+                                    f"ground {mechanism.ground!r}")
+            against = _unit_rows(path - mechanism.body(mechanism.ground).point(centre))
+            how = f"pushing away from {centre}"
+        elif load.tip_force_deg is not None:
+            a = math.radians(load.tip_force_deg)
+            against = np.broadcast_to(np.array([math.cos(a), math.sin(a)]), path.shape).copy()
+            how = f"at {load.tip_force_deg:g}° in the ground's frame"
+        else:
+            against = -_unit_rows(np.gradient(path, motion.inputs, axis=0))
+            how = "opposing its motion"
+        local = mechanism.body(body).point(point)
+        if actuated:
+            # the object at the tip holds what the actuator pushes: its force is solved, not given
+            reaction = PointForce(body, local, against, name=f"object at {point}")
+            said.append(f"the object at {point} holding the actuator, {how}")
+        else:
+            forces.append(PointForce(body, local, load.tip_force_N * against, name=f"tip force at {point}"))
+            said.append(f"tip force {load.tip_force_N:g} N at {point}, {how}")
+    if load.torque_Nmm > 0.0:
+        body = load.torque_body
+        if body not in mechanism.body_names or body == mechanism.ground:
+            raise GeometryError(f"strength: load.torque_body {body!r} is not a moving body of the mechanism "
+                                f"({', '.join(b for b in mechanism.body_names if b != mechanism.ground)})")
+        turn = np.gradient(motion.pose(body)[:, 2], motion.inputs)
+        sense = np.sign(np.where(turn == 0.0, 1.0, turn))
+        torques.append(BodyTorque(body, mechanism.ground, -load.torque_Nmm * sense))
+        said.append(f"torque {load.torque_Nmm:g} N·mm on {body}, resisting its turn")
     if load.springs:
         for spring in hints.get("springs", ()) or ():
             rate = float(spring.get("rate_Nmm_per_deg") or 0.0)
@@ -186,7 +220,7 @@ def design_loads(design: Any, mechanism: Mechanism, motion: Motion, hints: Mappi
         efforts.append(DriverEffort(0, value * sign))
         unit = "N" if driver.kind == "slide" else "N·mm"
         said.append(f"actuator {value:g} {unit} on the input")
-    return Loads(tuple(forces), tuple(torques), tuple(efforts), tuple(said))
+    return Loads(tuple(forces), tuple(torques), tuple(efforts), tuple(said), reaction)
 
 
 # -- the check ---------------------------------------------------------------------------------------
@@ -212,13 +246,45 @@ def _edge_distances(rings: list[np.ndarray], centre: np.ndarray, radius: float) 
     return out
 
 
-def _edge_along(edges: np.ndarray, directions: np.ndarray) -> np.ndarray:
+def _net_section_factors(rings: list[np.ndarray], hole: Any, thickness: float
+                         ) -> tuple[np.ndarray | None, np.ndarray]:
+    """Kt / net area (1/mm²) and Kt of the cut through a pin-loaded hole square to each test direction.
+
+    Between two measured directions the larger factor is used (:func:`_edge_along` with ``np.maximum``).
+    """
+    factor = np.zeros(_EDGE_DIRECTIONS)
+    kts = np.ones(_EDGE_DIRECTIONS)
+    for k in range(_EDGE_DIRECTIONS):
+        a = 2.0 * math.pi * k / _EDGE_DIRECTIONS
+        try:
+            sec = cut_section(rings, hole.centre, np.array([-math.sin(a), math.cos(a)]), thickness)
+        except GeometryError:
+            continue
+        kts[k] = models.hole_stress_concentration(hole.diameter_mm, sec.width_mm + hole.diameter_mm, True)
+        factor[k] = kts[k] / sec.area_mm2
+    if not np.any(factor > 0):
+        return None, kts
+    return factor, kts
+
+
+def _edge_along(values: np.ndarray, directions: np.ndarray, pick: Any = np.minimum) -> np.ndarray:
+    """A per-direction table (``_EDGE_DIRECTIONS`` entries) read at each direction (n, 2): of the two
+    measured neighbours, ``pick`` (the least edge distance, the largest stress factor), never optimistic."""
     ang = np.mod(np.arctan2(directions[:, 1], directions[:, 0]), 2.0 * math.pi)
     pos = ang / (2.0 * math.pi) * _EDGE_DIRECTIONS
     k0 = np.floor(pos).astype(int) % _EDGE_DIRECTIONS
     k1 = (k0 + 1) % _EDGE_DIRECTIONS
-    # the least of the two neighbours: never optimistic between measured directions
-    return np.minimum(edges[k0], edges[k1])
+    return pick(values[k0], values[k1])
+
+
+def solved_loads(loads: Loads, magnitude: np.ndarray) -> Loads:
+    """``loads`` with the object's solved reaction made a known force (for the free bodies)."""
+    r = loads.reaction
+    force = PointForce(r.body, r.local, np.asarray(r.force) * np.asarray(magnitude)[:, None], name=r.name)
+    k = int(np.argmax(np.abs(magnitude)))
+    said = tuple(d if not d.startswith("the object at") else
+                 f"{d} (solved: up to {abs(float(magnitude[k])):.1f} N)" for d in loads.described)
+    return Loads(loads.forces + (force,), loads.torques, loads.efforts, said, None)
 
 
 def body_loads(mechanism: Mechanism, motion: Motion, statics: Statics, loads: Loads
@@ -245,11 +311,8 @@ def body_loads(mechanism: Mechanism, motion: Motion, statics: Statics, loads: Lo
     for t in loads.torques:
         body_couples.setdefault(t.body, []).append((np.asarray(t.torque), t.joint))
         body_couples.setdefault(t.reaction, []).append((-np.asarray(t.torque), t.joint))
-    carried_all = statics.driver_efforts.copy()
-    for e in loads.efforts:
-        carried_all[:, e.index] += e.effort  # the actuator's known effort plus the multiplier's remainder
     for k, d in enumerate(mechanism.drivers):
-        carried = carried_all[:, k]  # torque (angle) or force (slide) the driver puts on its body
+        carried = statics.driver_efforts[:, k]  # torque (angle) or force (slide) the driver puts on its body
         if d.kind == "angle":
             j = _joint_between(mechanism, d.body, d.reference)
             body_couples.setdefault(d.body, []).append((carried, j.name if j else ""))
@@ -295,14 +358,27 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
     result.loads = loads.described
     if not loads.described:
         result.notes.append("the template states no [load]: strength checked at zero load")
-    statics = solve_statics(mechanism, motion, loads.forces, loads.torques, loads.efforts)
+    statics = solve_statics(mechanism, motion, loads.forces, loads.torques, loads.efforts, loads.reaction)
     result.statics = statics
+    if loads.reaction is not None:
+        solved = statics.reaction_N
+        loads = solved_loads(loads, solved)
+        result.loads = loads.described
     chord = partset.chord_tolerance_mm
     parts = [p for p in partset.parts if p.role != "spacer"]
     revolutes = {j.name: j for j in mechanism.joints if isinstance(j, Revolute)}
     load_name = "; ".join(loads.described) or "no load"
 
     body_point_loads, body_couples = body_loads(mechanism, motion, statics, loads)
+
+    # the gear coupling is a torque relation: the tooth force's push on the two axes comes on top of the
+    # joints' reactions there (added as a magnitude: never less than the true vector sum)
+    tooth_push: dict[str, np.ndarray] = {}
+    for pair in gear_pairs:
+        if pair.coupling in statics.gear_torques:
+            fn = _tooth_normal_force(pair, statics.gear_torques[pair.coupling], motion)
+            for axis in (pair.axis_a, pair.axis_b):
+                tooth_push[axis] = tooth_push.get(axis, 0.0) + fn
 
     # -- pins --------------------------------------------------------------------------------------
     for pin in partset.pins:
@@ -313,7 +389,7 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
         for j in joints:
             force = force + statics.joint_forces[j] if len(joints) == 1 else np.maximum(
                 force, np.abs(statics.joint_forces[j]))
-        mag = np.hypot(force[:, 0], force[:, 1])
+        mag = np.hypot(force[:, 0], force[:, 1]) + sum((tooth_push.get(j, 0.0) for j in joints), np.zeros(1))
         i = int(np.argmax(mag))
         on_pin = sorted((p for p in parts if any(h.joint in joints for h in p.holes)), key=lambda p: p.z_mm)
         if len(on_pin) < 2:
@@ -357,7 +433,7 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
         holes = [h for h in part.holes if h.joint in revolutes]
         for h in holes:
             f = sum((lf for lp, lf, at in loads_local if at == h.joint), np.zeros((len(motion.inputs), 2)))
-            mag = np.hypot(f[:, 0], f[:, 1])
+            mag = np.hypot(f[:, 0], f[:, 1]) + tooth_push.get(h.joint, 0.0) / share
             if not np.any(mag > 0):
                 continue
             i = int(np.argmax(mag))
@@ -367,35 +443,32 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
                                            material.compressive_MPa, i, f"{mag[i]:.1f} N at {h.joint}",
                                            "a thicker plate (process.thickness_mm) or a larger pin", bearing))
             edges = _edge_distances(rings, h.centre, 0.5 * h.diameter_mm)
-            unit = f / np.maximum(mag, 1e-300)[:, None]
-            e = _edge_along(edges, unit)
+            fmag = np.hypot(f[:, 0], f[:, 1])
+            # where the load's direction is unknown (the tooth push is added as a magnitude) take the worst
+            known = fmag >= 0.999 * mag
+            unit = f / np.maximum(fmag, 1e-300)[:, None]
+            e = np.where(known, _edge_along(edges, unit), edges.min())
             with np.errstate(divide="ignore", invalid="ignore"):
-                tear = np.array([models.tearout_stress(mag[k], e[k], h.diameter_mm, t)
-                                 if e[k] > 0.5 * h.diameter_mm else math.inf for k in range(len(mag))])
+                tear = np.where(e > 0.5 * h.diameter_mm,
+                                np.asarray(models.tearout_stress(mag, np.maximum(e, 0.5 * h.diameter_mm + 1e-9),
+                                                                 h.diameter_mm, t), dtype=np.float64), math.inf)
             k = int(np.argmax(tear))
             result.findings.append(Finding(part.name, f"hole {h.joint} tear-out", "hole", float(tear[k]),
                                            material.shear_MPa, k,
                                            f"{mag[k]:.1f} N at {h.joint} (edge {e[k]:.2f} mm)",
                                            "more material round the hole (parts.boss_wall_mm / link_width_mm)",
                                            tear))
-            # the net section across a pin-loaded hole, square to the load
-            worst = (0.0, 0, 0.0)
-            for k in np.unique([i, int(np.argmax(tear))]):
-                u = unit[k]
-                try:
-                    sec = cut_section(rings, h.centre, np.array([-u[1], u[0]]), t)
-                except GeometryError:
-                    continue
-                kt = models.hole_stress_concentration(h.diameter_mm, sec.width_mm + h.diameter_mm, True)
-                s = kt * mag[k] / sec.area_mm2
-                if s > worst[0]:
-                    worst = (s, int(k), kt)
-            if worst[0] > 0:
-                k = worst[1]
-                result.findings.append(Finding(part.name, f"net section at hole {h.joint} (Kt {worst[2]:.2f})",
-                                               "link", worst[0], material.tensile_MPa, k,
-                                               f"{mag[k]:.1f} N at {h.joint}",
-                                               "a wider link (parts.link_width_mm) or a thicker plate"))
+            # the net section across a pin-loaded hole, square to the load: Kt / area per load direction
+            factor, kts = _net_section_factors(rings, h, t)
+            if factor is None:
+                continue
+            per_pose = np.where(known, _edge_along(factor, unit, np.maximum), factor.max())
+            net = mag * per_pose
+            k = int(np.argmax(net))
+            kt = float(_edge_along(kts, unit[k:k + 1], np.maximum)[0] if known[k] else kts[int(np.argmax(factor))])
+            result.findings.append(Finding(part.name, f"net section at hole {h.joint} (Kt {kt:.2f})", "link",
+                                           float(net[k]), material.tensile_MPa, k, f"{mag[k]:.1f} N at {h.joint}",
+                                           "a wider link (parts.link_width_mm) or a thicker plate", net))
         # sections at and between every pair of holes: free body on one side of the cut
         for a_idx in range(len(holes)):
             for b_idx in range(a_idx + 1, len(holes)):
@@ -463,6 +536,22 @@ def _section_finding(part, sec, point, u, station, ha, hb, loads_local, couples,
                    "a wider link (parts.link_width_mm) or a thicker plate (process.thickness_mm)", stress)
 
 
+def _pressure_angle(pair: Any) -> float:
+    """The pair's rack pressure angle (rad)."""
+    spec = getattr(pair, "spec", None)
+    return math.radians(float(getattr(spec, "pressure_angle_deg", 20.0)))
+
+
+def _tooth_normal_force(pair: Any, torque_b: np.ndarray, motion: Motion) -> np.ndarray:
+    """Tooth normal force (N) of a pair at every pose from the torque on gear b (pitch point on the line of
+    centres, pressure angle from the pair)."""
+    xa = motion.relative_angle(pair.body_a, pair.carrier)
+    ratio = np.abs(np.asarray(pair.law(xa, 1), dtype=np.float64))
+    r_b = pair.center_distance_mm / (1.0 + ratio)
+    phi = _pressure_angle(pair)
+    return np.abs(torque_b) / np.maximum(r_b, 1e-9) / math.cos(phi)
+
+
 def _gear_findings(result, pair, torque_b, mechanism, motion, parts, material) -> None:
     """Lewis bending and Hertz contact of one gear pair under the statics' torque."""
     xa = motion.relative_angle(pair.body_a, pair.carrier)
@@ -474,7 +563,7 @@ def _gear_findings(result, pair, torque_b, mechanism, motion, parts, material) -
     face = min((p.thickness_mm for p in parts if p.gear == pair.name), default=None)
     if face is None:
         return
-    phi = math.radians(float(getattr(pair, "pressure_angle_deg", 20.0)))
+    phi = _pressure_angle(pair)
     rho = [_min_curvature_radius(pair.pitch_a), _min_curvature_radius(pair.pitch_b)]
     for gear, radius in (("a", rho[0]), ("b", rho[1])):
         teeth = 2.0 * radius / pair.module if math.isfinite(radius) and radius > 0 else math.inf
@@ -497,14 +586,18 @@ def _gear_findings(result, pair, torque_b, mechanism, motion, parts, material) -
 
 
 def _min_curvature_radius(points: np.ndarray) -> float:
-    """Smallest convex radius of curvature (mm) along a closed or open pitch polyline (three-point circles)."""
+    """Smallest convex radius of curvature (mm) along a pitch polyline (three-point circles); inf if none.
+
+    Convex means turning the way the whole curve turns (its signed area's sense), whichever way it runs.
+    """
     p = np.asarray(points, dtype=np.float64)
     if len(p) < 3:
         return math.inf
     a, b, c = p[:-2], p[1:-1], p[2:]
     ab, bc, ca = np.hypot(*(b - a).T), np.hypot(*(c - b).T), np.hypot(*(a - c).T)
     cross = (b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]
+    sense = 1.0 if float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])) >= 0 else -1.0
     with np.errstate(divide="ignore", invalid="ignore"):
-        radius = ab * bc * ca / (2.0 * cross)  # signed: positive where the curve turns left (convex, CCW)
+        radius = sense * ab * bc * ca / (2.0 * cross)
     convex = radius[np.isfinite(radius) & (radius > 0)]
     return float(convex.min()) if len(convex) else math.inf

@@ -71,9 +71,12 @@ class Statics:
     gear_torques : dict pair -> (n,) array
         Torque (N·mm) ``gear_b`` receives relative to the carrier.
     driver_efforts : (n, d) array
-        Effort each driver supplies (N·mm or N).
+        Effort each driver puts on its body (N·mm for an angle, N for a slide): the known effort of an
+        actuator, the multiplier of any other driver.
     residual : float
         Largest ``|Q + J^T lambda|`` over the motion (N or N·mm): equilibrium holds where it is tiny.
+    reaction_N : (n,) array
+        Solved magnitude of the unknown reaction (zeros when there is none).
     """
 
     joint_forces: dict[str, np.ndarray]
@@ -82,6 +85,7 @@ class Statics:
     gear_torques: dict[str, np.ndarray]
     driver_efforts: np.ndarray
     residual: float
+    reaction_N: np.ndarray | None = None
 
 
 def generalised_forces(mechanism: Mechanism, motion: Motion, forces: Sequence[PointForce],
@@ -109,12 +113,17 @@ def generalised_forces(mechanism: Mechanism, motion: Motion, forces: Sequence[Po
 
 
 def solve_statics(mechanism: Mechanism, motion: Motion, forces: Sequence[PointForce] = (),
-                  torques: Sequence[BodyTorque] = (), efforts: Sequence[DriverEffort] = ()) -> Statics:
+                  torques: Sequence[BodyTorque] = (), efforts: Sequence[DriverEffort] = (),
+                  reaction: PointForce | None = None) -> Statics:
     """Constraint forces at every pose of ``motion`` under the applied loads.
 
-    Known driver efforts (an actuator's force) are applied as generalised forces along their driver's
-    coordinate; the driver's multiplier then holds only what the applied loads leave over (for a driver
-    that stands for the object or a stop, it is the effort that one supplies).
+    A known driver effort (an actuator's force) is applied along its driver's coordinate and that
+    driver's constraint is dropped: the other drivers (in the underactuated finger and the gripper they
+    stand for the object and the stops) and the loads hold the mechanism against it.
+
+    ``reaction`` is a force of unknown magnitude along given unit directions (``force``, (n, 2)): the
+    object resisting the actuator at the tip. Its magnitude at every pose is solved with the multipliers
+    (``Statics.reaction_N``).
 
     Raises
     ------
@@ -128,32 +137,47 @@ def solve_statics(mechanism: Mechanism, motion: Motion, forces: Sequence[PointFo
     n = len(motion.inputs)
     q_applied = generalised_forces(mechanism, motion, forces, torques)
     n_rev, n_sl, n_g = 2 * len(revolutes), 2 * len(sliders), len(mechanism.gears)
-    lam = np.zeros((n, n_rev + n_sl + n_g + len(mechanism.drivers)))
+    n_rows = n_rev + n_sl + n_g + len(mechanism.drivers)
+    known = {e.index: np.broadcast_to(np.asarray(e.effort, dtype=np.float64), (n,)) for e in efforts}
+    # an actuator of known effort is not a rigid constraint: its row leaves the system (the object or
+    # the other drivers, which stand for stops and contacts, must hold the mechanism against it)
+    keep = np.array([r for r in range(n_rows) if r - (n_rev + n_sl + n_g) not in known], dtype=np.int64)
+    lam = np.zeros((n, n_rows))
+    magnitude = np.zeros(n)
+    unit = generalised_forces(mechanism, motion, [reaction], ()) if reaction is not None else None
     worst = 0.0
     for i in range(n):
         q = motion.q[i].reshape(-1)
-        _, jac, ds = system.jacobian(q, float(motion.inputs[i]))
+        _, jac, _ = system.jacobian(q, float(motion.inputs[i]))
         applied = q_applied[i].copy()
-        for e in efforts:
-            # a driver row is (coordinate - value(s)); its gradient is the coordinate's direction, so
-            # an effort along the coordinate is that row times the effort
-            row = jac[n_rev + n_sl + n_g + e.index]
-            applied += row * float(np.broadcast_to(e.effort, (n,))[i])
-        sol, *_ = np.linalg.lstsq(jac.T, -applied, rcond=None)
-        miss = float(np.max(np.abs(applied + jac.T @ sol), initial=0.0))
+        for k, effort in known.items():
+            # a driver row is (coordinate - value(s)): its gradient is the coordinate's direction, so an
+            # effort along the coordinate is that row times the effort
+            applied += jac[n_rev + n_sl + n_g + k] * float(effort[i])
+        system_t = jac[keep].T if unit is None else np.column_stack([jac[keep].T, unit[i]])
+        sol, *_ = np.linalg.lstsq(system_t, -applied, rcond=None)
+        miss = float(np.max(np.abs(applied + system_t @ sol), initial=0.0))
         scale = max(1.0, float(np.max(np.abs(applied), initial=0.0)))
         if not np.all(np.isfinite(sol)) or miss > 1e-6 * scale:
+            what = ("nothing but the actuator holds the mechanism: a known input effort needs a load or "
+                    "another driver (a stop, the object) to push against" if known else
+                    "a dead point of the mechanism")
             raise GeometryError(f"statics: no equilibrium at input {float(motion.inputs[i]):.6g} "
-                                f"{mechanism.input_unit} (a dead point of the mechanism)")
+                                f"{mechanism.input_unit} ({what})")
         worst = max(worst, miss)
-        lam[i] = sol
+        if unit is not None:
+            magnitude[i] = sol[-1]
+            sol = sol[:-1]
+        lam[i, keep] = sol
+        for k, effort in known.items():
+            lam[i, n_rev + n_sl + n_g + k] = effort[i]
     joint_forces = {j.name: lam[:, 2 * k:2 * k + 2] for k, j in enumerate(revolutes)}
     slider_forces = {j.name: lam[:, n_rev + 2 * k + 1] for k, j in enumerate(sliders)}
     slider_torques = {j.name: lam[:, n_rev + 2 * k] for k, j in enumerate(sliders)}
     gear_torques = {g.name: lam[:, n_rev + n_sl + k] for k, g in enumerate(mechanism.gears)}
     return Statics(joint_forces=joint_forces, slider_forces=slider_forces, slider_torques=slider_torques,
                    gear_torques=gear_torques,
-                   driver_efforts=lam[:, n_rev + n_sl + n_g:], residual=worst)
+                   driver_efforts=lam[:, n_rev + n_sl + n_g:], residual=worst, reaction_N=magnitude)
 
 
 def body_forces(mechanism: Mechanism, statics: Statics, body: str, joint: str) -> np.ndarray:

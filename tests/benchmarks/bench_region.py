@@ -22,7 +22,7 @@ from fabricate.synthesis.watt_six_bar_region import finger_positions, solution_r
 
 def _spec() -> wsb.WattSixBarSpec:
     root = Table(read_toml(TEMPLATE_DIR / "finger_watt_six_bar.toml"))
-    for generic in ("design", "process", "checks", "gears", "parts"):
+    for generic in ("design", "process", "checks", "gears", "parts", "load"):
         if root.has(generic):
             root.table(generic)
     return wsb.parse_spec(root)

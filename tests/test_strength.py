@@ -1,0 +1,237 @@
+"""Statics over the motion and the strength check (issue 12).
+
+Expected values come from closed forms written out here (two-force members, moment balances, virtual
+power through the mechanism's own velocities), never from the code under test.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from conftest import make_four_bar
+from test_parts import slider_crank
+
+from fabricate.cli import main
+from fabricate.spec import TEMPLATE_DIR
+from fabricate.strength.check import body_loads, design_loads, solved_loads
+from fabricate.strength.spec import LoadSpec
+from fabricate.strength.statics import BodyTorque, PointForce, solve_statics
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def test_four_bar_statics_match_the_two_force_member_closed_form():
+    """A torque on the rocker: the coupler is a two-force member along A-B, so its force follows from
+    the rocker's moment balance about D and the crank torque from the crank's about O."""
+    mech = make_four_bar()
+    motion = mech.sweep(73)
+    t_out = 250.0  # N·mm on the rocker (against the ground)
+    st = solve_statics(mech, motion, torques=[BodyTorque("rocker", "ground", np.full(73, t_out))])
+    a, b = motion.point("A", "crank"), motion.point("B", "rocker")
+    o, d = np.zeros(2), np.array([40.0, 0.0])
+    e = (b - a) / np.hypot(*(b - a).T)[:, None]
+    c = -t_out / _cross(b - d, e)  # coupler force on the rocker is c e
+    t_in = _cross(a - o, c[:, None] * e)  # the crank's driver balances the coupler's pull at A
+    for joint in ("O", "A", "B", "D"):
+        got = np.hypot(*st.joint_forces[joint].T)
+        np.testing.assert_allclose(got, np.abs(c), rtol=1e-9, err_msg=joint)
+    # joint B's pair is the force on its body_a (the coupler) from the rocker: -c e
+    np.testing.assert_allclose(st.joint_forces["B"], -c[:, None] * e, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(st.driver_efforts[:, 0], t_in, rtol=1e-9, atol=1e-9)
+    assert st.residual < 1e-9
+
+
+def test_slider_crank_input_force_by_virtual_power():
+    """A torque on the crank held by the slide driver: by virtual power F v_rod + T w_crank = 0, with the
+    velocities from a finite difference of the solved motion (not the statics' Jacobian)."""
+    mech = slider_crank()
+    s = np.linspace(0.0, 8.0, 41)
+    motion = mech.sweep(s)
+    torque = 120.0
+    st = solve_statics(mech, motion, torques=[BodyTorque("crank", "ground", np.full(len(s), torque))])
+    crank_angle = np.unwrap(motion.pose("crank")[:, 2])
+    w = np.gradient(crank_angle, s, edge_order=2)  # rad per mm of slide
+    expected = -torque * w  # the driver's force along the slide (v_rod = 1 mm per mm)
+    np.testing.assert_allclose(st.driver_efforts[1:-1, 0], expected[1:-1], rtol=2e-3)
+    # the rod's guide holds the coupler's sideways push: the slider's normal force is not zero
+    assert np.max(np.abs(st.slider_forces["G"])) > 1.0
+
+
+def test_actuator_effort_is_held_by_the_object_at_the_tip():
+    """A known crank torque with the object at the rocker's tip: the solved tip force does the same work
+    (virtual power T w_crank + F (u . v_tip) = 0, velocities by finite differences of the motion)."""
+    mech = make_four_bar()
+    s = np.linspace(60.0, 160.0, 51)
+    motion = mech.sweep(s)
+    hints = {"tip_point": "B", "pads": {"rocker": {"point": "B"}}}
+    loads = design_loads(_design(input_torque_Nmm=80.0), mech, motion, hints)
+    assert loads.reaction is not None and not loads.forces
+    st = solve_statics(mech, motion, loads.forces, loads.torques, loads.efforts, loads.reaction)
+    np.testing.assert_allclose(st.driver_efforts[:, 0], 80.0)
+    w = np.radians(1.0)  # the crank turns 1 deg per unit input
+    v_tip = np.gradient(motion.point("B", "rocker"), s, axis=0, edge_order=2)
+    u = loads.reaction.force
+    expected = -80.0 * w / np.sum(u * v_tip, axis=1)
+    np.testing.assert_allclose(st.reaction_N[2:-2], expected[2:-2], rtol=2e-3)
+    # with the actuator alone (no object), nothing holds the one-driver four-bar: a clear error
+    from fabricate.errors import GeometryError
+
+    with pytest.raises(GeometryError, match="nothing but the actuator"):
+        solve_statics(mech, motion, efforts=loads.efforts)
+
+
+def _design(**load) -> SimpleNamespace:
+    return SimpleNamespace(load=LoadSpec(**load))
+
+
+def test_tip_force_opposes_the_tip_motion_and_springs_follow_their_rate():
+    mech = make_four_bar()
+    motion = mech.sweep(np.linspace(60.0, 200.0, 61))
+    hints = {"tip_point": "B", "pads": {"rocker": {"point": "B"}},
+             "springs": [{"joint": "D", "rate_Nmm_per_deg": 2.0, "preload_deg": 10.0}]}
+    loads = design_loads(_design(tip_force_N=7.0), mech, motion, hints)
+    (tip,) = loads.forces
+    path = motion.point("B", "rocker")
+    step = path[2:] - path[:-2]  # central differences, independent of the code's gradient
+    moving = np.hypot(*step.T) > 0.2 * np.hypot(*step.T).max()  # away from the rocker's turning points
+    np.testing.assert_allclose(np.hypot(*tip.force.T), 7.0, rtol=1e-12)
+    cosine = np.sum(tip.force[1:-1] * step, axis=1) / (7.0 * np.hypot(*step.T))
+    assert np.all(cosine[moving] < -0.99)
+    (spring,) = loads.torques
+    # rocker angle from its two points, independently of the motion's stored angle
+    d_to_b = path - np.array([40.0, 0.0])
+    rocker = np.degrees(np.unwrap(np.arctan2(d_to_b[:, 1], d_to_b[:, 0])))
+    turned = np.abs(rocker - rocker[0])
+    assert np.all(np.diff(turned) > 0.0)  # one way over this range: the deflection only grows
+    np.testing.assert_allclose(np.abs(spring.torque), 2.0 * (10.0 + turned), rtol=1e-9)
+
+
+@pytest.mark.parametrize("load", [{"tip_force_N": 5.0}, {"input_torque_Nmm": 40.0}])
+def test_every_body_is_in_equilibrium_under_all_its_loads(load):
+    """Joint reactions, the tip force (given, or solved against the actuator), springs and the drivers'
+    efforts balance on each body (forces and moments), so a section's free body is the same from either
+    side."""
+    mech = make_four_bar()
+    motion = mech.sweep(49)
+    hints = {"tip_point": "B", "pads": {"rocker": {"point": "B"}},
+             "springs": [{"joint": "A", "rate_Nmm_per_deg": 3.0, "preload_deg": 20.0}]}
+    loads = design_loads(_design(**load), mech, motion, hints)
+    st = solve_statics(mech, motion, loads.forces, loads.torques, loads.efforts, loads.reaction)
+    if loads.reaction is not None:
+        loads = solved_loads(loads, st.reaction_N)
+    points, couples = body_loads(mech, motion, st, loads)
+    for body in ("crank", "coupler", "rocker"):
+        pose = motion.pose(body)
+        force = np.zeros((49, 2))
+        moment = np.zeros(49)
+        for local, f, _ in points[body]:
+            c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+            arm = np.column_stack([c * local[0] - s * local[1], s * local[0] + c * local[1]])
+            force += f
+            moment += _cross(arm, f)
+        for torque, _ in couples.get(body, []):
+            moment += torque
+        assert np.max(np.abs(force)) < 1e-9, body
+        assert np.max(np.abs(moment)) < 1e-7, body
+
+
+def test_gripper_statics_reproduce_the_papers_rod_force():
+    """Seed 003's grasp: the can's 4.50 N on the pad (horizontal, through the arc centre) and the spring at
+    B give the two-force rod the paper's static force (eqs 3-4, the synthesis' own model), and leave the
+    free hinge C (k1 = 0) unloaded. Two independent statics of one grasp agree to 1e-6 (measured 5e-10)."""
+    from fabricate.pipeline import synthesise
+    from fabricate.spec import load_design
+
+    design = load_design("gripper_compliant")
+    result = synthesise(design)
+    grasp = result.report["grasp"]
+    # the template states F_n1 rounded to 4.5 N as the paper prints it; eqs 3-4 give it exactly
+    exact = result.report["paper_optimum"]["F_n1_N"]
+    assert exact == pytest.approx(4.5, abs=0.1)
+    design = dataclasses.replace(design, load=dataclasses.replace(design.load, tip_force_N=exact))
+    mech = result.mechanism
+    s = np.linspace(mech.input_range[0], grasp["stroke_mm"], 60)
+    motion = mech.sweep(s)
+    loads = design_loads(design, mech, motion, result.parts)
+    st = solve_statics(mech, motion, loads.forces, loads.torques, loads.efforts, loads.reaction)
+    rod = float(np.hypot(*st.joint_forces["E"][-1]))
+    assert rod == pytest.approx(grasp["rod_force_static_N"], rel=1e-6)
+    (spring,) = loads.torques
+    assert abs(spring.torque[-1]) == pytest.approx(grasp["spring_torques_Nmm"][1], rel=1e-3)
+    hinge_c = next(k for k, d in enumerate(mech.drivers) if d.kind == "angle" and d.body == "tip")
+    assert abs(st.driver_efforts[-1, hinge_c]) < 1e-6 * abs(spring.torque[-1])
+
+
+def test_point_force_on_the_ground_is_carried_by_the_ground():
+    mech = make_four_bar()
+    motion = mech.sweep(5)
+    st = solve_statics(mech, motion, forces=[PointForce("ground", np.zeros(2), np.ones((5, 2)))])
+    assert all(np.max(np.abs(f)) == 0.0 for f in st.joint_forces.values())
+
+
+# -- the check through the pipeline ----------------------------------------------------------------
+
+def _template(name: str, **replace: str) -> str:
+    text = (TEMPLATE_DIR / f"{name}.toml").read_text(encoding="utf-8")
+    for old, new in replace.items():
+        assert old in text
+        text = text.replace(old, new)
+    return text
+
+
+def test_weakened_finger_fails_naming_part_feature_and_load(tmp_path, capsys):
+    """The underactuated finger pushed with 2000 N instead of 60 N: exit 1, the files and a report that
+    names the part, the feature, the load and the fix."""
+    path = tmp_path / "weak.toml"
+    path.write_text(_template("finger_underactuated", **{"input_force_N = 60.0": "input_force_N = 2000.0"}),
+                    encoding="utf-8")
+    code = main(["build", str(path), "-o", str(tmp_path / "out")])
+    captured = capsys.readouterr()
+    out = captured.out + captured.err
+    assert code == 1
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    strength = report["strength"]
+    assert strength["passed"] is False
+    weak = [p for p in strength["parts"] if p["min_safety_factor"] < 2.0]
+    assert weak
+    worst = min(weak, key=lambda p: p["min_safety_factor"])
+    # the worst part is named in the failure with its feature and the load that governs
+    failure = next(f for f in report["checks"]["failures"] if f.startswith(f"strength: part {worst['name']},"))
+    assert worst["feature"] in failure and worst["input"] in failure
+    assert any("2000 N on the input" in load for load in strength["loads"])
+    assert "safety factor" in failure and ("wider" in failure or "thicker" in failure or "larger" in failure)
+    assert f"part {worst['name']}" in out
+    # the stresses scale with the load: 2000 / 60 times the shipped design's (linear statics)
+    assert worst["stress_MPa"] == pytest.approx(worst["allowable_MPa"] / worst["min_safety_factor"], rel=1e-4)
+    assert (tmp_path / "out" / "plots" / "strength.png").is_file()
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("tip_force_N", "-1.0", "load.tip_force_N"),
+    ("input_force_N", '"a lot"', "load.input_force_N"),
+    ("tip_forse_N", "1.0", "load.tip_forse_N"),
+])
+def test_bad_load_field_exits_2_naming_it(tmp_path, capsys, field, value, message):
+    path = tmp_path / "bad.toml"
+    path.write_text(_template("finger_underactuated", **{"input_force_N = 60.0": f"{field} = {value}"}),
+                    encoding="utf-8")
+    code = main(["build", str(path), "-o", str(tmp_path / "out"), "-q"])
+    assert code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_unknown_material_exits_2_naming_the_field(tmp_path, capsys):
+    path = tmp_path / "bad.toml"
+    text = _template("finger_underactuated", **{'profile = "sla"': 'profile = "sla"\nmaterial = "unobtainium"'})
+    path.write_text(text, encoding="utf-8")
+    assert main(["build", str(path), "-o", str(tmp_path / "out"), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "material" in err and "unobtainium" in err and "standard_resin" in err
+
