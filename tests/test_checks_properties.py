@@ -129,3 +129,46 @@ def test_input_ranges_are_contiguous_runs():
     assert result.input_ranges(np.array([], dtype=int)) == []
     assert result.input_ranges(np.array([3])) == [(x[3], x[3])]
     assert result.input_ranges(np.array([0, 1, 2, 5, 6, 9])) == [(x[0], x[2]), (x[5], x[6]), (x[9], x[9])]
+
+
+def test_outline_orients_its_rings_and_drops_repeated_vertices():
+    """Rings given the wrong way round (outer clockwise, hole counter-clockwise) with a closing vertex and a
+    doubled vertex: the outline is the plate minus the hole (area 400 - 16), outer CCW, hole CW; the centre and
+    radius of its vertex box are the closed forms."""
+    from fabricate.planar import polygon_area
+
+    outer = np.array([[0, 0], [0, 20], [20, 20], [20, 20], [20, 0], [0, 0]], dtype=float)  # clockwise, closed
+    hole = np.array([[8, 8], [12, 8], [12, 12], [8, 12]], dtype=float)  # counter-clockwise
+    out = Outline([outer, hole])
+    assert [len(r) for r in out.rings] == [4, 4]
+    assert polygon_area(out.rings[0]) == pytest.approx(400.0) and polygon_area(out.rings[1]) == pytest.approx(-16.0)
+    assert out.polygon.area == pytest.approx(384.0)
+    np.testing.assert_allclose(out.centre, [10.0, 10.0])
+    assert out.radius == pytest.approx(10 * np.sqrt(2))
+    np.testing.assert_allclose(out.bounds, [0, 0, 20, 20])
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 8, 9, 10**6])
+def test_clearance_and_overlap_do_not_depend_on_the_chunk_size(monkeypatch, chunk):
+    """The posed copies are built in chunks of POSED_VERTICES_PER_CHUNK vertices: any chunk size (one pose at a
+    time, two at a time, all at once) gives the same distances and areas, equal to shapely on raw
+    coordinates; touching boundaries give exactly 0."""
+    import fabricate.checks.distance as distance
+
+    monkeypatch.setattr(distance, "POSED_VERTICES_PER_CHUNK", chunk)
+    plate = np.array([[0, 0], [20, 0], [20, 6], [0, 6]], dtype=float)
+    square = np.array([[0, 0], [3, 0], [3, 3], [0, 3]], dtype=float)
+    a, b = Outline([plate]), Outline([square])
+    q = np.array([[5, 7, 0.0], [5, 6.5, 0.1], [5, 6, 0.0], [5, 8.5, 0.0], [4, 4, 0.2], [25, 2, 0.0], [5, 7, 0.0],
+                  [40, 40, 0.0]])
+    got = distance.planar_clearance(a, b, RelativePoses(q), search_mm=4.0)
+    truth = np.array([shapely.Polygon(plate).distance(_posed_shapely(square, p)) for p in q])
+    area = np.array([shapely.Polygon(plate).intersection(_posed_shapely(square, p)).area for p in q])
+    assert got[2] == 0.0  # the square's bottom edge lies on the plate's top edge
+    assert got[4] == -np.inf and area[4] > 0
+    assert got[7] == np.inf  # farther than the search length
+    keep = (truth <= 4.0) & (area == 0)
+    np.testing.assert_allclose(got[keep], truth[keep], atol=1e-9)
+    np.testing.assert_allclose(distance.overlap_areas(a, b, RelativePoses(q)), area, atol=1e-9)
+    assert distance.overlap_areas(a, b, RelativePoses(np.zeros((0, 3)))).shape == (0,)
+    assert distance.planar_clearance(a, b, RelativePoses(np.zeros((0, 3))), 4.0).shape == (0,)

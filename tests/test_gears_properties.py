@@ -391,6 +391,20 @@ def test_constant_ratio_pitch_curves_are_the_two_circles():
     # by default arc length counts from x = 0
     default = PitchCurves(law, 30.0, (0.0, 2 * np.pi), intervals=64)
     np.testing.assert_allclose(default.s_of_x(np.array([0.0, 1.0])), [0.0, 10.0], atol=1e-9)
+    assert len(default.nodes) == 65  # 64 intervals asked for
+
+
+def test_pitch_curves_reject_a_law_that_reverses_inside_the_domain():
+    """x_b = -(x - 0.012 tanh((x - 1.3) / 0.01)): ratio 1 - 1.2 sech^2((x - 1.3) / 0.01), negative only for
+    |x - 1.3| < 0.0044 rad, positive at both ends of the domain: the construction check (a grid of
+    4 x 512 + 1 angles, step 0.0015 rad) must find it."""
+    from fabricate.errors import SpecError
+    from fabricate.gears.pitch import PitchCurves
+
+    law = FormulaLaw("x - 0.012*tanh((x - 1.3)/0.01)")
+    with pytest.raises(SpecError, match="ratio"):
+        PitchCurves(law, 30.0, (0.0, 3.0), intervals=512)
+    PitchCurves(FormulaLaw("x - 0.008*tanh((x - 1.3)/0.01)"), 30.0, (0.0, 3.0), intervals=512)  # 1 - 0.8 sech^2 > 0
 
 
 def test_elliptic_pitch_curve_radius_derivatives_arc_length_and_curvature():
@@ -543,3 +557,234 @@ def test_working_pressure_angles_of_the_elliptic_pair():
         # law'' by central differences: 1e-6 deg
         assert out["drive_flank_deg"] == pytest.approx([drive.min(), drive.max()], abs=1e-6)
         assert out["coast_flank_deg"] == pytest.approx([coast.min(), coast.max()], abs=1e-6)
+
+
+# -- the basic rack and the envelope mappings against their geometry ---------------------------------
+def test_basic_rack_is_flat_round_and_straight_flank():
+    """Module 2, 20 deg, h_f = 1.25 m, rho_f = 0.38 m: the root flat on v = -h_f, the round at distance rho_f
+    from its centre and tangent to both the flat and the flank line u = -p/4 + v tan(alpha), the flank
+    points on that line up to v = (h_a + 0.02) m with the normal (-cos, sin); the right half the mirror
+    image; gear b's cutter the reflection across the pitch line."""
+    from fabricate.gears.rack import FLANK, FLAT_ROOT_A, ROUND_ROOT_A, basic_rack
+
+    m, alpha, hf, rho = 2.0, np.radians(20.0), 2.5, 0.76
+    p = np.pi * m
+    rack = basic_rack(m, alpha, 1.25, 0.38, addendum=1.0, flank_points=11, round_points=7, flat_points=3)
+    pts, nrm, el = rack.points, rack.normals, rack.element
+    assert rack.pitch == pytest.approx(p)
+    assert np.all(np.diff(pts[:, 0]) > 0)  # in order of increasing u
+    np.testing.assert_allclose(np.hypot(*nrm.T), 1.0, rtol=1e-12)
+    left = pts[:, 0] < 0
+    assert pts[0, 0] == pytest.approx(-p / 2)
+    flat = el == FLAT_ROOT_A
+    np.testing.assert_allclose(pts[flat, 1], -hf, atol=1e-12)
+    np.testing.assert_allclose(nrm[flat], [[0.0, 1.0]] * int(flat.sum()), atol=1e-12)
+    # the round's centre: rho above the root, rho from the flank line on the tooth-space side
+    cv = -hf + rho
+    cu = -p / 4 + cv * np.tan(alpha) - rho / np.cos(alpha)
+    rnd = (el == ROUND_ROOT_A) & left
+    assert rnd.sum() == 7
+    np.testing.assert_allclose(np.hypot(pts[rnd, 0] - cu, pts[rnd, 1] - cv), rho, rtol=1e-12)
+    np.testing.assert_allclose(nrm[rnd], -(pts[rnd] - [cu, cv]) / rho, atol=1e-12)
+    assert pts[rnd][0] == pytest.approx([cu, -hf])  # starts where the flat ends (tangent)
+    fl = (el == FLANK) & left
+    assert fl.sum() == 11
+    line_u = -p / 4 + pts[fl, 1] * np.tan(alpha)
+    np.testing.assert_allclose(pts[fl, 0], line_u, atol=1e-12)
+    np.testing.assert_allclose(nrm[fl], [[-np.cos(alpha), np.sin(alpha)]] * 11, atol=1e-12)
+    assert pts[fl, 1].max() == pytest.approx(1.02 * m)
+    assert pts[fl, 1].min() == pytest.approx(cv - rho * np.sin(alpha))  # tangent point of the round
+    np.testing.assert_allclose(rack.flank_u[fl], -p / 4)
+    np.testing.assert_allclose(rack.flank_u[(el == FLANK) & ~left], p / 4)
+    assert np.all(np.isnan(rack.flank_u[el != FLANK]))
+    # mirror symmetry: (u, v) -> (-u, v) maps the profile onto itself, normals likewise (the period is
+    # [-p/2, p/2): the first point's mirror image is the next period's first point)
+    np.testing.assert_allclose(pts[1:][::-1] * [-1, 1], pts[1:], atol=1e-12)
+    np.testing.assert_allclose(nrm[1:][::-1] * [-1, 1], nrm[1:], atol=1e-12)
+    np.testing.assert_array_equal(el[1:][::-1], el[1:])
+    b = rack.for_gear_b()
+    np.testing.assert_allclose(b.points, pts * [1, -1])
+    np.testing.assert_allclose(b.normals, nrm * [-1, 1])
+    np.testing.assert_array_equal(b.element, el)
+    assert b.pitch == rack.pitch
+    np.testing.assert_array_equal(b.flank_u, rack.flank_u)
+    no_round = basic_rack(m, alpha, 1.25, 0.0, flank_points=5, round_points=7, flat_points=3)
+    assert not np.any(no_round.element == ROUND_ROOT_A)
+    with pytest.raises(ValueError, match="root fillet too large"):
+        basic_rack(m, alpha, 1.25, 1.25)
+
+
+@pytest.mark.parametrize("deg", [14.5, 20.0, 25.0, 30.0])
+def test_rack_fit_leaves_the_minimum_root_land(deg):
+    """The deepest dedendum leaves a 0.02 m half land at the tooth space centre: (pi/4 - 0.02) / tan(alpha);
+    the largest fillet for a dedendum puts the round's end 0.02 m from the half period (centre geometry as in
+    the previous test), and never exceeds the dedendum."""
+    from fabricate.gears.rack import MIN_ROOT_LAND, rack_fit
+
+    alpha = np.radians(deg)
+    max_hf, _ = rack_fit(alpha, 10.0)
+    assert max_hf == pytest.approx((np.pi / 4 - MIN_ROOT_LAND) / np.tan(alpha), rel=1e-12)
+    for hf in (0.6, 1.0, 1.25, 10.0):
+        got_max, rho = rack_fit(alpha, hf)
+        assert got_max == max_hf
+        h = min(hf, max_hf)
+        centre_u = -np.pi / 4 + (rho - h) * np.tan(alpha) - rho / np.cos(alpha)  # module 1
+        if 0.0 < rho < h:
+            assert centre_u + np.pi / 2 == pytest.approx(MIN_ROOT_LAND, abs=1e-12)
+        else:
+            assert rho in (0.0, h)
+            assert centre_u + np.pi / 2 >= MIN_ROOT_LAND - 1e-12
+    assert rack_fit(np.radians(20.0), 1.25)[1] > 0.38  # the standard 0.38 m fillet fits the standard rack
+    assert rack_fit(np.radians(20.0), 0.1)[1] == pytest.approx(0.1)  # capped by a shallow root
+
+
+def test_offset_contact_abscissa_and_envelope_mapping():
+    """Offset thins the gear named (a: against the normal, b: along it); the contact abscissa is where the
+    point's normal line meets the pitch line v = 0; the envelope places (u, v) at P + (u - s) t +/- v n."""
+    from fabricate.gears.pitch import PitchFrames
+    from fabricate.gears.rack import contact_abscissa, envelope, offset_profile
+
+    pts = np.array([[0.3, -0.5], [1.0, 0.8], [-2.0, 0.2]])
+    ang = np.radians([70.0, 110.0, 45.0])
+    nrm = np.column_stack([np.cos(ang), np.sin(ang)])
+    np.testing.assert_allclose(offset_profile(pts, nrm, 0.1, "a"), pts - 0.1 * nrm)
+    np.testing.assert_allclose(offset_profile(pts, nrm, 0.1, "b"), pts + 0.1 * nrm)
+    s = contact_abscissa(pts, nrm)
+    t = -pts[:, 1] / nrm[:, 1]  # parameter along the normal where v = 0
+    np.testing.assert_allclose(s, pts[:, 0] + t * nrm[:, 0], atol=1e-12)
+    frames = PitchFrames(point=np.array([[1.0, 2.0]] * 3), tangent=np.array([[0.6, 0.8]] * 3),
+                         normal=np.array([[-0.8, 0.6]] * 3), curvature=np.zeros(3))
+    got_a, got_b = envelope(pts, s, frames, "a"), envelope(pts, s, frames, "b")
+    for i in range(3):
+        along = (pts[i, 0] - s[i]) * np.array([0.6, 0.8])
+        np.testing.assert_allclose(got_a[i], [1.0, 2.0] + along + pts[i, 1] * np.array([-0.8, 0.6]), atol=1e-12)
+        np.testing.assert_allclose(got_b[i], [1.0, 2.0] + along - pts[i, 1] * np.array([-0.8, 0.6]), atol=1e-12)
+
+
+@pytest.mark.parametrize("radius", [12.0, -30.0, np.inf])
+def test_osculating_frames_of_a_circle_are_the_circle(radius):
+    """For a pitch circle of radius R (gear a: clockwise travel, outward normal; R < 0 concave, R = inf a
+    straight line) the osculating frames at arc sigma from the tooth centre are the exact frames there,
+    for tiny sigma (series branch) and large ones."""
+    from fabricate.gears.pitch import PitchFrames
+    from fabricate.gears.rack import osculating_frames
+
+    k = 0.0 if np.isinf(radius) else 1.0 / radius
+    phi = 0.7
+    sigma = np.array([-5.0, -1e-9, 0.0, 3e-8, 2.0, 9.0])
+    n = len(sigma)
+    n0 = np.array([np.cos(phi), np.sin(phi)])
+    t0 = np.array([np.sin(phi), -np.cos(phi)])
+    p0 = np.array([4.0, -1.0])
+    centre = PitchFrames(np.tile(p0, (n, 1)), np.tile(t0, (n, 1)), np.tile(n0, (n, 1)), np.full(n, k))
+    got = osculating_frames(sigma + 10.0, np.full(n, 10.0), centre)
+    # exact: turn by k sigma about the centre of curvature p0 - n0 / k (clockwise for k > 0)
+    turn = k * sigma
+    if k == 0.0:
+        want_p = p0 + sigma[:, None] * t0
+    else:
+        c0 = p0 - n0 / k
+        want_p = c0 + (np.cos(turn)[:, None] * n0 + np.sin(turn)[:, None] * t0) / k
+    want_n = np.cos(turn)[:, None] * n0 + np.sin(turn)[:, None] * t0
+    want_t = np.cos(turn)[:, None] * t0 - np.sin(turn)[:, None] * n0
+    np.testing.assert_allclose(got.point, want_p, atol=1e-12)
+    np.testing.assert_allclose(got.normal, want_n, atol=1e-15)
+    np.testing.assert_allclose(got.tangent, want_t, atol=1e-15)
+    np.testing.assert_array_equal(got.curvature, np.full(n, k))
+
+
+# -- the mesh check's parts against closed forms and independent booleans ----------------------------------
+def test_mesh_summary_of_given_arrays():
+    """The summary of hand-made arrays: ranges over the steps with a contact pair, NaN steps counted, the
+    TE the largest magnitude in degrees, the measured contact ratio the mean teeth in contact."""
+    from fabricate.gears.mesh import MeshResult
+
+    nan = np.nan
+    r = MeshResult(x_a=np.array([0.0, 0.1, 0.2, 0.3]), free_plus=np.array([0.01, nan, 0.02, 0.015]),
+                   free_minus=np.array([0.02, nan, 0.01, 0.0]), backlash_mm=np.array([0.3, nan, 0.36, 0.15]),
+                   transmission_error=np.array([-0.002, nan, 0.001, 0.0]),
+                   contact_lag=np.array([0.01, nan, 0.02, 0.015]),
+                   interference_area_mm2=np.array([0.0, 0.5, 0.0, 0.25]), teeth_in_contact=np.array([1, 0, 2, 2]))
+    assert r.steps == 4
+    assert r.summary() == {
+        "steps": 4, "interference_area_mm2": 0.5, "backlash_mm": [0.15, 0.36],
+        "transmission_error_deg": pytest.approx(np.degrees(0.002)),
+        "contact_lag_deg": [pytest.approx(np.degrees(0.01)), pytest.approx(np.degrees(0.02))],
+        "steps_without_contact_pair": 1, "teeth_in_contact": [0, 2], "contact_ratio_measured": 1.25}
+    empty = MeshResult(x_a=np.zeros(2), free_plus=np.full(2, nan), free_minus=np.full(2, nan),
+                       backlash_mm=np.full(2, nan), transmission_error=np.full(2, nan), contact_lag=np.full(2, nan),
+                       interference_area_mm2=np.zeros(2))
+    assert empty.summary() == {"steps": 2, "interference_area_mm2": 0.0, "backlash_mm": [None, None],
+                               "transmission_error_deg": None, "contact_lag_deg": [None, None],
+                               "steps_without_contact_pair": 2, "teeth_in_contact": None,
+                               "contact_ratio_measured": None}
+
+
+def test_designed_lag_on_both_flanks_of_the_elliptic_pair():
+    """2 delta / d_B with delta = j cos(alpha) / 4 and d_B = r_b cos(alpha -/+ mu) (driving / coast flank),
+    r_b = a - r_a and mu the ellipse's tangent lean (closed forms); for circles j / (2 r_b) on both."""
+    from types import SimpleNamespace
+
+    from fabricate.gears.law import elliptic_law
+    from fabricate.gears.mesh import designed_lag
+    from fabricate.gears.pitch import PitchCurves
+    from fabricate.gears.spec import GearSpec
+
+    x = np.array([0.0, 0.8, 2.0, 4.0])
+    alpha, j, a = np.radians(20.0), 0.12, 30.0
+    for e in (0.0, 0.3):
+        pair = SimpleNamespace(spec=GearSpec(backlash_mm=j),
+                               pitch_model=PitchCurves(elliptic_law(e), a, (0.0, 2 * np.pi), intervals=16))
+        r_b = a - (a / 2) * (1 - e * e) / (1 + e * np.cos(x))
+        mu = np.arctan(e * np.sin(x) / (1 + e * np.cos(x)))
+        delta = j * np.cos(alpha) / 4
+        left, right = designed_lag(pair, x)
+        np.testing.assert_allclose(left, 2 * delta / (r_b * np.cos(alpha - mu)), rtol=1e-8)
+        np.testing.assert_allclose(right, 2 * delta / (r_b * np.cos(alpha + mu)), rtol=1e-8)
+        if e == 0.0:
+            np.testing.assert_allclose(left, j / (2 * 15.0), rtol=1e-12)
+
+
+def test_spur_mesh_contact_ratio_and_free_play_from_outlines():
+    """Equal 24-tooth spur gears, module 1: the measured teeth in contact average the contact ratio
+    (2 sqrt(r_a^2 - r_b^2) - a sin alpha) / (pi m cos alpha) = 1.602 (within one step of the 30 per tooth);
+    the free play found by bisection on booleans of the outlines alone (an independent method) is the
+    designed j / (2 r) each way within the outlines' chord error; the steps cover one turn of each gear."""
+    from fabricate.gears.mesh import free_play_outlines
+
+    pair = spur_pair()
+    mesh = pair.mesh
+    alpha = np.radians(20.0)
+    ratio = (2 * np.sqrt(13.0**2 - (12.0 * np.cos(alpha)) ** 2) - 24.0 * np.sin(alpha)) / (np.pi * np.cos(alpha))
+    assert np.mean(mesh.teeth_in_contact) == pytest.approx(ratio, abs=1 / 30)
+    assert set(np.unique(mesh.teeth_in_contact)) == {1, 2}
+    np.testing.assert_allclose(mesh.x_a, np.linspace(0.0, 2 * np.pi, 720, endpoint=False), atol=1e-12)
+    np.testing.assert_array_equal(mesh.contact_lag, mesh.free_plus)
+    x = np.array([0.05, 0.3, 1.0])
+    plus, minus = free_play_outlines(pair.outline_a, pair.outline_b, pair.law, pair.center_distance_mm, x, pair.module)
+    np.testing.assert_allclose(plus, 0.1 / 24.0, atol=2.5e-4)
+    np.testing.assert_allclose(minus, 0.1 / 24.0, atol=2.5e-4)
+
+
+def test_interference_area_against_the_whole_outlines():
+    """Centres 0.4 mm too close: the clipped, shifted booleans give the area of the intersection of the whole
+    posed outlines (shapely on raw coordinates); at the design distance there is none."""
+    from dataclasses import replace
+
+    from fabricate.gears.mesh import interference_areas
+
+    pair = spur_pair()
+    x = np.array([0.0, 0.11, 0.7])
+    np.testing.assert_array_equal(interference_areas(pair, x), 0.0)
+    close = replace(pair, center_distance_mm=pair.center_distance_mm - 0.4)
+    got = interference_areas(close, x)
+
+    def posed(outline, angle, dx):
+        c, s = np.cos(angle), np.sin(angle)
+        pts = np.asarray(outline)
+        return Polygon(np.column_stack([c * pts[:, 0] - s * pts[:, 1] + dx, s * pts[:, 0] + c * pts[:, 1]]))
+
+    want = [posed(pair.outline_a, xi, 0.0).intersection(posed(pair.outline_b, float(pair.law(xi)),
+                                                                close.center_distance_mm)).area for xi in x]
+    assert min(want) > 0.05
+    np.testing.assert_allclose(got, want, rtol=1e-9)

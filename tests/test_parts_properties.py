@@ -102,3 +102,48 @@ def test_fuse_fills_enclosed_gaps_and_drops_collinear_points():
     assert len(fused.vertices) == 4
     assert polygon_area(fused.vertices) > 0
     np.testing.assert_array_equal(fused.vertices[0], [0.0, 0.0])
+
+
+def _reversed(path: BulgePath) -> BulgePath:
+    """The same contour traversed the other way: vertices reversed, each arc's bulge negated on its reversed
+    segment."""
+    return BulgePath(path.vertices[::-1].copy(), -np.roll(path.bulges[::-1], -1))
+
+
+@pytest.mark.parametrize("d", [0.7, -0.7])
+def test_offset_of_a_hull_of_circles_is_the_hull_of_the_grown_circles(d):
+    """A pear (radii 4 and 2, 12 mm apart) offset by d is the exact hull of the circles with radii + d: same
+    vertices and bulges, area by the closed form; the same contour given clockwise is offset outwards too."""
+    centres, radii = np.array([[0.0, 0.0], [12.0, 0.0]]), np.array([4.0, 2.0])
+    pear = circle_hull(centres, radii)
+    grown = circle_hull(centres, radii + d)
+    out = offset_path(pear, d)
+    np.testing.assert_allclose(out.vertices, grown.vertices, atol=1e-12)
+    np.testing.assert_allclose(out.bulges, grown.bulges, atol=1e-12)
+    r1, r2, dist = 4.0 + d, 2.0 + d, 12.0
+    a = math.asin((r1 - r2) / dist)
+    expected = (r1 + r2) * dist * math.cos(a) + (math.pi + 2 * a) * r1**2 / 2 + (math.pi - 2 * a) * r2**2 / 2
+    assert out.area() == pytest.approx(expected, rel=1e-12)
+    cw = _reversed(pear)
+    assert cw.area() == pytest.approx(-pear.area(), rel=1e-12)
+    assert abs(offset_path(cw, d).area()) == pytest.approx(expected, rel=1e-12)
+
+
+def test_hull_of_three_circles_is_triangle_plus_band_plus_disc():
+    """Equal circles (r = 1.5) at the corners of a triangle and a fourth inside it: the hull's area is the
+    triangle's area + its perimeter x r + pi r^2 (closed form), the inner circle adds nothing; the path is
+    counter-clockwise with three arcs whose turns add up to one full turn."""
+    tri = np.array([[0.0, 0.0], [10.0, 0.0], [3.0, 7.0]])
+    r = 1.5
+    hull = circle_hull(np.vstack([tri, [[4.0, 2.0]]]), r)
+    (ux, uy), (vx, vy) = tri[1] - tri[0], tri[2] - tri[0]
+    area = 0.5 * abs(ux * vy - uy * vx)
+    perimeter = sum(np.hypot(*(tri[(i + 1) % 3] - tri[i])) for i in range(3))
+    assert hull.area() == pytest.approx(area + perimeter * r + math.pi * r * r, rel=1e-12)
+    arcs = hull.bulges[hull.bulges != 0]
+    assert len(arcs) == 3
+    assert np.sum(4 * np.arctan(arcs)) == pytest.approx(2 * math.pi, rel=1e-12)
+    assert polygon_area(hull.vertices) > 0
+    # every vertex is a tangent point: at distance r from its nearest corner
+    d = np.min(np.hypot(*(hull.vertices[:, None, :] - tri[None, :, :]).transpose(2, 0, 1)), axis=1)
+    np.testing.assert_allclose(d, r, atol=1e-12)
