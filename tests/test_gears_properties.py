@@ -443,6 +443,13 @@ def test_elliptic_pitch_curve_radius_derivatives_arc_length_and_curvature():
     assert pitch.perimeter_a == pytest.approx(4 * big_a * ellipe(e * e), rel=1e-10)
     kappa = (r**2 + 2 * dr**2 - r * ddr) / (r**2 + dr**2) ** 1.5
     np.testing.assert_allclose(pitch.frames_at_x(x, "a").curvature, kappa, rtol=1e-6)
+    # gear b: r_b = a - r_a at polar angle pi - law(x), turning at i = (1 - e^2) / (1 + e^2 + 2 e cos x)
+    q = 1 + e * e + 2 * e * np.cos(x)
+    i, di = (1 - e * e) / q, (1 - e * e) * 2 * e * np.sin(x) / q**2
+    rb, drb, ddrb = a - r, -dr, -ddr
+    r_t, r_tt = drb / i, (ddrb * i - drb * di) / i**3  # derivatives by the polar angle
+    kappa_b = (rb**2 + 2 * r_t**2 - rb * r_tt) / (rb**2 + r_t**2) ** 1.5
+    np.testing.assert_allclose(pitch.frames_at_x(x, "b").curvature, kappa_b, rtol=1e-6)
     # the two frames at one contact: tangents opposite in the world (rolling), points a apart
     s = pitch.s_of_x(x)
     np.testing.assert_allclose(pitch.x_of_s(s), x, atol=1e-12)
@@ -788,3 +795,73 @@ def test_interference_area_against_the_whole_outlines():
                                                                 close.center_distance_mm)).area for xi in x]
     assert min(want) > 0.05
     np.testing.assert_allclose(got, want, rtol=1e-9)
+
+
+@pytest.mark.parametrize(("shift", "words"), [(0.25, "outside 0.05..0.2 mm"), (-0.1, "outside 0.05..0.2 mm"),
+                                              (-0.2, "backlash closes")])
+def test_gear_mesh_check_judges_the_backlash_band(shift, words):
+    """Centres moved apart by 0.25 mm or together by 0.1 mm: the involute backlash changes by about
+    2 shift tan(20 deg) (0.282 or 0.027 mm), outside 0.5..2 x the designed 0.1 mm; 0.2 mm together closes it
+    and the teeth overlap (reported at the input of the largest overlap); 0.05 mm together stays inside."""
+    from dataclasses import replace
+
+    from fabricate.checks.gear_mesh import check_gear_mesh, check_gear_meshes
+
+    x = np.linspace(0.2, 0.6, 9)
+    pair = replace(spur_pair(), carrier="carrier", center_distance_mm=24.0 + shift)
+    result = check_gear_mesh(pair, fake_motion(x, np.asarray(pair.law(x))))
+    assert [f for f in result.failures if words in f]
+    expected = 0.1 + 2 * shift * np.tan(np.radians(20.0))
+    if expected > 0:
+        assert result.backlash_mm[0] == pytest.approx(expected, abs=0.01)
+        assert result.interference_area_mm2 == 0.0
+    else:
+        assert result.interference_area_mm2 > 1e-3
+        mesh = [f for f in result.failures if "teeth overlap" in f]
+        assert len(mesh) == 1 and f"{result.interference_area_mm2:.3g} mm^2 at input" in mesh[0]
+    assert result.report()["passed"] is False and not result.passed
+    fine = replace(spur_pair(), carrier="carrier", center_distance_mm=24.0 - 0.05)
+    ok = check_gear_meshes([fine], fake_motion(x, np.asarray(fine.law(x))))
+    assert len(ok) == 1 and ok[0].failures == () and ok[0].passed
+    assert ok[0].backlash_mm[0] == pytest.approx(0.1 - 0.1 * np.tan(np.radians(20.0)), abs=0.01)
+    report = ok[0].report()
+    assert report["steps"] == 9 and report["passed"] is True and report["name"] == fine.name
+    assert report["backlash_allowed_mm"] == [0.05, 0.2]
+
+
+def test_gear_mesh_check_tolerances_at_their_boundaries():
+    """The law may be missed by 1e-6 rad (the solver's tolerance), no more; a sector may be left by 1e-9 rad, no
+    more; poses past the sector's teeth are counted as out of mesh, named by the first such input."""
+    from dataclasses import replace
+
+    from fabricate.checks.gear_mesh import check_gear_mesh
+
+    pair = replace(spur_pair(), carrier="carrier")
+    x = np.linspace(0.2, 0.4, 5)
+    law = np.asarray(pair.law(x))
+    assert check_gear_mesh(pair, fake_motion(x, law + 0.9e-6)).failures == ()
+    off = check_gear_mesh(pair, fake_motion(x, law + 1.1e-6))
+    assert len(off.failures) == 1 and "departs from the gear law" in off.failures[0]
+    sector = replace(sector_pair(), carrier="carrier")
+    lo, hi = sector.working_range
+    for past, reported in ((0.5e-9, False), (2e-9, True)):
+        x = np.linspace(lo, hi + past, 5)
+        res = check_gear_mesh(sector, fake_motion(x, np.asarray(sector.law(x))))
+        assert any("outside the cut range" in f for f in res.failures) == reported
+        x = np.linspace(lo - past, hi, 5)
+        res = check_gear_mesh(sector, fake_motion(x, np.asarray(sector.law(x))))
+        assert any("outside the cut range" in f for f in res.failures) == reported
+    x = np.linspace(hi - 0.05, hi + 0.6, 14)
+    far = check_gear_mesh(sector, fake_motion(x, np.asarray(sector.law(x))))
+    out = [f for f in far.failures if "no flank pair in mesh" in f]
+    assert len(out) == 1 and far.steps_without_contact > 0
+    first = int(np.argmax(~np.isfinite(mesh_free(sector, x))))
+    assert f"at {far.steps_without_contact} pose(s), first at input {np.degrees(x[first]):g} deg" in out[0]
+    assert far.report()["steps_without_contact"] == far.steps_without_contact
+
+
+def mesh_free(pair, x):
+    from fabricate.gears.mesh import free_play
+
+    plus, minus = free_play(pair, x)
+    return plus + minus
