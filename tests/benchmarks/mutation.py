@@ -272,6 +272,19 @@ def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
     killing test): the mutants are the same as long as the module's source has not changed."""
     source, tests = MODULES[key]
     work = WORK / key.replace("/", "_")
+    if not (work / "mutants" / (source + ".meta")).exists():
+        # the work copy is git-ignored and may be gone: generate the mutants again from the current source;
+        # they are the measured ones only if every saved survivor comes back with the same change
+        print(f"{key}: no work copy left, generating the mutants again", flush=True)
+        work = prepare(key)
+        diffs = in_process_mutants(work)
+        for r in result["mutants"]:
+            if r["status"] not in ("survived", "no tests"):
+                continue
+            old, new = changed_tokens(diffs.get(r["name"], ""))
+            if (old.strip(), new.strip()) != (r["old"], r["new"]):
+                raise SystemExit(f"{key}: {r['name']} is not the measured mutant any more ({source} changed "
+                                 "since the full run): run the module again")
     if (ROOT / source).read_text() != (work / source).read_text():
         # the mutants are those of the work copy's source: the new tests are run against that version
         print(f"{key}: {source} changed since the full run; re-running the survivors of the version that "
