@@ -12,7 +12,7 @@ from fabricate.cli import main
 from fabricate.output import write_atomically
 from fabricate.spec import shipped_templates
 
-REPORT_KEYS = {"design", "mechanism", "synthesis", "gears", "parts", "interference", "checks", "files"}
+REPORT_KEYS = {"design", "mechanism", "synthesis", "gears", "parts", "interference", "strength", "checks", "files"}
 
 
 def _write(tmp_path: Path, text: str) -> Path:
@@ -92,6 +92,32 @@ def builds(tmp_path_factory):
         return cache[name]
 
     return get
+
+
+@pytest.mark.parametrize("name", TEMPLATES)
+def test_template_states_its_load_and_every_part_keeps_a_safety_factor_of_two(builds, name):
+    """Issue 12: every shipped template states a design load and builds with every part and pin at a
+    safety factor of at least 2 over the whole motion."""
+    _, out, _, _ = builds(name)
+    report = json.loads((out / "report.json").read_text())
+    strength = report["strength"]
+    assert strength["loads"], "the template states no [load]"
+    assert strength["required_safety_factor"] == 2.0 and strength["passed"] is True
+    rated = {p["name"]: p for p in strength["parts"]}
+    for part in report["parts"]:
+        if part["role"] != "spacer":
+            assert part["name"] in rated, part["name"]
+    for entry in rated.values():
+        # null means the part carries no stress at this load (an infinite safety factor)
+        assert entry["min_safety_factor"] is None or entry["min_safety_factor"] >= 2.0, entry
+        if entry["min_safety_factor"] is not None:
+            assert entry["stress_MPa"] * entry["min_safety_factor"] == pytest.approx(entry["allowable_MPa"], rel=1e-4)
+    # something is loaded: the weakest part is within a factor 50 of its limit (a load that reaches no part
+    # would pass vacuously)
+    finite = [e["min_safety_factor"] for e in rated.values() if e["min_safety_factor"] is not None]
+    assert finite and min(finite) < 50.0
+    assert (out / "plots" / "strength.png").is_file()
+    assert "## Strength" in (out / "report.md").read_text()
 
 
 @pytest.mark.parametrize("name", TEMPLATES)

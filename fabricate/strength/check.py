@@ -391,7 +391,8 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
                 force, np.abs(statics.joint_forces[j]))
         mag = np.hypot(force[:, 0], force[:, 1]) + sum((tooth_push.get(j, 0.0) for j in joints), np.zeros(1))
         i = int(np.argmax(mag))
-        on_pin = sorted((p for p in parts if any(h.joint in joints for h in p.holes)), key=lambda p: p.z_mm)
+        on_pin = sorted((p for p in parts if any(_joints_of(h) & set(joints) for h in p.holes)),
+                        key=lambda p: p.z_mm)
         if len(on_pin) < 2:
             continue
         body_a = revolutes[joints[0]].body_a
@@ -418,6 +419,9 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
                                        pin_material.flexural_MPa, i, f"{mag[i]:.1f} N at {pin.joint}",
                                        "a thicker pin or a smaller layer gap", sigma))
 
+    # holes that carry a mechanism joint (revolute, or a slider's guide pin); "A+B" is one pin for two
+    carried = set(revolutes) | {j.name for j in mechanism.joints if isinstance(j, Slider)}
+
     # -- parts: holes and sections ---------------------------------------------------------------------
     for part in parts:
         share = sum(1 for p in parts if p.body == part.body) or 1
@@ -426,14 +430,15 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
         t = part.thickness_mm
         loads_local = []  # (local point, local force (n, 2), at joint)
         for local, f, at in body_point_loads.get(part.body, []):
-            if at and at in revolutes and not any(h.joint == at for h in part.holes):
+            if at and at in revolutes and not any(at in _joints_of(h) for h in part.holes):
                 continue
             loads_local.append((np.asarray(local, dtype=np.float64), _on_body_local(np.asarray(f) / share, pose), at))
         couples = [(np.asarray(c) / share, at) for c, at in body_couples.get(part.body, [])]
-        holes = [h for h in part.holes if h.joint in revolutes]
+        holes = [h for h in part.holes if _joints_of(h) & carried]
         for h in holes:
-            f = sum((lf for lp, lf, at in loads_local if at == h.joint), np.zeros((len(motion.inputs), 2)))
-            mag = np.hypot(f[:, 0], f[:, 1]) + tooth_push.get(h.joint, 0.0) / share
+            f = sum((lf for lp, lf, at in loads_local if at in _joints_of(h)), np.zeros((len(motion.inputs), 2)))
+            push = sum((tooth_push.get(j, 0.0) for j in _joints_of(h)), np.zeros(1))
+            mag = np.hypot(f[:, 0], f[:, 1]) + push / share
             if not np.any(mag > 0):
                 continue
             i = int(np.argmax(mag))
@@ -511,12 +516,12 @@ def _section_finding(part, sec, point, u, station, ha, hb, loads_local, couples,
     for lp, lf, at in loads_local:
         side = float(np.dot(lp - point, u))
         # the cut through a hole's centre puts that hole's own load on the far side
-        if side < -1e-9 or (abs(side) <= 1e-9 and at and at == ha.joint and station == 1.0):
+        if side < -1e-9 or (abs(side) <= 1e-9 and at and at in _joints_of(ha) and station == 1.0):
             force += lf
             arm = lp - c
             moment += arm[0] * lf[:, 1] - arm[1] * lf[:, 0]
     for torque, at in couples:
-        spot = ha.centre if at == ha.joint else hb.centre if at == hb.joint else None
+        spot = ha.centre if at in _joints_of(ha) else hb.centre if at in _joints_of(hb) else None
         if spot is None:
             continue
         side = float(np.dot(spot - point, u))
@@ -534,6 +539,11 @@ def _section_finding(part, sec, point, u, station, ha, hb, loads_local, couples,
     return Finding(part.name, f"section {where}: N {axial[k]:.1f} N, M {moment[k]:.0f} N·mm"
                    + (f" (Kt {kt:.2f})" if at_hole else ""), "link", float(stress[k]), allowable, k, load_name,
                    "a wider link (parts.link_width_mm) or a thicker plate (process.thickness_mm)", stress)
+
+
+def _joints_of(hole: Any) -> set[str]:
+    """The joints a hole serves (a pin shared by coincident joints is named "A+B")."""
+    return set(hole.joint.split("+"))
 
 
 def _pressure_angle(pair: Any) -> float:
