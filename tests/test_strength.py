@@ -186,10 +186,10 @@ def _template(name: str, **replace: str) -> str:
 
 
 def test_weakened_finger_fails_naming_part_feature_and_load(tmp_path, capsys):
-    """The underactuated finger pushed with 2000 N instead of 60 N: exit 1, the files and a report that
+    """The underactuated finger pushed with 2000 N instead of its rated 20 N: exit 1, the files and a report that
     names the part, the feature, the load and the fix."""
     path = tmp_path / "weak.toml"
-    path.write_text(_template("finger_underactuated", **{"input_force_N = 60.0": "input_force_N = 2000.0"}),
+    path.write_text(_template("finger_underactuated", **{"input_force_N = 20.0": "input_force_N = 2000.0"}),
                     encoding="utf-8")
     code = main(["build", str(path), "-o", str(tmp_path / "out")])
     captured = capsys.readouterr()
@@ -219,7 +219,7 @@ def test_weakened_finger_fails_naming_part_feature_and_load(tmp_path, capsys):
 ])
 def test_bad_load_field_exits_2_naming_it(tmp_path, capsys, field, value, message):
     path = tmp_path / "bad.toml"
-    path.write_text(_template("finger_underactuated", **{"input_force_N = 60.0": f"{field} = {value}"}),
+    path.write_text(_template("finger_underactuated", **{"input_force_N = 20.0": f"{field} = {value}"}),
                     encoding="utf-8")
     code = main(["build", str(path), "-o", str(tmp_path / "out"), "-q"])
     assert code == 2
