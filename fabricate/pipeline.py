@@ -8,6 +8,7 @@ and the template text itself, so ``fabricate check DIR`` can verify the files an
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import multiprocessing
 import os
@@ -177,6 +178,16 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
     enter("gears")
     gear_pairs = build_gear_pairs(mechanism, design.gears, design.process.chord_tolerance_mm)
     report["gears"] = [pair.report() for pair in gear_pairs]
+    sizing = None
+    if design.parts.link_width_mm == "auto":
+        enter("sizing")
+        from fabricate.strength.sizing import size_link_width
+
+        width, tried = size_link_width(design, mechanism, motion, gear_pairs, result.parts,
+                                       lambda d: build_parts(d, mechanism, motion, gear_pairs, result.parts))
+        design = dataclasses.replace(design, parts=dataclasses.replace(design.parts, link_width_mm=width))
+        sizing = {"link_width_mm": width, "tried": [{"link_width_mm": w, "least_safety_factor": sf}
+                                                    for w, sf in tried]}
     enter("parts")
     partset = build_parts(design, mechanism, motion, gear_pairs, result.parts)
     # pictures take as long as everything else: draw them in a forked child on the second core
@@ -202,6 +213,8 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
         enter("strength")
         strength = run_strength(design, partset, mechanism, motion, gear_pairs, result.parts)
         report["strength"] = strength.report()
+        if sizing is not None:
+            report["strength"]["sizing"] = sizing
         failures += strength.failures()
         report["checks"] = {"passed": not failures, "failures": failures}
         enter("plots")

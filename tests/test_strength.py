@@ -235,3 +235,52 @@ def test_unknown_material_exits_2_naming_the_field(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "material" in err and "unobtainium" in err and "standard_resin" in err
 
+
+
+def _four_bar_design(link_width, tip_force_N: float):
+    from fabricate.parts.spec import PartsSpec
+    from fabricate.spec import ChecksSpec, load_design
+
+    process = load_design("finger_watt_six_bar").process  # the SLA profile with its materials, 3 mm pins
+    return SimpleNamespace(name="four_bar", process=process, parts=PartsSpec(link_width_mm=link_width),
+                           gears=SimpleNamespace(hub_diameter_mm=None), checks=ChecksSpec(),
+                           load=LoadSpec(tip_force_N=tip_force_N))
+
+
+def test_auto_link_width_is_the_smallest_width_that_passes():
+    """``link_width_mm = "auto"`` on a four-bar loaded at the rocker: the chosen width keeps every link and
+    hole at the safety factor, 0.1 mm less does not (both checked over the whole motion)."""
+    from fabricate.parts.build import build_parts
+    from fabricate.strength.check import run_strength
+    from fabricate.strength.sizing import RESOLUTION_MM, size_link_width
+
+    mech = make_four_bar()
+    motion = mech.sweep(121)
+    hints = {"tip_point": "B", "pads": {"rocker": {"point": "B"}}}
+    design = _four_bar_design("auto", 25.0)
+
+    def build(d):
+        return build_parts(d, mech, motion, [], hints)
+
+    width, tried = size_link_width(design, mech, motion, [], hints, build)
+    assert len(tried) <= 12 and width == pytest.approx(round(width / RESOLUTION_MM) * RESOLUTION_MM, abs=1e-9)
+
+    def least(w: float) -> float:
+        d = _four_bar_design(w, 25.0)
+        result = run_strength(d, build(d), mech, motion, [], hints)
+        return min(f.safety_factor for f in result.findings if f.kind in ("link", "hole"))
+
+    default = least(None)
+    assert default < 2.0  # the plain bosses are too narrow at 25 N: the sizing had work to do
+    assert least(width) >= 2.0
+    assert least(width - RESOLUTION_MM) < 2.0
+
+
+def test_link_width_auto_is_read_and_other_words_are_refused():
+    from fabricate.errors import SpecError
+    from fabricate.parts.spec import parse_parts_spec
+    from fabricate.spec import Table
+
+    assert parse_parts_spec(Table({"link_width_mm": "auto"}, "parts")).link_width_mm == "auto"
+    with pytest.raises(SpecError, match="parts.link_width_mm"):
+        parse_parts_spec(Table({"link_width_mm": "wide"}, "parts"))

@@ -6,8 +6,11 @@ choices about the part shapes and the layouts.
 
 Keys (all optional)
 -------------------
-``link_width_mm``        float > 0. Plate width of binary links. Absent: the synthesis hint
+``link_width_mm``        float > 0, or ``"auto"``. Plate width of binary links. Absent: the synthesis hint
                          ``link_width_mm`` if any, else the boss diameter (pin hole + 2 × wall).
+                         ``"auto"``: the smallest width (to 0.1 mm, up to :data:`MAX_AUTO_WIDTH_MM`) at
+                         which every link section and hole keeps ``[checks] min_safety_factor`` at the
+                         design load (``[load]``); the chosen width is in the report.
 ``boss_wall_mm``         float > 0. Radial wall around every pin hole. Absent: max(process min wall,
                          0.75 × pin diameter) so bosses are never thinner than the process allows.
 ``hub_diameter_mm``      float > 0. Hub of a gear fused to its body. Absent: ``[gears] hub_diameter_mm``
@@ -36,6 +39,10 @@ from dataclasses import dataclass
 
 from fabricate.spec import Table
 
+#: Widest link ``link_width_mm = "auto"`` tries (mm): beyond it the design needs a thicker plate or a
+#: stronger material, which the strength failure then says.
+MAX_AUTO_WIDTH_MM = 60.0
+
 
 @dataclass(frozen=True)
 class PartsSpec:
@@ -43,8 +50,8 @@ class PartsSpec:
 
     Attributes
     ----------
-    link_width_mm : float or None
-        Plate width of binary links.
+    link_width_mm : float, None or "auto"
+        Plate width of binary links ("auto": sized for strength by the pipeline).
     boss_wall_mm : float or None
         Radial wall around pin holes.
     hub_diameter_mm : float or None
@@ -65,7 +72,7 @@ class PartsSpec:
         Frames of the motion GIF.
     """
 
-    link_width_mm: float | None = None
+    link_width_mm: float | str | None = None
     boss_wall_mm: float | None = None
     hub_diameter_mm: float | None = None
     pad_radius_mm: float | None = None
@@ -95,8 +102,9 @@ def parse_parts_spec(table: Table) -> PartsSpec:
     SpecError
         On a field out of range or unknown, naming ``parts.<key>``.
     """
+    auto = table.has("link_width_mm") and table.raw("link_width_mm") == "auto"
     spec = PartsSpec(
-        link_width_mm=table.number("link_width_mm", None, positive=True, max=500.0),
+        link_width_mm="auto" if auto else table.number("link_width_mm", None, positive=True, max=500.0),
         boss_wall_mm=table.number("boss_wall_mm", None, positive=True, max=100.0),
         hub_diameter_mm=table.number("hub_diameter_mm", None, positive=True, max=1000.0),
         pad_radius_mm=table.number("pad_radius_mm", None, positive=True, max=200.0),

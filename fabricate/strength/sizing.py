@@ -1,0 +1,98 @@
+"""``[parts] link_width_mm = "auto"``: the narrowest links that keep the required safety factor.
+
+The width changes the link sections and the material round the holes; pins and gear teeth do not depend
+on it, so only findings of kind ``link`` and ``hole`` decide. Stresses fall monotonically with the width
+(bending roughly as 1/w², tension as 1/w), so a bracket and a bisection find the smallest passing width
+to :data:`RESOLUTION_MM`; the search uses every ``stride``-th pose and the pipeline's final check then
+runs over the whole motion.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Mapping
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+from fabricate.mechanism import Mechanism, Motion
+from fabricate.parts.spec import MAX_AUTO_WIDTH_MM
+from fabricate.strength.check import run_strength
+
+#: Width resolution of the search (mm).
+RESOLUTION_MM = 0.1
+
+
+def _with_width(design: Any, width: float | None) -> Any:
+    """``design`` with ``parts.link_width_mm = width`` (a DesignSpec, or any namespace of its fields)."""
+    parts = dataclasses.replace(design.parts, link_width_mm=width)
+    if dataclasses.is_dataclass(design):
+        return dataclasses.replace(design, parts=parts)
+    return SimpleNamespace(**{**vars(design), "parts": parts})
+
+
+def _coarse(motion: Motion, stride: int) -> Motion:
+    """Every ``stride``-th pose of ``motion`` (the last one kept)."""
+    idx = np.unique(np.r_[np.arange(0, len(motion.inputs), stride), len(motion.inputs) - 1])
+    return dataclasses.replace(motion, inputs=motion.inputs[idx], q=motion.q[idx])
+
+
+def size_link_width(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: list[Any],
+                    hints: Mapping[str, Any], build: Callable[[Any], Any], stride: int = 4
+                    ) -> tuple[float, list[tuple[float, float]]]:
+    """Smallest link width (mm, a multiple of :data:`RESOLUTION_MM`) whose links and holes keep
+    ``design.checks.min_safety_factor``; :data:`MAX_AUTO_WIDTH_MM` if none does.
+
+    Parameters
+    ----------
+    build : callable
+        ``build(design) -> PartSet`` (the pipeline's parts stage).
+
+    Returns
+    -------
+    width_mm : float
+    tried : list of (width mm, least link/hole safety factor)
+        Every evaluation, in order (for the report).
+    """
+    from fabricate.parts.build import derive_sizes
+
+    required = float(design.checks.min_safety_factor)
+    coarse = _coarse(motion, stride)
+    tried: list[tuple[float, float]] = []
+
+    def least(width: float) -> float:
+        trial = _with_width(design, width)
+        result = run_strength(trial, build(trial), mechanism, coarse, gear_pairs, hints)
+        value = min((f.safety_factor for f in result.findings if f.kind in ("link", "hole")), default=math.inf)
+        tried.append((width, float(value)))
+        return value
+
+    def snap(width: float) -> float:
+        return round(math.ceil(width / RESOLUTION_MM - 1e-9) * RESOLUTION_MM, 10)
+
+    plain = dataclasses.replace(design.parts, link_width_mm=None)
+    lo = snap(2.0 * derive_sizes(design.process, plain, hints).boss_radius_mm)
+    sf = least(lo)
+    if sf >= required:
+        return lo, tried
+    # bending stress falls about as 1/w^2: a first guess, then widen until it passes
+    hi = snap(min(MAX_AUTO_WIDTH_MM, lo * math.sqrt(required / max(sf, 1e-6)) if math.isfinite(sf) else lo))
+    while True:
+        hi = max(hi, snap(lo + RESOLUTION_MM))
+        sf = least(hi)
+        if sf >= required:
+            break
+        if hi >= MAX_AUTO_WIDTH_MM:
+            return MAX_AUTO_WIDTH_MM, tried
+        lo, hi = hi, snap(min(MAX_AUTO_WIDTH_MM, hi * 1.5))
+    while hi - lo > RESOLUTION_MM + 1e-9:
+        mid = snap(0.5 * (lo + hi))
+        if mid >= hi:
+            break
+        if least(mid) >= required:
+            hi = mid
+        else:
+            lo = mid
+    return hi, tried
