@@ -6,4 +6,14 @@ __version__ = "0.1.0"
 
 from fabricate.errors import FabricateError, GeometryError, LockupError, SpecError, SynthesisError
 
-__all__ = ["FabricateError", "GeometryError", "LockupError", "SpecError", "SynthesisError", "__version__"]
+__all__ = ["Build", "FabricateError", "GeometryError", "LockupError", "SpecError", "SynthesisError", "__version__",
+           "build", "load"]
+
+
+def __getattr__(name: str):
+    # the API pulls in numpy and the pipeline: load it on first use, so `import fabricate` stays light
+    if name in ("Build", "build", "load"):
+        from fabricate import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'fabricate' has no attribute {name!r}")

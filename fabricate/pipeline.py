@@ -161,7 +161,7 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
                   progress: Progress, stage: list[str]) -> BuildOutcome:
     """Gears, parts, exports, checks and pictures; ``stage[0]`` names the stage running (for failures)."""
     from fabricate.checks import run_checks
-    from fabricate.export import STEP_SKIPPED, assembly_csv, export_all, export_previews, export_step
+    from fabricate.export import STEP_SKIPPED, assembly_csv, export_all, export_previews, export_step, motion_csv
     from fabricate.export.step import step_available
     from fabricate.gears import build_gear_pairs
     from fabricate.parts.assembly import assembly_steps, pin_stacks, stacks_report
@@ -204,6 +204,7 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
         stacks = pin_stacks(partset)
         report["assembly"] = {"pins": stacks_report(stacks), "steps": assembly_steps(stacks, partset.copies)}
         files["assembly.csv"] = assembly_csv(stacks)
+        files["motion.csv"] = motion_csv(mechanism, motion)
         enter("checks")
         checks = run_checks(design, partset, mechanism, motion, gear_pairs)
         report["interference"] = checks.interference

@@ -59,6 +59,21 @@ def assembly_csv(stacks: list[Any]) -> bytes:
     return buffer.getvalue().encode("utf-8")
 
 
+def motion_csv(mechanism: Any, motion: Any) -> bytes:
+    """motion.csv: column ``input`` (the mechanism's input unit), then ``NAME_x``, ``NAME_y`` (mm, world) of
+    every named point in body order, one row per swept pose. A point shared by several bodies (a joint) is
+    taken from its first body; the solver holds the others on it to 1e-12 mm."""
+    names = mechanism.point_names()
+    columns = [motion.inputs] + [c for name in names for c in motion.point(name).T]
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(["input"] + [f"{name}_{axis}" for name in names for axis in ("x", "y")])
+    for row in zip(*columns, strict=True):
+        # 1 nm in mm (and 1e-6 of the input unit): far below any machine's resolution, and stable bytes
+        writer.writerow([f"{float(v):.6f}" for v in row])
+    return buffer.getvalue().encode("utf-8")
+
+
 def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews: bool = True,
                step: bool = True) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
     """Every export of a part set.
