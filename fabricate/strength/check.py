@@ -356,6 +356,11 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
         return result
     loads = design_loads(design, mechanism, motion, hints)
     result.loads = loads.described
+    if any(float(sp.get("rate_Nmm_per_deg") or 0.0) > 0.0 for sp in hints.get("springs", ()) or ()):
+        # the springs are bought parts (BOM rows with rate, preload, legs): their wire stress is the maker's
+        # rating; what the check covers is the torque they put on the printed parts
+        result.notes.append("springs are bought torsion springs (bom.csv): choose one rated for the torque "
+                            "above; their torque loads the parts here")
     if not loads.described:
         result.notes.append("the template states no [load]: strength checked at zero load")
     statics = solve_statics(mechanism, motion, loads.forces, loads.torques, loads.efforts, loads.reaction)
