@@ -70,6 +70,16 @@ MAX_STATICS_SAMPLES = 2001
 #: ``selection.refine_seeds`` (Watt six-bar): least-squares refinements started (100000 took 17 s
 #: of synthesis; the worst Watt template at 100000 used 45 s of CPU in all).
 MAX_REFINE_SEEDS = 10000
+#: Declared linkage (``kind = "linkage"``): bodies, joints, gear pairs, drivers and points of one body. The
+#: solver's Newton step is a dense solve in 3 × bodies unknowns per pose (40 bodies: 117 unknowns, well
+#: under a millisecond), and the layer conflict test compares every pair of bodies over the motion.
+MAX_LINKAGE_BODIES = 40
+MAX_LINKAGE_JOINTS = 80
+MAX_LINKAGE_GEARS = 8
+MAX_LINKAGE_DRIVERS = 8
+MAX_LINKAGE_POINTS = 32
+#: Samples of one sampled law of a declared linkage (gear law or driver table).
+MAX_LINKAGE_TABLE = 10000
 #: ``push_rod.samples`` (underactuated): stroke samples of the closing motion.
 MAX_STROKE_SAMPLES = 2001
 #: ``optimisation.path_samples`` (compliant gripper).

@@ -24,6 +24,7 @@ class _Kinds(dict):
         "underactuated": "fabricate.synthesis.underactuated",
         "compliant_gripper": "fabricate.synthesis.compliant",
         "gear_pair": "fabricate.synthesis.gear_pair",
+        "linkage": "fabricate.synthesis.linkage",
     }
 
     def __init__(self) -> None:
