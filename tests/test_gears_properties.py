@@ -433,6 +433,7 @@ def test_elliptic_pitch_curve_radius_derivatives_arc_length_and_curvature():
     np.testing.assert_allclose(ddra, ddr, rtol=1e-5)  # law''' by central differences (h = 1e-3)
     np.testing.assert_allclose(tha, -x, atol=0)
     np.testing.assert_allclose(dtha, -1.0, atol=0)
+    assert np.shape(dtha) == x.shape  # documented (n,) arrays, not a broadcast scalar
     rb, drb, ddrb, _, _ = pitch.radii(x, "b")
     np.testing.assert_allclose([rb, drb, ddrb], [a - r, -dr, -ddr], rtol=1e-5, atol=1e-9)
     np.testing.assert_allclose(pitch.speed(x), np.hypot(r, dr), rtol=1e-8)  # law'' by central differences
@@ -441,6 +442,13 @@ def test_elliptic_pitch_curve_radius_derivatives_arc_length_and_curvature():
                     0.5, xi, epsabs=1e-12, epsrel=1e-12)[0]
         assert pitch.s_of_x(np.array([xi]))[0] == pytest.approx(want, abs=1e-7)  # speed within 1e-8
     assert pitch.perimeter_a == pytest.approx(4 * big_a * ellipe(e * e), rel=1e-10)
+    # a little before the domain (extrapolated from its first node) and for a scalar angle
+    before = quad(lambda t: np.hypot(p / (1 + e * np.cos(t)), p * e * np.sin(t) / (1 + e * np.cos(t)) ** 2),
+                  0.5, -0.05, epsabs=1e-12, epsrel=1e-12)[0]
+    assert pitch.s_of_x(np.array([-0.05]))[0] == pytest.approx(before, abs=1e-7)
+    assert pitch.s_of_x(0.7) == pytest.approx(pitch.s_of_x(np.array([0.7]))[0], abs=1e-12)
+    sector = PitchCurves(elliptic_law(e), a, (0.0, 2.0), intervals=16)  # no periods: a sector
+    assert np.isnan(sector.perimeter_a) and np.isnan(sector.perimeter_b)
     kappa = (r**2 + 2 * dr**2 - r * ddr) / (r**2 + dr**2) ** 1.5
     np.testing.assert_allclose(pitch.frames_at_x(x, "a").curvature, kappa, rtol=1e-6)
     # gear b: r_b = a - r_a at polar angle pi - law(x), turning at i = (1 - e^2) / (1 + e^2 + 2 e cos x)
