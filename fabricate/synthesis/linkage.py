@@ -625,7 +625,8 @@ def _dead_point_joint(mech: Mechanism, s_lock: float) -> tuple[str, str, str] | 
             arms.append(np.array([c * arm[0] - s * arm[1], s * arm[0] + c * arm[1]]))
         if len(arms) != 2:
             continue
-        sine = abs(float(np.cross(arms[0], arms[1]))) / float(np.hypot(*arms[0]) * np.hypot(*arms[1]))
+        cross = arms[0][0] * arms[1][1] - arms[0][1] * arms[1][0]
+        sine = abs(float(cross)) / float(np.hypot(*arms[0]) * np.hypot(*arms[1]))
         if best is None or sine < best[0]:
             best = (sine, j.name, j.body_a, j.body_b)
     return None if best is None else (best[1], f"\"{best[2]}\"", f"\"{best[3]}\"")
