@@ -284,3 +284,41 @@ def test_link_width_auto_is_read_and_other_words_are_refused():
     assert parse_parts_spec(Table({"link_width_mm": "auto"}, "parts")).link_width_mm == "auto"
     with pytest.raises(SpecError, match="parts.link_width_mm"):
         parse_parts_spec(Table({"link_width_mm": "wide"}, "parts"))
+
+
+def test_local_pitch_radius_is_the_curvature_radius_of_an_ellipse():
+    """The Lewis/Hertz radius at a contact point against an ellipse's closed form
+    rho = (a^2 sin^2 t + b^2 cos^2 t)^(3/2) / (a b), either way round the curve."""
+    from fabricate.strength.check import _local_radius
+
+    a, b = 20.0, 12.0
+    t = np.linspace(0.0, 2.0 * np.pi, 4001)[:-1]
+    curve = np.column_stack([a * np.cos(t), b * np.sin(t)])
+    probe_t = np.linspace(0.1, 6.0, 25)
+    probe = np.column_stack([a * np.cos(probe_t), b * np.sin(probe_t)])
+    expected = (a ** 2 * np.sin(probe_t) ** 2 + b ** 2 * np.cos(probe_t) ** 2) ** 1.5 / (a * b)
+    np.testing.assert_allclose(_local_radius(curve, probe), expected, rtol=2e-3)  # nearest of 4000 vertices
+    np.testing.assert_allclose(_local_radius(curve[::-1], probe), expected, rtol=2e-3)
+
+
+def test_gear_contact_point_lies_on_both_pitch_curves_over_the_motion():
+    """The pitch point the gear check reads (on the line of centres, r_a = a i / (1 + i) from axis a) is on
+    gear a's and gear b's pitch curves at every pose of the elliptic pair."""
+    from fabricate.gears import build_gear_pairs
+    from fabricate.pipeline import synthesise
+    from fabricate.spec import load_design
+
+    design = load_design("gear_pair_elliptic")
+    mech = synthesise(design).mechanism
+    (pair,) = build_gear_pairs(mech, design.gears, design.process.chord_tolerance_mm)
+    motion = mech.sweep(73)
+    xa = motion.relative_angle(pair.body_a, pair.carrier)
+    xb = motion.relative_angle(pair.body_b, pair.carrier)
+    i = np.abs(pair.law(xa, 1))
+    r_a, r_b = pair.center_distance_mm * i / (1 + i), pair.center_distance_mm / (1 + i)
+    on_a = r_a[:, None] * np.column_stack([np.cos(-xa), np.sin(-xa)])
+    on_b = r_b[:, None] * np.column_stack([np.cos(np.pi - xb), np.sin(np.pi - xb)])
+    spacing = max(np.hypot(*np.diff(pair.pitch_a, axis=0).T).max(), np.hypot(*np.diff(pair.pitch_b, axis=0).T).max())
+    for curve, points in ((pair.pitch_a, on_a), (pair.pitch_b, on_b)):
+        gap = np.min(np.hypot(*(curve[None, :, :] - points[:, None, :]).transpose(2, 0, 1)), axis=1)
+        assert gap.max() < spacing

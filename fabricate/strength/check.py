@@ -568,51 +568,65 @@ def _tooth_normal_force(pair: Any, torque_b: np.ndarray, motion: Motion) -> np.n
 
 
 def _gear_findings(result, pair, torque_b, mechanism, motion, parts, material) -> None:
-    """Lewis bending and Hertz contact of one gear pair under the statics' torque."""
-    xa = motion.relative_angle(pair.body_a, pair.carrier)
-    ratio = np.abs(np.asarray(pair.law(xa, 1), dtype=np.float64))
-    a = pair.center_distance_mm
-    r_b = a / (1.0 + ratio)  # pitch radius of gear b at the contact (external pair: r_a + r_b = a)
-    ft = np.abs(torque_b) / np.maximum(r_b, 1e-9)
-    i = int(np.argmax(ft))
+    """Lewis root bending and Hertz contact of one gear pair at every pose, under the statics' torque.
+
+    At each pose the pitch point lies on the line of centres, ``r_a = a i / (1 + i)`` from axis a (``i`` the
+    instantaneous ratio); the local radius of curvature of each pitch curve there makes the equivalent
+    spur gear (``z_eq = 2 rho / m``) whose Lewis form factor the tooth gets, and the two radii (times
+    sin phi) are the involute flanks' radii for Hertz. A concave stretch takes the rack's form factor
+    and bears as a concave surface.
+    """
     face = min((p.thickness_mm for p in parts if p.gear == pair.name), default=None)
     if face is None:
         return
+    xa = motion.relative_angle(pair.body_a, pair.carrier)
+    xb = motion.relative_angle(pair.body_b, pair.carrier)
+    ratio = np.abs(np.asarray(pair.law(xa, 1), dtype=np.float64))
+    a = pair.center_distance_mm
+    r_a, r_b = a * ratio / (1.0 + ratio), a / (1.0 + ratio)
+    ft = np.abs(torque_b) / np.maximum(r_b, 1e-9)
     phi = _pressure_angle(pair)
-    rho = [_min_curvature_radius(pair.pitch_a), _min_curvature_radius(pair.pitch_b)]
-    for gear, radius in (("a", rho[0]), ("b", rho[1])):
-        teeth = 2.0 * radius / pair.module if math.isfinite(radius) and radius > 0 else math.inf
-        y = models.lewis_form_factor(teeth)
-        sigma = models.lewis_bending_stress(ft[i], pair.module, face, y)
+    # the contact in each gear's frame (pitch curves: x along the line of centres at relative angle 0)
+    contact_a = r_a[:, None] * np.column_stack([np.cos(-xa), np.sin(-xa)])
+    contact_b = r_b[:, None] * np.column_stack([np.cos(math.pi - xb), np.sin(math.pi - xb)])
+    rho_a = _local_radius(pair.pitch_a, contact_a)
+    rho_b = _local_radius(pair.pitch_b, contact_b)
+    for gear, rho in (("a", rho_a), ("b", rho_b)):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            teeth = np.where(np.isfinite(rho) & (rho > 0), 2.0 * rho / pair.module, np.inf)
+        y = np.asarray(models.lewis_form_factor(teeth), dtype=np.float64)
+        sigma = np.asarray(models.lewis_bending_stress(ft, pair.module, face, y), dtype=np.float64)
+        i = int(np.argmax(sigma))
         body = pair.body_a if gear == "a" else pair.body_b
         name = next((p.name for p in parts if p.body == body and p.gear == pair.name), body)
-        result.findings.append(Finding(name, f"gear {pair.name} tooth root (Lewis, Y {y:.3f}, z_eq {teeth:.1f})",
-                                       "gear", sigma, material.flexural_MPa, i, f"{ft[i]:.1f} N tangential",
-                                       "a larger module (gears.module) or a thicker plate"))
-    fn = ft[i] / math.cos(phi)
-    r1, r2 = models.involute_contact_radii(abs(rho[0]) if math.isfinite(rho[0]) else 1e9,
-                                           abs(rho[1]) if math.isfinite(rho[1]) else 1e9, phi)
-    hertz = models.hertz_line_contact_stress(fn, face, r1, r2, material.modulus_MPa, material.poisson,
-                                             material.modulus_MPa, material.poisson)
+        result.findings.append(Finding(name, f"gear {pair.name} tooth root (Lewis, Y {y[i]:.3f}, z_eq {teeth[i]:.1f})",
+                                       "gear", float(sigma[i]), material.flexural_MPa, i,
+                                       f"{ft[i]:.1f} N tangential", "a larger module (gears.module) or a thicker plate",
+                                       sigma))
+    fn = ft / math.cos(phi)
+    flat = 1e9  # a straight pitch stretch: a flat flank for Hertz
+    r1, r2 = models.involute_contact_radii(np.where(np.isfinite(rho_a), rho_a, flat),
+                                           np.where(np.isfinite(rho_b), rho_b, flat), phi)
+    hertz = np.asarray(models.hertz_line_contact_stress(fn, face, r1, r2, material.modulus_MPa, material.poisson,
+                                                        material.modulus_MPa, material.poisson), dtype=np.float64)
+    i = int(np.argmax(hertz))
     name = next((p.name for p in parts if p.gear == pair.name), pair.name)
-    result.findings.append(Finding(name, f"gear {pair.name} tooth contact (Hertz)", "gear", hertz,
-                                   material.compressive_MPa, i, f"{fn:.1f} N normal",
-                                   "a larger module or a thicker plate"))
+    result.findings.append(Finding(name, f"gear {pair.name} tooth contact (Hertz)", "gear", float(hertz[i]),
+                                   material.compressive_MPa, i, f"{fn[i]:.1f} N normal",
+                                   "a larger module or a thicker plate", hertz))
 
 
-def _min_curvature_radius(points: np.ndarray) -> float:
-    """Smallest convex radius of curvature (mm) along a pitch polyline (three-point circles); inf if none.
-
-    Convex means turning the way the whole curve turns (its signed area's sense), whichever way it runs.
-    """
+def _local_radius(points: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Signed radius of curvature (mm; positive where the curve turns with its own sense, i.e. convex) of a
+    pitch polyline at the vertex nearest each point of ``at`` (n, 2); inf where it is straight."""
     p = np.asarray(points, dtype=np.float64)
-    if len(p) < 3:
-        return math.inf
-    a, b, c = p[:-2], p[1:-1], p[2:]
-    ab, bc, ca = np.hypot(*(b - a).T), np.hypot(*(c - b).T), np.hypot(*(a - c).T)
-    cross = (b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]
-    sense = 1.0 if float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])) >= 0 else -1.0
+    prev, nxt = np.roll(p, 1, axis=0), np.roll(p, -1, axis=0)
+    ab, bc, ca = np.hypot(*(p - prev).T), np.hypot(*(nxt - p).T), np.hypot(*(prev - nxt).T)
+    cross = (p - prev)[:, 0] * (nxt - prev)[:, 1] - (p - prev)[:, 1] * (nxt - prev)[:, 0]
+    sense = 1.0 if float(np.sum(p[:, 0] * nxt[:, 1] - nxt[:, 0] * p[:, 1])) >= 0 else -1.0
     with np.errstate(divide="ignore", invalid="ignore"):
-        radius = sense * ab * bc * ca / (2.0 * cross)
-    convex = radius[np.isfinite(radius) & (radius > 0)]
-    return float(convex.min()) if len(convex) else math.inf
+        radius = np.where(cross != 0.0, sense * ab * bc * ca / (2.0 * cross), np.inf)
+    # an open curve's end vertices have no neighbour on one side: take their inner neighbour's value
+    radius[0], radius[-1] = radius[1], radius[-2]
+    nearest = np.argmin(np.sum((p[None, :, :] - at[:, None, :]) ** 2, axis=2), axis=1)
+    return radius[nearest]
