@@ -63,12 +63,10 @@ the joint nearest a dead point (exit 1).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from fabricate.bounds import (
     MAX_LENGTH_MM,
@@ -80,10 +78,11 @@ from fabricate.bounds import (
     MAX_LINKAGE_TABLE,
 )
 from fabricate.errors import LockupError, SpecError
-from fabricate.gears.law import FormulaLaw, check_ratio, elliptic_formula
-from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
+from fabricate.gears.law import FormulaLaw
+from fabricate.mechanism import Mechanism
 from fabricate.spec import Table, check_array
 from fabricate.synthesis.base import SynthesisResult
+from fabricate.synthesis.linkage_mechanism import build_mechanism, gear_law, sampled_law
 
 #: Largest distance (mm) between the two points of a revolute (or off a slider's line) at the reference
 #: pose: the template's coordinates are the assembled linkage, not a guess.
@@ -116,7 +115,7 @@ class JointSpec:
 
 
 @dataclass(frozen=True)
-class GearSpec:
+class LinkageGearSpec:
     """One ``[[linkage.gears]]`` entry (angles in degrees as written)."""
 
     name: str
@@ -165,7 +164,7 @@ class LinkageSpec:
     tip_point: str | None
     bodies: tuple[BodySpec, ...]
     joints: tuple[JointSpec, ...]
-    gears: tuple[GearSpec, ...]
+    gears: tuple[LinkageGearSpec, ...]
     drivers: tuple[DriverSpec, ...]
     pads: tuple[PadSpec, ...]
 
@@ -244,7 +243,7 @@ def _parse_joint(t: Table, bodies: dict[str, BodySpec]) -> JointSpec:
     return JointSpec(name, kind, (pair[0], pair[1]), axis)
 
 
-def _parse_gear(t: Table, bodies: dict[str, BodySpec], joints: dict[str, JointSpec]) -> GearSpec:
+def _parse_gear(t: Table, bodies: dict[str, BodySpec], joints: dict[str, JointSpec]) -> LinkageGearSpec:
     name = _name(t)
     carrier = t.string("carrier")
     if carrier not in bodies:
@@ -314,7 +313,7 @@ def _parse_gear(t: Table, bodies: dict[str, BodySpec], joints: dict[str, JointSp
             raise SpecError(t.field("working_range_deg"), f"gear \"{name}\": the working range lies outside "
                                                           "the table's x_deg")
     t.finish()
-    return GearSpec(name=name, carrier=carrier, bodies=(pair[0], pair[1]), axes=(axes[0], axes[1]), law=law,
+    return LinkageGearSpec(name=name, carrier=carrier, bodies=(pair[0], pair[1]), axes=(axes[0], axes[1]), law=law,
                     closed=closed, working_range_deg=(float(rng[0]), float(rng[1])), **extra)
 
 
@@ -467,7 +466,7 @@ def _check_reference_pose(spec: LinkageSpec) -> None:
             if not d.input[0] <= d.reference <= d.input[-1]:
                 raise SpecError(f"linkage.drivers[{k}].input", f"joint \"{d.joint}\": the table does not reach the "
                                                                f"reference input {d.reference:g}")
-            value = float(_table(d.input, d.value, d.spline)(d.reference))
+            value = float(sampled_law(d.input, d.value, d.spline)(d.reference))
             if abs(value) > 1e-9:
                 raise SpecError(f"linkage.drivers[{k}].value",
                                 f"joint \"{d.joint}\": the table gives {value:.6g} at the reference input "
@@ -481,199 +480,6 @@ def _check_reference_pose(spec: LinkageSpec) -> None:
 
 def _xy(p: np.ndarray) -> str:
     return f"({p[0]:.6g}, {p[1]:.6g})"
-
-
-# -- laws ------------------------------------------------------------------------------------------
-
-def _table(x: tuple[float, ...], y: tuple[float, ...], spline: str) -> Callable:
-    xa, ya = np.asarray(x), np.asarray(y)
-    return PchipInterpolator(xa, ya) if spline == "pchip" else CubicSpline(xa, ya)
-
-
-@dataclass(frozen=True)
-class PeriodicTableLaw:
-    """A sampled law that closes: ``y(x + P) = y(x) + (y_end - y_start)``, P the table's span.
-
-    The linear part ``k x`` (k = mean slope) is taken out and the rest interpolated by a periodic cubic
-    spline, so value, slope and curvature repeat after each period; ``sign`` makes it an external pair's
-    coupling law (gear b turns the other way). Angles in radians.
-    """
-
-    x: tuple[float, ...]
-    y: tuple[float, ...]
-    sign: float = -1.0
-
-    def __post_init__(self) -> None:
-        x, y = np.asarray(self.x), np.asarray(self.y)
-        slope = (y[-1] - y[0]) / (x[-1] - x[0])
-        rest = y - slope * x
-        rest[-1] = rest[0]  # exact closure of the periodic part (equal by construction up to rounding)
-        object.__setattr__(self, "_slope", float(slope))
-        object.__setattr__(self, "_spline", CubicSpline(x, rest, bc_type="periodic"))
-
-    def __call__(self, x: np.ndarray | float, nu: int = 0) -> np.ndarray | float:
-        x = np.asarray(x, dtype=np.float64)
-        out = self._spline(x, nu)
-        if nu == 0:
-            out = out + self._slope * x
-        elif nu == 1:
-            out = out + self._slope
-        return self.sign * out
-
-
-def gear_law(g: GearSpec, path: str) -> tuple[Callable, str]:
-    """The coupling law ``x_b = law(x_a)`` (rad; an external pair: negative slope) and its description."""
-    if g.law == "constant":
-        return LinearLaw(slope=-float(g.ratio)), f"constant ratio {g.ratio:g}"
-    if g.law == "elliptic":
-        text = elliptic_formula(g.eccentricity)
-        return FormulaLaw(text, sign=-1.0, path=f"{path}.eccentricity"), f"elliptic e = {g.eccentricity:g}: {text}"
-    if g.law == "expression":
-        return FormulaLaw(g.expression, sign=-1.0, path=f"{path}.expression"), g.expression
-    x, y = np.radians(g.x_deg), np.radians(g.y_deg)
-    if g.spline == "periodic":
-        return PeriodicTableLaw(tuple(x), tuple(y)), f"periodic cubic spline through {len(x)} samples"
-    spline = _table(tuple(x), tuple(y), g.spline)
-
-    def law(v: np.ndarray | float, nu: int = 0) -> np.ndarray | float:
-        return -spline(np.asarray(v, dtype=np.float64), nu)
-
-    return law, f"{g.spline} spline through {len(x)} samples"
-
-
-def _check_gear_law(g: GearSpec, law: Callable, path: str) -> None:
-    """Ratio positive and finite over the working range; a closed law repeats its ratio after a turn."""
-    lo, hi = np.radians(g.working_range_deg)
-    x = np.linspace(lo, hi, 2049)
-    check_ratio(law, x, f"{path}.law")
-    if g.closed:
-        ratio = -np.asarray(law(x, 1), dtype=np.float64)
-        after = -np.asarray(law(x + 2 * np.pi, 1), dtype=np.float64)
-        if np.max(np.abs(ratio - after)) > 1e-7 * np.max(np.abs(ratio)):
-            raise SpecError(f"{path}.law", f"gear \"{g.name}\": a closed pair's law must repeat its ratio after a "
-                                           "turn of gear a (y(x + 360) = y(x) + const); set closed = false or use "
-                                           "a periodic law")
-
-
-def _driver_law(d: DriverSpec, joint: JointSpec, unit: str) -> Callable:
-    """Input (``unit``) to joint coordinate (rad for an angle, mm for a slide), 0 at the reference."""
-    if d.law == "linear":
-        slope = math.pi / 180.0 if joint.type == "revolute" else 1.0
-        return LinearLaw(slope=slope, offset=-slope * d.reference)
-    value = np.radians(d.value) if joint.type == "revolute" else np.asarray(d.value)
-    return _table(d.input, tuple(value), d.spline)
-
-
-# -- the mechanism -------------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class LinkageMechanism(Mechanism):
-    """A declared linkage's mechanism: lock-ups name the driven joints and the joint at a dead point.
-
-    ``unreachable`` holds the lock-up met on the way from the reference pose to the start of the range
-    (then every sweep raises it: the start pose is not on the drawn branch).
-    """
-
-    unreachable: LockupError | None = None
-    driven: tuple[str, ...] = ()
-
-    def sweep(self, inputs: np.ndarray | int | None = None) -> Any:
-        if self.unreachable is not None:
-            raise self.unreachable
-        try:
-            return super().sweep(inputs)
-        except LockupError as exc:
-            raise _explain(self, exc) from exc
-
-
-def _explain(mech: Mechanism, exc: LockupError) -> LockupError:
-    """The lock-up with the driven joints and the joint nearest a dead point (two links in line there)."""
-    base = str(exc).rsplit(" (at input", 1)[0]
-    driven = ", ".join(f"\"{j}\"" for j in getattr(mech, "driven", ()))
-    text = f"{base}; driven joint {driven}"
-    joint = _dead_point_joint(mech, exc.input_value)
-    if joint is not None:
-        text += f"; nearest dead point at joint \"{joint[0]}\" ({joint[1]} and {joint[2]} in line)"
-    return LockupError(exc.input_value, text)
-
-
-def _dead_point_joint(mech: Mechanism, s_lock: float) -> tuple[str, str, str] | None:
-    """The revolute whose two bodies are most nearly in line just before ``s_lock`` (a toggle)."""
-    s0 = mech.input_range[0]
-    s_near = s_lock - 1e-3 * (s_lock - s0)
-    if s_near == s0 or not np.isfinite(s_near):
-        s_near = s0
-    try:
-        motion = Mechanism.sweep(mech, np.array([s0, s_near]) if s_near != s0 else np.array([s0]))
-    except LockupError:
-        return None
-    i = len(motion.inputs) - 1
-    best = None
-    for j in mech.joints:
-        if not isinstance(j, Revolute):
-            continue
-        arms = []
-        for body in (j.body_a, j.body_b):
-            b = mech.body(body)
-            here = b.point(j.name)
-            others = [b.point(p) - here for p in b.points if np.hypot(*(b.point(p) - here)) > 1e-6]
-            if not others:
-                break
-            arm = max(others, key=lambda v: float(np.hypot(*v)))
-            theta = motion.pose(body)[i, 2]
-            c, s = math.cos(theta), math.sin(theta)
-            arms.append(np.array([c * arm[0] - s * arm[1], s * arm[0] + c * arm[1]]))
-        if len(arms) != 2:
-            continue
-        cross = arms[0][0] * arms[1][1] - arms[0][1] * arms[1][0]
-        sine = abs(float(cross)) / float(np.hypot(*arms[0]) * np.hypot(*arms[1]))
-        if best is None or sine < best[0]:
-            best = (sine, j.name, j.body_a, j.body_b)
-    return None if best is None else (best[1], f"\"{best[2]}\"", f"\"{best[3]}\"")
-
-
-def build_mechanism(name: str, spec: LinkageSpec) -> LinkageMechanism:
-    """The declared linkage as a :class:`LinkageMechanism`, assembled at the start of its range."""
-    bodies = tuple(Body(b.name, {p: xy for p, xy in b.points}) for b in spec.bodies)
-    joints_by_name = {j.name: j for j in spec.joints}
-    joints: list[Revolute | Slider] = []
-    for j in spec.joints:
-        if j.type == "revolute":
-            joints.append(Revolute(j.name, j.bodies[0], j.bodies[1]))
-        else:  # both frames are the world's at the reference pose: the relative angle is locked at 0
-            joints.append(Slider(j.name, j.bodies[0], j.bodies[1], axis=j.axis, angle=0.0))
-    gears = []
-    for k, g in enumerate(spec.gears):
-        path = f"linkage.gears[{k}]"
-        law, _ = gear_law(g, path)
-        _check_gear_law(g, law, path)
-        lo, hi = (float(v) for v in np.radians(g.working_range_deg))
-        gears.append(GearCoupling(g.name, carrier=g.carrier, gear_a=g.bodies[0], gear_b=g.bodies[1], law=law,
-                                  axis_a=g.axes[0], axis_b=g.axes[1], working_range=(lo, hi)))
-    drivers = []
-    for d in spec.drivers:
-        j = joints_by_name[d.joint]
-        law = _driver_law(d, j, spec.input_unit)
-        kind = "angle" if j.type == "revolute" else "slide"
-        drivers.append(Driver(kind, body=j.bodies[1], reference=j.bodies[0], joint=j.name if kind == "slide" else "",
-                              law=law))
-    zero = {b.name: (0.0, 0.0, 0.0) for b in spec.bodies if b.name != spec.ground}
-    common = dict(name=name, bodies=bodies, ground=spec.ground, joints=tuple(joints), gears=tuple(gears),
-                  drivers=tuple(drivers), input_unit=spec.input_unit, driven=tuple(d.joint for d in spec.drivers))
-    start, reference = spec.input_range[0], spec.reference
-    if reference == start:
-        return LinkageMechanism(input_range=spec.input_range, assembly=zero, **common)
-    # from the reference pose (all frames at the world's) to the start, by continuation on the input
-    way = LinkageMechanism(input_range=(reference, start), assembly=zero, **common)
-    try:
-        motion = way.sweep(np.array([reference, start]))
-    except LockupError as exc:
-        unreachable = LockupError(exc.input_value, f"{name}: cannot move from the reference pose (input "
-                                                   f"{reference:g}) to the start of the range: "
-                                                   f"{str(exc).rsplit(' (at input', 1)[0]}")
-        return LinkageMechanism(input_range=spec.input_range, assembly=zero, unreachable=unreachable, **common)
-    assembly = {b: tuple(float(v) for v in motion.pose(b)[-1]) for b in zero}
-    return LinkageMechanism(input_range=spec.input_range, assembly=assembly, **common)
 
 
 def _check_gear_ranges(spec: LinkageSpec, mech: Mechanism, motion: Any) -> None:
