@@ -465,3 +465,21 @@ law = "linear"
     crank = math.radians(60.0) + motion.pose("crank")[:, 2]  # the body turns from its drawn 60 deg
     x = s0 + inputs  # law of cosines in triangle O-A-S
     assert np.allclose(crank, np.arccos((100.0 + x * x - 900.0) / (20.0 * x)), atol=1e-9)
+
+
+def test_sector_gears_follow_a_table_and_keep_to_their_working_range():
+    law = ('law = "table"\nx_deg = [0.0, 30.0, 60.0, 90.0]\ny_deg = [0.0, 40.0, 70.0, 90.0]\nspline = "pchip"\n'
+           "closed = false")
+    text = GEARED.replace("LAW", law).replace("[gears]\nteeth = [30, 30]\n", "")
+    short = text.replace("input_range = [0.0, 360.0]", "input_range = [0.0, 90.0]")
+    design = design_from_text(short, "g.toml")
+    assert design.method.gears[0].working_range_deg == (0.0, 90.0)  # the table's span
+    mech = synthesise(design).mechanism
+    turned = -np.degrees(mech.sweep(np.array([0.0, 30.0, 60.0, 90.0])).relative_angle("gear_b", "frame"))
+    assert np.allclose(turned, [0.0, 40.0, 70.0, 90.0], atol=1e-9)
+    with pytest.raises(SpecError) as info:
+        synthesise(design_from_text(text.replace("input_range = [0.0, 360.0]", "input_range = [0.0, 89.0]")
+                                    .replace('law = "table"', 'working_range_deg = [0.0, 45.0]\nlaw = "table"'),
+                                    "g.toml"))
+    assert info.value.path == "linkage.gears[0].working_range_deg"
+    assert 'gear "g": the motion turns gear a from 0.000 to 89.000 deg' in info.value.message

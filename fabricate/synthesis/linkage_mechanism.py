@@ -77,12 +77,17 @@ def gear_law(g: LinkageGearSpec, path: str) -> tuple[Callable, str]:
     x, y = np.radians(g.x_deg), np.radians(g.y_deg)
     if g.spline == "periodic":
         return PeriodicTableLaw(tuple(x), tuple(y)), f"periodic cubic spline through {len(x)} samples"
-    spline = sampled_law(tuple(x), tuple(y), g.spline)
+    return NegatedLaw(sampled_law(tuple(x), tuple(y), g.spline)), f"{g.spline} spline through {len(x)} samples"
 
-    def law(v: np.ndarray | float, nu: int = 0) -> np.ndarray | float:
-        return -spline(np.asarray(v, dtype=np.float64), nu)
 
-    return law, f"{g.spline} spline through {len(x)} samples"
+@dataclass(frozen=True)
+class NegatedLaw:
+    """``-law(x)``: a driven angle counted in gear b's own sense as an external pair's coupling law."""
+
+    law: Callable
+
+    def __call__(self, x: np.ndarray | float, nu: int = 0) -> np.ndarray | float:
+        return -self.law(np.asarray(x, dtype=np.float64), nu)
 
 
 def _check_gear_law(g: LinkageGearSpec, law: Callable, path: str) -> None:
