@@ -401,7 +401,9 @@ def test_gear_axis_must_join_the_carrier_and_its_gear():
     assert 'joint "OA" joins [\'frame\', \'gear_a\'], not the carrier "frame" and gear "gear_b"' in info.value.message
 
 
-def test_slider_crank_driven_on_the_slide():
+@pytest.mark.parametrize("guide_x", [None, 20.0])
+def test_slider_crank_driven_on_the_slide(guide_x):
+    """The slide is measured from the reference pose, wherever the guide's point lies on the slide line."""
     # crank 10 about O, rod 30 to the slider point S on the x axis; the slide is the input (mm)
     # drawn with the crank at 60 deg: A = (5, 8.66), S on the x axis 30 from A
     ax, ay = 5.0, 10.0 * math.sin(math.radians(60.0))
@@ -418,7 +420,7 @@ input_range = [0.0, -10.0]
 
 [[linkage.bodies]]
 name = "frame"
-points = {{ O = [0.0, 0.0], S = [{s0!r}, 0.0] }}
+points = {{ O = [0.0, 0.0], S = [{s0 if guide_x is None else guide_x!r}, 0.0] }}
 
 [[linkage.bodies]]
 name = "crank"

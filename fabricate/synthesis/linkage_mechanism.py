@@ -104,13 +104,18 @@ def _check_gear_law(g: LinkageGearSpec, law: Callable, path: str) -> None:
                                            "a periodic law")
 
 
-def _driver_law(d: DriverSpec, joint: JointSpec, unit: str) -> Callable:
-    """Input (``unit``) to joint coordinate (rad for an angle, mm for a slide), 0 at the reference."""
+def _driver_law(d: DriverSpec, joint: JointSpec, at_reference: float) -> Callable:
+    """Input to the mechanism's joint coordinate (rad for an angle, mm for a slide).
+
+    The template's joint value is 0 at the reference input; ``at_reference`` is the coordinate the
+    mechanism measures there (0 for an angle; for a slide the offset along the axis of the slider's point
+    from its guide's point, which need only lie on the slide line).
+    """
     if d.law == "linear":
         slope = math.pi / 180.0 if joint.type == "revolute" else 1.0
-        return LinearLaw(slope=slope, offset=-slope * d.reference)
+        return LinearLaw(slope=slope, offset=at_reference - slope * d.reference)
     value = np.radians(d.value) if joint.type == "revolute" else np.asarray(d.value)
-    return sampled_law(d.input, tuple(value), d.spline)
+    return sampled_law(d.input, tuple(value + at_reference), d.spline)
 
 
 # -- the mechanism -------------------------------------------------------------------------------
@@ -185,6 +190,7 @@ def build_mechanism(name: str, spec: LinkageSpec) -> LinkageMechanism:
     """The declared linkage as a :class:`LinkageMechanism`, assembled at the start of its range."""
     bodies = tuple(Body(b.name, {p: xy for p, xy in b.points}) for b in spec.bodies)
     joints_by_name = {j.name: j for j in spec.joints}
+    bodies_spec = {b.name: b for b in spec.bodies}
     joints: list[Revolute | Slider] = []
     for j in spec.joints:
         if j.type == "revolute":
@@ -202,7 +208,11 @@ def build_mechanism(name: str, spec: LinkageSpec) -> LinkageMechanism:
     drivers = []
     for d in spec.drivers:
         j = joints_by_name[d.joint]
-        law = _driver_law(d, j, spec.input_unit)
+        offset = 0.0
+        if j.type == "slider":
+            pa, pb = (np.asarray(dict(b.points)[j.name]) for b in (bodies_spec[j.bodies[0]], bodies_spec[j.bodies[1]]))
+            offset = float(np.dot(pb - pa, j.axis))
+        law = _driver_law(d, j, offset)
         kind = "angle" if j.type == "revolute" else "slide"
         drivers.append(Driver(kind, body=j.bodies[1], reference=j.bodies[0], joint=j.name if kind == "slide" else "",
                               law=law))
