@@ -485,3 +485,16 @@ def test_sector_gears_follow_a_table_and_keep_to_their_working_range():
                                     "g.toml"))
     assert info.value.path == "linkage.gears[0].working_range_deg"
     assert 'gear "g": the motion turns gear a from 0.000 to 89.000 deg' in info.value.message
+
+
+def test_table_driver_maps_the_input_to_the_joint_and_is_zero_at_the_reference():
+    table = ('[[linkage.drivers]]\njoint = "O"\nlaw = "table"\ninput = [0.0, 5.0, 10.0]\nvalue = [0.0, 45.0, 90.0]\n'
+             'spline = "pchip"\n')
+    text = four_bar(drivers=table).replace('input_unit = "deg"', 'input_unit = "mm"').replace(
+        "input_range = [0.0, 360.0]", "input_range = [0.0, 10.0]")
+    mech = synthesise(design_from_text(text, "t.toml")).mechanism
+    a = mech.sweep(np.array([0.0, 5.0, 10.0])).point("A")
+    assert np.allclose(a, [[15.0, 0.0], [15.0 * math.sqrt(0.5), 15.0 * math.sqrt(0.5)], [0.0, 15.0]], atol=1e-9)
+    with pytest.raises(SpecError) as info:
+        design_from_text(text.replace("value = [0.0, 45.0, 90.0]", "value = [10.0, 45.0, 90.0]"), "t.toml")
+    assert info.value.path == "linkage.drivers[0].value" and "0 there" in info.value.message
