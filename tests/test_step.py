@@ -230,3 +230,17 @@ def test_freecad_imports_a_part_with_its_volume(tmp_path: Path) -> None:
     _, count, volume, valid = line.split()
     assert (int(count), valid) == (1, "True")
     assert float(volume) == pytest.approx(part.volume_mm3(), rel=VOLUME_REL_TOL)
+
+
+def test_occurrence_ids_and_their_line_wrap_do_not_depend_on_the_process_counter() -> None:
+    """OCCT numbers assembly occurrences with a process-wide counter and wraps lines at 72 columns counting
+    its digits: the file written after ten others must equal the first (the gripper's laser assembly
+    differed in one line break in a full test run)."""
+    from fabricate.export.step import _fixed_file_name
+
+    head = b"HEADER;\nFILE_NAME('x','t',(''),(''),'s','s','');\nENDSEC;\nDATA;\n"
+    first = head + b"#5544 = NEXT_ASSEMBLY_USAGE_OCCURRENCE('5','two_force_rod','',#5,#5297,$\n  );\nENDSEC;\n"
+    later = head + b"#5544 = NEXT_ASSEMBLY_USAGE_OCCURRENCE('15','two_force_rod','',#5,#5297,\n  $);\nENDSEC;\n"
+    a, b = _fixed_file_name(first, "assembly"), _fixed_file_name(later, "assembly")
+    assert a == b
+    assert b"NEXT_ASSEMBLY_USAGE_OCCURRENCE('1','two_force_rod','',#5,#5297,$);" in a

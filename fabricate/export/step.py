@@ -320,6 +320,10 @@ def _set_name(label: Any, name: str) -> None:
 
 _FILE_NAME = re.compile(rb"FILE_NAME\(.*?\);\s*\n", re.DOTALL)
 _OCCURRENCE_ID = re.compile(rb"(NEXT_ASSEMBLY_USAGE_OCCURRENCE\s*\(\s*')\d+'")
+#: One whole occurrence entity, continuation lines included (the writer wraps it where the counter's digits
+#: pushed it; after renumbering, the same entity is put on one line so the wrap no longer depends on them)
+_OCCURRENCE_ENTITY = re.compile(rb"NEXT_ASSEMBLY_USAGE_OCCURRENCE\(.*?\);", re.DOTALL)
+_CONTINUATION = re.compile(rb"\r?\n[ \t]*")
 
 
 def _write(document: Any, title: str) -> bytes:
@@ -390,7 +394,11 @@ def _fixed_file_name(data: bytes, title: str) -> bytes:
     # OCCT numbers assembly occurrences from a counter that lives as long as the process, so the second
     # assembly written gets ids 9, 10, ... where a fresh process writes 1, 2, ...: number them in file order
     occurrence = iter(range(1, 1 << 31))
-    return _OCCURRENCE_ID.sub(lambda m: m.group(1) + str(next(occurrence)).encode("ascii") + b"'", data)
+    data = _OCCURRENCE_ID.sub(lambda m: m.group(1) + str(next(occurrence)).encode("ascii") + b"'", data)
+    # the writer wrapped these lines at 72 columns counting the old id's digits (a 2-digit id moves the
+    # break of a long entity by one token): put each occurrence on one line (STEP ignores line breaks
+    # between tokens; names are written without newlines, see _step_string)
+    return _OCCURRENCE_ENTITY.sub(lambda m: _CONTINUATION.sub(b"", m.group(0)), data)
 
 
 def _step_string(text: str) -> str:
