@@ -133,41 +133,55 @@ def test_input_ranges_are_contiguous_runs():
 
 def test_outline_orients_its_rings_and_drops_repeated_vertices():
     """Rings given the wrong way round (outer clockwise, hole counter-clockwise) with a closing vertex and a
-    doubled vertex: the outline is the plate minus the hole (area 400 - 16), outer CCW, hole CW; the centre and
-    radius of its vertex box are the closed forms."""
+    doubled vertex: the outline is the plate minus the hole (area 600 - 16), outer CCW, hole CW; the centre and
+    radius of its vertex box are the closed forms. Small rings (under 1 mm^2) are oriented too, and vertices
+    1e-9 mm apart are distinct (only repeats within 1e-12 mm are dropped)."""
     from fabricate.planar import polygon_area
 
-    outer = np.array([[0, 0], [0, 20], [20, 20], [20, 20], [20, 0], [0, 0]], dtype=float)  # clockwise, closed
-    hole = np.array([[8, 8], [12, 8], [12, 12], [8, 12]], dtype=float)  # counter-clockwise
+    shift = np.array([2.0, -3.0])
+    outer = np.array([[0, 0], [0, 20], [30, 20], [30, 20], [30, 0], [0, 0]], dtype=float) + shift  # CW, closed
+    hole = np.array([[8, 8], [12, 8], [12, 12], [8, 12]], dtype=float) + shift  # counter-clockwise
     out = Outline([outer, hole])
     assert [len(r) for r in out.rings] == [4, 4]
-    assert polygon_area(out.rings[0]) == pytest.approx(400.0) and polygon_area(out.rings[1]) == pytest.approx(-16.0)
-    assert out.polygon.area == pytest.approx(384.0)
-    np.testing.assert_allclose(out.centre, [10.0, 10.0])
-    assert out.radius == pytest.approx(10 * np.sqrt(2))
-    np.testing.assert_allclose(out.bounds, [0, 0, 20, 20])
+    assert polygon_area(out.rings[0]) == pytest.approx(600.0) and polygon_area(out.rings[1]) == pytest.approx(-16.0)
+    assert out.polygon.area == pytest.approx(584.0)
+    np.testing.assert_allclose(out.centre, [17.0, 7.0])
+    assert out.radius == pytest.approx(np.hypot(15.0, 10.0))
+    np.testing.assert_allclose(out.bounds, [2, -3, 32, 17])
+    small = Outline([np.array([[0, 0], [1, 0], [1, 0.5], [0, 0.5]], dtype=float),  # 0.5 mm^2, CCW
+                     np.array([[0.2, 0.1], [0.4, 0.1], [0.4, 0.3], [0.2, 0.3]], dtype=float)])  # 0.04 mm^2, CCW
+    assert polygon_area(small.rings[0]) == pytest.approx(0.5) and polygon_area(small.rings[1]) == pytest.approx(-0.04)
+    near = np.array([[100, 100], [110, 100], [110, 110], [100, 110], [100, 100 + 1e-9]], dtype=float)
+    assert len(Outline([near]).rings[0]) == 5
+    doubled_first = np.array([[0, 0], [0, 0], [5, 0], [5, 5], [0, 5]], dtype=float)
+    np.testing.assert_array_equal(Outline([doubled_first]).rings[0], [[0, 0], [5, 0], [5, 5], [0, 5]])
 
 
 @pytest.mark.parametrize("chunk", [1, 7, 8, 9, 10**6])
-def test_clearance_and_overlap_do_not_depend_on_the_chunk_size(monkeypatch, chunk):
+@pytest.mark.parametrize("shift", [(0.0, 0.0), (0.0, 50.0), (-40.0, 3.0)])
+def test_clearance_and_overlap_do_not_depend_on_the_chunk_size(monkeypatch, chunk, shift):
     """The posed copies are built in chunks of POSED_VERTICES_PER_CHUNK vertices: any chunk size (one pose at a
     time, two at a time, all at once) gives the same distances and areas, equal to shapely on raw
-    coordinates; touching boundaries give exactly 0."""
+    coordinates, wherever the plate lies; touching boundaries give exactly 0, a distance equal to the search
+    length is resolved."""
     import fabricate.checks.distance as distance
 
     monkeypatch.setattr(distance, "POSED_VERTICES_PER_CHUNK", chunk)
-    plate = np.array([[0, 0], [20, 0], [20, 6], [0, 6]], dtype=float)
+    plate = np.array([[0, 0], [20, 0], [20, 6], [0, 6]], dtype=float) + shift
     square = np.array([[0, 0], [3, 0], [3, 3], [0, 3]], dtype=float)
     a, b = Outline([plate]), Outline([square])
     q = np.array([[5, 7, 0.0], [5, 6.5, 0.1], [5, 6, 0.0], [5, 8.5, 0.0], [4, 4, 0.2], [25, 2, 0.0], [5, 7, 0.0],
-                  [40, 40, 0.0]])
+                  [40, 40, 0.0], [5, 10, 0.0], [-3, 1, 0.0]])
+    q[:, :2] += shift
     got = distance.planar_clearance(a, b, RelativePoses(q), search_mm=4.0)
     truth = np.array([shapely.Polygon(plate).distance(_posed_shapely(square, p)) for p in q])
     area = np.array([shapely.Polygon(plate).intersection(_posed_shapely(square, p)).area for p in q])
     assert got[2] == 0.0  # the square's bottom edge lies on the plate's top edge
     assert got[4] == -np.inf and area[4] > 0
     assert got[7] == np.inf  # farther than the search length
+    assert got[8] == pytest.approx(4.0, abs=1e-12)  # exactly the search length away: resolved, not +inf
     keep = (truth <= 4.0) & (area == 0)
+    assert keep.sum() == 7
     np.testing.assert_allclose(got[keep], truth[keep], atol=1e-9)
     np.testing.assert_allclose(distance.overlap_areas(a, b, RelativePoses(q)), area, atol=1e-9)
     assert distance.overlap_areas(a, b, RelativePoses(np.zeros((0, 3)))).shape == (0,)

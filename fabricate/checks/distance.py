@@ -172,8 +172,11 @@ def planar_clearance(a: Outline, b: Outline, rel: RelativePoses, search_mm: floa
 
 def _clipped_distance(a: Outline, poly_b: shapely.Polygon, bounds_b: np.ndarray, search: float) -> float:
     """Distance of ``a`` and ``poly_b`` if at most ``search`` (exact), else a value > ``search``."""
-    lo = np.maximum(a.bounds[:2], bounds_b[:2]) - search
-    hi = np.minimum(a.bounds[2:], bounds_b[2:]) + search
+    # at a distance of exactly ``search`` the closest points can lie on the window's edge, where clipping
+    # leaves a zero-area slice that GEOS drops: the window is a hair wider than the search length
+    pad = search * (1.0 + 1e-9) + 1e-12
+    lo = np.maximum(a.bounds[:2], bounds_b[:2]) - pad
+    hi = np.minimum(a.bounds[2:], bounds_b[2:]) + pad
     # boxes 2 x search apart or more on an axis: the parts are farther apart than search (which is > 0);
     # lo == hi would also hand GEOS a degenerate clip window, which it refuses
     if np.any(lo >= hi):
@@ -183,8 +186,8 @@ def _clipped_distance(a: Outline, poly_b: shapely.Polygon, bounds_b: np.ndarray,
         return math.inf
     # B's closest point is within ``search`` of the clipped A (which holds A's closest point)
     ca = clip_a.bounds
-    clip_b = shapely.clip_by_rect(poly_b, max(lo[0], ca[0] - search), max(lo[1], ca[1] - search),
-                                  min(hi[0], ca[2] + search), min(hi[1], ca[3] + search))
+    clip_b = shapely.clip_by_rect(poly_b, max(lo[0], ca[0] - pad), max(lo[1], ca[1] - pad),
+                                  min(hi[0], ca[2] + pad), min(hi[1], ca[3] + pad))
     if clip_b.is_empty:
         return math.inf
     return float(shapely.distance(clip_a, clip_b))
