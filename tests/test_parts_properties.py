@@ -147,3 +147,64 @@ def test_hull_of_three_circles_is_triangle_plus_band_plus_disc():
     # every vertex is a tangent point: at distance r from its nearest corner
     d = np.min(np.hypot(*(hull.vertices[:, None, :] - tri[None, :, :]).transpose(2, 0, 1)), axis=1)
     np.testing.assert_allclose(d, r, atol=1e-12)
+
+
+@pytest.mark.parametrize("d", [0.04, -0.04])
+def test_offset_of_a_small_hull_keeps_unit_normals(d):
+    """The pear scaled to a twentieth (radii 0.2 and 0.1 mm, 0.6 mm apart; every segment shorter than 1 mm):
+    still the exact hull of the grown circles."""
+    centres, radii = np.array([[0.0, 0.0], [0.6, 0.0]]), np.array([0.2, 0.1])
+    out = offset_path(circle_hull(centres, radii), d)
+    grown = circle_hull(centres, radii + d)
+    np.testing.assert_allclose(out.vertices, grown.vertices, atol=1e-12)
+    assert out.area() == pytest.approx(grown.area(), rel=1e-12)
+
+
+def test_offset_of_a_tombstone_mitres_its_sharp_corners():
+    """A 6 mm wide block with a semicircular top (radius 3) and two square bottom corners: grown by 0.5 mm the
+    top is the semicircle of radius 3.5 and the bottom corners stay square (moved diagonally by 0.5 mm each
+    way), so the area is 7 x (4 + 0.5) + pi 3.5^2 / 2 (closed form)."""
+    w, h, r, d = 6.0, 4.0, 3.0, 0.5
+    tomb = BulgePath(np.array([[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]]), np.array([0.0, 0.0, 1.0, 0.0]))
+    assert tomb.area() == pytest.approx(w * h + math.pi * r * r / 2, rel=1e-12)
+    out = offset_path(tomb, d)
+    np.testing.assert_allclose(out.vertices, [[-d, -d], [w + d, -d], [w + d, h], [-d, h]], atol=1e-12)
+    assert out.area() == pytest.approx((w + 2 * d) * (h + d) + math.pi * (r + d) ** 2 / 2, rel=1e-12)
+
+
+def test_polygon_offset_rounds_convex_corners_with_the_documented_sagitta():
+    """A square grown by 2 mm: every vertex of the round corners lies on the exact offset (2 mm from the
+    square), and the largest gap between a chord and the exact offset is the sagitta of 32 segments per
+    quarter turn, 2 (1 - cos(pi / 128)) = 6.0e-4 mm (closed form; within 3e-4 of the distance as documented)."""
+    square = BulgePath.polyline(np.array([[0, 0], [10, 0], [10, 10], [0, 10]], dtype=float))
+    out = offset_path(square, 2.0).vertices
+    body = shapely.Polygon(square.vertices)
+    dist = shapely.distance(shapely.points(out), body)
+    np.testing.assert_allclose(dist, 2.0, atol=1e-9)
+    mids = 0.5 * (out + np.roll(out, -1, axis=0))
+    gap = 2.0 - shapely.distance(shapely.points(mids), body)
+    assert gap.max() == pytest.approx(2.0 * (1 - math.cos(math.pi / 128)), rel=1e-6)
+    assert gap.max() <= 3.02e-4 * 2.0
+
+
+def test_fuse_starts_at_the_smallest_vertex_and_drops_points_on_slanted_edges():
+    """A rotated square (45 deg, a diamond) with points in the middle of its slanted edges, fused with a bar
+    that leaves part of one edge: the result starts at the lexicographically smallest vertex (least x, then
+    least y), is counter-clockwise, keeps every corner and no point in the middle of an edge."""
+    c, s = math.cos(math.pi / 4), math.sin(math.pi / 4)
+    corners = np.array([[5 * c, -5 * s], [10 * c, 0.0], [5 * c, 5 * s], [0.0, 0.0]]) + [1.0, 2.0]
+    mids = 0.5 * (corners + np.roll(corners, -1, axis=0))
+    ring = np.empty((8, 2))
+    ring[0::2], ring[1::2] = corners, mids
+    base = BulgePath.polyline(ring)
+    bar = np.array([[4.0, 1.0], [9.0, 1.0], [9.0, 1.5], [4.0, 1.5]])  # pokes out of the lower right edge
+    fused = fuse_polygons(base, [bar], 0.01)
+    union = shapely.union_all([shapely.Polygon(corners), shapely.Polygon(bar)])
+    assert shapely.Polygon(fused.vertices).equals(union)
+    assert polygon_area(fused.vertices) > 0
+    assert tuple(fused.vertices[0]) == min(map(tuple, fused.vertices))
+    assert len(fused.vertices) == len(shapely.Polygon(union.exterior).simplify(0).exterior.coords) - 1
+    # every vertex is a true corner: not on the segment between its neighbours
+    prev, nxt = np.roll(fused.vertices, 1, axis=0), np.roll(fused.vertices, -1, axis=0)
+    for p, a, b in zip(fused.vertices, prev, nxt, strict=True):
+        assert shapely.LineString([a, b]).distance(shapely.Point(p)) > 1e-6
