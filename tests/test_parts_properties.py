@@ -208,3 +208,13 @@ def test_fuse_starts_at_the_smallest_vertex_and_drops_points_on_slanted_edges():
     prev, nxt = np.roll(fused.vertices, 1, axis=0), np.roll(fused.vertices, -1, axis=0)
     for p, a, b in zip(fused.vertices, prev, nxt, strict=True):
         assert shapely.LineString([a, b]).distance(shapely.Point(p)) > 1e-6
+
+
+@pytest.mark.parametrize("phi", [0.0, 0.7, 2.0])
+@pytest.mark.parametrize("r2", [2.0, 4.5])
+def test_hull_of_an_internally_tangent_circle_is_the_outer_circle(phi, r2):
+    """A circle inside a larger one and touching it (at any angle) adds nothing: the hull is the outer circle."""
+    centres = np.array([[0.0, 0.0], [(5.0 - r2) * math.cos(phi), (5.0 - r2) * math.sin(phi)]])
+    hull = circle_hull(centres, np.array([5.0, r2]))
+    assert hull.area() == pytest.approx(math.pi * 25.0, rel=1e-12)
+    np.testing.assert_allclose(np.hypot(*hull.vertices.T), 5.0, rtol=1e-12)
