@@ -588,3 +588,91 @@ def test_assembly_3mf_places_each_part_at_its_body_pose():
     np.testing.assert_array_equal(vertices[:, 2], flat_v[:, 2])
     assert flat_v[:, 2].min() == pytest.approx(0.0, abs=1e-9)  # lying on the plate, not at z = 2
     assert cache.solid(link) is cache.solid(link)
+
+
+def tetra_mesh() -> tuple[np.ndarray, np.ndarray]:
+    """An irregular tetrahedron, outward triangles: volume det(v1 - v0, v2 - v0, v3 - v0) / 6 = 5.55 / 6 mm^3."""
+    v = np.array([[0.0, 0.0, 0.0], [2.0, 0.3, 0.0], [0.4, 1.5, 0.2], [0.5, 0.6, 2.0]])
+    f = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+    return v, f
+
+
+def test_stl_findings_at_their_boundaries():
+    """A first triangle whose normal has a non-zero low byte (the count is the 4 bytes 80-83, not more); a single
+    triangle is a triangle (not 'no triangles'); a closed mesh of zero volume and a small positive one; the
+    volume tolerance is relative with a default of 1e-3 and strict."""
+    from fabricate.export.stl import stl_bytes
+
+    v, f = tetra_mesh()
+    data = stl_bytes(v, f)
+    assert data[84] != 0  # the first normal's first byte
+    assert validate_stl(data, 5.55 / 6.0, rel_tol=1e-6) == []  # float32 corners
+    single = validate_stl(stl_bytes(v[:3], f[:1]))
+    assert "not watertight" in single and "no triangles" not in single
+    flat = trimesh.Trimesh(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2], [0, 2, 1]]),
+                           process=False)  # two faces back to back: closed, volume exactly 0
+    with np.errstate(invalid="ignore"):  # trimesh divides by the zero volume for the centre of mass
+        assert mesh_problems(flat) == ["volume 0 mm^3 is not positive"]
+    small_v, small_f = box_mesh((0.5, 0.5, 0.5))
+    assert mesh_problems(trimesh.Trimesh(small_v, small_f, process=False)) == []  # 0.125 mm^3
+    box = trimesh.Trimesh(*box_mesh(), process=False)
+    assert mesh_problems(box, 24.0, rel_tol=0.0) == []  # exactly the volume: no tolerance needed
+    assert mesh_problems(box, 24.02) == []  # default 1e-3
+    assert mesh_problems(box, 24.03) == ["volume 24 mm^3 differs from 24.03 mm^3"]
+
+
+def test_plate_stl_numbers_each_shell_after_the_previous_ones():
+    """Three meshes of 8, 4 and 8 vertices: the triangles of each refer to its own vertices, so the plate is three
+    closed shells with the sum of the volumes."""
+    from fabricate.export.stl import plate_stl
+
+    tv, tf = tetra_mesh()
+    meshes = [box_mesh(), (tv + [10.0, 0.0, 0.0], tf), box_mesh((1.0, 1.0, 1.0), origin=(20.0, 0.0, 0.0))]
+    data = plate_stl(meshes)
+    assert validate_stl(data, 24.0 + 5.55 / 6.0 + 1.0, rel_tol=1e-6) == []  # float32 corners
+    mesh = trimesh.load(io.BytesIO(data), file_type="stl")
+    assert len(mesh.split(only_watertight=True)) == 3
+
+
+def test_read_3mf_reads_every_object_and_checks_each_index():
+    """The 3MF core default unit is the millimetre (no attribute: no finding); an object with an unreadable number
+    or a bad index is reported and the objects after it are still read; no triangles, a negative index and an
+    index equal to the vertex count are each reported; a triangle soup (unshared vertices) is read as it is, so
+    it is not watertight."""
+    import zipfile
+
+    from fabricate.export.stl import model_3mf, read_3mf
+
+    box = box_mesh()
+
+    def model_text(objects) -> str:
+        with zipfile.ZipFile(io.BytesIO(model_3mf(objects, "t"))) as z:
+            return z.read("3D/3dmodel.model").decode()
+
+    def rewrite(model: str) -> bytes:
+        buf = io.BytesIO()
+        with zipfile.ZipFile(buf, "w") as z:
+            z.writestr("3D/3dmodel.model", model)
+        return buf.getvalue()
+
+    text = model_text([("first", *box), ("second", *box)])
+    objects, problems = read_3mf(rewrite(text.replace(' unit="millimeter"', "")))
+    assert problems == [] and list(objects) == ["first", "second"]
+    first = text.index('name="second"')
+    bad_number = text[:first].replace('x="2.000000"', 'x="two"', 1) + text[first:]
+    objects, problems = read_3mf(rewrite(bad_number))
+    assert list(objects) == ["second"] and len(problems) == 1 and problems[0].startswith("object first: unreadable")
+    for index in ("8", "-1"):
+        bad = text[:first].replace('v3="1"/>', f'v3="{index}"/>', 1) + text[first:]
+        objects, problems = read_3mf(rewrite(bad))
+        assert list(objects) == ["second"]
+        assert problems == ["object first: no triangles or triangle indices outside its vertices"]
+    empty = model_text([("none", box[0], np.zeros((0, 3), dtype=int)), ("second", *box)])
+    objects, problems = read_3mf(rewrite(empty))
+    assert list(objects) == ["second"]
+    assert problems == ["object none: no triangles or triangle indices outside its vertices"]
+    soup_v = box[0][box[1]].reshape(-1, 3)  # each triangle with its own three vertices
+    soup_f = np.arange(len(soup_v)).reshape(-1, 3)
+    objects, problems = read_3mf(model_3mf([("soup", soup_v, soup_f)], "t"))
+    assert problems == [] and len(objects["soup"].vertices) == 36
+    assert "not watertight" in mesh_problems(objects["soup"])
