@@ -95,17 +95,48 @@ def load(template: str | Path | Mapping[str, Any], process: str | None = None) -
     return load_design(template, process)
 
 
+def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | None = None,
+                   pads: Mapping[str, Mapping[str, Any]] | None = None,
+                   tables: Mapping[str, Any] | None = None) -> DesignSpec:
+    """A design from a :class:`~fabricate.mechanism.Mechanism` built in code: it is written as a
+    ``kind = "linkage"`` template (see :mod:`fabricate.synthesis.linkage_write`) and validated like one, so
+    the build's report embeds a template ``fabricate check`` can rebuild.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    process : str
+        Process profile, ``"sla"`` or ``"laser"``.
+    tip_point, pads
+        The output point and fingertip pads (``{body: {"point": name, "radius_mm": r}}``).
+    tables : Mapping, optional
+        More template tables: ``{"load": {...}, "parts": {...}, "checks": {...}}``.
+    """
+    from fabricate.synthesis.linkage_write import linkage_tables
+
+    template: dict[str, Any] = {"design": {"name": mechanism.name, "kind": "linkage"},
+                                "process": {"profile": process}}
+    for key, value in (tables or {}).items():
+        template[key] = dict(value) if key != "process" else {**template["process"], **value}
+    template["linkage"] = linkage_tables(mechanism, tip_point=tip_point, pads=pads)
+    return load(template)
+
+
 def build(design: DesignSpec | str | Path | Mapping[str, Any]) -> Build:
-    """Run the whole pipeline in memory (see :func:`load` for what ``design`` may be).
+    """Run the whole pipeline in memory (see :func:`load` for what ``design`` may be; a
+    :class:`~fabricate.mechanism.Mechanism` goes through :func:`from_mechanism` with its defaults).
 
     Raises
     ------
     SpecError, SynthesisError
         Bad input or nothing feasible (the CLI's exit code 2).
     """
+    from fabricate.mechanism import Mechanism
     from fabricate.pipeline import run_build
 
-    if not isinstance(design, DesignSpec):
+    if isinstance(design, Mechanism):
+        design = from_mechanism(design)
+    elif not isinstance(design, DesignSpec):
         design = load(design)
     outcome = run_build(design)
     return Build(exit_code=outcome.exit_code, report=outcome.report, files=dict(outcome.files), design=design,
