@@ -533,14 +533,14 @@ def test_feasibility_limits_at_their_boundaries():
 
 
 def test_contact_ratio_of_spur_gears_and_of_the_rack_limit():
-    """Pitch circles 10 and 20 mm, module 1: the spur contact ratio
-    (sqrt(r_a1^2 - r_b1^2) + sqrt(r_a2^2 - r_b2^2) - a sin alpha) / (pi m cos alpha); a flat or concave curve
-    counts as a rack (addendum / sin alpha)."""
+    """Pitch circles 10 and 20 mm, module 2: the spur contact ratio
+    (sqrt(r_a1^2 - r_b1^2) + sqrt(r_a2^2 - r_b2^2) - a sin alpha) / (pi m cos alpha) with the addendum h_a = m; a
+    flat or concave curve (curvature up to 1e-9 /mm) counts as a rack (addendum / sin alpha)."""
     from fabricate.gears.checks import local_contact_ratio
     from fabricate.gears.spec import GearSpec
 
     alpha = np.radians(20.0)
-    m, ha = 1.0, 1.0
+    m, ha = 2.0, 2.0
 
     def path(r):
         return np.sqrt((r + ha) ** 2 - (r * np.cos(alpha)) ** 2)
@@ -549,7 +549,7 @@ def test_contact_ratio_of_spur_gears_and_of_the_rack_limit():
     got = local_contact_ratio(_Curvatures([0.1, 0.1], [0.05, 0.05]), np.zeros(2), m, GearSpec())
     np.testing.assert_allclose(got, spur, rtol=1e-12)
     rack = ha / np.sin(alpha)
-    got = local_contact_ratio(_Curvatures([0.0, -0.2], [0.05, 1e-10]), np.zeros(2), m, GearSpec())
+    got = local_contact_ratio(_Curvatures([0.0, -0.2], [0.05, 1e-9]), np.zeros(2), m, GearSpec())
     want = [(rack + path(20.0) - 20.0 * np.sin(alpha)), 2 * rack]
     np.testing.assert_allclose(got, np.array(want) / (np.pi * m * np.cos(alpha)), rtol=1e-12)
 
