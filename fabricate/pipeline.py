@@ -168,6 +168,7 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
     from fabricate.parts.build import build_parts
     from fabricate.strength.check import run_strength
     from fabricate.strength.plots import strength_plot
+    from fabricate.synthesis.mechanism_toml import mechanism_toml
 
     def enter(name: str) -> None:
         stage[0] = name
@@ -205,6 +206,7 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
         report["assembly"] = {"pins": stacks_report(stacks), "steps": assembly_steps(stacks, partset.copies)}
         files["assembly.csv"] = assembly_csv(stacks)
         files["motion.csv"] = motion_csv(mechanism, motion)
+        files["mechanism.toml"] = mechanism_toml(design, mechanism, result.parts)
         enter("checks")
         checks = run_checks(design, partset, mechanism, motion, gear_pairs)
         report["interference"] = checks.interference

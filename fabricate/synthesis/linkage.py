@@ -43,6 +43,11 @@ Template tables
 ``[[linkage.pads]]`` (optional)
     ``body``, ``point``, ``radius_mm``: a pad disc fused to the body at the point (parts layer).
 
+``exact = true`` (in ``[linkage]``)
+    The exact form every build writes as ``mechanism.toml``: bodies with points in their own frames, the
+    first pose's ``assembly``, joints and drivers as the mechanism has them, laws by their coefficients,
+    and the parts ``hints``; see :mod:`fabricate.synthesis.mechanism_toml`.
+
 Reference pose and start
 ------------------------
 Because points are world coordinates at the reference pose, every body's frame is the world frame there:
@@ -361,9 +366,25 @@ def _parse_pad(t: Table, bodies: dict[str, BodySpec]) -> PadSpec:
     return PadSpec(body, point, radius)
 
 
-def parse_spec(root: Table) -> LinkageSpec:
+@dataclass(frozen=True)
+class ExactLinkageSpec:
+    """The exact form (``[linkage] exact = true``, what every build writes as ``mechanism.toml``): the
+    mechanism as it was, and the parts hints it came with (see :mod:`fabricate.synthesis.mechanism_toml`)."""
+
+    mechanism: Any
+    hints: dict
+    tip_point: str | None = None
+
+
+def parse_spec(root: Table) -> LinkageSpec | ExactLinkageSpec:
     """Read ``[linkage]`` from the template root (see the module docstring)."""
     t = root.table("linkage")
+    if t.has("exact") and t.boolean("exact"):
+        from fabricate.synthesis.mechanism_toml import parse_exact
+
+        name = str(root.data.get("design", {}).get("name", "linkage"))
+        mech, hints, tip = parse_exact(t, name)
+        return ExactLinkageSpec(mech, hints, tip)
     unit = t.string("input_unit", choices=("deg", "mm"))
     bound = MAX_INPUT_DEG if unit == "deg" else MAX_LENGTH_MM
     rng = t.array("input_range", shape=(2,), min=-bound, max=bound)
@@ -498,6 +519,10 @@ def _check_gear_ranges(spec: LinkageSpec, mech: Mechanism, motion: Any) -> None:
 def synthesise(design: Any) -> SynthesisResult:
     """Build the declared linkage (no synthesis: the template is the design)."""
     spec: LinkageSpec = design.method
+    if isinstance(spec, ExactLinkageSpec):
+        report = {"method": "declared linkage, exact form (a build's mechanism.toml)",
+                  "degrees_of_freedom": spec.mechanism.degrees_of_freedom(), "tip_point": spec.tip_point}
+        return SynthesisResult(mechanism=spec.mechanism, report=report, parts=dict(spec.hints))
     mech = build_mechanism(design.name, spec)
     sweep_poses = int(getattr(getattr(design, "checks", None), "sweep_poses", 360))
     motion = None

@@ -1,0 +1,221 @@
+"""``mechanism.toml``: every build's mechanism as a ``kind = "linkage"`` template that rebuilds it.
+
+The template is the *exact* form of the linkage kind (``[linkage] exact = true``): bodies with their
+points in their own frames, the assembly guess of the first pose, revolute and slider joints as the
+mechanism has them, and every law written so that it evaluates to the same floats: the identity, a
+:class:`~fabricate.mechanism.LinearLaw`, or a piecewise polynomial (scipy's ``PPoly``: ``CubicSpline``,
+``PchipInterpolator``, …) by its breakpoints and coefficients, floats written with ``repr``. The build's
+generic tables (process, gears, parts, checks, load) and the synthesis' hints for the parts layer (pads,
+springs, purchased items, copies) come along, so the same parts come out byte for byte. A law of another
+kind (a method's own piecewise class) is written as dense samples under a PCHIP and the file says that
+its rebuild is close, not identical.
+
+Edit it by hand (move a point, change a law) and ``fabricate build mechanism.toml`` builds the edit.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from fabricate.errors import SpecError
+from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
+
+#: Samples of a law written approximately (a law of a kind this file cannot write exactly).
+SAMPLED_LAW_POINTS = 2001
+#: Generic tables of the design copied into the template as they were written.
+GENERIC_TABLES = ("process", "gears", "parts", "checks", "load")
+
+
+# -- writing -----------------------------------------------------------------------------------------
+
+def law_table(law: Any, domain: tuple[float, float]) -> tuple[dict[str, Any], bool]:
+    """A law as a table, and whether it is exact (else dense samples over ``domain``)."""
+    from scipy.interpolate import PPoly
+
+    if law is None:
+        return {"type": "identity"}, True
+    if isinstance(law, LinearLaw):
+        return {"type": "linear", "slope": float(law.slope), "offset": float(law.offset)}, True
+    if isinstance(law, PPoly):
+        extrapolate = law.extrapolate if isinstance(law.extrapolate, str) else bool(law.extrapolate)
+        return {"type": "ppoly", "x": np.asarray(law.x, dtype=np.float64).tolist(),
+                "c": np.asarray(law.c, dtype=np.float64).tolist(), "extrapolate": extrapolate}, True
+    lo, hi = sorted(domain)
+    x = np.linspace(lo, hi, SAMPLED_LAW_POINTS)
+    return {"type": "samples", "x": x.tolist(), "y": np.asarray(law(x), dtype=np.float64).tolist()}, False
+
+
+def _plain(value: Any) -> Any:
+    """Hints as TOML values: tuples and arrays as lists, numpy scalars as numbers, None left out."""
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items() if v is not None}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value if v is not None]
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    return value
+
+
+def exact_linkage(mechanism: Mechanism, hints: Mapping[str, Any]) -> tuple[dict[str, Any], bool]:
+    """The ``[linkage]`` table of the exact form, and whether every law in it is exact."""
+    exact = True
+    lo, hi = (float(v) for v in mechanism.input_range)
+    bodies = [{"name": b.name, "points": {p: [float(v) for v in b.point(p)] for p in b.points}}
+              for b in mechanism.bodies]
+    joints = []
+    for j in mechanism.joints:
+        entry: dict[str, Any] = {"name": j.name, "type": "revolute" if isinstance(j, Revolute) else "slider",
+                                 "bodies": [j.body_a, j.body_b]}
+        if isinstance(j, Slider):
+            entry["axis"] = [float(v) for v in j.axis]
+            entry["angle_rad"] = float(j.angle)
+        joints.append(entry)
+    gears = []
+    for g in mechanism.gears:
+        law, ok = law_table(g.law, tuple(g.working_range) if g.working_range[1] != g.working_range[0]
+                            else (-math.pi, math.pi))
+        exact &= ok
+        gears.append({"name": g.name, "carrier": g.carrier, "bodies": [g.gear_a, g.gear_b],
+                      "axes": [g.axis_a, g.axis_b], "working_range_rad": [float(v) for v in g.working_range],
+                      "law": law})
+    drivers = []
+    for d in mechanism.drivers:
+        law, ok = law_table(d.law, (lo, hi))
+        exact &= ok
+        entry = {"kind": d.kind, "body": d.body, "reference": d.reference, "law": law}
+        if d.joint:
+            entry["joint"] = d.joint
+        drivers.append(entry)
+    table: dict[str, Any] = {
+        "exact": True, "ground": mechanism.ground, "input_unit": mechanism.input_unit, "input_range": [lo, hi],
+        "assembly": {name: [float(v) for v in pose] for name, pose in mechanism.assembly.items()},
+        "hints": _plain(dict(hints)),
+        "bodies": bodies, "joints": joints, "drivers": drivers,
+    }
+    if gears:
+        table["gears"] = gears
+    return table, exact
+
+
+def mechanism_toml(design: Any, mechanism: Mechanism, hints: Mapping[str, Any]) -> bytes:
+    """``mechanism.toml`` of a build: see the module docstring."""
+    from fabricate.spec import parse_toml
+    from fabricate.tomlwrite import dumps
+
+    linkage, exact = exact_linkage(mechanism, hints)
+    source = parse_toml(design.template_text, str(design.template)) if design.template_text else {}
+    tables: dict[str, Any] = {"design": {"name": design.name, "kind": "linkage",
+                                         "description": f"the mechanism of {design.name} ({design.kind}), exact"}}
+    for key in GENERIC_TABLES:
+        if key in source:
+            tables[key] = source[key]
+    tables["linkage"] = linkage
+    note = ("every law is written exactly: this template rebuilds the same mechanism and the same parts"
+            if exact else "a law is written as samples under a PCHIP: the rebuild is close, not identical")
+    head = (f"# The mechanism of {design.name} (kind {design.kind}), written by fabricate as a linkage template:\n"
+            f"# {note}. Edit it and `fabricate build` it like any template.\n\n")
+    return (head + dumps(tables)).encode("utf-8")
+
+
+# -- reading (the exact form of kind "linkage") ---------------------------------------------------------
+
+def _law(table: Any, field: str) -> Any:
+    from scipy.interpolate import PchipInterpolator, PPoly
+
+    kind = table.string("type", choices=("identity", "linear", "ppoly", "samples"))
+    if kind == "identity":
+        table.finish()
+        return None
+    if kind == "linear":
+        law = LinearLaw(table.number("slope", min=-1e6, max=1e6), table.number("offset", 0.0, min=-1e6, max=1e6))
+        table.finish()
+        return law
+    if kind == "ppoly":
+        x = table.array("x", shape=(None,), min_rows=2, min=-1e6, max=1e6)
+        c = table.array("c", shape=(None, len(x) - 1), min_rows=1, min=-1e12, max=1e12)
+        extrapolate = table.raw("extrapolate", True)
+        if extrapolate not in (True, False, "periodic"):
+            raise SpecError(table.field("extrapolate"), "expected true, false or \"periodic\"")
+        table.finish()
+        if np.any(np.diff(x) <= 0):
+            raise SpecError(table.field("x"), "breakpoints must increase strictly")
+        return PPoly(c, x, extrapolate=extrapolate)
+    x = table.array("x", shape=(None,), min_rows=2, min=-1e6, max=1e6)
+    y = table.array("y", shape=(len(x),), min=-1e6, max=1e6)
+    table.finish()
+    if np.any(np.diff(x) <= 0):
+        raise SpecError(table.field("x"), "samples must increase strictly")
+    return PchipInterpolator(x, y)
+
+
+def parse_exact(t: Any, name: str) -> tuple[Mechanism, dict[str, Any], str | None]:
+    """The mechanism and the parts hints of an exact ``[linkage]`` table (``t`` after ``exact``)."""
+    from fabricate.bounds import MAX_LINKAGE_BODIES, MAX_LINKAGE_DRIVERS, MAX_LINKAGE_GEARS, MAX_LINKAGE_JOINTS
+
+    unit = t.string("input_unit", choices=("deg", "mm"))
+    rng = t.array("input_range", shape=(2,), min=-1e5, max=1e5)
+    ground = t.string("ground")
+    tables = t.tables("bodies")
+    if not 2 <= len(tables) <= MAX_LINKAGE_BODIES:
+        raise SpecError(t.field("bodies"), f"expected 2 to {MAX_LINKAGE_BODIES} bodies, got {len(tables)}")
+    bodies = []
+    for b in tables:
+        points = b.table("points")
+        pts = {k: tuple(points.array(k, shape=(2,), min=-1e4, max=1e4).tolist()) for k in list(points.data)}
+        points.finish()
+        bodies.append(Body(b.string("name"), pts))
+        b.finish()
+    joints: list[Any] = []
+    tables = t.tables("joints")
+    if len(tables) > MAX_LINKAGE_JOINTS:
+        raise SpecError(t.field("joints"), f"at most {MAX_LINKAGE_JOINTS} joints")
+    for j in tables:
+        kind = j.string("type", choices=("revolute", "slider"))
+        pair = j.strings("bodies")
+        if len(pair) != 2:
+            raise SpecError(j.field("bodies"), "expected two bodies")
+        if kind == "revolute":
+            joints.append(Revolute(j.string("name"), pair[0], pair[1]))
+        else:
+            axis = j.array("axis", shape=(2,), min=-1e6, max=1e6)
+            if not np.hypot(*axis) > 0:
+                raise SpecError(j.field("axis"), "expected a non-zero direction")
+            joints.append(Slider(j.string("name"), pair[0], pair[1], tuple(axis.tolist()),
+                                 j.number("angle_rad", 0.0, min=-1e3, max=1e3)))
+        j.finish()
+    gears = []
+    tables = t.tables("gears", [])
+    if len(tables) > MAX_LINKAGE_GEARS:
+        raise SpecError(t.field("gears"), f"at most {MAX_LINKAGE_GEARS} gear pairs")
+    for g in tables:
+        pair, axes = g.strings("bodies"), g.strings("axes")
+        if len(pair) != 2 or len(axes) != 2:
+            raise SpecError(g.field("bodies"), "expected two bodies and two axes")
+        working = g.array("working_range_rad", shape=(2,), min=-1e3, max=1e3)
+        gears.append(GearCoupling(g.string("name"), g.string("carrier"), pair[0], pair[1],
+                                  _law(g.table("law"), g.field("law")), axes[0], axes[1],
+                                  (float(working[0]), float(working[1]))))
+        g.finish()
+    drivers = []
+    tables = t.tables("drivers")
+    if not 1 <= len(tables) <= MAX_LINKAGE_DRIVERS:
+        raise SpecError(t.field("drivers"), f"expected 1 to {MAX_LINKAGE_DRIVERS} drivers")
+    for d in tables:
+        drivers.append(Driver(d.string("kind", choices=("angle", "slide")), d.string("body"), d.string("reference"),
+                              d.string("joint", ""), _law(d.table("law"), d.field("law"))))
+        d.finish()
+    assembly_t = t.table("assembly", {})
+    assembly = {k: tuple(assembly_t.array(k, shape=(3,), min=-1e5, max=1e5).tolist()) for k in list(assembly_t.data)}
+    assembly_t.finish()
+    hints = dict(t.raw("hints", {}))
+    if not isinstance(t.raw("hints", {}), Mapping):
+        raise SpecError(t.field("hints"), "expected a table")
+    t.finish()
+    mech = Mechanism(name=name, bodies=tuple(bodies), ground=ground, joints=tuple(joints), gears=tuple(gears),
+                     drivers=tuple(drivers), input_range=(float(rng[0]), float(rng[1])), input_unit=unit,
+                     assembly=assembly)
+    return mech, hints, hints.get("tip_point")
