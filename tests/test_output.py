@@ -250,8 +250,11 @@ def test_ctrl_c_exits_130_with_one_line_and_the_previous_output_intact(tmp_path)
     out = tmp_path / "out"
     write_output(fake_output("a"), out)
     marker = tmp_path / "inside"
+    # a terminal's Ctrl-C: SIGINT at its default disposition (pytest-xdist workers ignore SIGINT, an ignored
+    # signal stays ignored across exec, and Python then installs no KeyboardInterrupt handler)
     child = subprocess.Popen([sys.executable, "-c", CTRL_C_CHILD, str(marker), str(out)],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 120
     while not marker.exists():  # wait until the build is under way: no race with a fast machine
         assert child.poll() is None and time.monotonic() < deadline, child.communicate()
