@@ -56,7 +56,7 @@ from dataclasses import dataclass
 from fabricate.bounds import MAX_MESH_STEPS, MAX_TEETH
 from fabricate.errors import SpecError
 from fabricate.gears.rack import MIN_ROOT_LAND, rack_fit
-from fabricate.spec import Table
+from fabricate.table import Table
 
 METHODS = ("exact", "approx")
 #: Smallest module: finer teeth than no process resolves (SLA min feature 0.3 mm) only cost time.

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fabricate.spec import Table
+from fabricate.table import Table
 
 #: Widest link ``link_width_mm = "auto"`` tries (mm): beyond it the design needs a thicker plate or a
 #: stronger material, which the strength failure then says.

@@ -32,7 +32,6 @@ from fabricate.bounds import (
 )
 from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, LinearLaw, Mechanism, Revolute, Slider
-from fabricate.spec import Table
 from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.compliant_model import (
     ContactPath,
@@ -48,6 +47,7 @@ from fabricate.synthesis.compliant_model import (
     spring_torques,
 )
 from fabricate.synthesis.compliant_optimise import OptimumResult, ParameterGrid, optimise
+from fabricate.table import Table
 
 
 @dataclass(frozen=True)

@@ -37,10 +37,10 @@ from fabricate.bounds import MAX_KAPPA_SAMPLES, MAX_LENGTH_MM, MIN_CURVE_STEP_MM
 from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, GearCoupling, Mechanism, Motion, Revolute
 from fabricate.planar import rotation, unit, wrap_angle
-from fabricate.spec import Table
 from fabricate.synthesis import kinematic_mapping as km
 from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.five_bar_law import GearLaw, gear_law
+from fabricate.table import Table
 
 #: Rules for picking one dyad of the feasible domain.
 SELECTION_RULES = ("x_A", "least_pose_error")

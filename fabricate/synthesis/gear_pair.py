@@ -34,8 +34,8 @@ from fabricate.errors import SpecError
 from fabricate.gears.law import FormulaLaw, check_ratio, elliptic_formula, samples_law
 from fabricate.gears.pitch import PitchCurves
 from fabricate.mechanism import Body, Driver, GearCoupling, Mechanism, Revolute
-from fabricate.spec import Table
 from fabricate.synthesis.base import SynthesisResult
+from fabricate.table import Table
 
 PAIR_NAME = "pair"
 

@@ -85,9 +85,9 @@ from fabricate.bounds import (
 from fabricate.errors import LockupError, SpecError
 from fabricate.gears.law import FormulaLaw
 from fabricate.mechanism import Mechanism
-from fabricate.spec import Table, check_array
 from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.linkage_mechanism import build_mechanism, gear_law, sampled_law
+from fabricate.table import Table, check_array
 
 #: Largest distance (mm) between the two points of a revolute (or off a slider's line) at the reference
 #: pose: the template's coordinates are the assembled linkage, not a guess.

@@ -27,7 +27,6 @@ from fabricate.bounds import MAX_FORCE_N, MAX_LENGTH_MM, MAX_SPRING_RATE, MAX_ST
 from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute, Slider
 from fabricate.planar import cross2
-from fabricate.spec import Table
 from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.underactuated_model import (
     FingerDesign,
@@ -42,6 +41,7 @@ from fabricate.synthesis.underactuated_model import (
     stroke_gradients,
     transmission_ratios,
 )
+from fabricate.table import Table
 
 
 @dataclass(frozen=True)

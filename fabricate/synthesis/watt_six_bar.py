@@ -35,7 +35,7 @@ from fabricate.bounds import (
 )
 from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute
-from fabricate.spec import DesignSpec, Table
+from fabricate.spec import DesignSpec
 from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.watt_six_bar_burmester import distance_to_curve
 from fabricate.synthesis.watt_six_bar_refine import RefinedCandidates, merge, refine_region
@@ -56,6 +56,7 @@ from fabricate.synthesis.watt_six_bar_statics import (
     joint_loads,
     lagrange_joint_forces,
 )
+from fabricate.table import Table
 
 BOX_NAMES = ("d0", "d", "e", "f")
 

@@ -1,0 +1,214 @@
+"""The strict template reader every spec parser uses: :class:`Table` and the number / array checks.
+
+Its own module so that the parsers of the generic tables (``fabricate.gears.spec``, ``fabricate.parts.spec``)
+and of each synthesis method read templates without importing :mod:`fabricate.spec`, which imports them
+(the loop spec -> gears.spec -> spec is gone). :mod:`fabricate.spec` re-exports these names.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from fabricate.errors import SpecError
+
+_MISSING = object()
+
+
+def _describe(value: Any) -> str:
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, Mapping):
+        return "a table"
+    if isinstance(value, (list, tuple)):
+        return f"a list of {len(value)}"
+    return repr(value)
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+class Table:
+    """Strict, path-aware reader over one TOML table.
+
+    Parameters
+    ----------
+    data : Mapping
+        The table.
+    path : str
+        Its dotted path in the template ('' for the root).
+
+    Notes
+    -----
+    Every getter records the key as used; :meth:`finish` raises on keys never read, so a typo in a
+    template is an error and not a silently ignored field.
+    """
+
+    def __init__(self, data: Mapping[str, Any], path: str = "") -> None:
+        if not isinstance(data, Mapping):
+            raise SpecError(path, f"expected a table, got {_describe(data)}")
+        self.data = data
+        self.path = path
+        self._used: set[str] = set()
+
+    # -- helpers -----------------------------------------------------------------------------
+    def field(self, key: str) -> str:
+        """Dotted path of ``key`` in this table."""
+        return f"{self.path}.{key}" if self.path else key
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def _get(self, key: str, default: Any) -> Any:
+        self._used.add(key)
+        if key in self.data:
+            return self.data[key]
+        if default is _MISSING:
+            raise SpecError(self.field(key), "missing required field")
+        return default
+
+    # -- getters -----------------------------------------------------------------------------
+    def number(
+        self,
+        key: str,
+        default: Any = _MISSING,
+        *,
+        min: float | None = None,
+        max: float | None = None,
+        positive: bool = False,
+        integer: bool = False,
+    ) -> float:
+        """A finite number, optionally bounded. ``positive`` means strictly greater than zero."""
+        value = self._get(key, default)
+        if value is default and default is not _MISSING:
+            return value
+        return check_number(value, self.field(key), min=min, max=max, positive=positive, integer=integer)
+
+    def integer(self, key: str, default: Any = _MISSING, *, min: int | None = None,
+                max: int | None = None) -> int:
+        """A whole number, optionally bounded."""
+        return int(self.number(key, default, min=min, max=max, integer=True))
+
+    def string(self, key: str, default: Any = _MISSING, *, choices: Sequence[str] | None = None) -> str:
+        """A string, optionally one of ``choices``."""
+        value = self._get(key, default)
+        if value is default and default is not _MISSING:
+            return value
+        if not isinstance(value, str):
+            raise SpecError(self.field(key), f"expected a string, got {_describe(value)}")
+        if choices is not None and value not in choices:
+            raise SpecError(self.field(key), f"expected one of {', '.join(map(repr, choices))}, got \"{value}\"")
+        return value
+
+    def boolean(self, key: str, default: Any = _MISSING) -> bool:
+        value = self._get(key, default)
+        if not isinstance(value, bool):
+            raise SpecError(self.field(key), f"expected true or false, got {_describe(value)}")
+        return value
+
+    def array(
+        self,
+        key: str,
+        default: Any = _MISSING,
+        *,
+        shape: tuple[int | None, ...] | None = None,
+        min_rows: int = 0,
+        min: float | None = None,
+        max: float | None = None,
+        positive: bool = False,
+    ) -> np.ndarray:
+        """A list (or nested list) of finite numbers as a float64 array.
+
+        ``shape`` may use ``None`` for a free dimension, e.g. ``(None, 3)``.
+        """
+        value = self._get(key, default)
+        if value is default and default is not _MISSING:
+            return value
+        return check_array(value, self.field(key), shape=shape, min_rows=min_rows, min=min, max=max,
+                           positive=positive)
+
+    def strings(self, key: str, default: Any = _MISSING) -> tuple[str, ...]:
+        value = self._get(key, default)
+        if value is default and default is not _MISSING:
+            return value
+        if not isinstance(value, list):
+            raise SpecError(self.field(key), f"expected a list of strings, got {_describe(value)}")
+        for i, item in enumerate(value):
+            if not isinstance(item, str):
+                raise SpecError(f"{self.field(key)}[{i}]", f"expected a string, got {_describe(item)}")
+        return tuple(value)
+
+    def table(self, key: str, default: Any = _MISSING) -> Table:
+        """A sub-table; with a default of ``{}`` a missing table reads as empty."""
+        value = self._get(key, default)
+        return Table(value, self.field(key))
+
+    def tables(self, key: str, default: Any = _MISSING) -> list[Table]:
+        """An array of tables (``[[key]]``)."""
+        value = self._get(key, default)
+        if not isinstance(value, list):
+            raise SpecError(self.field(key), f"expected an array of tables, got {_describe(value)}")
+        return [Table(item, f"{self.field(key)}[{i}]") for i, item in enumerate(value)]
+
+    def raw(self, key: str, default: Any = _MISSING) -> Any:
+        return self._get(key, default)
+
+    def finish(self) -> None:
+        """Raise on the first key that no getter read (a typo or a field this kind does not know)."""
+        for key in self.data:
+            if key not in self._used:
+                raise SpecError(self.field(key), "unknown field")
+
+
+def check_number(value: Any, path: str, *, min: float | None = None, max: float | None = None,
+                 positive: bool = False, integer: bool = False) -> float:
+    """Validate one number; see :meth:`Table.number`."""
+    if not _is_number(value):
+        raise SpecError(path, f"expected a number, got {_describe(value)}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise SpecError(path, f"expected a finite number, got {value}")
+    if integer and value != round(value):
+        raise SpecError(path, f"expected a whole number, got {value:g}")
+    if positive and value <= 0:
+        raise SpecError(path, f"expected a positive number, got {value:g}")
+    if min is not None and value < min:
+        raise SpecError(path, f"expected a number >= {min:g}, got {value:g}")
+    if max is not None and value > max:
+        raise SpecError(path, f"expected a number <= {max:g}, got {value:g}")
+    return value
+
+
+def check_array(value: Any, path: str, *, shape: tuple[int | None, ...] | None = None, min_rows: int = 0,
+                min: float | None = None, max: float | None = None, positive: bool = False) -> np.ndarray:
+    """Validate a (nested) list of numbers element by element so the error names the bad index."""
+
+    def walk(item: Any, where: str, depth: int) -> Any:
+        if isinstance(item, list):
+            if shape is not None and depth < len(shape) and shape[depth] is not None \
+                    and len(item) != shape[depth]:
+                raise SpecError(where, f"expected {shape[depth]} values, got {len(item)}")
+            return [walk(x, f"{where}[{i}]", depth + 1) for i, x in enumerate(item)]
+        if shape is not None and depth < len(shape):
+            raise SpecError(where, f"expected a list, got {_describe(item)}")
+        return check_number(item, where, min=min, max=max, positive=positive)
+
+    if not isinstance(value, list):
+        raise SpecError(path, f"expected a list, got {_describe(value)}")
+    nested = walk(value, path, 0)
+    if len(nested) < min_rows:
+        raise SpecError(path, f"expected at least {min_rows} entries, got {len(nested)}")
+    try:
+        arr = np.asarray(nested, dtype=np.float64)
+    except ValueError as exc:  # ragged lists
+        raise SpecError(path, "expected rows of equal length") from exc
+    if shape is not None and arr.ndim != len(shape):
+        raise SpecError(path, f"expected a {len(shape)}-dimensional list, got {arr.ndim} dimensions")
+    return arr
+
+
+# -- templates -------------------------------------------------------------------------------
