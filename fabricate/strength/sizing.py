@@ -23,6 +23,8 @@ from fabricate.strength.check import run_strength
 
 #: Width resolution of the search (mm).
 RESOLUTION_MM = 0.1
+#: Most poses one trial checks (the final check runs over the whole motion).
+MAX_SEARCH_POSES = 120
 
 
 def _with_width(design: Any, width: float | None) -> Any:
@@ -59,7 +61,8 @@ def size_link_width(design: Any, mechanism: Mechanism, motion: Motion, gear_pair
     from fabricate.parts.build import derive_sizes
 
     required = float(design.checks.min_safety_factor)
-    coarse = _coarse(motion, stride)
+    # at most ~MAX_SEARCH_POSES poses per trial, so a 5000-pose sweep stays within the minute a build has
+    coarse = _coarse(motion, max(stride, math.ceil(len(motion.inputs) / MAX_SEARCH_POSES)))
     tried: list[tuple[float, float]] = []
 
     def least(width: float) -> float:
