@@ -508,8 +508,8 @@ def test_undercut_limit_is_the_classical_one():
 
 
 def test_feasibility_limits_at_their_boundaries():
-    """Module limit 2 rho / min_teeth (rho = 8 mm, 8 teeth: 2 mm) and concave radius limit 2 h_f m (1 mm module:
-    2.5 mm): just inside passes, just outside raises naming the field and the largest module."""
+    """Module limit 2 rho / min_teeth (rho = 8 mm, 8 teeth: 2 mm) and concave radius limit 2 h_f m (2 mm module:
+    5 mm): just inside passes, just outside raises naming the field and the largest module."""
     from fabricate.errors import SpecError
     from fabricate.gears.checks import check_feasible
     from fabricate.gears.spec import GearSpec
@@ -526,9 +526,9 @@ def test_feasibility_limits_at_their_boundaries():
         check_feasible(curv(30.0, 8.0), 2.001, spec, "gear_pair.module_mm")
     assert info.value.path == "gear_pair.module_mm"
     assert "holds 7.996 teeth" not in str(info.value) and "holds 8.0 teeth (min_teeth = 8)" in str(info.value)
-    check_feasible(curv(30.0, 30.0, 2.5, 9.0), 1.0, spec)  # concave radius exactly 2 h_f m
-    with pytest.raises(SpecError, match=r"concave with radius 2.49 mm; needs module <= 0.996 mm") as info:
-        check_feasible(curv(30.0, 30.0, 9.0, 2.49), 1.0, spec)
+    check_feasible(curv(30.0, 30.0, 5.0, 9.0), 2.0, spec)  # concave radius exactly 2 h_f m (module 2)
+    with pytest.raises(SpecError, match=r"concave with radius 4.9 mm; needs module <= 1.96 mm") as info:
+        check_feasible(curv(30.0, 30.0, 9.0, 4.9), 2.0, spec)
     assert info.value.path == "gears.module_mm"
 
 
