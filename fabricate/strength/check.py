@@ -32,11 +32,13 @@ from fabricate.errors import GeometryError
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
 from fabricate.planar import rotation
 from fabricate.strength import models
-from fabricate.strength.section import cut_section
+from fabricate.strength.section import cut_section, plate_polygon
 from fabricate.strength.statics import BodyTorque, DriverEffort, PointForce, Statics, solve_statics
 
-#: Directions at which each hole's edge distance is measured (interpolated between them).
+#: Directions at which each hole's edge distance is measured (the worse neighbour between them).
 _EDGE_DIRECTIONS = 72
+#: Load directions at which the net section across a pin-loaded hole is cut (every 10 degrees).
+_NET_DIRECTIONS = 36
 
 
 @dataclass
@@ -246,34 +248,39 @@ def _edge_distances(rings: list[np.ndarray], centre: np.ndarray, radius: float) 
     return out
 
 
-def _net_section_factors(rings: list[np.ndarray], hole: Any, thickness: float
-                         ) -> tuple[np.ndarray | None, np.ndarray]:
-    """Kt / net area (1/mm²) and Kt of the cut through a pin-loaded hole square to each test direction.
+def _net_section_factors(plate: Any, hole: Any, thickness: float,
+                         directions: int = _NET_DIRECTIONS) -> tuple[np.ndarray | None, np.ndarray]:
+    """Kt / net area (1/mm²) and Kt of the cut through a pin-loaded hole square to each of ``directions``
+    load directions (a load and its opposite share the cut line: half of them are cut).
 
     Between two measured directions the larger factor is used (:func:`_edge_along` with ``np.maximum``).
     """
-    factor = np.zeros(_EDGE_DIRECTIONS)
-    kts = np.ones(_EDGE_DIRECTIONS)
-    for k in range(_EDGE_DIRECTIONS):
-        a = 2.0 * math.pi * k / _EDGE_DIRECTIONS
+    half = directions // 2
+    factor = np.zeros(directions)
+    kts = np.ones(directions)
+    for k in range(half):
+        a = 2.0 * math.pi * k / directions
         try:
-            sec = cut_section(rings, hole.centre, np.array([-math.sin(a), math.cos(a)]), thickness)
+            sec = cut_section(plate, hole.centre, np.array([-math.sin(a), math.cos(a)]), thickness)
         except GeometryError:
             continue
-        kts[k] = models.hole_stress_concentration(hole.diameter_mm, sec.width_mm + hole.diameter_mm, True)
-        factor[k] = kts[k] / sec.area_mm2
+        kts[k] = kts[k + half] = models.hole_stress_concentration(hole.diameter_mm, sec.width_mm + hole.diameter_mm,
+                                                                  True)
+        factor[k] = factor[k + half] = kts[k] / sec.area_mm2
     if not np.any(factor > 0):
         return None, kts
     return factor, kts
 
 
 def _edge_along(values: np.ndarray, directions: np.ndarray, pick: Any = np.minimum) -> np.ndarray:
-    """A per-direction table (``_EDGE_DIRECTIONS`` entries) read at each direction (n, 2): of the two
-    measured neighbours, ``pick`` (the least edge distance, the largest stress factor), never optimistic."""
+    """A per-direction table (``len(values)`` directions evenly round the circle from +x) read at each
+    direction (n, 2): of the two measured neighbours, ``pick`` (the least edge distance, the largest stress
+    factor), never optimistic."""
+    count = len(values)
     ang = np.mod(np.arctan2(directions[:, 1], directions[:, 0]), 2.0 * math.pi)
-    pos = ang / (2.0 * math.pi) * _EDGE_DIRECTIONS
-    k0 = np.floor(pos).astype(int) % _EDGE_DIRECTIONS
-    k1 = (k0 + 1) % _EDGE_DIRECTIONS
+    pos = ang / (2.0 * math.pi) * count
+    k0 = np.floor(pos).astype(int) % count
+    k1 = (k0 + 1) % count
     return pick(values[k0], values[k1])
 
 
@@ -431,6 +438,7 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
     for part in parts:
         share = sum(1 for p in parts if p.body == part.body) or 1
         rings = part.polygons(chord)
+        plate = plate_polygon(rings)  # made and validated once: every cut below reads it
         pose = motion.pose(part.body)
         t = part.thickness_mm
         loads_local = []  # (local point, local force (n, 2), at joint)
@@ -469,7 +477,7 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
                                            "more material round the hole (parts.boss_wall_mm / link_width_mm)",
                                            tear))
             # the net section across a pin-loaded hole, square to the load: Kt / area per load direction
-            factor, kts = _net_section_factors(rings, h, t)
+            factor, kts = _net_section_factors(plate, h, t)
             if factor is None:
                 continue
             per_pose = np.where(known, _edge_along(factor, unit, np.maximum), factor.max())
@@ -491,7 +499,7 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
                 for station in (0.0, 0.25, 0.5, 0.75, 1.0):
                     point = ha.centre + station * axis
                     try:
-                        sec = cut_section(rings, point, np.array([-u[1], u[0]]), t)
+                        sec = cut_section(plate, point, np.array([-u[1], u[0]]), t)
                     except GeometryError:
                         continue
                     finding = _section_finding(part, sec, point, u, station, ha, hb, loads_local, couples,
@@ -536,7 +544,7 @@ def _section_finding(part, sec, point, u, station, ha, hb, loads_local, couples,
     at_hole = station in (0.0, 1.0)
     hole = ha if station == 0.0 else hb
     kt = models.hole_stress_concentration(hole.diameter_mm, sec.width_mm + hole.diameter_mm, False) if at_hole else 1.0
-    stress = np.array([models.net_section_stress(axial[k], moment[k], sec, kt) for k in range(n)])
+    stress = np.asarray(models.net_section_stress(axial, moment, sec, kt), dtype=np.float64)
     k = int(np.argmax(stress))
     where = f"at hole {hole.joint}" if at_hole else f"between {ha.joint} and {hb.joint} ({station:.2f})"
     allowable = material.flexural_MPa if abs(moment[k]) * sec.extreme_fibre_mm / sec.inertia_mm4 > abs(

@@ -351,7 +351,7 @@ def hole_stress_concentration(hole_diameter_mm: float, width_mm: float, pin_load
     return kt * (PIN_CLEARANCE_FACTOR if pin_clearance else 1.0)
 
 
-def net_section_stress(axial_N: float, moment_Nmm: float, section: Section, kt: float = 1.0) -> float:
+def net_section_stress(axial_N: ArrayLike, moment_Nmm: ArrayLike, section: Section, kt: float = 1.0) -> ArrayLike:
     """Peak normal stress on a cut section: ``sigma = Kt (|N| / A + |M| c / I)``.
 
     Axial force and in-plane bending moment (the moment vector normal to the plate) of everything on
@@ -366,9 +366,9 @@ def net_section_stress(axial_N: float, moment_Nmm: float, section: Section, kt: 
 
     Parameters
     ----------
-    axial_N : float
-        Axial force normal to the section (N).
-    moment_Nmm : float
+    axial_N : float or (n,) array
+        Axial force normal to the section (N), e.g. at every pose.
+    moment_Nmm : float or (n,) array
         In-plane bending moment about the section centroid (N·mm).
     section : Section
         The cut section (:func:`fabricate.strength.section.cut_section`).
@@ -377,16 +377,16 @@ def net_section_stress(axial_N: float, moment_Nmm: float, section: Section, kt: 
 
     Returns
     -------
-    float
+    float or (n,) array
         Peak normal stress (MPa).
     """
     if not (math.isfinite(kt) and kt >= 1.0):
         raise ValueError(f"stress concentration factor must be >= 1, got {kt}")
-    n = float(_magnitude("axial_N", axial_N))
-    m = float(_magnitude("moment_Nmm", moment_Nmm))
+    n = _magnitude("axial_N", axial_N)
+    m = _magnitude("moment_Nmm", moment_Nmm)
     if section.area_mm2 <= 0.0 or section.inertia_mm4 <= 0.0:
         raise GeometryError("section has no material")
-    return kt * (n / section.area_mm2 + m * section.extreme_fibre_mm / section.inertia_mm4)
+    return _out(kt * (n / section.area_mm2 + m * section.extreme_fibre_mm / section.inertia_mm4))
 
 
 # -- gear teeth ---------------------------------------------------------------------------------------

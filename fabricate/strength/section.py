@@ -79,13 +79,37 @@ def _line_pieces(geometry: shapely.Geometry) -> list[np.ndarray]:
     return []  # a Point: the line only touches a vertex, no material width
 
 
-def cut_section(rings: list[np.ndarray], point: np.ndarray, direction: np.ndarray,
+def plate_polygon(rings: list[np.ndarray]) -> shapely.Polygon:
+    """The valid shapely polygon of a plate's rings (outline, then holes): made once per part and handed to
+    :func:`cut_section` for its many cuts.
+
+    Raises
+    ------
+    GeometryError
+        The rings do not form a valid polygon.
+    ValueError
+        No outline ring.
+    """
+    if not len(rings):
+        raise ValueError("cut_section needs at least the outline ring")
+    try:
+        polygon = shapely.Polygon(np.asarray(rings[0], dtype=np.float64),
+                                  [np.asarray(r, dtype=np.float64) for r in rings[1:]])
+    except (ValueError, shapely.errors.ShapelyError) as exc:
+        raise GeometryError(f"cut_section: rings do not form a polygon: {exc}") from exc
+    if polygon.is_empty or not polygon.is_valid:
+        raise GeometryError(f"cut_section: invalid plate polygon ({shapely.is_valid_reason(polygon)})")
+    shapely.prepare(polygon)
+    return polygon
+
+
+def cut_section(rings: list[np.ndarray] | shapely.Polygon, point: np.ndarray, direction: np.ndarray,
                 thickness_mm: float) -> Section:
     """The section of a plate on the infinite line through ``point`` along ``direction``.
 
     Parameters
     ----------
-    rings : list of (n, 2) float64 arrays
+    rings : list of (n, 2) float64 arrays, or a polygon from :func:`plate_polygon`
         The plate outline (counter-clockwise) then its holes (clockwise), mm: what
         :meth:`fabricate.parts.model.Part.polygons` returns. Orientation is not relied on.
     point : (2,) array
@@ -111,19 +135,11 @@ def cut_section(rings: list[np.ndarray], point: np.ndarray, direction: np.ndarra
     """
     if not (math.isfinite(thickness_mm) and thickness_mm > 0.0):
         raise ValueError(f"plate thickness must be positive, got {thickness_mm}")
-    if not rings:
-        raise ValueError("cut_section needs at least the outline ring")
     u = _unit_direction(direction)
     p0 = np.asarray(point, dtype=np.float64).reshape(2)
     if not np.all(np.isfinite(p0)):
         raise ValueError(f"cut point must be finite, got {p0.tolist()}")
-    try:
-        polygon = shapely.Polygon(np.asarray(rings[0], dtype=np.float64),
-                                  [np.asarray(r, dtype=np.float64) for r in rings[1:]])
-    except (ValueError, shapely.errors.ShapelyError) as exc:
-        raise GeometryError(f"cut_section: rings do not form a polygon: {exc}") from exc
-    if polygon.is_empty or not polygon.is_valid:
-        raise GeometryError(f"cut_section: invalid plate polygon ({shapely.is_valid_reason(polygon)})")
+    polygon = rings if isinstance(rings, shapely.Polygon) else plate_polygon(rings)
 
     # A segment long enough to cross the whole part from wherever the reference point lies.
     xmin, ymin, xmax, ymax = polygon.bounds
