@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from fabricate.errors import SpecError
 from fabricate.spec import DesignSpec
 
 
@@ -98,9 +99,10 @@ def load(template: str | Path | Mapping[str, Any], process: str | None = None) -
 def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | None = None,
                    pads: Mapping[str, Mapping[str, Any]] | None = None,
                    tables: Mapping[str, Any] | None = None) -> DesignSpec:
-    """A design from a :class:`~fabricate.mechanism.Mechanism` built in code: it is written as a
-    ``kind = "linkage"`` template (see :mod:`fabricate.synthesis.linkage_write`) and validated like one, so
-    the build's report embeds a template ``fabricate check`` can rebuild.
+    """A design from a :class:`~fabricate.mechanism.Mechanism` built in code: it is written as the exact
+    form of a ``kind = "linkage"`` template (bodies in their own frames, every law by its coefficients;
+    see :mod:`fabricate.synthesis.mechanism_toml`) and validated like one, so the build is of this very
+    mechanism and its report embeds a template ``fabricate check`` can rebuild.
 
     Parameters
     ----------
@@ -112,13 +114,23 @@ def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | Non
     tables : Mapping, optional
         More template tables: ``{"load": {...}, "parts": {...}, "checks": {...}}``.
     """
-    from fabricate.synthesis.linkage_write import linkage_tables
+    from fabricate.synthesis.mechanism_toml import exact_linkage
 
     template: dict[str, Any] = {"design": {"name": mechanism.name, "kind": "linkage"},
                                 "process": {"profile": process}}
     for key, value in (tables or {}).items():
         template[key] = dict(value) if key != "process" else {**template["process"], **value}
-    template["linkage"] = linkage_tables(mechanism, tip_point=tip_point, pads=pads)
+    hints: dict[str, Any] = {}
+    if tip_point:
+        hints["tip_point"] = tip_point
+    if pads:
+        hints["pads"] = {body: dict(pad) for body, pad in pads.items()}
+    linkage, exact = exact_linkage(mechanism, hints)
+    if not exact:
+        raise SpecError("mechanism", "a law of this mechanism is neither linear nor a piecewise polynomial "
+                                     "(scipy PPoly: CubicSpline, PchipInterpolator, ...): it cannot be written "
+                                     "exactly")
+    template["linkage"] = linkage
     return load(template)
 
 
