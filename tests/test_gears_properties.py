@@ -388,6 +388,13 @@ def test_constant_ratio_pitch_curves_are_the_two_circles():
     # closed gears repeat after their own perimeter: one turn later on a, 40 pi mm later on b
     np.testing.assert_allclose(pitch.frames(10.0 * (x - 0.3) + 20 * np.pi, "a").point, fa.point, atol=1e-8)
     np.testing.assert_allclose(pitch.frames(10.0 * (x - 0.3) + 40 * np.pi, "b").point, fb.point, atol=1e-8)
+    # a pair whose gear b is the smaller (ratio 2, r_a = 20, r_b = 10 mm): gear a's arc length wraps at its own
+    # perimeter 40 pi, not at gear b's 20 pi
+    small_b = PitchCurves(FormulaLaw("2*x"), 30.0, (0.0, 2 * np.pi), periods=(2 * np.pi, np.pi), intervals=64)
+    assert (small_b.perimeter_a, small_b.perimeter_b) == pytest.approx((40 * np.pi, 20 * np.pi), rel=1e-12)
+    s_far = np.array([20 * np.pi + 5.0, 30 * np.pi])
+    np.testing.assert_allclose(small_b.frames(s_far, "a").point,
+                               20.0 * np.column_stack([np.cos(s_far / 20), -np.sin(s_far / 20)]), atol=1e-8)
     # by default arc length counts from x = 0
     default = PitchCurves(law, 30.0, (0.0, 2 * np.pi), intervals=64)
     np.testing.assert_allclose(default.s_of_x(np.array([0.0, 1.0])), [0.0, 10.0], atol=1e-9)
