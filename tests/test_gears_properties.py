@@ -880,3 +880,22 @@ def mesh_free(pair, x):
 
     plus, minus = free_play(pair, x)
     return plus + minus
+
+
+@pytest.mark.parametrize("k", [1e-9, -1e-9])
+def test_osculating_frames_of_a_nearly_straight_pitch_curve(k):
+    """Curvature 1e-9 /mm over +-500 mm (k sigma <= 1e-6: the series branch): the point is
+    P + sin(k s) / k t - 2 sin^2(k s / 2) / k n (the circle, written without cancellation), the bend
+    k s^2 / 2 ~ 1e-4 mm must come out right to 1e-12 mm."""
+    from fabricate.gears.pitch import PitchFrames
+    from fabricate.gears.rack import osculating_frames
+
+    sigma = np.array([-500.0, -120.0, 0.0, 3.0, 250.0, 500.0])
+    n = len(sigma)
+    t0, n0, p0 = np.array([0.6, -0.8]), np.array([0.8, 0.6]), np.array([3.0, 4.0])
+    centre = PitchFrames(np.tile(p0, (n, 1)), np.tile(t0, (n, 1)), np.tile(n0, (n, 1)), np.full(n, k))
+    got = osculating_frames(sigma, np.zeros(n), centre)
+    along = np.sin(k * sigma) / k
+    bend = 2 * np.sin(k * sigma / 2) ** 2 / k
+    np.testing.assert_allclose(got.point, p0 + along[:, None] * t0 - bend[:, None] * n0, atol=1e-12, rtol=0)
+    assert np.max(np.abs(bend)) > 1e-4  # the bend is there to be measured
