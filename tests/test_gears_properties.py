@@ -899,3 +899,15 @@ def test_osculating_frames_of_a_nearly_straight_pitch_curve(k):
     bend = 2 * np.sin(k * sigma / 2) ** 2 / k
     np.testing.assert_allclose(got.point, p0 + along[:, None] * t0 - bend[:, None] * n0, atol=1e-12, rtol=0)
     assert np.max(np.abs(bend)) > 1e-4  # the bend is there to be measured
+
+
+def test_basic_rack_default_sampling():
+    """Defaults as documented: addendum 1 m (flank sampled to 1.02 m), and per side 5 root-flat, 25 round and 241
+    flank samples (the flank density keeps the envelope's chord error far below 1 um)."""
+    from fabricate.gears.rack import FLANK, FLAT_ROOT_A, ROUND_ROOT_A, basic_rack
+
+    rack = basic_rack(1.5, np.radians(20.0), 1.25, 0.38)
+    left = rack.points[:, 0] < 0
+    counts = [int(np.count_nonzero((rack.element == e) & left)) for e in (FLAT_ROOT_A, ROUND_ROOT_A, FLANK)]
+    assert counts == [5, 25, 241]
+    assert rack.points[:, 1].max() == pytest.approx(1.02 * 1.5)
