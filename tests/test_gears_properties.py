@@ -911,3 +911,19 @@ def test_basic_rack_default_sampling():
     counts = [int(np.count_nonzero((rack.element == e) & left)) for e in (FLAT_ROOT_A, ROUND_ROOT_A, FLANK)]
     assert counts == [5, 25, 241]
     assert rack.points[:, 1].max() == pytest.approx(1.02 * 1.5)
+
+
+def test_basic_rack_rejects_a_fillet_that_does_not_fit_either_way():
+    """The root round must be smaller than the dedendum and its centre inside the tooth space: module 2, 20 deg,
+    a 1.2 m round in a 1.25 m root has its centre beyond the half period (-p/2); a 0.5 m round in a 0.5 m root
+    fits the space but is as deep as the root; 0.49 m in 0.5 m fits."""
+    from fabricate.gears.rack import basic_rack
+
+    alpha = np.radians(20.0)
+    centre_u = -np.pi * 2 / 4 + ((2.4 - 2.5) * np.sin(alpha) - 2.4) / np.cos(alpha)
+    assert centre_u < -np.pi * 2 / 2
+    with pytest.raises(ValueError, match="root fillet too large"):
+        basic_rack(2.0, alpha, 1.25, 1.2)
+    with pytest.raises(ValueError, match="root fillet too large"):
+        basic_rack(2.0, alpha, 0.5, 0.5)
+    basic_rack(2.0, alpha, 0.5, 0.49, flank_points=5, round_points=5, flat_points=3)
