@@ -101,7 +101,7 @@ def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | Non
                    tables: Mapping[str, Any] | None = None) -> DesignSpec:
     """A design from a :class:`~fabricate.mechanism.Mechanism` built in code: it is written as the exact
     form of a ``kind = "linkage"`` template (bodies in their own frames, every law by its coefficients;
-    see :mod:`fabricate.synthesis.mechanism_toml`) and validated like one, so the build is of this very
+    see :mod:`fabricate.synthesis.linkage.exact`) and validated like one, so the build is of this very
     mechanism and its report embeds a template ``fabricate check`` can rebuild.
 
     Parameters
@@ -114,7 +114,7 @@ def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | Non
     tables : Mapping, optional
         More template tables: ``{"load": {...}, "parts": {...}, "checks": {...}}``.
     """
-    from fabricate.synthesis.mechanism_toml import exact_linkage
+    from fabricate.synthesis.linkage.exact import exact_linkage
 
     template: dict[str, Any] = {"design": {"name": mechanism.name, "kind": "linkage"},
                                 "process": {"profile": process}}

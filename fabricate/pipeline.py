@@ -168,7 +168,7 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
     from fabricate.parts.build import build_parts
     from fabricate.strength.check import run_strength
     from fabricate.strength.plots import strength_plot
-    from fabricate.synthesis.mechanism_toml import mechanism_toml
+    from fabricate.synthesis.linkage.exact import mechanism_toml
 
     def enter(name: str) -> None:
         stage[0] = name

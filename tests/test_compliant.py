@@ -14,7 +14,15 @@ from fabricate.errors import SpecError
 from fabricate.planar import cross2
 from fabricate.spec import Table
 from fabricate.synthesis import compliant as cg
-from fabricate.synthesis.compliant_model import (
+from fabricate.synthesis.compliant.grid_search import (
+    ParameterGrid,
+    brute_force,
+    build_tables,
+    evaluate_points,
+    interval_bounds,
+    optimise,
+)
+from fabricate.synthesis.compliant.model import (
     GripperGeometry,
     Load,
     Springs,
@@ -23,14 +31,6 @@ from fabricate.synthesis.compliant_model import (
     solve_grasp,
     spring_torques,
     static_forces,
-)
-from fabricate.synthesis.compliant_optimise import (
-    ParameterGrid,
-    brute_force,
-    build_tables,
-    evaluate_points,
-    interval_bounds,
-    optimise,
 )
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -160,7 +160,7 @@ def test_interval_bounds_hold_for_every_point_of_a_path():
 
 def test_search_in_blocks_gives_the_same_optimum(monkeypatch):
     """Long paths or fine grids are searched in blocks of k1 and of points (bounded memory): same answer."""
-    import fabricate.synthesis.compliant_optimise as co
+    import fabricate.synthesis.compliant.grid_search as co
 
     grid = ParameterGrid(np.radians([80.0, 85.0]), np.arange(0, 3.0), np.arange(0, 31.0, 3),
                          np.arange(0, 31.0, 3), np.radians(np.arange(0, 181, 6.0)), np.radians(np.arange(0, 181, 4.0)))

@@ -21,7 +21,7 @@ from fabricate.errors import LockupError, SpecError, SynthesisError
 from fabricate.planar import transform_points
 from fabricate.spec import TEMPLATE_DIR, Table, read_toml
 from fabricate.synthesis import five_bar as fb
-from fabricate.synthesis import kinematic_mapping as km
+from fabricate.synthesis.five_bar import kinematic_mapping as km
 
 PAPER = json.loads((Path(__file__).parent / "data" / "five_bar_paper.json").read_text())
 TEMPLATE = TEMPLATE_DIR / "finger_five_bar_ncg.toml"

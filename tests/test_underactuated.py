@@ -16,7 +16,7 @@ from fabricate.errors import SpecError
 from fabricate.planar import circle_circle_intersection, unit
 from fabricate.spec import Table
 from fabricate.synthesis import underactuated as ua
-from fabricate.synthesis.underactuated_model import (
+from fabricate.synthesis.underactuated.model import (
     contact_forces,
     crank_rate,
     distal_rate,

@@ -18,20 +18,20 @@ from hypothesis import strategies as st
 from fabricate.errors import SpecError
 from fabricate.spec import TEMPLATE_DIR, Table, read_toml
 from fabricate.synthesis import watt_six_bar as wsb
-from fabricate.synthesis.watt_six_bar_burmester import (
+from fabricate.synthesis.watt_six_bar.burmester import (
     cubic_real_roots,
     distance_to_curve,
     dyad_curve,
     grid_in_range,
     sample_curve,
 )
-from fabricate.synthesis.watt_six_bar_region import (
+from fabricate.synthesis.watt_six_bar.region import (
     RegionInputs,
     finger_positions,
     solution_region,
     stage_two_curves,
 )
-from fabricate.synthesis.watt_six_bar_statics import (
+from fabricate.synthesis.watt_six_bar.statics import (
     JOINTS,
     SixBarBatch,
     assemble,
@@ -152,7 +152,7 @@ def test_paper_mechanism_1_fits_the_printed_positions():
     assert np.allclose(finger.c[0], m1["c"]) and np.allclose(finger.b[0], m1["b"])
     # dyad lengths over the four positions: the curve equations hold to 0.33 mm of length
     dd, ee = finger.proximal.apply(m1["d"]), finger.distal.apply(m1["e"])
-    from fabricate.synthesis.watt_six_bar_region import coupler_motion
+    from fabricate.synthesis.watt_six_bar.region import coupler_motion
 
     ff = coupler_motion(finger, m1["d"], m1["e"]).apply(m1["f"])
     spread_de = np.ptp(np.hypot(*(dd - ee).T))
@@ -203,7 +203,7 @@ def test_region_of_the_printed_tables(paper_region):
     # every point is an exact solution: dyads keep their length at the four positions
     finger = finger_positions(np.asarray(DATA["phalanx_lengths_mm"]), np.radians(DATA["theta_deg"]))
     idx = np.linspace(0, len(region) - 1, 200).astype(int)
-    from fabricate.synthesis.watt_six_bar_region import coupler_motion
+    from fabricate.synthesis.watt_six_bar.region import coupler_motion
 
     ff = coupler_motion(finger, region.d[idx], region.e[idx]).apply(region.f[idx])
     length = np.hypot(*(ff - region.d0[idx, None]).transpose(2, 0, 1))

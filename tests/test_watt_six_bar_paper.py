@@ -32,8 +32,8 @@ import pytest
 
 from fabricate.spec import TEMPLATE_DIR, Table, read_toml
 from fabricate.synthesis import watt_six_bar as wsb
-from fabricate.synthesis.watt_six_bar_burmester import distance_to_curve, dyad_curve, sample_curve
-from fabricate.synthesis.watt_six_bar_region import (
+from fabricate.synthesis.watt_six_bar.burmester import distance_to_curve, dyad_curve, sample_curve
+from fabricate.synthesis.watt_six_bar.region import (
     RegionInputs,
     coupler_motion,
     finger_positions,

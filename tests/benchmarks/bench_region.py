@@ -17,7 +17,7 @@ import numpy as np  # noqa: E402
 
 from fabricate.spec import TEMPLATE_DIR, Table, read_toml  # noqa: E402
 from fabricate.synthesis import watt_six_bar as wsb  # noqa: E402
-from fabricate.synthesis.watt_six_bar_region import finger_positions, solution_region, stage_one  # noqa: E402
+from fabricate.synthesis.watt_six_bar.region import finger_positions, solution_region, stage_one  # noqa: E402
 
 
 def _spec() -> wsb.WattSixBarSpec:

@@ -18,14 +18,14 @@ from pathlib import Path
 
 import numpy as np
 
-from fabricate.synthesis.compliant_model import GripperGeometry, Load, Springs, contact_path, solve_grasp
-from fabricate.synthesis.compliant_optimise import (
+from fabricate.synthesis.compliant.grid_search import (
     ParameterGrid,
     build_tables,
     evaluate_points,
     interval_bounds,
     optimise,
 )
+from fabricate.synthesis.compliant.model import GripperGeometry, Load, Springs, contact_path, solve_grasp
 
 
 def _brute_paths(geom, grid, load, samples, margin, count) -> list[tuple[float, float, float]]:

@@ -69,7 +69,7 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "parts/build": ("fabricate/parts/build.py", PARTS_TESTS),
     "export/dxf": ("fabricate/export/dxf.py", EXPORT_TESTS),
     "export/stl": ("fabricate/export/stl.py", EXPORT_TESTS),
-    "synthesis/kinematic_mapping": ("fabricate/synthesis/kinematic_mapping.py", ["tests/test_five_bar.py"]),
+    "synthesis/kinematic_mapping": ("fabricate/synthesis/five_bar/kinematic_mapping.py", ["tests/test_five_bar.py"]),
 }
 
 #: The six hand-made mutants of issue 15 and the tests that must kill them (``--examples`` checks it).

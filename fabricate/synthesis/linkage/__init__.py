@@ -46,7 +46,7 @@ Template tables
 ``exact = true`` (in ``[linkage]``)
     The exact form every build writes as ``mechanism.toml``: bodies with points in their own frames, the
     first pose's ``assembly``, joints and drivers as the mechanism has them, laws by their coefficients,
-    and the parts ``hints``; see :mod:`fabricate.synthesis.mechanism_toml`.
+    and the parts ``hints``; see :mod:`fabricate.synthesis.linkage.exact`.
 
 Reference pose and start
 ------------------------
@@ -86,7 +86,7 @@ from fabricate.errors import LockupError, SpecError
 from fabricate.gears.law import FormulaLaw
 from fabricate.mechanism import Mechanism
 from fabricate.synthesis.base import SynthesisResult
-from fabricate.synthesis.linkage_mechanism import build_mechanism, gear_law, sampled_law
+from fabricate.synthesis.linkage.mechanism import build_mechanism, gear_law, sampled_law
 from fabricate.table import Table, check_array
 
 #: Largest distance (mm) between the two points of a revolute (or off a slider's line) at the reference
@@ -369,7 +369,7 @@ def _parse_pad(t: Table, bodies: dict[str, BodySpec]) -> PadSpec:
 @dataclass(frozen=True)
 class ExactLinkageSpec:
     """The exact form (``[linkage] exact = true``, what every build writes as ``mechanism.toml``): the
-    mechanism as it was, and the parts hints it came with (see :mod:`fabricate.synthesis.mechanism_toml`)."""
+    mechanism as it was, and the parts hints it came with (see :mod:`fabricate.synthesis.linkage.exact`)."""
 
     mechanism: Any
     hints: dict
@@ -380,7 +380,7 @@ def parse_spec(root: Table) -> LinkageSpec | ExactLinkageSpec:
     """Read ``[linkage]`` from the template root (see the module docstring)."""
     t = root.table("linkage")
     if t.has("exact") and t.boolean("exact"):
-        from fabricate.synthesis.mechanism_toml import parse_exact
+        from fabricate.synthesis.linkage.exact import parse_exact
 
         name = str(root.data.get("design", {}).get("name", "linkage"))
         mech, hints, tip = parse_exact(t, name)

@@ -23,7 +23,7 @@ def compliant_figures(spec, path, grasp, motion, optimum) -> dict[str, bytes]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from fabricate.synthesis.compliant_model import finger_state, grasp_force_curve
+    from fabricate.synthesis.compliant.model import finger_state, grasp_force_curve
 
     out: dict[str, bytes] = {}
     strokes, f_static, f_hover = grasp_force_curve(path, spec.springs, spec.load.mu)

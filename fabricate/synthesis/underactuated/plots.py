@@ -15,7 +15,7 @@ def closing_figures(spec, motion, free, final) -> dict[str, bytes]:
     """``{file name: PNG bytes}``: closing.png (poses on the object), joint_angles.png."""
     plt = pyplot()
 
-    from fabricate.synthesis.underactuated_model import finger_pose
+    from fabricate.synthesis.underactuated.model import finger_pose
 
     d = spec.design
     out: dict[str, bytes] = {}

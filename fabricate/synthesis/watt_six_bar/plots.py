@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from fabricate.plotting import png_bytes, pyplot
-from fabricate.synthesis.watt_six_bar_burmester import CubicCurve, grid_in_range, sample_curve
+from fabricate.synthesis.watt_six_bar.burmester import CubicCurve, grid_in_range, sample_curve
 
 _BRANCH_COLOURS = ("tab:blue", "tab:orange", "tab:green")
 
@@ -76,7 +76,7 @@ def plot_curve_d(spec, region, choice) -> bytes:
 
 def plot_curve_d0(spec, finger, choice) -> bytes:
     """C_d0 and C_f for the chosen dyad d-e, with the boxes and the chosen d0, f."""
-    from fabricate.synthesis.watt_six_bar_region import stage_two_curves
+    from fabricate.synthesis.watt_six_bar.region import stage_two_curves
 
     plt = pyplot()
     curve_d0, curve_f = stage_two_curves(finger, choice.d, choice.e)

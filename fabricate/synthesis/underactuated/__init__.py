@@ -8,7 +8,7 @@ theta_dot_{n+1} = E_n theta_dot_n and the statics, but gives no dimensions. This
   stroke, joints on their open stops until the springs let them go) and the closing on a cylinder
   (the same, with the phalanges kept outside it), which yields the contact sequence,
 - computes the contact forces at the end for the template's push force (the force chain of
-  :func:`fabricate.synthesis.underactuated_model.contact_forces`), the velocity ratios E_i and the
+  :func:`fabricate.synthesis.underactuated.model.contact_forces`), the velocity ratios E_i and the
   mobility, and
 - returns a 1-input :class:`~fabricate.mechanism.Mechanism`: the push rod is a slider with a "slide"
   driver over the stroke; the n-1 phalanx angles the actuator does not fix are "angle" drivers whose
@@ -28,7 +28,7 @@ from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute, Slider
 from fabricate.planar import cross2
 from fabricate.synthesis.base import SynthesisResult
-from fabricate.synthesis.underactuated_model import (
+from fabricate.synthesis.underactuated.model import (
     FingerDesign,
     FingerPose,
     FingerPoses,
@@ -636,7 +636,7 @@ def synthesise(design) -> SynthesisResult:
     }
 
     def figures() -> dict[str, bytes]:
-        from fabricate.synthesis.underactuated_plots import closing_figures
+        from fabricate.synthesis.underactuated.plots import closing_figures
         return closing_figures(spec, motion, free, final)
 
     data = {"motion": motion, "free": free, "final": final, "spec": spec}

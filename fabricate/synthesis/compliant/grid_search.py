@@ -43,7 +43,7 @@ crosses zero; that is a degenerate optimum, not a design.
 
 The optimum is that of the sampled path (linear interpolation between samples), like
 :func:`brute_force`; ``tests/test_compliant.py`` checks it against plain enumeration of a sub-grid
-and the caller re-solves the winning point exactly (:func:`~fabricate.synthesis.compliant_model.solve_grasp`).
+and the caller re-solves the winning point exactly (:func:`~fabricate.synthesis.compliant.model.solve_grasp`).
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fabricate.synthesis.compliant_model import (
+from fabricate.synthesis.compliant.model import (
     DEG_PER_RAD,
     ContactPath,
     GripperGeometry,

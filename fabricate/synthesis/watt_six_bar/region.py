@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fabricate.planar import unit
-from fabricate.synthesis.watt_six_bar_burmester import (
+from fabricate.synthesis.watt_six_bar.burmester import (
     CubicCurve,
     CurveSample,
     PlaneMotion,
@@ -30,7 +30,7 @@ from fabricate.synthesis.watt_six_bar_burmester import (
     plane_motion,
     sample_curve,
 )
-from fabricate.synthesis.watt_six_bar_statics import (
+from fabricate.synthesis.watt_six_bar.statics import (
     SixBarBatch,
     fingertip_errors,
     force_index,

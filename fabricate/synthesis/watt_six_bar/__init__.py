@@ -10,10 +10,10 @@ Template tables read here (see ``templates/finger_watt_six_bar.toml``):
                  from its centreline a-b over the motion; 0 switches the check off).
 ``[selection]``  rule ("nearest" to ``target = [d_x, d0_x]`` or "least_k"), optional branches = [m, n],
                  refine (when no exact region point qualifies, look for approximate defect-free
-                 mechanisms from the region points, see :mod:`.watt_six_bar_refine`), refine_seeds.
+                 mechanisms from the region points, see :mod:`.refine`), refine_seeds.
 ``[reference]``  optional published design (d, e, f, d0) to compare with; report only.
 
-The pipeline: curves and region (:mod:`.watt_six_bar_region`), force index K (:mod:`.watt_six_bar_statics`),
+The pipeline: curves and region (:mod:`.region`), force index K (:mod:`.statics`),
 selection, the six-bar :class:`~fabricate.mechanism.Mechanism` (bodies ground, proximal, middle, distal,
 coupler, rocker; one angle driver proximal vs ground in degrees), and the checks reported in
 ``report["synthesis"]``: fingertip error at the positions through the generic solver, and K against
@@ -37,9 +37,9 @@ from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute
 from fabricate.spec import DesignSpec
 from fabricate.synthesis.base import SynthesisResult
-from fabricate.synthesis.watt_six_bar_burmester import distance_to_curve
-from fabricate.synthesis.watt_six_bar_refine import RefinedCandidates, merge, refine_region
-from fabricate.synthesis.watt_six_bar_region import (
+from fabricate.synthesis.watt_six_bar.burmester import distance_to_curve
+from fabricate.synthesis.watt_six_bar.refine import RefinedCandidates, merge, refine_region
+from fabricate.synthesis.watt_six_bar.region import (
     FingerPositions,
     RegionInputs,
     SolutionRegion,
@@ -48,7 +48,7 @@ from fabricate.synthesis.watt_six_bar_region import (
     solution_region,
     stage_two_curves,
 )
-from fabricate.synthesis.watt_six_bar_statics import (
+from fabricate.synthesis.watt_six_bar.statics import (
     JOINTS,
     SixBarBatch,
     assemble,
@@ -293,7 +293,7 @@ def _load_on_distal(mech: Mechanism, poses: dict[str, np.ndarray], force: float)
 
 def virtual_work_check(mech: Mechanism, theta_deg: np.ndarray, force: float) -> dict[str, float]:
     """K and the input torque by the generic solver + constraint multipliers + virtual power."""
-    from fabricate.synthesis.watt_six_bar_statics import virtual_work_torque
+    from fabricate.synthesis.watt_six_bar.statics import virtual_work_torque
 
     motion = mech.sweep(theta_deg)
     k_max, torques, power_torques = 0.0, [], []
@@ -327,7 +327,7 @@ def _reference_report(spec: WattSixBarSpec, finger: FingerPositions, inputs: Reg
     batch = SixBarBatch(finger.a[0], finger.b[0], finger.c[0], d[None], e[None], f[None], d0[None],
                         float(inputs.angles[0, 0]))
     theta = np.linspace(inputs.angles[0, 0], inputs.angles[0, -1], inputs.statics_samples)
-    from fabricate.synthesis.watt_six_bar_statics import fingertip_errors
+    from fabricate.synthesis.watt_six_bar.statics import fingertip_errors
 
     tip = fingertip_errors(batch, inputs.angles[0], finger.c)[0]
     return {
@@ -341,7 +341,7 @@ def _reference_report(spec: WattSixBarSpec, finger: FingerPositions, inputs: Reg
 
 
 def _curve_d(finger: FingerPositions):
-    from fabricate.synthesis.watt_six_bar_burmester import dyad_curve
+    from fabricate.synthesis.watt_six_bar.burmester import dyad_curve
 
     return dyad_curve(finger.proximal, finger.distal)
 
@@ -435,7 +435,7 @@ def synthesise_spec(spec: WattSixBarSpec, name: str = "finger_watt_six_bar") -> 
         report["reference"] = _reference_report(spec, finger, inputs)
 
     def figures() -> dict[str, bytes]:
-        from fabricate.synthesis import watt_six_bar_plots as plots
+        from fabricate.synthesis.watt_six_bar import plots
 
         return plots.all_figures(spec, finger, region, refined, choice)
 
@@ -454,7 +454,7 @@ def _region_qualifies(spec: WattSixBarSpec, region: SolutionRegion) -> bool:
 
 def _clearance_of(finger: FingerPositions, choice: Choice, theta: np.ndarray) -> float:
     """Smallest distance of d and e from the middle link over the motion (mm) of the chosen design."""
-    from fabricate.synthesis.watt_six_bar_statics import middle_link_clearance
+    from fabricate.synthesis.watt_six_bar.statics import middle_link_clearance
 
     batch = SixBarBatch(finger.a[0], finger.b[0], finger.c[0], choice.d[None], choice.e[None], choice.f[None],
                         choice.d0[None], float(theta[0]))

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fabricate.synthesis.watt_six_bar_statics import (
+from fabricate.synthesis.watt_six_bar.statics import (
     SixBarBatch,
     assemble,
     fingertip_errors,

@@ -2,11 +2,11 @@
 
 Reads ``[finger]``, ``[springs]``, ``[object]``, ``[optimisation]`` and ``[drive]``; computes
 
-- the grasp of the paper's procedure (:func:`fabricate.synthesis.compliant_model.solve_grasp`): the
+- the grasp of the paper's procedure (:func:`fabricate.synthesis.compliant.model.solve_grasp`): the
   stroke where the hover force reaches F_n2 = mg/(3 mu s), and F_n1 at that stroke, on the physical
   branch (tip turned in on the can, two-force rod pushing);
 - the grasp force against stroke (paper Fig 3);
-- the certified optimum of Delta N over the Table 1 grid (:mod:`fabricate.synthesis.compliant_optimise`);
+- the certified optimum of Delta N over the Table 1 grid (:mod:`fabricate.synthesis.compliant.grid_search`);
 - the no-load closing (eqs 1-2: least spring energy at each stroke with the hinges on their stops
   until the rod overcomes the preloads), continued on the can up to the grasp stroke;
 
@@ -33,7 +33,8 @@ from fabricate.bounds import (
 from fabricate.errors import SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, LinearLaw, Mechanism, Revolute, Slider
 from fabricate.synthesis.base import SynthesisResult
-from fabricate.synthesis.compliant_model import (
+from fabricate.synthesis.compliant.grid_search import OptimumResult, ParameterGrid, optimise
+from fabricate.synthesis.compliant.model import (
     ContactPath,
     Grasp,
     GripperGeometry,
@@ -46,7 +47,6 @@ from fabricate.synthesis.compliant_model import (
     solve_grasp,
     spring_torques,
 )
-from fabricate.synthesis.compliant_optimise import OptimumResult, ParameterGrid, optimise
 from fabricate.table import Table
 
 
@@ -367,7 +367,7 @@ def synthesise(design) -> SynthesisResult:
     }
 
     def figures() -> dict[str, bytes]:
-        from fabricate.synthesis.compliant_plots import compliant_figures
+        from fabricate.synthesis.compliant.plots import compliant_figures
         return compliant_figures(spec, path, grasp, motion, optimum)
 
     data = {"path": path, "grasp": grasp, "motion": motion, "optimum": optimum,

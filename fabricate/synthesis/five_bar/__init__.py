@@ -37,9 +37,9 @@ from fabricate.bounds import MAX_KAPPA_SAMPLES, MAX_LENGTH_MM, MIN_CURVE_STEP_MM
 from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
 from fabricate.mechanism import Body, Driver, GearCoupling, Mechanism, Motion, Revolute
 from fabricate.planar import rotation, unit, wrap_angle
-from fabricate.synthesis import kinematic_mapping as km
 from fabricate.synthesis.base import SynthesisResult
-from fabricate.synthesis.five_bar_law import GearLaw, gear_law
+from fabricate.synthesis.five_bar import kinematic_mapping as km
+from fabricate.synthesis.five_bar.law import GearLaw, gear_law
 from fabricate.table import Table
 
 #: Rules for picking one dyad of the feasible domain.
@@ -608,7 +608,7 @@ def synthesise(design: Any) -> SynthesisResult:
                        position_error=position, orientation_error=orientation, motion=motion)
 
     def figures() -> dict[str, bytes]:
-        from fabricate.synthesis.five_bar_plots import five_bar_figures
+        from fabricate.synthesis.five_bar.plots import five_bar_figures
 
         return five_bar_figures(data)
 
