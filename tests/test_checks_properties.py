@@ -115,11 +115,16 @@ def test_overlap_areas_and_clearance_match_shapely():
     assert far.sum() == 1 and np.all(got[far] > 5.0)  # beyond the search length: a lower bound only
 
 
-def test_clearance_when_the_search_windows_just_touch():
-    """Boxes 10 mm apart on both axes with a 5 mm search length: farther than the search, so +inf."""
+@pytest.mark.parametrize("gap", [10.0, 2 * (5.0 * (1.0 + 1e-9) + 1e-12)])
+def test_clearance_when_the_search_windows_just_touch(gap):
+    """Boxes 10 mm apart on both axes with a 5 mm search length: farther than the search, so +inf. The clip
+    window's half-width is a hair over the search length (5 (1 + 1e-9) + 1e-12 mm): boxes exactly two of them apart
+    give a zero-width window, which must not reach GEOS (it raises on an empty clip rectangle)."""
     a = Outline([np.array([[0, 0], [20, 0], [20, 20], [0, 20]], dtype=float)])
     b = Outline([np.array([[0, 0], [3, 0], [3, 3], [0, 3]], dtype=float)])
-    got = planar_clearance(a, b, RelativePoses(np.array([[30.0, 30.0, 0.0]])), search_mm=5.0)
+    got = planar_clearance(a, b, RelativePoses(np.array([[20.0 + gap, 20.0 + gap, 0.0]])), search_mm=5.0)
+    assert got[0] == np.inf
+    got = planar_clearance(a, b, RelativePoses(np.array([[20.0 + gap, 10.0, 0.0]])), search_mm=5.0)
     assert got[0] == np.inf
 
 
