@@ -400,6 +400,30 @@ def check_examples() -> list[str]:
     return lines
 
 
+def _results_text(results: dict) -> str:
+    """results.json: one line per mutant (a reviewable diff, and under 1 MB where indenting every field
+    of every mutant was not)."""
+    lines = ["{"]
+    modules = list(results.items())
+    for m, (name, value) in enumerate(modules):
+        if isinstance(value, dict):
+            fields = list(value.items())
+            lines.append(f"{json.dumps(name)}: {{")
+            for f, (key, item) in enumerate(fields):
+                sep = "," if f < len(fields) - 1 else ""
+                if isinstance(item, list):
+                    lines.append(f" {json.dumps(key)}: [")
+                    lines += [f"  {json.dumps(x, separators=(',', ':'))}" + ("," if i < len(item) - 1 else "")
+                              for i, x in enumerate(item)]
+                    lines.append(f" ]{sep}")
+                else:
+                    lines.append(f" {json.dumps(key)}: {json.dumps(item, separators=(',', ':'))}{sep}")
+            lines.append("}" + ("," if m < len(modules) - 1 else ""))
+        else:
+            lines.append(f"{json.dumps(name)}: {json.dumps(value)}" + ("," if m < len(modules) - 1 else ""))
+    return "\n".join(lines + ["}"]) + "\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("modules", nargs="*", help=f"some of: {', '.join(MODULES)}")
@@ -436,7 +460,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{key}: {s['killed']}/{s['run'] - s['equivalent']} killed ({100 * s['rate']:.1f}%), "
                   f"{s['survived']} survived, {s['no_tests']} without tests, {s['equivalent']} equivalent",
                   flush=True)
-            RESULTS.write_text(json.dumps(results, indent=1) + "\n")
+            RESULTS.write_text(_results_text(results))
     else:
         table = load_equivalents()
         for key, res in results.items():  # re-apply the string filter and the equivalents table
@@ -446,7 +470,7 @@ def main(argv: list[str] | None = None) -> int:
                     reason = equivalent_reason(key, r["function"], r["old"], r["new"], table)
                     if reason:
                         r["status"], r["reason"] = "equivalent", reason
-        RESULTS.write_text(json.dumps(results, indent=1) + "\n")
+        RESULTS.write_text(_results_text(results))
     REPORT.write_text(write_report(results))
     print(REPORT.read_text())
     return 0
