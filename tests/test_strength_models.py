@@ -446,7 +446,6 @@ def quarter_plate_mesh(width: float, length: float, radius: float, m: int):
     round the arc, m layers graded towards the hole); beyond it a structured grid grows towards the
     loaded end. Returns a ``skfem.MeshTri``.
     """
-    from skfem import MeshTri
 
     half = width / 2.0
     theta = (math.pi / 2.0) * np.arange(2 * m + 1) / (2 * m)
@@ -462,16 +461,23 @@ def quarter_plate_mesh(width: float, length: float, radius: float, m: int):
         xs.append(min(xs[-1] + min(half / m * 1.15 ** len(xs), half / 2.0), length / 2.0))
     gx, gy = np.meshgrid(np.array(xs), half * np.arange(m + 1) / m, indexing="ij")
     far = np.stack([gx, gy], -1)
-    points = np.concatenate([near.reshape(-1, 2), far.reshape(-1, 2)])
+    return blocks_mesh([near, far])  # the two blocks share the nodes on x = width/2
+
+
+def blocks_mesh(blocks: list[np.ndarray]):
+    """One ``skfem.MeshTri`` from structured point blocks ((i, j, 2) arrays, two triangles per cell); nodes
+    that blocks share (equal to 1e-9 mm) are merged and every triangle is made counter-clockwise."""
+    from skfem import MeshTri
+
+    points = np.concatenate([b.reshape(-1, 2) for b in blocks])
     tris = []
     offset = 0
-    for block in (near, far):
+    for block in blocks:
         idx = offset + np.arange(block.shape[0] * block.shape[1]).reshape(block.shape[:2])
         a, b, c, e = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
         tris += [np.column_stack([a, b, c]), np.column_stack([a, c, e])]
         offset += idx.size
     t = np.concatenate(tris)
-    # the two blocks share the nodes on x = width/2
     _, first, inverse = np.unique(np.round(points * 1e9).astype(np.int64), axis=0, return_index=True,
                                   return_inverse=True)
     p, t = points[first], inverse.ravel()[t]

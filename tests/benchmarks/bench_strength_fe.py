@@ -32,7 +32,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository: tests/ helpers
 
 from fabricate.strength.models import OPEN_HOLE_MARGIN, hole_stress_concentration  # noqa: E402
-from tests.test_strength_models import plate_hole_peak_von_mises  # noqa: E402
+from tests.test_strength_models import blocks_mesh, plate_hole_peak_von_mises  # noqa: E402
 
 MODULUS, POISSON = 2800.0, 0.35
 
@@ -43,7 +43,6 @@ def half_lug_mesh(width: float, end: float, far: float, radius: float, m: int):
     A mapped mesh from the half circle to the square [-w/2, w/2] x [0, w/2] (4m segments round the arc,
     m layers graded to the hole), structured blocks to either side sharing its edge nodes.
     """
-    from skfem import MeshTri
 
     half = width / 2.0
     theta = math.pi * np.arange(4 * m + 1) / (4 * m)
@@ -69,22 +68,7 @@ def half_lug_mesh(width: float, end: float, far: float, radius: float, m: int):
         gx, gy = np.meshgrid(xs, ys, indexing="ij")
         return np.stack([gx, gy], -1)
 
-    blocks = [near, strip(half, far), strip(-half, -end)]
-    points = np.concatenate([b.reshape(-1, 2) for b in blocks])
-    tris, offset = [], 0
-    for block in blocks:
-        idx = offset + np.arange(block.shape[0] * block.shape[1]).reshape(block.shape[:2])
-        a, b, c, e = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
-        tris += [np.column_stack([a, b, c]), np.column_stack([a, c, e])]
-        offset += idx.size
-    t = np.concatenate(tris)
-    _, first, inverse = np.unique(np.round(points * 1e9).astype(np.int64), axis=0, return_index=True,
-                                  return_inverse=True)
-    p, t = points[first], inverse.ravel()[t]
-    v = p[t]
-    area = (v[:, 1, 0] - v[:, 0, 0]) * (v[:, 2, 1] - v[:, 0, 1]) - (v[:, 2, 0] - v[:, 0, 0]) * (v[:, 1, 1] - v[:, 0, 1])
-    t[area < 0] = t[area < 0][:, [0, 2, 1]]
-    return MeshTri(p.T.copy(), t.T.copy())
+    return blocks_mesh([near, strip(half, far), strip(-half, -end)])
 
 
 def lug_peak_stress(width: float, hole_d: float, traction: float, m: int) -> float:
