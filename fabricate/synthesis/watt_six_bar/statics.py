@@ -215,7 +215,7 @@ def lagrange_joint_forces(mechanism, poses: dict[str, np.ndarray], point: np.nda
     driver: theta_body - theta_reference - input), equilibrium under applied generalised forces ``Q``
     is ``Q + J^T lambda = 0``: the multipliers of a revolute are the force the joint applies to its
     ``body_a``; the driver's multiplier is the input torque. Nothing of the link-by-link statics
-    above is used.
+    above is used: the multipliers come from :func:`fabricate.strength.statics.solve_statics`.
 
     Parameters
     ----------
@@ -230,44 +230,20 @@ def lagrange_joint_forces(mechanism, poses: dict[str, np.ndarray], point: np.nda
     -------
     (dict joint -> |force| N, torque N*mm)
     """
-    free = [b.name for b in mechanism.bodies if b.name != mechanism.ground]
-    index = {name: k for k, name in enumerate(free)}
-    bodies = {b.name: b for b in mechanism.bodies}
-    rows: list[np.ndarray] = []
+    # the generic statics of the strength check (one pose): no second copy of the multiplier assembly
+    from fabricate.mechanism import Motion
+    from fabricate.strength.statics import PointForce, solve_statics
 
-    def point_jacobian(body_name: str, local: np.ndarray, sign: float, block: np.ndarray) -> None:
-        if body_name not in index:
-            return
-        k = index[body_name]
-        pose = np.asarray(poses[body_name], dtype=np.float64)
-        arm = rotation(pose[2]) @ local
-        block[:, 3 * k:3 * k + 2] += sign * np.eye(2)
-        block[:, 3 * k + 2] += sign * np.array([-arm[1], arm[0]])
-
-    names = []
-    for joint in mechanism.joints:
-        block = np.zeros((2, 3 * len(free)))
-        point_jacobian(joint.body_a, bodies[joint.body_a].point(joint.name), 1.0, block)
-        point_jacobian(joint.body_b, bodies[joint.body_b].point(joint.name), -1.0, block)
-        rows.extend(block)
-        names.append(joint.name)
-    for driver in mechanism.drivers:
-        r = np.zeros(3 * len(free))
-        if driver.body in index:
-            r[3 * index[driver.body] + 2] += 1.0
-        if driver.reference in index:
-            r[3 * index[driver.reference] + 2] -= 1.0
-        rows.append(r)
-    jac = np.array(rows)
-    applied = np.zeros(3 * len(free))
-    k = index[body]
-    origin = np.asarray(poses[body], dtype=np.float64)[:2]
-    applied[3 * k:3 * k + 2] = load
-    applied[3 * k + 2] = cross2(np.asarray(point) - origin, np.asarray(load))
-    multipliers = np.linalg.solve(jac.T, -applied)
-    forces = {name: float(np.hypot(*multipliers[2 * i:2 * i + 2])) for i, name in enumerate(names)}
+    free = tuple(b.name for b in mechanism.bodies if b.name != mechanism.ground)
+    q = np.array([[np.asarray(poses[name], dtype=np.float64) for name in free]])
+    motion = Motion(inputs=np.zeros(1), body_names=mechanism.body_names, ground=mechanism.ground, free=free, q=q,
+                    mechanism=mechanism)
+    pose = np.asarray(poses[body], dtype=np.float64)
+    local = rotation(-pose[2]) @ (np.asarray(point, dtype=np.float64) - pose[:2])
+    statics = solve_statics(mechanism, motion, [PointForce(body, local, np.asarray(load, dtype=np.float64)[None, :])])
+    forces = {name: float(np.hypot(*f[0])) for name, f in statics.joint_forces.items()}
     # the driver row is theta_proximal - theta_ground: its multiplier is the torque ground applies
-    return forces, float(multipliers[-1])
+    return forces, float(statics.driver_efforts[0, -1])
 
 
 def virtual_work_torque(mechanism, motion, point_local: np.ndarray, body: str, load_of_pose,
