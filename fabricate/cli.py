@@ -1,4 +1,4 @@
-"""Command line: ``fabricate build|synth|check|list|init``.
+"""Command line: ``fabricate build|synth|check|sweep|list|init``.
 
 Exit codes: 0 all checks pass; 1 the design fails a check (files are written, the report says why);
 2 invalid input or usage (nothing is written); 3 an internal error (a bug: please report it with the
@@ -12,6 +12,7 @@ import re
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 from fabricate import __version__
 from fabricate.errors import FabricateError, SpecError
@@ -59,6 +60,29 @@ def _parser() -> argparse.ArgumentParser:
         cmd.add_argument("--process", metavar="sla|laser|PATH",
                          help="make it with this process profile instead of the template's (the template's "
                               "pin diameter is kept)")
+    w = sub.add_parser("sweep", help="many designs from one template on Dask: tables, plots, the best built",
+                       description="Run a design-space sweep: a spec (TOML with [sweep], [vary], [set]) or a "
+                                   "template with --vary. Writes sweep.csv, sweep.parquet, plots/ and best/.")
+    w.add_argument("spec", help="sweep spec (path or shipped name) or a design template (then --vary)")
+    w.add_argument("--vary", action="append", default=[], metavar="FIELD=VALUES",
+                   help="vary a template field: FIELD=start:stop:count, FIELD=a,b,c or FIELD='[[...], ...]' "
+                        "(repeatable; adds to or replaces the spec's [vary])")
+    w.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE",
+                   help="change a template field for every point (repeatable)")
+    w.add_argument("--sampling", choices=("grid", "lhs", "sobol"))
+    w.add_argument("--samples", type=int, help="points of an lhs or sobol sweep")
+    w.add_argument("--seed", type=int, help="seed of the lhs/sobol sampler")
+    w.add_argument("--stage", choices=("synth", "build"), help="synthesis only, or the whole build")
+    w.add_argument("--metric", action="append", default=[], metavar="KEY.PATH",
+                   help="a report.json key path to collect, e.g. synthesis.pose_error_mm.max or "
+                        "'min(strength.parts[*].min_safety_factor)' (repeatable; replaces the spec's)")
+    w.add_argument("--best", type=int, help="build this many of the best passing points in full")
+    where = w.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, help="processes of the local Dask cluster (default: the cores)")
+    where.add_argument("--scheduler", metavar="ADDR", help="an existing Dask scheduler, e.g. tcp://host:8786")
+    w.add_argument("-o", "--output", type=Path, help="output folder (default outputs/<name>-sweep/): new, empty, "
+                                                     "or an earlier run of the same sweep, which is resumed")
+    w.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     sub.add_parser("list", help="templates shipped")
     i = sub.add_parser("init", help="write an editable copy of a shipped template into the current folder")
     i.add_argument("name", help="name of the new design (writes NAME.toml)")
@@ -121,6 +145,76 @@ def _check(args: argparse.Namespace) -> int:
     return EXIT_OK if not failures else EXIT_FAILED
 
 
+def _value(text: str, where: str, many: bool) -> Any:
+    """A command-line value: TOML (``[1, 2]``, ``0.5``, ``"x"``), else ``a,b,c`` or a bare word."""
+    from fabricate.spec import parse_toml
+
+    try:
+        return parse_toml(f"v = {text}", where)["v"]
+    except SpecError:
+        pass
+    if many and ":" not in text and "," in text:
+        return [_value(part.strip(), where, False) for part in text.split(",")]
+    return text
+
+
+def _assignments(items: list[str], flag: str, many: bool) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        if not sep or not key.strip() or not text.strip():
+            raise SpecError(flag, f'expected FIELD=VALUE{"S" if many else ""}, got "{item}"')
+        value = _value(text.strip(), f"{flag} {key.strip()}", many)
+        if many and not isinstance(value, list) and not (isinstance(value, str) and ":" in value):
+            value = [value]
+        out[key.strip()] = value
+    return out
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from fabricate.spec import parse_toml, read_text
+    from fabricate.sweep.spec import find_sweep, sweep_from_tables
+
+    source = find_sweep(args.spec)
+    if source is not None:
+        tables = parse_toml(read_text(source), str(source))
+        base_dir: Path | None = source.parent
+    else:
+        tables = {"sweep": {"template": args.spec}}
+        base_dir = None
+    tables = {k: dict(v) if isinstance(v, dict) else v for k, v in tables.items()}
+    sweep = tables.setdefault("sweep", {})
+    tables.setdefault("vary", {}).update(_assignments(args.vary, "--vary", True))
+    if args.set:
+        tables.setdefault("set", {}).update(_assignments(args.set, "--set", False))
+    for key in ("sampling", "samples", "seed", "stage", "best"):
+        if getattr(args, key) is not None:
+            sweep[key] = getattr(args, key)
+    if args.metric:
+        sweep["metrics"] = list(args.metric)
+    if args.workers is not None and not 1 <= args.workers <= 512:
+        raise SpecError("--workers", f"expected 1 .. 512 processes, got {args.workers}")
+    spec = sweep_from_tables(tables, base_dir)
+    from fabricate.sweep.runner import run_sweep
+
+    out = args.output or Path("outputs") / f"{spec.name}-sweep"
+    outcome = run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler, quiet=args.quiet)
+    if outcome.exit_code == EXIT_INTERRUPTED:
+        print(f"fabricate: interrupted; {outcome.done} of {outcome.total} points are recorded in {outcome.out} "
+              "(run the same command again to resume)", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if not args.quiet:
+        c = outcome.counts
+        errors = f", {c['3']} internal errors" if c.get("3") else ""
+        print(f"sweep {spec.name}: {outcome.total} points ({outcome.resumed} done earlier): {c.get('0', 0)} pass, "
+              f"{c.get('1', 0)} fail a check, {c.get('2', 0)} invalid or infeasible{errors} -> {outcome.out}")
+        for entry in outcome.best:
+            metric = spec.best_metric.name if spec.best_metric else ""
+            print(f"  best {entry['rank']}: point {entry['point']} {metric} = {entry.get(metric)!r} "
+                  f"-> {entry.get('folder', '')}")
+    return outcome.exit_code
+
+
 def _list() -> int:
     from fabricate.spec import read_toml, shipped_templates
 
@@ -165,6 +259,8 @@ def main(argv: list[str] | None = None) -> int:
             return _init(args)
         if args.command == "check":
             return _check(args)
+        if args.command == "sweep":
+            return _sweep(args)
         return _build(args)
     except FabricateError as exc:  # invalid input, nothing feasible, a refused folder: nothing written
         print(f"fabricate: error: {exc}", file=sys.stderr)

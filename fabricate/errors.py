@@ -28,6 +28,9 @@ class SpecError(FabricateError, ValueError):
         self.message = message
         super().__init__(f"{path}: {message}" if path else message)
 
+    def __reduce__(self):  # a sweep's worker sends errors across processes: rebuild from both arguments
+        return (type(self), (self.path, self.message))
+
 
 class SynthesisError(FabricateError):
     """Synthesis found no design that satisfies the template's limits."""
@@ -46,7 +49,11 @@ class LockupError(FabricateError):
 
     def __init__(self, input_value: float, message: str) -> None:
         self.input_value = float(input_value)
+        self.message = message
         super().__init__(f"{message} (at input {input_value:.6g})")
+
+    def __reduce__(self):
+        return (type(self), (self.input_value, self.message))
 
 
 class GeometryError(FabricateError):

@@ -270,14 +270,17 @@ def _child(jobs: list[Callable[[], dict[str, bytes]]], conn: Any) -> None:
 class Background:
     """Run jobs returning ``{path: bytes}`` in a forked child process while the caller goes on.
 
-    Where ``fork`` is unavailable, or ``FABRICATE_SERIAL`` is set, or the child fails, the jobs run in
-    the calling process when :meth:`result` is asked for, so the outcome never depends on it.
+    Where ``fork`` is unavailable, or ``FABRICATE_SERIAL`` is set, or this process is a daemon (a Dask
+    worker), or the child fails, the jobs run in the calling process when :meth:`result` is asked for, so
+    the outcome never depends on it.
     """
 
     def __init__(self, jobs: list[Callable[[], dict[str, bytes]]]) -> None:
         self.jobs = jobs
         self._process = None
         if os.environ.get("FABRICATE_SERIAL") or "fork" not in multiprocessing.get_all_start_methods():
+            return
+        if multiprocessing.current_process().daemon:  # e.g. a Dask worker: daemons may not have children
             return
         ctx = multiprocessing.get_context("fork")
         self._conn, sender = ctx.Pipe(duplex=False)

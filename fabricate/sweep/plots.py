@@ -1,0 +1,87 @@
+"""Plots of a sweep as PNG bytes: each metric against each varied numeric field, and a feasibility map of
+two fields (which points pass, fail a check, or are invalid or infeasible)."""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from fabricate.plotting import figure, png_bytes
+
+#: More plots than this are not drawn (a sweep of 16 fields x 64 metrics would make 1024).
+MAX_PLOTS = 64
+
+_OUTCOMES = (  # exit code, label, marker style
+    (0, "passes every check", {"marker": "o", "color": "#1b7837"}),
+    (1, "fails a check", {"marker": "s", "color": "#d6604d"}),
+    (2, "invalid or infeasible", {"marker": "x", "color": "#4d4d4d"}),
+    (3, "error", {"marker": "+", "color": "#762a83"}),
+)
+
+
+def slug(text: str) -> str:
+    """A file-name-safe form of a field path or metric name."""
+    return re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_")[:80] or "x"
+
+
+def _numeric(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(float(v))
+
+
+def metric_plot(rows: Sequence[Mapping[str, Any]], field: str, metric: str) -> bytes:
+    """``metric`` against ``field``: one marker per point, by outcome; points without the metric are not
+    drawn (they are counted in the legend)."""
+    fig = figure((6.4, 4.2), 100)
+    ax = fig.add_subplot(1, 1, 1)
+    for code, label, style in _OUTCOMES:
+        pts = [(float(r[field]), float(r[metric])) for r in rows
+               if r["exit_code"] == code and _numeric(r.get(field)) and _numeric(r.get(metric))]
+        missing = sum(1 for r in rows if r["exit_code"] == code and not _numeric(r.get(metric)))
+        if pts or missing:
+            xs, ys = zip(*pts, strict=True) if pts else ((), ())
+            extra = f", {missing} without it" if missing else ""
+            ax.scatter(xs, ys, s=18, label=f"{label} ({len(pts)}{extra})",
+                       facecolors="none" if code == 1 else None, **style)
+    ax.set_xlabel(field)
+    ax.set_ylabel(metric)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    return png_bytes(fig)
+
+
+def feasibility_map(rows: Sequence[Mapping[str, Any]], x: str, y: str) -> bytes:
+    """Every point at (``x``, ``y``), marked by outcome: where the design stays feasible."""
+    fig = figure((6.0, 5.2), 100)
+    ax = fig.add_subplot(1, 1, 1)
+    for code, label, style in _OUTCOMES:
+        pts = [(float(r[x]), float(r[y])) for r in rows
+               if r["exit_code"] == code and _numeric(r.get(x)) and _numeric(r.get(y))]
+        if pts:
+            xs, ys = zip(*pts, strict=True)
+            ax.scatter(xs, ys, s=30, label=f"{label} ({len(pts)})", **style)
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    ax.set_title("feasibility")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    return png_bytes(fig)
+
+
+def sweep_plots(rows: Sequence[Mapping[str, Any]], fields: Sequence[str], metrics: Sequence[str],
+                map_fields: Sequence[str]) -> dict[str, bytes]:
+    """``{"plots/<metric>__vs__<field>.png": bytes, "plots/feasibility.png": bytes}`` for the numeric fields
+    (at most :data:`MAX_PLOTS`)."""
+    numeric = [f for f in fields if any(_numeric(r.get(f)) for r in rows)]
+    out: dict[str, bytes] = {}
+    if len(map_fields) == 2:
+        out["plots/feasibility.png"] = feasibility_map(rows, map_fields[0], map_fields[1])
+    for metric in metrics:
+        for field in numeric:
+            if len(out) >= MAX_PLOTS:
+                return out
+            out[f"plots/{slug(metric)}__vs__{slug(field)}.png"] = metric_plot(rows, field, metric)
+    return out

@@ -1,0 +1,485 @@
+"""Run a sweep on Dask distributed: a local cluster of processes by default, or an existing cluster.
+
+The output folder holds:
+
+- ``sweep.json``: the spec (as plain values), the counts and the best points; it marks the folder as a
+  sweep's (a re-run of the same spec resumes it; another spec is refused);
+- ``rows.jsonl``: the journal, one JSON row per finished point, appended (one ``write`` per finished task,
+  flushed and synced) as tasks finish; a torn last line (a killed run) is dropped on resume;
+- ``sweep.csv`` and ``sweep.parquet``: every finished point, sorted, rewritten atomically as rows arrive
+  (at most every few seconds) and at the end;
+- ``plots/``: each metric against each varied field, and the feasibility map;
+- ``best/<rank>-point<index>/``: the best points built in full, each a normal ``fabricate build`` output.
+
+A re-run into the same folder skips the points whose rows are done (exit codes 0, 1, 2; a point that hit
+an internal error or lost its worker every time is run again).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+import sys
+import tempfile
+import time
+from collections import deque
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fabricate.errors import SpecError
+from fabricate.sweep.spec import SweepSpec
+from fabricate.sweep.task import EXIT_INTERNAL, build_point, row_from_json, row_json, run_batch
+
+SWEEP_JSON = "sweep.json"
+JOURNAL = "rows.jsonl"
+#: Results are rewritten at most this often while a sweep runs (and always at its end).
+FLUSH_SECONDS = 5.0
+#: A task that raised (not a bad point: those are rows) is tried this many more times by Dask.
+TASK_RETRIES = 2
+#: Largest number of points in one task, whatever the timing says.
+MAX_BATCH = 256
+
+Progress = Callable[[str], None]
+
+
+@dataclass
+class SweepOutcome:
+    """What a sweep did.
+
+    Attributes
+    ----------
+    exit_code : int
+        0 every point has its row; 1 some point ended in an internal error (its reason says why);
+        130 interrupted (the rows done are kept; the same command resumes).
+    out : Path
+    total, done, resumed : int
+        Points in the sweep, points with a row now, rows found from an earlier run.
+    counts : dict
+        Rows per exit code.
+    """
+
+    exit_code: int
+    out: Path
+    total: int
+    done: int
+    resumed: int
+    counts: dict[str, int] = field(default_factory=dict)
+    best: list[dict[str, Any]] = field(default_factory=list)
+    seconds: float = 0.0
+    workers: int = 0
+
+
+# -- output folder ------------------------------------------------------------------------------------------
+
+def _write_file(path: Path, data: bytes) -> None:
+    """Replace ``path`` atomically: a temporary sibling, synced, then renamed over it."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _marker(spec: SweepSpec, extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    from fabricate import __version__
+
+    return {"fabricate": __version__, "kind": "sweep", "spec": spec.describe(), "spec_digest": spec.digest,
+            "template_text": spec.template_text, **(extra or {})}
+
+
+def prepare_folder(out: Path, spec: SweepSpec) -> bool:
+    """Check the output folder before any work. Returns whether it holds an earlier run of this spec.
+
+    Raises
+    ------
+    SpecError
+        The folder is a file, holds files fabricate did not write, or a sweep of another spec.
+    """
+    if os.path.lexists(out) and (out.is_symlink() or not out.is_dir()):
+        raise SpecError(str(out), "is not a folder; a sweep writes into a new, empty or earlier sweep folder")
+    if not out.exists():
+        return False
+    entries = sorted(p.name for p in out.iterdir())
+    if not entries:
+        return False
+    marker = out / SWEEP_JSON
+    if not marker.is_file():
+        raise SpecError(str(out), f"holds files fabricate did not write ({', '.join(entries[:3])}"
+                                  f"{', ...' if len(entries) > 3 else ''}); choose a new or empty folder")
+    try:
+        previous = json.loads(marker.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise SpecError(str(marker), f"cannot be read as a sweep's record: {exc}") from None
+    if previous.get("kind") != "sweep":
+        raise SpecError(str(out), "holds a sweep.json fabricate did not write; choose a new or empty folder")
+    if previous.get("spec_digest") != spec.digest or previous.get("spec") != spec.describe():
+        raise SpecError(str(out), "holds a sweep of another spec (template, values, stage or metrics differ); "
+                                  "choose another folder to keep both")
+    return True
+
+
+def read_journal(out: Path, spec: SweepSpec) -> dict[str, dict[str, Any]]:
+    """Rows of an earlier run by point id (a torn last line is cut off so appending can go on)."""
+    path = out / JOURNAL
+    if not path.is_file():
+        return {}
+    data = path.read_bytes()
+    if data and not data.endswith(b"\n"):
+        cut = data.rfind(b"\n") + 1
+        with open(path, "r+b") as fh:
+            fh.truncate(cut)
+        data = data[:cut]
+    rows: dict[str, dict[str, Any]] = {}
+    for line in data.decode("utf-8").splitlines():
+        try:
+            row = row_from_json(line, spec.metrics)
+        except ValueError:
+            continue
+        rows[str(row["id"])] = row
+    return rows
+
+
+class Journal:
+    """Append-only rows file: one ``write`` of whole lines per finished task, flushed and synced."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self._fh = open(path, "a", encoding="utf-8")  # noqa: SIM115 - closed by close()
+
+    def append(self, rows: list[dict[str, Any]]) -> None:
+        self._fh.write("".join(row_json(r) + "\n" for r in rows))
+        self._fh.flush()
+        os.fsync(self._fh.fileno())
+
+    def close(self) -> None:
+        self._fh.close()
+
+
+# -- Dask ----------------------------------------------------------------------------------------------------
+
+def connect(workers: int | None, scheduler: str | None) -> tuple[Any, Any]:
+    """A Dask client and the local cluster it owns (None with ``scheduler``).
+
+    Raises
+    ------
+    SpecError
+        Dask is not installed, or the scheduler cannot be reached.
+    """
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise SpecError("sweep", "needs Dask distributed and pyarrow: pip install \"fabricate[sweep]\"") from None
+    for name in ("distributed", "distributed.nanny", "distributed.scheduler", "distributed.worker",
+                 "distributed.core", "distributed.client"):
+        logging.getLogger(name).setLevel(logging.ERROR)
+    if scheduler:
+        try:
+            client = Client(scheduler, timeout="15s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise SpecError("--scheduler", f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+        return client, None
+    n = workers or default_workers()
+    # one single-threaded process per core: a point is CPU-bound Python; the memory limit is Dask's share
+    # of this machine per worker (a point stays within the template bounds' 4 GB)
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                           silence_logs=logging.ERROR)
+    client = Client(cluster)
+    return client, cluster
+
+
+def default_workers() -> int:
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # macOS, Windows
+        return max(1, os.cpu_count() or 1)
+
+
+def _bar(done: int, total: int, counts: Mapping[str, int], start: float, resumed: int) -> str:
+    width = 28
+    filled = int(width * done / total) if total else width
+    rate = (done - resumed) / max(time.perf_counter() - start, 1e-9)
+    left = (total - done) / rate if rate > 0 else math.inf
+    eta = f"{int(left // 60)}:{int(left % 60):02d}" if math.isfinite(left) else "--:--"
+    return (f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{total} points · "
+            f"{counts.get('0', 0)} pass · {counts.get('1', 0)} fail · {counts.get('2', 0)} invalid"
+            f"{f' · {counts.get(str(EXIT_INTERNAL))} errors' if counts.get(str(EXIT_INTERNAL)) else ''}"
+            f" · {rate:.2f} pt/s · ETA {eta} ")
+
+
+def _counts(rows: Mapping[str, Mapping[str, Any]]) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for row in rows.values():
+        key = str(row["exit_code"])
+        counts[key] = counts.get(key, 0) + 1
+    return dict(sorted(counts.items()))
+
+
+def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, scheduler: str | None = None,
+              quiet: bool = False, progress_bar: bool | None = None, log: Progress | None = None) -> SweepOutcome:
+    """Run every point of ``spec`` not done yet in ``out``, then write the tables, plots and best builds.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+    out : str or Path
+        Output folder (new, empty, or an earlier run of this spec, which is resumed).
+    workers : int, optional
+        Processes of the local cluster (default: the cores this process may use).
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``); its workers need fabricate installed.
+    quiet : bool
+        No progress output.
+    progress_bar : bool, optional
+        Draw the progress bar on stderr (default: when stderr is a terminal).
+    """
+    out = Path(os.path.abspath(out))
+    resuming = prepare_folder(out, spec)
+    points = spec.points()
+    ids = [spec.point_id(values) for values in points]
+    by_id = dict(zip(ids, range(len(points)), strict=True))
+    done: dict[str, dict[str, Any]] = {}
+    if resuming:
+        done = {pid: row for pid, row in read_journal(out, spec).items()
+                if pid in by_id and row["exit_code"] != EXIT_INTERNAL}
+    resumed = len(done)
+    out.mkdir(parents=True, exist_ok=True)
+    _write_file(out / SWEEP_JSON, _json(_marker(spec, {"points": len(points), "done": resumed, "complete": False})))
+    say = log or (lambda msg: None if quiet else print(msg, file=sys.stderr, flush=True))
+    draw = (not quiet) and (sys.stderr.isatty() if progress_bar is None else progress_bar)
+
+    todo = deque((i, points[i], ids[i]) for i in range(len(points)) if ids[i] not in done)
+    start = time.perf_counter()
+    journal = Journal(out / JOURNAL)
+    client = cluster = None
+    interrupted = False
+    n_workers = 0
+    try:
+        if todo:
+            client, cluster = connect(workers, scheduler)
+            n_workers = _wait_for_workers(client, scheduler)
+            say(f"sweep {spec.name}: {len(points)} points ({resumed} done earlier), stage {spec.stage}, "
+                f"{n_workers} Dask worker{'s' if n_workers != 1 else ''}"
+                f"{' at ' + scheduler if scheduler else ' (local cluster)'}")
+            _run_points(client, spec, todo, done, journal, out, start, resumed, len(points),
+                        draw, say)
+        elif not quiet:
+            say(f"sweep {spec.name}: all {len(points)} points done earlier; writing the results")
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        journal.close()
+        if draw:
+            print(file=sys.stderr)
+    rows = [done[pid] for pid in ids if pid in done]
+    try:
+        _write_results(out, spec, rows)
+        best: list[dict[str, Any]] = []
+        if not interrupted and len(rows) == len(points):
+            best = _best(spec, rows)
+            if best:
+                if client is None:
+                    client, cluster = connect(workers, scheduler)
+                _build_best(client, spec, best, out, say)
+        counts = _counts(done)
+        complete = len(rows) == len(points)
+        _write_file(out / SWEEP_JSON, _json(_marker(spec, {
+            "points": len(points), "done": len(rows), "complete": complete, "counts": counts,
+            "best": best, "files": ["sweep.csv", "sweep.parquet", JOURNAL, "plots/", *(["best/"] if best else [])],
+        })))
+    except KeyboardInterrupt:
+        interrupted = True
+        counts, best = _counts(done), []
+    finally:
+        _close(client, cluster)
+    code = 130 if interrupted else (1 if counts.get(str(EXIT_INTERNAL)) else 0)
+    return SweepOutcome(exit_code=code, out=out, total=len(points), done=len(rows), resumed=resumed,
+                        counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers)
+
+
+def _json(data: Any) -> bytes:
+    return (json.dumps(data, indent=1, sort_keys=False, allow_nan=False, default=str) + "\n").encode()
+
+
+def _wait_for_workers(client: Any, scheduler: str | None) -> int:
+    deadline = time.monotonic() + 60.0
+    while True:
+        n = len(client.scheduler_info(n_workers=-1).get("workers", {})) if _takes_n_workers(client) \
+            else len(client.scheduler_info().get("workers", {}))
+        if n:
+            return n
+        if time.monotonic() > deadline:
+            raise SpecError("--scheduler" if scheduler else "--workers", "no Dask worker joined within 60 s")
+        time.sleep(0.2)
+
+
+def _takes_n_workers(client: Any) -> bool:
+    import inspect
+
+    return "n_workers" in inspect.signature(client.scheduler_info).parameters
+
+
+def _close(client: Any, cluster: Any) -> None:
+    for thing in (client, cluster):
+        if thing is not None:
+            try:
+                thing.close()
+            except Exception:  # noqa: BLE001 - closing a broken cluster must not hide the sweep's outcome
+                pass
+
+
+def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[str, Any]], journal: Journal,
+                out: Path, start: float, resumed: int, total: int, draw: bool, say: Progress) -> None:
+    """Submit batches, keep about two per worker in flight, and record rows as tasks finish."""
+    from distributed import as_completed
+
+    base, parts, metrics = spec.base, spec.field_parts(), list(spec.metrics)
+    # the base template and metrics go to the cluster once; every task refers to them
+    shared = client.scatter([base, parts, metrics], broadcast=True, hash=False)
+    batch_size = 1  # the first tasks measure a point's time; later batches aim at spec.batch_seconds
+    timed: list[float] = []
+    attempts: dict[str, int] = {}
+    in_flight: dict[Any, list[tuple[int, Any, str]]] = {}
+    queue = as_completed()
+    last_flush = time.perf_counter()
+
+    def workers_now() -> int:
+        try:
+            return max(1, len(client.scheduler_info(n_workers=-1)["workers"]) if _takes_n_workers(client)
+                       else len(client.scheduler_info()["workers"]))
+        except Exception:  # noqa: BLE001
+            return 1
+
+    def submit(batch: list[tuple[int, Any, str]]) -> None:
+        fut = client.submit(run_batch, batch, shared[0], shared[1], spec.stage, shared[2], pure=False,
+                            retries=TASK_RETRIES)
+        in_flight[fut] = batch
+        queue.add(fut)
+
+    def fill() -> None:
+        want = 2 * workers_now()
+        while todo and len(in_flight) < want:
+            n = min(batch_size, len(todo))
+            submit([todo.popleft() for _ in range(n)])
+
+    fill()
+    try:
+        while in_flight:
+            fut = next(queue)
+            batch = in_flight.pop(fut)
+            try:
+                rows = fut.result()
+            except Exception as exc:  # noqa: BLE001 - a task that raised or lost its worker too often
+                rows = []
+                for item in batch:
+                    pid = item[2]
+                    attempts[pid] = attempts.get(pid, 0) + 1
+                    if len(batch) > 1 or attempts[pid] < 2:
+                        todo.appendleft(item)  # tried again alone
+                    else:
+                        rows.append(_error_row(spec, item, exc))
+            if rows:
+                journal.append(rows)
+                for row in rows:
+                    done[str(row["id"])] = row
+                    if row["exit_code"] != EXIT_INTERNAL:
+                        timed.append(float(row.get("seconds", 0.0)))
+                if timed:
+                    mean = max(sum(timed[-64:]) / len(timed[-64:]), 1e-6)
+                    batch_size = int(min(MAX_BATCH, max(1, round(spec.batch_seconds / mean))))
+            if draw:
+                print(_bar(len(done), total, _counts(done), start, resumed), end="", file=sys.stderr, flush=True)
+            if time.perf_counter() - last_flush > FLUSH_SECONDS:
+                _write_tables(out, spec, list(done.values()))
+                last_flush = time.perf_counter()
+            fill()
+    except BaseException:
+        for fut in list(in_flight):
+            fut.cancel()
+        raise
+
+
+def _error_row(spec: SweepSpec, item: tuple[int, Any, str], exc: BaseException) -> dict[str, Any]:
+    index, values, pid = item
+    name = type(exc).__name__
+    why = ("its worker died running it every time it was tried (out of memory, or killed)"
+           if name == "KilledWorker" else f"the task failed on the cluster: {name}: {' '.join(str(exc).split())}")
+    row: dict[str, Any] = {"point": int(index), "id": pid, **values, "exit_code": EXIT_INTERNAL,
+                           "reason": why[:2000]}
+    for m in spec.metrics:
+        row[m.name] = math.nan
+    return row
+
+
+def _write_tables(out: Path, spec: SweepSpec, rows: list[dict[str, Any]]) -> None:
+    from fabricate.sweep.tables import columns, csv_bytes, parquet_bytes
+
+    fields = [f.path for f in spec.fields]
+    names = [m.name for m in spec.metrics]
+    _write_file(out / "sweep.csv", csv_bytes(rows, columns(fields, names)))
+    _write_file(out / "sweep.parquet", parquet_bytes(rows, fields, names))
+
+
+def _write_results(out: Path, spec: SweepSpec, rows: list[dict[str, Any]]) -> None:
+    from fabricate.sweep.plots import sweep_plots
+
+    _write_tables(out, spec, rows)
+    plots = sweep_plots(rows, [f.path for f in spec.fields], [m.name for m in spec.metrics], spec.map_fields)
+    for rel, data in plots.items():
+        _write_file(out / rel, data)
+
+
+def _best(spec: SweepSpec, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The ``spec.best`` passing points, ranked by the best metric (ties by point index)."""
+    if not spec.best or spec.best_metric is None:
+        return []
+    name = spec.best_metric.name
+    sign = 1.0 if spec.best_goal == "min" else -1.0
+    ok = [r for r in rows if r["exit_code"] == 0 and isinstance(r.get(name), float) and not math.isnan(r[name])]
+    ok.sort(key=lambda r: (sign * r[name], r["point"]))
+    return [{"rank": k + 1, "point": int(r["point"]), "id": r["id"], name: r[name],
+             "values": {f.path: r[f.path] for f in spec.fields}} for k, r in enumerate(ok[:spec.best])]
+
+
+def _build_best(client: Any, spec: SweepSpec, best: list[dict[str, Any]], out: Path, say: Progress) -> None:
+    """Build the best points in full on the cluster and write each as a normal build output folder."""
+    from fabricate.output import write_output
+    from fabricate.sweep.task import point_text
+
+    parts = spec.field_parts()
+    wanted = []
+    for entry in best:
+        folder = out / "best" / f"{entry['rank']:02d}-point{entry['point']}"
+        entry["folder"] = folder.relative_to(out).as_posix()
+        report = folder / "report.json"
+        if report.is_file():  # an earlier run built it: the same template gives the same files
+            try:
+                previous = json.loads(report.read_text(encoding="utf-8")).get("template_text")
+            except (OSError, ValueError):
+                previous = None
+            if previous == point_text(spec.base, parts, entry["values"]):
+                continue
+        wanted.append((entry, folder))
+    if not wanted:
+        return
+    say(f"building the best {len(best)} point{'s' if len(best) != 1 else ''} in full")
+    futures = [client.submit(build_point, entry["values"], spec.base, parts, pure=False, retries=TASK_RETRIES)
+               for entry, _ in wanted]
+    for (entry, folder), fut in zip(wanted, futures, strict=True):
+        code, reason, files = fut.result()
+        entry["build_exit_code"] = code
+        if not files:
+            entry["build_reason"] = reason
+            continue
+        write_output(files, folder, stage="build")

@@ -1,0 +1,557 @@
+"""Sweep specifications: which template, which fields vary over which values, and what to collect.
+
+A sweep spec is a TOML file with a ``[sweep]`` table (see ``templates/sweeps/`` and README.md)::
+
+    [sweep]
+    template = "finger_five_bar_ncg"        # a shipped name, or a path relative to this file
+    stage = "synth"                          # "synth" or "build"
+    sampling = "grid"                        # "grid", "lhs" or "sobol"
+    samples = 64                             # lhs / sobol only
+    seed = 0
+    metrics = ["synthesis.pose_error_mm.max", "min(strength.parts[*].min_safety_factor)"]
+
+    [vary]                                   # template field path -> values
+    "finger.lengths_mm[0]" = "36.0:44.0:5"   # start:stop:count (grid); start:stop is a range for lhs/sobol
+    "gears.module_mm" = [0.4, 0.5, 0.6]      # a list: these values (lhs/sobol pick among them)
+
+    [set]                                    # fixed changes applied to every point
+    "synthesis.select" = "least_pose_error"
+
+Everything here is pure: the points are computed from the spec alone (the samplers are seeded), so the
+same spec gives the same points on every machine with the same scipy.
+"""
+
+from __future__ import annotations
+
+import copy
+import functools
+import hashlib
+import itertools
+import json
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fabricate.errors import SpecError
+
+STAGES = ("synth", "build")
+SAMPLINGS = ("grid", "lhs", "sobol")
+
+#: Bounds that keep a sweep's bookkeeping small next to its builds (a point costs seconds of CPU).
+MAX_POINTS = 100_000
+MAX_FIELDS = 16
+MAX_METRICS = 64
+MAX_BEST = 20
+MAX_VALUES_PER_FIELD = 10_000
+
+_NAME = r"[A-Za-z_][A-Za-z0-9_-]*"
+_PATH = re.compile(rf"^{_NAME}(?:\.{_NAME}|\[\d+\])*$")
+_METRIC_PATH = re.compile(rf"^{_NAME}(?:\.{_NAME}|\[(?:\d+|\*)\])*$")
+_AGGREGATES = ("min", "max", "mean", "sum", "count")
+_AGGREGATE = re.compile(rf"^({'|'.join(_AGGREGATES)})\((.+)\)$")
+_TOKEN = re.compile(rf"\.?({_NAME})|\[(\d+|\*)\]")
+
+#: Report sections that only a full build writes: a metric under one of them needs ``stage = "build"``.
+BUILD_ONLY_SECTIONS = ("assembly", "bom", "gears", "interference", "parts", "strength", "notes")
+
+
+def parse_path(path: str, *, wildcard: bool = False) -> tuple[str | int, ...]:
+    """Split a field path such as ``finger.lengths_mm[0]`` into ``("finger", "lengths_mm", 0)``.
+
+    ``wildcard`` allows ``[*]`` (every element; metrics only), returned as the string ``"*"``.
+    """
+    pattern = _METRIC_PATH if wildcard else _PATH
+    if not isinstance(path, str) or not pattern.match(path):
+        raise ValueError(f'"{path}" is not a field path (names joined by ".", list indices in [ ])')
+    parts: list[str | int] = []
+    for name, index in _TOKEN.findall(path):
+        parts.append(name if name else ("*" if index == "*" else int(index)))
+    return tuple(parts)
+
+
+def get_path(data: Any, parts: Sequence[str | int]) -> Any:
+    """The value at ``parts`` in nested dicts/lists; ``KeyError`` when it is not there."""
+    node = data
+    for part in parts:
+        if isinstance(part, int):
+            if not isinstance(node, list) or part >= len(node):
+                raise KeyError(part)
+            node = node[part]
+        else:
+            if not isinstance(node, Mapping) or part not in node:
+                raise KeyError(part)
+            node = node[part]
+    return node
+
+
+def set_path(data: dict[str, Any], parts: Sequence[str | int], value: Any) -> None:
+    """Set ``value`` at ``parts`` in place. Missing tables and the last key are created; a list index
+    must exist (a sweep changes an element, it never grows a list)."""
+    node: Any = data
+    for i, part in enumerate(parts):
+        last = i == len(parts) - 1
+        if isinstance(part, int):
+            if not isinstance(node, list) or part >= len(node):
+                raise KeyError(part)
+            if last:
+                node[part] = value
+            else:
+                node = node[part]
+        else:
+            if not isinstance(node, dict):
+                raise KeyError(part)
+            if last:
+                node[part] = value
+            else:
+                node = node.setdefault(part, {})
+
+
+@dataclass(frozen=True)
+class Metric:
+    """A number read from each point's report.json: a key path, optionally aggregated over ``[*]``.
+
+    Attributes
+    ----------
+    name : str
+        As written, e.g. ``synthesis.pose_error_mm.max`` or ``min(strength.parts[*].min_safety_factor)``;
+        also the column name.
+    aggregate : str or None
+        ``min``, ``max``, ``mean``, ``sum`` or ``count`` over the values a ``[*]`` path selects.
+    parts : tuple
+        The key path.
+    """
+
+    name: str
+    aggregate: str | None
+    parts: tuple[str | int, ...]
+
+    @property
+    def section(self) -> str:
+        return str(self.parts[0])
+
+    def read(self, report: Mapping[str, Any]) -> float:
+        """This metric's value in ``report`` as a float; NaN where the report does not have it (an
+        invalid point, or a key the design's kind does not write). Booleans read as 0/1."""
+        values = _select(report, self.parts)
+        numbers = [float(v) for v in values if isinstance(v, (int, float)) and not isinstance(v, str)]
+        if self.aggregate is None:
+            return numbers[0] if len(values) == 1 and len(numbers) == 1 else math.nan
+        if self.aggregate == "count":
+            return float(len(values))
+        if not numbers:
+            return math.nan
+        if self.aggregate == "min":
+            return min(numbers)
+        if self.aggregate == "max":
+            return max(numbers)
+        if self.aggregate == "sum":
+            return math.fsum(numbers)
+        return math.fsum(numbers) / len(numbers)
+
+
+def _select(node: Any, parts: Sequence[str | int]) -> list[Any]:
+    if not parts:
+        return [node]
+    head, rest = parts[0], parts[1:]
+    if head == "*":
+        return [v for item in node for v in _select(item, rest)] if isinstance(node, list) else []
+    if isinstance(head, int):
+        return _select(node[head], rest) if isinstance(node, list) and head < len(node) else []
+    return _select(node[head], rest) if isinstance(node, Mapping) and head in node else []
+
+
+def parse_metric(text: str, where: str) -> Metric:
+    """A :class:`Metric` from ``path`` or ``min(path)`` (``[*]`` needs an aggregate)."""
+    if not isinstance(text, str):
+        raise SpecError(where, f"expected a report key path (string), got {text!r}")
+    name = text.strip()
+    m = _AGGREGATE.match(name)
+    aggregate, path = (m.group(1), m.group(2).strip()) if m else (None, name)
+    try:
+        parts = parse_path(path, wildcard=True)
+    except ValueError as exc:
+        raise SpecError(where, f"{exc}; an aggregate is one of {', '.join(_AGGREGATES)}, e.g. "
+                               "min(strength.parts[*].min_safety_factor)") from None
+    if "*" in parts and aggregate is None:
+        raise SpecError(where, f'"{name}" selects several values ([*]): wrap it in one of '
+                               f"{', '.join(_AGGREGATES)}, e.g. min({name})")
+    return Metric(name=name, aggregate=aggregate, parts=parts)
+
+
+@dataclass(frozen=True)
+class Field:
+    """One varied template field.
+
+    Attributes
+    ----------
+    path : str
+        Template field path, e.g. ``finger.lengths_mm[0]``; also the column name.
+    values : tuple or None
+        Explicit values (a list, or ``start:stop:count`` expanded); ``None`` for a continuous range.
+    low, high : float
+        The range of ``start:stop`` (lhs/sobol sample it continuously).
+    integer : bool
+        The template's value here is an integer: sampled values are rounded.
+    """
+
+    path: str
+    parts: tuple[str | int, ...]
+    values: tuple[Any, ...] | None = None
+    low: float = math.nan
+    high: float = math.nan
+    integer: bool = False
+
+    def at(self, u: float) -> Any:
+        """The value at unit coordinate ``u`` in [0, 1) (lhs/sobol)."""
+        if self.values is not None:
+            return self.values[min(int(u * len(self.values)), len(self.values) - 1)]
+        x = self.low + u * (self.high - self.low)
+        return int(round(x)) if self.integer else float(x)
+
+
+_RANGE = re.compile(r"^\s*([^:]+):([^:]+)(?::([^:]+))?\s*$")
+
+
+def parse_values(raw: Any, where: str, sampling: str, integer: bool) -> tuple[tuple[Any, ...] | None, float, float]:
+    """Values of a ``[vary]`` entry: a list, or ``"start:stop:count"`` (grid), ``"start:stop"`` (lhs/sobol).
+
+    Returns ``(values, low, high)``: explicit values, or ``None`` and a continuous range.
+    """
+    if isinstance(raw, list):
+        if not raw:
+            raise SpecError(where, "expected at least one value, got an empty list")
+        if len(raw) > MAX_VALUES_PER_FIELD:
+            raise SpecError(where, f"at most {MAX_VALUES_PER_FIELD} values, got {len(raw)}")
+        return tuple(raw), math.nan, math.nan
+    if isinstance(raw, str):
+        m = _RANGE.match(raw)
+        if m:
+            try:
+                start, stop = float(m.group(1)), float(m.group(2))
+            except ValueError:
+                raise SpecError(where, f'expected numbers in "start:stop[:count]", got "{raw}"') from None
+            if not (math.isfinite(start) and math.isfinite(stop)):
+                raise SpecError(where, f'expected finite numbers in "start:stop[:count]", got "{raw}"')
+            count_text = m.group(3)
+            if sampling == "grid":
+                if count_text is None:
+                    raise SpecError(where, f'a grid needs a count: "start:stop:count", got "{raw}"')
+                try:
+                    count = int(count_text)
+                except ValueError:
+                    raise SpecError(where, f'count must be a whole number, got "{count_text}"') from None
+                if not 1 <= count <= MAX_VALUES_PER_FIELD:
+                    raise SpecError(where, f"count must be in 1 .. {MAX_VALUES_PER_FIELD}, got {count}")
+                grid = np.linspace(start, stop, count) if count > 1 else np.array([start])
+                values = tuple(int(round(v)) for v in grid) if integer else tuple(float(v) for v in grid)
+                return values, math.nan, math.nan
+            if stop < start:
+                raise SpecError(where, f'expected start <= stop in "{raw}"')
+            return None, start, stop
+    raise SpecError(where, f'expected a list of values or "start:stop:count", got {raw!r}')
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A validated sweep.
+
+    Attributes
+    ----------
+    name : str
+        Names the default output folder ``outputs/<name>-sweep/``.
+    template_text : str
+        The base template's text; ``template`` is where it came from.
+    base : dict
+        The base template's tables with ``[set]`` applied (every point starts from a deep copy).
+    fields : tuple of Field
+    sampling, samples, seed, stage
+    metrics : tuple of Metric
+    best, best_metric, best_goal
+        Build the ``best`` points in full, ranked by ``best_metric`` (``"min"`` or ``"max"``), among the
+        points that pass every check.
+    map_fields : tuple of str
+        The two fields of the feasibility map.
+    batch_seconds : float
+        Target run time of one Dask task (points are batched to about this).
+    """
+
+    name: str
+    template: str
+    template_text: str
+    base: dict[str, Any]
+    fields: tuple[Field, ...]
+    sampling: str = "grid"
+    samples: int = 0
+    seed: int = 0
+    stage: str = "synth"
+    metrics: tuple[Metric, ...] = ()
+    best: int = 0
+    best_metric: Metric | None = None
+    best_goal: str = "min"
+    map_fields: tuple[str, ...] = ()
+    batch_seconds: float = 1.0
+    sets: dict[str, Any] = field(default_factory=dict)
+
+    def points(self) -> list[dict[str, Any]]:
+        """Every point as ``{field path: value}``, in a fixed order (the grid's last field varies
+        fastest; lhs/sobol in the sampler's order)."""
+        if self.sampling == "grid":
+            combos = itertools.product(*(f.values for f in self.fields))
+            return [dict(zip((f.path for f in self.fields), combo, strict=True)) for combo in combos]
+        unit = unit_samples(self.sampling, len(self.fields), self.samples, self.seed)
+        return [{f.path: f.at(float(u[j])) for j, f in enumerate(self.fields)} for u in unit]
+
+    def count(self) -> int:
+        """How many points, without making them."""
+        if self.sampling == "grid":
+            return math.prod(len(f.values or ()) for f in self.fields)
+        return self.samples
+
+    def point_template(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        """The base template's tables with one point's values set."""
+        data = copy.deepcopy(self.base)
+        for f in self.fields:
+            set_path(data, f.parts, copy.deepcopy(values[f.path]))
+        return data
+
+    @functools.cached_property
+    def digest(self) -> str:
+        """What every point shares: the base tables (with ``[set]``), the stage and the metrics."""
+        blob = json.dumps({"base": self.base, "stage": self.stage, "metrics": [m.name for m in self.metrics]},
+                          sort_keys=True, default=str)
+        return hashlib.sha256(blob.encode()).hexdigest()
+
+    def point_id(self, values: Mapping[str, Any]) -> str:
+        """A point's identity (its row's ``id``): the shared digest and its values. A resumed sweep skips the
+        points whose id is done."""
+        blob = json.dumps([self.digest, [[f.path, values[f.path]] for f in self.fields]], default=str)
+        return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+    def field_parts(self) -> list[tuple[str, tuple[str | int, ...]]]:
+        return [(f.path, f.parts) for f in self.fields]
+
+    def describe(self) -> dict[str, Any]:
+        """The spec as plain values (sweep.json; two runs resume each other only when these are equal)."""
+        out: dict[str, Any] = {
+            "name": self.name, "template": self.template, "stage": self.stage, "sampling": self.sampling,
+            "seed": self.seed, "samples": self.count(),
+            "vary": {f.path: (list(f.values) if f.values is not None else f"{f.low!r}:{f.high!r}")
+                     for f in self.fields},
+            "set": self.sets, "metrics": [m.name for m in self.metrics],
+            "best": {"count": self.best, "metric": self.best_metric.name if self.best_metric else None,
+                     "goal": self.best_goal},
+            "map": list(self.map_fields),
+        }
+        return out
+
+
+def unit_samples(sampling: str, dims: int, n: int, seed: int) -> np.ndarray:
+    """``(n, dims)`` points in the unit cube: a Latin hypercube or a scrambled Sobol' sequence (scipy.stats.qmc),
+    seeded so the same spec gives the same points."""
+    from scipy.stats import qmc
+
+    engine_type = qmc.LatinHypercube if sampling == "lhs" else qmc.Sobol
+    try:  # scipy >= 1.15 names the generator `rng`; older releases `seed`
+        engine = engine_type(d=dims, rng=np.random.default_rng(seed))
+    except TypeError:
+        engine = engine_type(d=dims, seed=np.random.default_rng(seed))
+    if sampling == "sobol":
+        return engine.random_base2(int(round(math.log2(n))))
+    return engine.random(n)
+
+
+def _int(t: Mapping[str, Any], key: str, default: int, lo: int, hi: int) -> int:
+    v = t.get(key, default)
+    if isinstance(v, bool) or not isinstance(v, int):
+        raise SpecError(f"sweep.{key}", f"expected a whole number, got {v!r}")
+    if not lo <= v <= hi:
+        raise SpecError(f"sweep.{key}", f"must be in {lo} .. {hi}, got {v}")
+    return v
+
+
+def _choice(t: Mapping[str, Any], key: str, default: str, choices: Sequence[str]) -> str:
+    v = t.get(key, default)
+    if v not in choices:
+        raise SpecError(f"sweep.{key}", f"expected one of {', '.join(map(repr, choices))}, got {v!r}")
+    return str(v)
+
+
+_SWEEP_KEYS = {"name", "template", "stage", "sampling", "samples", "seed", "metrics", "best", "best_metric",
+               "best_goal", "map", "batch_seconds"}
+
+
+def default_metrics(stage: str) -> list[str]:
+    """Collected when a sweep names none: the verdicts every kind of design reports."""
+    if stage == "build":
+        return ["interference.min_clearance_mm", "min(strength.parts[*].min_safety_factor)"]
+    return []
+
+
+def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None) -> SweepSpec:
+    """Validate a sweep spec's tables (``[sweep]``, ``[vary]``, ``[set]``); :class:`SpecError` names the field.
+
+    ``base_dir`` is where a relative ``sweep.template`` path is looked for first.
+    """
+    from fabricate.spec import design_from_text, find_template, parse_toml, read_text
+
+    unknown = sorted(set(tables) - {"sweep", "vary", "set"})
+    if unknown:
+        raise SpecError(unknown[0], "unknown table (a sweep spec has [sweep], [vary] and [set])")
+    sweep = tables.get("sweep")
+    if not isinstance(sweep, Mapping):
+        raise SpecError("sweep", "missing table [sweep]")
+    bad = sorted(set(sweep) - _SWEEP_KEYS)
+    if bad:
+        raise SpecError(f"sweep.{bad[0]}", "unknown field")
+    template_arg = sweep.get("template")
+    if not isinstance(template_arg, str) or not template_arg:
+        raise SpecError("sweep.template", "expected the base template's name or path")
+    candidate = (base_dir / template_arg) if base_dir is not None else None
+    path = candidate if candidate is not None and candidate.is_file() else find_template(template_arg)
+    text = read_text(path)
+    design_from_text(text, path)  # the base template must be valid by itself
+    base = parse_toml(text, str(path))
+
+    stage = _choice(sweep, "stage", "synth", STAGES)
+    sampling = _choice(sweep, "sampling", "grid", SAMPLINGS)
+    seed = _int(sweep, "seed", 0, 0, 2**32 - 1)
+    if sampling == "grid":
+        if "samples" in sweep:
+            raise SpecError("sweep.samples", "a grid's size is set by its values; samples is for lhs/sobol")
+        samples = 0
+    else:
+        samples = _int(sweep, "samples", 64, 1, MAX_POINTS)
+        if sampling == "sobol" and samples & (samples - 1):
+            raise SpecError("sweep.samples", f"a Sobol' sequence keeps its balance only with a power of two "
+                                             f"points (e.g. {1 << max(0, samples.bit_length() - 1)} or "
+                                             f"{1 << samples.bit_length()}), got {samples}")
+
+    sets_raw = tables.get("set", {})
+    if not isinstance(sets_raw, Mapping):
+        raise SpecError("set", "expected a table of field path = value")
+    sets: dict[str, Any] = {}
+    for key, value in sets_raw.items():
+        try:
+            parts = parse_path(key)
+            set_path(base, parts, copy.deepcopy(value))
+        except (ValueError, KeyError) as exc:
+            raise SpecError(f"set.{key}", f"not a field of the template ({exc})") from None
+        sets[key] = value
+
+    vary = tables.get("vary")
+    if not isinstance(vary, Mapping) or not vary:
+        raise SpecError("vary", "expected a table of field path = values, with at least one field")
+    if len(vary) > MAX_FIELDS:
+        raise SpecError("vary", f"at most {MAX_FIELDS} fields, got {len(vary)}")
+    fields: list[Field] = []
+    for key, raw in vary.items():
+        where = f"vary.{key}"
+        try:
+            parts = parse_path(key)
+        except ValueError as exc:
+            raise SpecError(where, str(exc)) from None
+        if key in sets:
+            raise SpecError(where, "is also in [set]: a field is either varied or set")
+        try:
+            current = get_path(base, parts)
+        except KeyError:
+            current = None
+            try:  # a field the template leaves at its default: the table (or list) above it must exist
+                get_path(base, parts[:-1]) if len(parts) > 1 else None
+            except KeyError:
+                raise SpecError(where, "not a field of the template (its table or list is not there)") from None
+            if isinstance(parts[-1], int):
+                raise SpecError(where, "the list has no such element (a sweep never grows a list)") from None
+        integer = isinstance(current, int) and not isinstance(current, bool)
+        values, low, high = parse_values(raw, where, sampling, integer)
+        fields.append(Field(path=key, parts=parts, values=values, low=low, high=high, integer=integer))
+
+    count = math.prod(len(f.values or ()) for f in fields) if sampling == "grid" else samples
+    if count > MAX_POINTS:
+        raise SpecError("vary", f"the sweep has {count} points; at most {MAX_POINTS}")
+
+    metrics_raw = sweep.get("metrics", default_metrics(stage))
+    if not isinstance(metrics_raw, list) or len(metrics_raw) > MAX_METRICS:
+        raise SpecError("sweep.metrics", f"expected a list of at most {MAX_METRICS} report key paths")
+    metrics = tuple(parse_metric(m, f"sweep.metrics[{i}]") for i, m in enumerate(metrics_raw))
+    names = [m.name for m in metrics]
+    if len(set(names)) != len(names):
+        raise SpecError("sweep.metrics", "a metric is listed twice")
+    for i, m in enumerate(metrics):
+        if m.name in {f.path for f in fields} or m.name in ("point", "id", "exit_code", "reason"):
+            raise SpecError(f"sweep.metrics[{i}]", f'"{m.name}" is also the name of another column')
+        if stage == "synth" and m.section in BUILD_ONLY_SECTIONS:
+            raise SpecError(f"sweep.metrics[{i}]", f'"{m.name}" is written by a full build only: set '
+                                                   'sweep.stage = "build" (or --stage build)')
+
+    best = _int(sweep, "best", 0, 0, MAX_BEST)
+    best_metric = None
+    best_goal = _choice(sweep, "best_goal", "min", ("min", "max"))
+    if best:
+        if "best_metric" in sweep:
+            best_metric = parse_metric(sweep["best_metric"], "sweep.best_metric")
+            if best_metric.name not in names:
+                raise SpecError("sweep.best_metric", f'"{best_metric.name}" is not one of sweep.metrics')
+        elif metrics:
+            best_metric = metrics[0]
+        else:
+            raise SpecError("sweep.best", "ranking the best points needs a metric (sweep.metrics)")
+
+    numeric = [f.path for f in fields if _is_numeric(f)]
+    map_raw = sweep.get("map", numeric[:2] if len(numeric) >= 2 else [])
+    if not isinstance(map_raw, list) or len(map_raw) not in (0, 2):
+        raise SpecError("sweep.map", "expected two varied field paths (the feasibility map's axes)")
+    for i, path in enumerate(map_raw):
+        if path not in numeric:
+            raise SpecError(f"sweep.map[{i}]", f'"{path}" is not a varied numeric field')
+    if len(map_raw) == 2 and map_raw[0] == map_raw[1]:
+        raise SpecError("sweep.map", "the two axes must be different fields")
+
+    batch = sweep.get("batch_seconds", 1.0)
+    if isinstance(batch, bool) or not isinstance(batch, (int, float)) or not 0.01 <= batch <= 600:
+        raise SpecError("sweep.batch_seconds", f"expected a number of seconds in 0.01 .. 600, got {batch!r}")
+
+    name = sweep.get("name", Path(str(template_arg)).stem)
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}", name):
+        raise SpecError("sweep.name", f"expected a plain name (letters, digits, _ . -), got {name!r}")
+    return SweepSpec(name=name, template=str(template_arg), template_text=text, base=base, fields=tuple(fields),
+                     sampling=sampling, samples=samples, seed=seed, stage=stage, metrics=metrics, best=best,
+                     best_metric=best_metric, best_goal=best_goal, map_fields=tuple(map_raw),
+                     batch_seconds=float(batch), sets=sets)
+
+
+def _is_numeric(f: Field) -> bool:
+    if f.values is None:
+        return True
+    return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in f.values)
+
+
+def find_sweep(path: str | Path) -> Path | None:
+    """The sweep spec file ``path`` names (a path, or a shipped spec's name from ``templates/sweeps/``), or
+    None when ``path`` is not a sweep spec (a design template, say)."""
+    from fabricate.spec import TEMPLATE_DIR, parse_toml, read_text
+
+    candidate = Path(path)
+    if not candidate.is_file():
+        stem = candidate.name[:-5] if candidate.name.endswith(".toml") else candidate.name
+        shipped = TEMPLATE_DIR / "sweeps" / f"{stem}.toml"
+        return shipped if candidate.parent == Path(".") and shipped.is_file() else None
+    try:
+        return candidate if "sweep" in parse_toml(read_text(candidate), str(candidate)) else None
+    except SpecError:
+        return None
+
+
+def load_sweep(path: str | Path) -> SweepSpec:
+    """Read and validate a sweep spec file (a path, or a shipped spec's name from ``templates/sweeps/``)."""
+    from fabricate.spec import parse_toml, read_text
+
+    source = find_sweep(path)
+    if source is None:
+        raise SpecError("", f"sweep spec not found: {path} (a TOML file with a [sweep] table)")
+    return sweep_from_tables(parse_toml(read_text(source), str(source)), source.parent)

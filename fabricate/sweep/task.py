@@ -1,0 +1,127 @@
+"""One sweep point, and a batch of them: what a Dask task runs (no Dask in here).
+
+A point is a template like any other: it is validated, synthesised (``stage = "synth"``) or built in full
+(``"build"``), and its report's metrics are read. Whatever happens, the point becomes a row; a bad point is a
+row with its exit code and reason, never an exception out of the task.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import os
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from fabricate.sweep.spec import Metric
+
+#: Exit codes of a row, as the CLI's: 0 passes, 1 fails a check, 2 invalid or infeasible, 3 internal error.
+EXIT_OK, EXIT_FAILED, EXIT_INVALID, EXIT_INTERNAL = 0, 1, 2, 3
+
+
+def point_text(base: Mapping[str, Any], fields: Sequence[tuple[str, Sequence[str | int]]],
+               values: Mapping[str, Any]) -> str:
+    """A point's template as TOML text: the base tables with the point's values set."""
+    from fabricate.sweep.spec import set_path
+    from fabricate.tomlwrite import dumps
+
+    data = copy.deepcopy(dict(base))
+    for path, parts in fields:
+        set_path(data, parts, copy.deepcopy(values[path]))
+    return dumps(data)
+
+
+def _reason(exc: BaseException) -> str:
+    return " ".join(str(exc).split())[:2000]
+
+
+def evaluate(text: str, stage: str) -> tuple[int, str, dict[str, Any] | None, Any]:
+    """Validate and run one template text.
+
+    Returns
+    -------
+    exit_code, reason, report, outcome
+        ``report`` is None when the point never got one (invalid or infeasible: exit code 2; a bug: 3).
+    """
+    from fabricate.errors import FabricateError
+    from fabricate.pipeline import run_build, run_synth
+    from fabricate.spec import design_from_text
+
+    try:
+        design = design_from_text(text, "point.toml")
+        outcome = (run_build if stage == "build" else run_synth)(design)
+    except FabricateError as exc:
+        return EXIT_INVALID, _reason(exc), None, None
+    except MemoryError:
+        return EXIT_INTERNAL, "out of memory", None, None
+    except Exception as exc:  # noqa: BLE001 - a bug in one point must not end the sweep
+        return EXIT_INTERNAL, f"internal error: {type(exc).__name__}: {_reason(exc)}", None, None
+    report = outcome.report
+    failures = list(report.get("checks", {}).get("failures", []))
+    return outcome.exit_code, "; ".join(failures)[:2000], report, outcome
+
+
+def run_point(index: int, values: Mapping[str, Any], pid: str, base: Mapping[str, Any],
+              fields: Sequence[tuple[str, Sequence[str | int]]], stage: str,
+              metrics: Sequence[Metric]) -> dict[str, Any]:
+    """One row: ``point``, ``id``, the varied values, ``exit_code``, ``reason``, one float per metric (NaN
+    where the report has no such key), and ``seconds`` (the run time, kept out of the result tables)."""
+    start = time.perf_counter()
+    try:
+        text = point_text(base, fields, values)
+    except (KeyError, TypeError, ValueError) as exc:  # the spec was checked; a value TOML cannot hold
+        code, reason, report = EXIT_INVALID, f"cannot write this point's template: {_reason(exc)}", None
+    else:
+        code, reason, report, _ = evaluate(text, stage)
+    row: dict[str, Any] = {"point": int(index), "id": pid}
+    row.update(values)
+    row["exit_code"] = int(code)
+    row["reason"] = reason
+    for m in metrics:
+        row[m.name] = m.read(report) if report is not None else math.nan
+    row["seconds"] = round(time.perf_counter() - start, 4)
+    return row
+
+
+def run_batch(points: Sequence[tuple[int, Mapping[str, Any], str]], base: Mapping[str, Any],
+              fields: Sequence[tuple[str, Sequence[str | int]]], stage: str,
+              metrics: Sequence[Metric]) -> list[dict[str, Any]]:
+    """Rows of several points ``(index, values, id)``, run one after the other in this process (one Dask
+    task).
+
+    Plots that a build would draw in a forked child are drawn in this process: a Dask worker runs one task
+    per core already.
+    """
+    os.environ.setdefault("FABRICATE_SERIAL", "1")
+    return [run_point(i, values, pid, base, fields, stage, metrics) for i, values, pid in points]
+
+
+def build_point(values: Mapping[str, Any], base: Mapping[str, Any],
+                fields: Sequence[tuple[str, Sequence[str | int]]]) -> tuple[int, str, dict[str, bytes]]:
+    """A point built in full (the sweep's best points): exit code, reason and every output file."""
+    os.environ.setdefault("FABRICATE_SERIAL", "1")
+    code, reason, _report, outcome = evaluate(point_text(base, fields, values), "build")
+    return code, reason, (dict(outcome.files) if outcome is not None else {})
+
+
+def _plain(v: Any) -> Any:
+    if isinstance(v, float) and not math.isfinite(v):
+        return None if math.isnan(v) else ("inf" if v > 0 else "-inf")
+    return v
+
+
+def row_json(row: Mapping[str, Any]) -> str:
+    """A row as one JSON line (NaN as null), for the sweep's journal."""
+    clean = {k: _plain(v) for k, v in row.items()}
+    return json.dumps(clean, separators=(",", ":"), allow_nan=False)
+
+
+def row_from_json(line: str, metrics: Sequence[Metric]) -> dict[str, Any]:
+    """Inverse of :func:`row_json` (a missing metric reads back as NaN, an infinite one as inf)."""
+    row = json.loads(line)
+    for m in metrics:
+        v = row.get(m.name)
+        row[m.name] = math.nan if v is None else (float(v) if isinstance(v, str) else v)
+    return row
