@@ -53,6 +53,29 @@ def _one_rebuild_per_template(monkeypatch):
     monkeypatch.setattr(pipeline, "run_build", cached)
 
 
+_STEP_VERDICTS: dict[tuple, list[str]] = {}
+
+
+@pytest.fixture(autouse=True)
+def _one_step_reading_per_file(monkeypatch):
+    """Reading STEP back with OCP is most of a check's time (~2.5 s a file); a tampering of another file
+    leaves the STEP files as they were, so their verdict (a function of the bytes and the expectation) is
+    kept by content hash. A changed STEP file has another hash and is read for real."""
+    import hashlib
+
+    import fabricate.export.step as step
+
+    real = step.step_problems
+
+    def cached(data, expected=None, rel_tol=1e-6):
+        key = (hashlib.sha256(data).hexdigest(), tuple(sorted((expected or {}).items())), rel_tol)
+        if key not in _STEP_VERDICTS:
+            _STEP_VERDICTS[key] = real(data, expected, rel_tol)
+        return list(_STEP_VERDICTS[key])
+
+    monkeypatch.setattr(step, "step_problems", cached)
+
+
 @pytest.fixture
 def copy(built, tmp_path) -> Path:
     target = tmp_path / FAST

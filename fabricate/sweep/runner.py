@@ -71,6 +71,7 @@ class SweepOutcome:
     best: list[dict[str, Any]] = field(default_factory=list)
     seconds: float = 0.0
     workers: int = 0
+    tasks: int = 0
 
 
 # -- output folder ------------------------------------------------------------------------------------------
@@ -264,7 +265,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     journal = Journal(out / JOURNAL)
     client = cluster = None
     interrupted = False
-    n_workers = 0
+    n_workers = tasks = 0
     try:
         if todo:
             client, cluster = connect(workers, scheduler)
@@ -272,8 +273,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
             say(f"sweep {spec.name}: {len(points)} points ({resumed} done earlier), stage {spec.stage}, "
                 f"{n_workers} Dask worker{'s' if n_workers != 1 else ''}"
                 f"{' at ' + scheduler if scheduler else ' (local cluster)'}")
-            _run_points(client, spec, todo, done, journal, out, start, resumed, len(points),
-                        draw, say)
+            tasks = _run_points(client, spec, todo, done, journal, out, start, resumed, len(points), draw, say)
         elif not quiet:
             say(f"sweep {spec.name}: all {len(points)} points done earlier; writing the results")
     except KeyboardInterrupt:
@@ -305,7 +305,8 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
         _close(client, cluster)
     code = 130 if interrupted else (1 if counts.get(str(EXIT_INTERNAL)) else 0)
     return SweepOutcome(exit_code=code, out=out, total=len(points), done=len(rows), resumed=resumed,
-                        counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers)
+                        counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers,
+                        tasks=tasks)
 
 
 def _json(data: Any) -> bytes:
@@ -340,8 +341,9 @@ def _close(client: Any, cluster: Any) -> None:
 
 
 def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[str, Any]], journal: Journal,
-                out: Path, start: float, resumed: int, total: int, draw: bool, say: Progress) -> None:
-    """Submit batches, keep about two per worker in flight, and record rows as tasks finish."""
+                out: Path, start: float, resumed: int, total: int, draw: bool, say: Progress) -> int:
+    """Submit batches, keep about two per worker in flight, and record rows as tasks finish. Returns the
+    number of tasks submitted."""
     from distributed import as_completed
 
     base, parts, metrics = spec.base, spec.field_parts(), list(spec.metrics)
@@ -353,6 +355,7 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
     in_flight: dict[Any, list[tuple[int, Any, str]]] = {}
     queue = as_completed()
     last_flush = time.perf_counter()
+    submitted = 0
 
     def workers_now() -> int:
         try:
@@ -362,6 +365,8 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
             return 1
 
     def submit(batch: list[tuple[int, Any, str]]) -> None:
+        nonlocal submitted
+        submitted += 1
         fut = client.submit(run_batch, batch, shared[0], shared[1], spec.stage, shared[2], pure=False,
                             retries=TASK_RETRIES)
         in_flight[fut] = batch
@@ -408,6 +413,7 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
         for fut in list(in_flight):
             fut.cancel()
         raise
+    return submitted
 
 
 def _error_row(spec: SweepSpec, item: tuple[int, Any, str], exc: BaseException) -> dict[str, Any]:

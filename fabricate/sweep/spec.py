@@ -470,6 +470,8 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None) -
         integer = isinstance(current, int) and not isinstance(current, bool)
         values, low, high = parse_values(raw, where, sampling, integer)
         fields.append(Field(path=key, parts=parts, values=values, low=low, high=high, integer=integer))
+        if current is None:
+            _check_known(base, fields[-1], where, str(path))
 
     count = math.prod(len(f.values or ()) for f in fields) if sampling == "grid" else samples
     if count > MAX_POINTS:
@@ -523,6 +525,21 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None) -
                      sampling=sampling, samples=samples, seed=seed, stage=stage, metrics=metrics, best=best,
                      best_metric=best_metric, best_goal=best_goal, map_fields=tuple(map_raw),
                      batch_seconds=float(batch), sets=sets)
+
+
+def _check_known(base: dict[str, Any], f: Field, where: str, source: str) -> None:
+    """A field the base template leaves at its default must be one the template's kind knows: set its first
+    value and validate (a misspelt path would otherwise make every point an "unknown field" row)."""
+    from fabricate.spec import design_from_text
+    from fabricate.tomlwrite import dumps
+
+    data = copy.deepcopy(base)
+    set_path(data, f.parts, f.values[0] if f.values is not None else f.at(0.0))
+    try:
+        design_from_text(dumps(data), source)
+    except SpecError as exc:
+        if exc.path == f.path and exc.message == "unknown field":
+            raise SpecError(where, "not a field of the template (unknown field)") from None
 
 
 def _is_numeric(f: Field) -> bool:

@@ -1,0 +1,392 @@
+"""Design-space sweeps (fabricate.sweep): the spec, the samplers, one point, a local Dask cluster, a real
+``dask scheduler`` with two ``dask worker`` processes (one killed mid-sweep), and an interrupted sweep that
+resumes.
+
+The sweeps here vary the elliptic gear pair (``gear_pair_elliptic``, synthesis stage: ~0.2 s a point): its
+pitch curves have closed forms, so every row can be checked against the values in its own columns (a row
+mixed up with another point's metrics fails), and an eccentricity >= 1 is an invalid point.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fabricate.errors import SpecError
+from fabricate.sweep.spec import (
+    get_path,
+    parse_metric,
+    parse_path,
+    set_path,
+    sweep_from_tables,
+    unit_samples,
+)
+from fabricate.sweep.task import run_point
+
+pytest.importorskip("distributed")
+pytest.importorskip("pyarrow")
+
+GEAR_METRICS = ["synthesis.center_distance_mm", "min(synthesis.transmission_ratio[*])",
+                "max(synthesis.transmission_ratio[*])", "synthesis.pitch_radius_a_mm[0]",
+                "synthesis.pitch_radius_a_mm[1]"]
+
+
+def _values(v):
+    return v if isinstance(v, str) else [float(x) for x in v]
+
+
+def gear_tables(eccentricities=(0.1, 0.2, 0.3, 1.5), modules=(0.8, 1.0), **sweep) -> dict:
+    return {"sweep": {"template": "gear_pair_elliptic", "stage": "synth", "metrics": list(GEAR_METRICS),
+                      "name": "gears", **sweep},
+            "vary": {"gear_pair.eccentricity": _values(eccentricities), "gears.module_mm": _values(modules)},
+            "set": {"checks.sweep_poses": 30}}
+
+
+def reference_rows(spec) -> list[dict]:
+    """Every point run one by one in this process, without Dask."""
+    return [run_point(i, values, spec.point_id(values), spec.base, spec.field_parts(), spec.stage,
+                      list(spec.metrics)) for i, values in enumerate(spec.points())]
+
+
+def same_row(a: dict, b: dict) -> bool:
+    """Equal in every column but the run time, floats bit for bit (NaN equals NaN)."""
+    keys = (set(a) | set(b)) - {"seconds"}
+    for k in keys:
+        x, y = a.get(k), b.get(k)
+        if isinstance(x, float) and isinstance(y, float) and math.isnan(x) and math.isnan(y):
+            continue
+        if type(x) is not type(y) or x != y:
+            return False
+    return True
+
+
+def check_gear_row(row: dict) -> None:
+    """Closed forms of a 1:1 elliptic pair turning about the foci: the pitch radius runs from a(1 - e) to
+    a(1 + e), the centre distance is 2a, and the ratio spans (1 - e)/(1 + e) .. (1 + e)/(1 - e)."""
+    e = row["gear_pair.eccentricity"]
+    r_min, r_max = row["synthesis.pitch_radius_a_mm[0]"], row["synthesis.pitch_radius_a_mm[1]"]
+    assert r_max / r_min == pytest.approx((1 + e) / (1 - e), rel=1e-6)
+    assert row["synthesis.center_distance_mm"] == pytest.approx(r_min + r_max, rel=1e-6)
+    assert row["max(synthesis.transmission_ratio[*])"] == pytest.approx((1 + e) / (1 - e), rel=1e-6)
+    assert row["min(synthesis.transmission_ratio[*])"] == pytest.approx((1 - e) / (1 + e), rel=1e-6)
+
+
+# -- spec, paths, samplers (pure) ------------------------------------------------------------------------------
+
+def test_field_paths_get_and_set():
+    assert parse_path("finger.lengths_mm[0]") == ("finger", "lengths_mm", 0)
+    assert parse_path("a[1][2].b-c") == ("a", 1, 2, "b-c")
+    assert parse_path("strength.parts[*].x", wildcard=True) == ("strength", "parts", "*", "x")
+    for bad in ("", "a..b", "a[x]", "a[-1]", "[0]", "a.[0]", "a[*]"):
+        with pytest.raises(ValueError):
+            parse_path(bad)
+    data = {"finger": {"lengths_mm": [40.0, 28.0, 20.0]}}
+    set_path(data, ("finger", "lengths_mm", 1), 30.0)
+    set_path(data, ("synthesis", "select"), "x_A")  # a missing table is created
+    assert data == {"finger": {"lengths_mm": [40.0, 30.0, 20.0]}, "synthesis": {"select": "x_A"}}
+    assert get_path(data, ("finger", "lengths_mm", 2)) == 20.0
+    with pytest.raises(KeyError):
+        set_path(data, ("finger", "lengths_mm", 3), 1.0)  # a sweep never grows a list
+
+
+def test_metrics_read_paths_and_aggregates():
+    report = {"strength": {"parts": [{"sf": 3.0}, {"sf": 2.5}, {"sf": 7.0}]}, "a": {"b": [1, 2], "ok": True}}
+    assert parse_metric("min(strength.parts[*].sf)", "m").read(report) == 2.5
+    assert parse_metric("max(strength.parts[*].sf)", "m").read(report) == 7.0
+    assert parse_metric("mean(strength.parts[*].sf)", "m").read(report) == pytest.approx(12.5 / 3, rel=1e-15)
+    assert parse_metric("count(strength.parts[*])", "m").read(report) == 3.0
+    assert parse_metric("a.b[1]", "m").read(report) == 2.0
+    assert parse_metric("a.ok", "m").read(report) == 1.0
+    assert math.isnan(parse_metric("a.missing", "m").read(report))
+    assert math.isnan(parse_metric("a.b", "m").read(report))  # a list is not a number
+    with pytest.raises(SpecError, match="selects several values"):
+        parse_metric("strength.parts[*].sf", "sweep.metrics[0]")
+
+
+def test_grid_points_are_the_product_in_order():
+    spec = sweep_from_tables(gear_tables(eccentricities=(0.1, 0.2), modules="0.5:1.0:3"))
+    points = spec.points()
+    assert spec.count() == len(points) == 6
+    assert [p["gear_pair.eccentricity"] for p in points] == [0.1, 0.1, 0.1, 0.2, 0.2, 0.2]
+    assert [p["gears.module_mm"] for p in points] == [0.5, 0.75, 1.0] * 2
+    assert len({spec.point_id(p) for p in points}) == 6
+
+
+@pytest.mark.parametrize("n, dims, seed", [(7, 1, 0), (50, 3, 1), (64, 5, 123)])
+def test_latin_hypercube_has_one_point_per_stratum(n, dims, seed):
+    u = unit_samples("lhs", dims, n, seed)
+    assert u.shape == (n, dims) and np.all((u >= 0) & (u < 1))
+    for j in range(dims):  # the defining property: each of the n equal slices of every axis holds one point
+        assert sorted(np.floor(u[:, j] * n).astype(int)) == list(range(n))
+    assert np.array_equal(u, unit_samples("lhs", dims, n, seed))  # seeded
+
+
+@pytest.mark.parametrize("m, dims", [(3, 2), (6, 4)])
+def test_sobol_points_are_balanced(m, dims):
+    n = 2 ** m
+    u = unit_samples("sobol", dims, n, 7)
+    for j in range(dims):  # a (0, m, s)-net in base 2: every dyadic slice of 1/2 .. 1/2^m holds n/2^k points
+        for k in range(1, m + 1):
+            counts = np.bincount(np.floor(u[:, j] * 2 ** k).astype(int), minlength=2 ** k)
+            assert np.all(counts == n // 2 ** k)
+
+
+def test_lhs_sweep_samples_ranges_and_choices():
+    tables = gear_tables(sampling="lhs", samples=40, seed=3)
+    tables["vary"] = {"gear_pair.eccentricity": "0.05:0.35", "gears.teeth[0]": "20:40",
+                      "gears.module_mm": [0.8, 1.0, 1.25]}
+    spec = sweep_from_tables(tables)
+    points = spec.points()
+    assert len(points) == 40
+    e = np.array([p["gear_pair.eccentricity"] for p in points])
+    assert np.all((e >= 0.05) & (e <= 0.35))
+    assert sorted(np.floor((e - 0.05) / 0.3 * 40).astype(int)) == list(range(40))  # still one per stratum
+    teeth = [p["gears.teeth[0]"] for p in points]
+    assert all(isinstance(t, int) and 20 <= t <= 40 for t in teeth)  # the template's integer stays integer
+    modules = [p["gears.module_mm"] for p in points]
+    assert {modules.count(v) for v in (0.8, 1.0, 1.25)} <= {13, 14}  # a list is split evenly
+
+
+@pytest.mark.parametrize("change, field", [
+    (lambda t: t["vary"].update({"gear_pair.eccentrcity": [0.1]}), "vary.gear_pair.eccentrcity"),
+    (lambda t: t["vary"].update({"gears.teeth[2]": [30]}), "vary.gears.teeth[2]"),
+    (lambda t: t["vary"].update({"gears.module_mm": "0.5:1.0"}), "vary.gears.module_mm"),
+    (lambda t: t["vary"].update({"gears.module_mm": []}), "vary.gears.module_mm"),
+    (lambda t: t["sweep"].update({"metrics": ["strength.passed"]}), "sweep.metrics[0]"),
+    (lambda t: t["sweep"].update({"metrics": ["a.b[*]"]}), "sweep.metrics[0]"),
+    (lambda t: t["sweep"].update({"sampling": "sobol", "samples": 48}), "sweep.samples"),
+    (lambda t: t["sweep"].update({"sampling": "random"}), "sweep.sampling"),
+    (lambda t: t["sweep"].update({"samples": 8}), "sweep.samples"),
+    (lambda t: t["sweep"].update({"best": 2, "metrics": []}), "sweep.best"),
+    (lambda t: t["sweep"].update({"map": ["gears.module_mm", "gears.module_mm"]}), "sweep.map"),
+    (lambda t: t["sweep"].update({"map": ["gears.teeth[0]", "gears.module_mm"]}), "sweep.map[0]"),
+    (lambda t: t["sweep"].update({"stage": "all"}), "sweep.stage"),
+    (lambda t: t["sweep"].update({"template": "no_such_template"}), ""),
+    (lambda t: t["sweep"].update({"colour": "red"}), "sweep.colour"),
+    (lambda t: t["vary"].update({"gears.module_mm": "0.1:2.0:10000", "gear_pair.eccentricity": "0:0.5:11"}),
+     "vary"),
+    (lambda t: t["set"].update({"gears.module_mm": 1.0}), "vary.gears.module_mm"),
+])
+def test_bad_sweep_specs_name_the_field(change, field):
+    tables = gear_tables()
+    change(tables)
+    with pytest.raises(SpecError) as info:
+        sweep_from_tables(tables)
+    assert info.value.path == field, str(info.value)
+
+
+def test_a_bad_point_is_a_row_with_its_reason():
+    spec = sweep_from_tables(gear_tables(eccentricities=(1.5,), modules=(1.0,)))
+    (values,) = spec.points()
+    row = run_point(0, values, spec.point_id(values), spec.base, spec.field_parts(), spec.stage,
+                    list(spec.metrics))
+    assert row["exit_code"] == 2 and "gear_pair.eccentricity" in row["reason"]
+    assert all(math.isnan(row[m]) for m in GEAR_METRICS)
+
+
+# -- Dask: local cluster, real scheduler and workers, resume ----------------------------------------------------
+
+def test_local_cluster_sweep_equals_the_points_one_by_one(tmp_path):
+    import pyarrow.parquet as pq
+
+    from fabricate.sweep.runner import run_sweep
+    from fabricate.sweep.tables import columns, csv_bytes
+
+    spec = sweep_from_tables(gear_tables(best=1, best_metric="synthesis.center_distance_mm", best_goal="min"))
+    expected = reference_rows(spec)
+    out = tmp_path / "sweep"
+    outcome = run_sweep(spec, out, workers=2, quiet=True)
+    assert outcome.exit_code == 0 and outcome.done == outcome.total == 8 and outcome.workers == 2
+    assert outcome.counts == {"0": 6, "2": 2}
+    assert outcome.tasks < outcome.total  # points of ~0.2 s are batched towards batch_seconds (1 s)
+
+    journal = [json.loads(line) for line in (out / "rows.jsonl").read_text().splitlines()]
+    assert sorted(r["point"] for r in journal) == list(range(8))  # every point once
+    cols = columns([f.path for f in spec.fields], GEAR_METRICS)
+    assert (out / "sweep.csv").read_bytes() == csv_bytes(expected, cols)  # every metric bit for bit
+    table = pq.read_table(out / "sweep.parquet").to_pylist()
+    assert len(table) == 8
+    for got, want in zip(table, expected, strict=True):
+        want = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in want.items()}
+        assert {k: got[k] for k in cols} == {k: want[k] for k in cols}
+    for row in expected:
+        if row["exit_code"] == 0:
+            check_gear_row(row)
+    by_e = {(r["gear_pair.eccentricity"], r["gears.module_mm"]): r for r in expected}
+    assert by_e[(0.2, 0.8)]["synthesis.center_distance_mm"] == pytest.approx(
+        0.8 * by_e[(0.2, 1.0)]["synthesis.center_distance_mm"], rel=1e-9)  # the pair scales with the module
+
+    plots = sorted(p.name for p in (out / "plots").iterdir())
+    assert "feasibility.png" in plots and len(plots) == 1 + 2 * len(GEAR_METRICS)
+    assert all((out / "plots" / p).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in plots)
+
+    record = json.loads((out / "sweep.json").read_text())
+    assert record["complete"] and record["counts"] == {"0": 6, "2": 2}
+    (best,) = record["best"]  # 4 a E(e) = pi m z: the least eccentric, finest pair is the smallest
+    assert best["values"] == {"gear_pair.eccentricity": 0.1, "gears.module_mm": 0.8}
+    report = json.loads((out / best["folder"] / "report.json").read_text())
+    assert report["design"]["kind"] == "gear_pair"
+    # the full build is judged like any build (its checks may fail where synthesis passed); the sweep says so
+    assert best["build_exit_code"] == (0 if report["checks"]["passed"] else 1)
+    assert report["synthesis"]["center_distance_mm"] == pytest.approx(  # a build's report rounds to 1e-9 mm
+        by_e[(0.1, 0.8)]["synthesis.center_distance_mm"], abs=1e-9)
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _dask(*args: str) -> subprocess.Popen:
+    exe = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
+    assert exe, "the dask command (dask distributed) is not installed"
+    return subprocess.Popen([exe, *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+
+
+def _journal_points(path: Path) -> list[int]:
+    if not path.is_file():
+        return []
+    return [json.loads(line)["point"] for line in path.read_text().splitlines() if line.endswith("}")]
+
+
+def _cli(*args: str, **kw) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "fabricate", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, **kw)
+
+
+def test_sweep_through_a_real_scheduler_survives_a_killed_worker(tmp_path):
+    """``dask scheduler`` and two ``dask worker`` processes on localhost; one worker is killed (SIGKILL) once
+    rows arrive: the sweep still ends with every point exactly once, equal to the points run one by one."""
+    spec_tables = gear_tables(eccentricities=tuple(np.round(np.linspace(0.05, 0.4, 12), 6)), modules=(0.8, 1.0))
+    spec_tables["sweep"]["batch_seconds"] = 0.01  # one point per task: the killed worker surely holds some
+    spec_file = tmp_path / "gears.toml"
+    from fabricate.tomlwrite import dumps
+
+    spec_file.write_text(dumps(spec_tables))
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    procs = [_dask("scheduler", "--host", "127.0.0.1", "--port", str(port), "--dashboard-address", ":0")]
+    try:
+        for _ in range(2):
+            procs.append(_dask("worker", address, "--nthreads", "1", "--no-nanny", "--no-dashboard",
+                               "--memory-limit", "0", "--death-timeout", "60"))
+        out = tmp_path / "out"
+        child = _cli("sweep", str(spec_file), "--scheduler", address, "-o", str(out))
+        deadline = time.monotonic() + 120
+        while len(_journal_points(out / "rows.jsonl")) < 2:
+            assert child.poll() is None and time.monotonic() < deadline, child.communicate()
+            time.sleep(0.02)
+        os.killpg(procs[1].pid, signal.SIGKILL)  # a worker dies mid-sweep
+        stdout, stderr = child.communicate(timeout=180)
+        assert child.returncode == 0, (stdout, stderr)
+        assert "2 Dask workers at " + address in stderr
+    finally:
+        for p in procs:
+            try:
+                os.killpg(p.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+            p.wait()
+    points = _journal_points(out / "rows.jsonl")
+    assert len(_journal_points(out / "rows.jsonl")) > 2 and sorted(set(points)) == list(range(24))
+    assert len(points) == 24, "a point was recorded twice"
+    spec = sweep_from_tables(spec_tables)
+    from fabricate.sweep.tables import columns, csv_bytes
+
+    expected = reference_rows(spec)
+    assert (out / "sweep.csv").read_bytes() == csv_bytes(expected, columns([f.path for f in spec.fields],
+                                                                           GEAR_METRICS))
+    for row in expected:
+        check_gear_row(row)
+
+
+def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path):
+    from fabricate.sweep.tables import columns, csv_bytes
+
+    tables = gear_tables(eccentricities=tuple(np.round(np.linspace(0.05, 0.4, 10), 6)), modules=(1.0,))
+    tables["sweep"]["batch_seconds"] = 0.01
+    from fabricate.tomlwrite import dumps
+
+    spec_file = tmp_path / "gears.toml"
+    spec_file.write_text(dumps(tables))
+    out = tmp_path / "out"
+    # a terminal's Ctrl-C (SIGINT at its default disposition: pytest-xdist workers ignore it)
+    child = _cli("sweep", str(spec_file), "--workers", "1", "-o", str(out),
+                 preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.monotonic() + 120
+    while len(_journal_points(out / "rows.jsonl")) < 2:
+        assert child.poll() is None and time.monotonic() < deadline, child.communicate()
+        time.sleep(0.02)
+    child.send_signal(signal.SIGINT)
+    stdout, stderr = child.communicate(timeout=120)
+    assert child.returncode == 130, (stdout, stderr)
+    assert "Traceback" not in stderr and "run the same command again to resume" in stderr
+    first = _journal_points(out / "rows.jsonl")
+    assert 2 <= len(first) < 10
+    record = json.loads((out / "sweep.json").read_text())
+    assert not record["complete"] and record["done"] == len(set(first))
+    with (out / "rows.jsonl").open("a") as fh:  # a run killed while appending leaves a torn line
+        fh.write('{"point": 9, "id": "tor')
+
+    again = _cli("sweep", str(spec_file), "--workers", "1", "-o", str(out))
+    stdout, stderr = again.communicate(timeout=120)
+    assert again.returncode == 0, (stdout, stderr)
+    assert f"({len(set(first))} done earlier)" in stdout
+    points = _journal_points(out / "rows.jsonl")
+    assert sorted(points) == list(range(10)), "every point exactly once (none lost, none run twice)"
+    spec = sweep_from_tables(tables)
+    assert (out / "sweep.csv").read_bytes() == csv_bytes(reference_rows(spec),
+                                                         columns([f.path for f in spec.fields], GEAR_METRICS))
+
+
+# -- command line ---------------------------------------------------------------------------------------------
+
+def test_cli_vary_values_parse_like_toml():
+    from fabricate.cli import _assignments
+
+    got = _assignments(["a.b=0.1:0.3:3", "c=1,2.5,x", "d=[[1.0, 2.0], [3.0, 4.0]]", "e=7", 'f="s"'], "--vary",
+                       True)
+    assert got == {"a.b": "0.1:0.3:3", "c": [1, 2.5, "x"], "d": [[1.0, 2.0], [3.0, 4.0]], "e": [7], "f": ["s"]}
+    assert _assignments(["g=least_pose_error", "h=0.5"], "--set", False) == {"g": "least_pose_error", "h": 0.5}
+    with pytest.raises(SpecError, match="FIELD=VALUES"):
+        _assignments(["nothing"], "--vary", True)
+
+
+@pytest.mark.parametrize("args, field", [
+    (["--vary", "gear_pair.eccentrcity=0.1,0.2"], "vary.gear_pair.eccentrcity"),
+    (["--vary", "gears.module_mm=1:2"], "vary.gears.module_mm"),
+    (["--vary", "gears.module_mm=1,2", "--metric", "strength.passed"], "sweep.metrics[0]"),
+    (["--vary", "gears.module_mm=1,2", "--workers", "0"], "--workers"),
+])
+def test_cli_bad_sweep_exits_2_and_writes_nothing(tmp_path, capsys, args, field):
+    from fabricate.cli import main
+
+    out = tmp_path / "out"
+    assert main(["sweep", "gear_pair_elliptic", *args, "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert f"error: {field}:" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_cli_sweep_never_writes_into_a_foreign_folder(tmp_path, capsys):
+    from fabricate.cli import main
+
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep")
+    assert main(["sweep", "gear_pair_elliptic", "--vary", "gears.module_mm=1,2", "-o", str(out)]) == 2
+    assert "did not write" in capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
