@@ -208,10 +208,14 @@ def _sweep(args: argparse.Namespace) -> int:
         errors = f", {c['3']} internal errors" if c.get("3") else ""
         print(f"sweep {spec.name}: {outcome.total} points ({outcome.resumed} done earlier): {c.get('0', 0)} pass, "
               f"{c.get('1', 0)} fail a check, {c.get('2', 0)} invalid or infeasible{errors} -> {outcome.out}")
+        for note in outcome.notes:
+            print(f"  note: {note}")
         for entry in outcome.best:
             metric = spec.best_metric.name if spec.best_metric else ""
+            verdict = {0: "", 1: " (its full build fails a check: see its report)"}.get(
+                entry.get("build_exit_code", 0), f" (not built: {entry.get('build_reason', '')})")
             print(f"  best {entry['rank']}: point {entry['point']} {metric} = {entry.get(metric)!r} "
-                  f"-> {entry.get('folder', '')}")
+                  f"-> {entry.get('folder', '')}{verdict}")
     return outcome.exit_code
 
 
@@ -221,6 +225,12 @@ def _list() -> int:
     for path in shipped_templates():
         design = read_toml(path).get("design", {})
         print(f"{path.stem:28s} {design.get('kind', '?'):18s} {design.get('description', '')}")
+    from fabricate.spec import TEMPLATE_DIR
+
+    for path in sorted((TEMPLATE_DIR / "sweeps").glob("*.toml")):
+        sweep = read_toml(path).get("sweep", {})
+        print(f"{path.stem:28s} {'sweep':18s} fabricate sweep {path.stem} ({sweep.get('template', '?')}, "
+              f"stage {sweep.get('stage', 'synth')})")
     return EXIT_OK
 
 

@@ -42,8 +42,9 @@ def _run(site: Path, cwd: Path, *args: str) -> subprocess.CompletedProcess:
 def test_the_wheel_carries_every_template(installed):
     wheel, _ = installed
     names = set(zipfile.ZipFile(wheel).namelist())
-    shipped = sorted(p.name for p in (ROOT / "templates").glob("*.toml"))
+    shipped = sorted(p.relative_to(ROOT / "templates").as_posix() for p in (ROOT / "templates").rglob("*.toml"))
     assert len(shipped) >= 7 and any(n.startswith("process_") for n in shipped)
+    assert any(n.startswith("sweeps/") for n in shipped)  # the shipped sweep specs too
     for name in shipped:
         assert f"fabricate/templates/{name}" in names, name
         data = zipfile.ZipFile(wheel).read(f"fabricate/templates/{name}")
@@ -61,6 +62,8 @@ def test_installed_it_lists_and_builds_from_a_foreign_folder(installed, tmp_path
     assert listed.returncode == 0
     for path in sorted((ROOT / "templates").glob("*.toml")):
         assert (path.stem in listed.stdout) == (not path.name.startswith("process_"))
+    for path in sorted((ROOT / "templates" / "sweeps").glob("*.toml")):
+        assert f"fabricate sweep {path.stem}" in listed.stdout
     built = _run(site, foreign, "build", "gear_pair_elliptic", "-q")
     assert built.returncode == 0, built.stderr
     report = json.loads((foreign / "outputs" / "gear_pair_elliptic" / "report.json").read_text())

@@ -33,7 +33,7 @@ def _numeric(v: Any) -> bool:
 def metric_plot(rows: Sequence[Mapping[str, Any]], field: str, metric: str) -> bytes:
     """``metric`` against ``field``: one marker per point, by outcome; points without the metric are not
     drawn (they are counted in the legend)."""
-    fig = figure((6.4, 4.2), 100)
+    fig = figure((6.4, 4.8), 100)
     ax = fig.add_subplot(1, 1, 1)
     for code, label, style in _OUTCOMES:
         pts = [(float(r[field]), float(r[metric])) for r in rows
@@ -47,26 +47,45 @@ def metric_plot(rows: Sequence[Mapping[str, Any]], field: str, metric: str) -> b
     ax.set_xlabel(field)
     ax.set_ylabel(metric)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
     fig.tight_layout()
     return png_bytes(fig)
 
 
 def feasibility_map(rows: Sequence[Mapping[str, Any]], x: str, y: str) -> bytes:
-    """Every point at (``x``, ``y``), marked by outcome: where the design stays feasible."""
-    fig = figure((6.0, 5.2), 100)
+    """Every point at (``x``, ``y``), marked by outcome: where the design stays feasible.
+
+    When other varied fields put several points at one (``x``, ``y``), each spot is coloured by the share of
+    its points that pass every check and labelled ``passing/points``.
+    """
+    fig = figure((6.0, 5.6), 100)
     ax = fig.add_subplot(1, 1, 1)
-    for code, label, style in _OUTCOMES:
-        pts = [(float(r[x]), float(r[y])) for r in rows
-               if r["exit_code"] == code and _numeric(r.get(x)) and _numeric(r.get(y))]
-        if pts:
-            xs, ys = zip(*pts, strict=True)
-            ax.scatter(xs, ys, s=30, label=f"{label} ({len(pts)})", **style)
+    spots: dict[tuple[float, float], list[int]] = {}
+    for r in rows:
+        if _numeric(r.get(x)) and _numeric(r.get(y)):
+            spots.setdefault((float(r[x]), float(r[y])), []).append(int(r["exit_code"]))
+    if all(len(codes) == 1 for codes in spots.values()):
+        for code, label, style in _OUTCOMES:
+            pts = [xy for xy, codes in spots.items() if codes[0] == code]
+            if pts:
+                xs, ys = zip(*pts, strict=True)
+                ax.scatter(xs, ys, s=30, label=f"{label} ({len(pts)})", **style)
+        # below the axes: a legend inside would hide points of a full grid
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
+    else:
+        xy = sorted(spots)
+        share = [sum(c == 0 for c in spots[k]) / len(spots[k]) for k in xy]
+        xs, ys = zip(*xy, strict=True)
+        dots = ax.scatter(xs, ys, c=share, cmap="RdYlGn", vmin=0.0, vmax=1.0, s=60, edgecolors="k", linewidths=0.4)
+        for (px, py) in xy:
+            codes = spots[(px, py)]
+            ax.annotate(f"{sum(c == 0 for c in codes)}/{len(codes)}", (px, py), textcoords="offset points",
+                        xytext=(0, 7), ha="center", fontsize=6)
+        fig.colorbar(dots, ax=ax, label="share of points passing every check")
     ax.set_xlabel(x)
     ax.set_ylabel(y)
     ax.set_title("feasibility")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
     return png_bytes(fig)
 

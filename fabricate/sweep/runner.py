@@ -72,6 +72,7 @@ class SweepOutcome:
     seconds: float = 0.0
     workers: int = 0
     tasks: int = 0
+    notes: list[str] = field(default_factory=list)
 
 
 # -- output folder ------------------------------------------------------------------------------------------
@@ -294,19 +295,21 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
                 _build_best(client, spec, best, out, say)
         counts = _counts(done)
         complete = len(rows) == len(points)
+        notes = _notes(spec, rows)
         _write_file(out / SWEEP_JSON, _json(_marker(spec, {
             "points": len(points), "done": len(rows), "complete": complete, "counts": counts,
-            "best": best, "files": ["sweep.csv", "sweep.parquet", JOURNAL, "plots/", *(["best/"] if best else [])],
+            "best": best, "notes": notes,
+            "files": ["sweep.csv", "sweep.parquet", JOURNAL, "plots/", *(["best/"] if best else [])],
         })))
     except KeyboardInterrupt:
         interrupted = True
-        counts, best = _counts(done), []
+        counts, best, notes = _counts(done), [], []
     finally:
         _close(client, cluster)
     code = 130 if interrupted else (1 if counts.get(str(EXIT_INTERNAL)) else 0)
     return SweepOutcome(exit_code=code, out=out, total=len(points), done=len(rows), resumed=resumed,
                         counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers,
-                        tasks=tasks)
+                        tasks=tasks, notes=notes)
 
 
 def _json(data: Any) -> bytes:
@@ -426,6 +429,15 @@ def _error_row(spec: SweepSpec, item: tuple[int, Any, str], exc: BaseException) 
     for m in spec.metrics:
         row[m.name] = math.nan
     return row
+
+
+def _notes(spec: SweepSpec, rows: list[dict[str, Any]]) -> list[str]:
+    """A metric that no point's report has is most likely a misspelt key path: say so."""
+    reported = [r for r in rows if r["exit_code"] in (0, 1)]
+    if not reported:
+        return []
+    return [f'metric "{m.name}" is in no point\'s report (a misspelt key path? see report.json of one build)'
+            for m in spec.metrics if all(math.isnan(r[m.name]) for r in reported)]
 
 
 def _write_tables(out: Path, spec: SweepSpec, rows: list[dict[str, Any]]) -> None:
