@@ -256,21 +256,26 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
         done = {pid: row for pid, row in read_journal(out, spec).items()
                 if pid in by_id and row["exit_code"] != EXIT_INTERNAL}
     resumed = len(done)
-    out.mkdir(parents=True, exist_ok=True)
-    _write_file(out / SWEEP_JSON, _json(_marker(spec, {"points": len(points), "done": resumed, "complete": False})))
     say = log or (lambda msg: None if quiet else print(msg, file=sys.stderr, flush=True))
     draw = (not quiet) and (sys.stderr.isatty() if progress_bar is None else progress_bar)
 
     todo = deque((i, points[i], ids[i]) for i in range(len(points)) if ids[i] not in done)
     start = time.perf_counter()
-    journal = Journal(out / JOURNAL)
     client = cluster = None
     interrupted = False
     n_workers = tasks = 0
+    if todo:  # a cluster that cannot be had is a usage error: nothing is written
+        client, cluster = connect(workers, scheduler)
+        try:
+            n_workers = _wait_for_workers(client, scheduler)
+        except BaseException:
+            _close(client, cluster)
+            raise
+    out.mkdir(parents=True, exist_ok=True)
+    _write_file(out / SWEEP_JSON, _json(_marker(spec, {"points": len(points), "done": resumed, "complete": False})))
+    journal = Journal(out / JOURNAL)
     try:
         if todo:
-            client, cluster = connect(workers, scheduler)
-            n_workers = _wait_for_workers(client, scheduler)
             say(f"sweep {spec.name}: {len(points)} points ({resumed} done earlier), stage {spec.stage}, "
                 f"{n_workers} Dask worker{'s' if n_workers != 1 else ''}"
                 f"{' at ' + scheduler if scheduler else ' (local cluster)'}")
@@ -358,6 +363,8 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
     in_flight: dict[Any, list[tuple[int, Any, str]]] = {}
     queue = as_completed()
     last_flush = time.perf_counter()
+    flush_every = FLUSH_SECONDS
+    counts = _counts(done)
     submitted = 0
 
     def workers_now() -> int:
@@ -400,6 +407,8 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
             if rows:
                 journal.append(rows)
                 for row in rows:
+                    key = str(row["exit_code"])
+                    counts[key] = counts.get(key, 0) + 1
                     done[str(row["id"])] = row
                     if row["exit_code"] != EXIT_INTERNAL:
                         timed.append(float(row.get("seconds", 0.0)))
@@ -407,10 +416,13 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
                     mean = max(sum(timed[-64:]) / len(timed[-64:]), 1e-6)
                     batch_size = int(min(MAX_BATCH, max(1, round(spec.batch_seconds / mean))))
             if draw:
-                print(_bar(len(done), total, _counts(done), start, resumed), end="", file=sys.stderr, flush=True)
-            if time.perf_counter() - last_flush > FLUSH_SECONDS:
+                print(_bar(len(done), total, counts, start, resumed), end="", file=sys.stderr, flush=True)
+            if time.perf_counter() - last_flush > flush_every:
+                began = time.perf_counter()
                 _write_tables(out, spec, list(done.values()))
                 last_flush = time.perf_counter()
+                # a large sweep's tables take a while to write: keep that under a tenth of the main process
+                flush_every = max(FLUSH_SECONDS, 10.0 * (last_flush - began))
             fill()
     except BaseException:
         for fut in list(in_flight):
