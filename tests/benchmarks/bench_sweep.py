@@ -79,7 +79,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--stage", choices=("synth", "build"), default="synth")
     args = parser.parse_args(argv)
     batched = _spec(args.points, args.stage, 1.0)
-    single = _spec(args.points, args.stage, 0.001)  # one point per task
+    single = _spec(args.points, args.stage, 0.01)  # one point per task (a point takes ~0.2 s)
     _in_process(_spec(2, args.stage, 1.0))  # warm the imports and caches of this process
     serial = _in_process(batched)
     one = _dask(batched, 1)
