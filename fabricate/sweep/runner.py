@@ -412,9 +412,7 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
                     done[str(row["id"])] = row
                     if row["exit_code"] != EXIT_INTERNAL:
                         timed.append(float(row.get("seconds", 0.0)))
-                if timed:
-                    mean = max(sum(timed[-64:]) / len(timed[-64:]), 1e-6)
-                    batch_size = int(min(MAX_BATCH, max(1, round(spec.batch_seconds / mean))))
+                batch_size = next_batch_size(timed, spec.batch_seconds)
             if draw:
                 print(_bar(len(done), total, counts, start, resumed), end="", file=sys.stderr, flush=True)
             if time.perf_counter() - last_flush > flush_every:
@@ -429,6 +427,16 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
             fut.cancel()
         raise
     return submitted
+
+
+def next_batch_size(seconds: list[float], target: float) -> int:
+    """Points per task so a task takes about ``target`` seconds, from the run times of recent points (the
+    median of the last 64, so a worker's first point, which pays for its imports, does not set it)."""
+    recent = sorted(seconds[-64:])
+    if not recent:
+        return 1
+    typical = max(recent[len(recent) // 2], 1e-6)
+    return int(min(MAX_BATCH, max(1, round(target / typical))))
 
 
 def _error_row(spec: SweepSpec, item: tuple[int, Any, str], exc: BaseException) -> dict[str, Any]:
