@@ -21,6 +21,7 @@ Results per module go to ``tests/benchmarks/mutation/results.json``; the kill-ra
 from __future__ import annotations
 
 import argparse
+import contextlib
 import io
 import json
 import os
@@ -28,6 +29,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import tokenize
 from pathlib import Path
 
@@ -424,6 +426,31 @@ def _results_text(results: dict) -> str:
     return "\n".join(lines + ["}"]) + "\n"
 
 
+def _save(key: str, result: dict) -> None:
+    """Write one module's result into results.json, re-reading it first: runs of other modules (on the other
+    core) may have saved theirs since this run started."""
+    fd, tmp = tempfile.mkstemp(dir=HERE, prefix=".results.", suffix=".tmp")
+    with _results_lock():
+        current = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
+        current[key] = result
+        with os.fdopen(fd, "w") as fh:
+            fh.write(_results_text(dict(sorted(current.items(), key=lambda kv: list(MODULES).index(kv[0])
+                                                if kv[0] in MODULES else len(MODULES)))))
+        os.replace(tmp, RESULTS)
+
+
+@contextlib.contextmanager
+def _results_lock():
+    import fcntl
+
+    with open(HERE / ".results.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("modules", nargs="*", help=f"some of: {', '.join(MODULES)}")
@@ -460,7 +487,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{key}: {s['killed']}/{s['run'] - s['equivalent']} killed ({100 * s['rate']:.1f}%), "
                   f"{s['survived']} survived, {s['no_tests']} without tests, {s['equivalent']} equivalent",
                   flush=True)
-            RESULTS.write_text(_results_text(results))
+            _save(key, results[key])
     else:
         table = load_equivalents()
         for key, res in results.items():  # re-apply the string filter and the equivalents table
