@@ -6,4 +6,5 @@ import sys
 
 from fabricate.cli import main
 
-sys.exit(main())
+if __name__ == "__main__":  # a spawned worker process (Dask, multiprocessing) may import this module
+    sys.exit(main())
