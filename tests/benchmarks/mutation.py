@@ -307,7 +307,7 @@ def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
     for r in result["mutants"]:
         if r["name"] in names:
             r["status"] = STATUS.get(codes.get(r["name"]), "suspicious")
-        if r["status"] != "killed":
+        if r["status"] not in ("killed", "timeout") and "old" in r:
             reason = equivalent_reason(key, r["function"], r["old"], r["new"], table)
             if reason:
                 r["status"], r["reason"] = "equivalent", reason
@@ -317,7 +317,8 @@ def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
 
 def drop_string_only(result: dict) -> dict:
     """Move rows the (current) string-only filter excludes out of the run set."""
-    keep = [r for r in result["mutants"] if not is_string_only(r["old"], r["new"])]
+    # a killed mutant is stored without its lines (see _results_text): it was run, so it is not string-only
+    keep = [r for r in result["mutants"] if "old" not in r or not is_string_only(r["old"], r["new"])]
     result["string_only_skipped"] += len(result["mutants"]) - len(keep)
     result["mutants"] = keep
     return result
@@ -404,7 +405,7 @@ def check_examples() -> list[str]:
 
 def _results_text(results: dict) -> str:
     """results.json: one line per mutant (a reviewable diff, and under 1 MB where indenting every field
-    of every mutant was not)."""
+    of every mutant was not); killed mutants keep only their name, function and status."""
     lines = ["{"]
     modules = list(results.items())
     for m, (name, value) in enumerate(modules):
@@ -414,6 +415,9 @@ def _results_text(results: dict) -> str:
             for f, (key, item) in enumerate(fields):
                 sep = "," if f < len(fields) - 1 else ""
                 if isinstance(item, list):
+                    if key == "mutants":  # a killed mutant's lines are not needed again: keep the file < 1 MB
+                        item = [{k: v for k, v in x.items() if k in ("name", "function", "status")}
+                                if x.get("status") in ("killed", "timeout") else x for x in item]
                     lines.append(f" {json.dumps(key)}: [")
                     lines += [f"  {json.dumps(x, separators=(',', ':'))}" + ("," if i < len(item) - 1 else "")
                               for i, x in enumerate(item)]
