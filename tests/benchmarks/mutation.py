@@ -45,7 +45,8 @@ RESULTS = HERE / "results.json"
 EQUIVALENT = HERE / "equivalent.toml"
 REPORT = ROOT / "tests" / "benchmarks" / "mutation_report.md"
 
-GEARS_TESTS = ["tests/test_gears_properties.py", "tests/test_gears.py", "tests/test_gears_mesh.py"]
+GEARS_TESTS = ["tests/test_gears_properties.py", "tests/test_gears.py", "tests/test_gears_mesh.py",
+               "tests/test_gears_pair.py"]
 CHECK_TESTS = ["tests/test_checks_properties.py", "tests/test_interference.py"]
 PARTS_TESTS = ["tests/test_parts_properties.py", "tests/test_parts.py"]
 # test_export.py builds every template with both processes (minutes per mutant): not in the mutation run
@@ -125,7 +126,6 @@ def toml_value(v) -> str:
 
 def prepare(key: str) -> Path:
     """A fresh work copy for one module with its own [tool.mutmut]."""
-    source, tests = MODULES[key]
     work = WORK / key.replace("/", "_")
     if work.exists():
         shutil.rmtree(work)
@@ -133,13 +133,20 @@ def prepare(key: str) -> Path:
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".hypothesis")
     for name in ("fabricate", "tests", "templates"):
         shutil.copytree(ROOT / name, work / name, ignore=ignore)
+    write_config(key, work)
+    return work
+
+
+def write_config(key: str, work: Path) -> None:
+    """The work copy's pyproject.toml: the repository's [tool.mutmut] plus this module's source and its
+    test files as listed now (a survivor re-run picks up test files added since the full run)."""
+    source, tests = MODULES[key]
     config = dict(base_config())
     config["only_mutate"] = [source]
     config["pytest_add_cli_args_test_selection"] = [t for t in tests if (ROOT / t).exists()]
     lines = ["[tool.mutmut]"] + [f"{k} = {toml_value(v)}" for k, v in config.items()]
     lines += ["", "[tool.pytest.ini_options]", 'testpaths = ["tests"]', 'addopts = ""', ""]
     (work / "pyproject.toml").write_text("\n".join(lines))
-    return work
 
 
 def changed_tokens(diff: str) -> tuple[list[str], list[str]]:
@@ -295,6 +302,8 @@ def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
     for target in (work / "tests", work / "mutants" / "tests"):
         shutil.rmtree(target, ignore_errors=True)
         shutil.copytree(ROOT / "tests", target, ignore=shutil.ignore_patterns("__pycache__", ".hypothesis"))
+    write_config(key, work)
+    shutil.copy2(work / "pyproject.toml", work / "mutants" / "pyproject.toml")
     (work / "mutants" / "mutmut-stats.json").unlink(missing_ok=True)  # new tests: map them again
     result = drop_string_only(result)
     names = [r["name"] for r in result["mutants"] if r["status"] in ("survived", "no tests")]
