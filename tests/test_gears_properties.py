@@ -927,3 +927,287 @@ def test_basic_rack_rejects_a_fillet_that_does_not_fit_either_way():
     with pytest.raises(ValueError, match="root fillet too large"):
         basic_rack(2.0, alpha, 0.5, 0.5)
     basic_rack(2.0, alpha, 0.5, 0.49, flank_points=5, round_points=5, flat_points=3)
+
+
+# -- free play, contacts and the outline windows against closed forms and whole-outline booleans -----------------
+@cache
+def unequal_pair():
+    """18/27 involute spur gears, module 1 (law x_b = -2 x_a / 3, r_a = 9, r_b = 13.5 mm)."""
+    spec = GearSpec(teeth=(18, 27), module_mm=1.0, backlash_mm=0.1, compare_methods=False, mesh_steps=6)
+    return make_gear_pair(FormulaLaw("2*x/3"), 22.5, (0.0, 2 * np.pi), spec, closed=True, run_mesh_check=False)
+
+
+@cache
+def module2_pair():
+    """12-tooth spur gears of module 2 (r = 12 mm)."""
+    spec = GearSpec(teeth=(12, 12), module_mm=2.0, backlash_mm=0.1, compare_methods=False, min_teeth=8)
+    return make_gear_pair(FormulaLaw("x"), 24.0, (0.0, 2 * np.pi), spec, closed=True, run_mesh_check=False)
+
+
+def posed_outline(outline, angle: float, dx: float = 0.0) -> Polygon:
+    """The whole outline turned by ``angle`` about its axis, the axis moved to (dx, 0)."""
+    c, s = np.cos(angle), np.sin(angle)
+    pts = np.asarray(outline)
+    return Polygon(np.column_stack([c * pts[:, 0] - s * pts[:, 1] + dx, s * pts[:, 0] + c * pts[:, 1]]))
+
+
+def test_pad_flanks_puts_each_flank_in_the_row_of_its_key():
+    """Flanks keyed 5, 3, 6 (4 missing, e.g. cut away): row = key - 3, the missing row all NaN and not present,
+    shorter flanks NaN-padded to the longest."""
+    from fabricate.gears.mesh import _pad_flanks
+
+    f3, f5, f6 = np.array([[1.0, 2.0], [3.0, 4.0]]), np.full((3, 2), 5.0), np.array([[7.0, 8.0], [9.0, 0.5]])
+    table, present, offset = _pad_flanks({5: f5, 3: f3, 6: f6})
+    assert offset == 3 and table.shape == (4, 3, 2)
+    np.testing.assert_array_equal(present, [True, False, True, True])
+    np.testing.assert_array_equal(table[0, :2], f3)
+    np.testing.assert_array_equal(table[2], f5)
+    np.testing.assert_array_equal(table[3, :2], f6)
+    assert np.isnan(table[1]).all() and np.isnan(table[0, 2]).all() and np.isnan(table[3, 2]).all()
+
+
+def test_polar_tables_sort_each_flank_by_radius_with_unwrapped_angles():
+    """Row 0: three points out of radius order whose angles cross +-pi; row 1 missing (all NaN); row 2 two points
+    and padding. Keys radius + row * 1e6 ascending, angles continuous along the flank (3.0, 3.1, 3.2 rad, not
+    wrapped to -3.08), padding NaN angles with keys above the row's radii, and each row's radius range
+    (empty, [inf, -inf], for the missing row)."""
+    from fabricate.gears.mesh import _polar_tables
+
+    def polar(r, t):
+        return [r * np.cos(t), r * np.sin(t)]
+
+    nan = [np.nan, np.nan]
+    table = np.array([[polar(5.0, 3.1), polar(4.0, 3.0), polar(6.0, 3.2)], [nan, nan, nan],
+                      [polar(2.5, -0.2), polar(2.0, 0.1), nan]])
+    key, phi, ranges = _polar_tables(table)
+    key, phi = key.reshape(3, 3), phi.reshape(3, 3)
+    np.testing.assert_allclose(key[0], [4.0, 5.0, 6.0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(key[2, :2], [2e6 + 2.0, 2e6 + 2.5], rtol=0, atol=1e-9)
+    assert np.all(np.diff(key.ravel()) >= 0)
+    assert np.all((key[1] >= 1e6) & (key[1] < 2e6)) and 2e6 + 2.5 < key[2, 2] < 3e6
+    np.testing.assert_allclose(phi[0], [3.0, 3.1, 3.2], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(phi[2, :2], [0.1, -0.2], rtol=0, atol=1e-12)
+    assert np.isnan(phi[1]).all() and np.isnan(phi[2, 2])
+    np.testing.assert_allclose(ranges, [[4.0, 6.0], [np.inf, -np.inf], [2.0, 2.5]], rtol=0, atol=1e-12)
+
+
+def test_window_chains_are_the_runs_of_a_polygon_within_the_angle():
+    """A regular 12-gon (vertex k at k * 30 deg): each window is the run of consecutive vertices within the half
+    angle of its centre, in ring order also across the ring's end, closed through the axis and padded with the
+    axis to one length; one vertex, none, two across the end, all but one (the run skips it, not the whole
+    ring)."""
+    from fabricate.gears.mesh import _window_chains
+
+    angles = np.arange(12) * np.pi / 6
+    poly = 2.0 * np.column_stack([np.cos(angles), np.sin(angles)])
+    axis = [0.0, 0.0]
+
+    def chain(run, width):
+        return np.vstack([poly[run], np.tile(axis, (width - len(run), 1))])
+
+    got = _window_chains(poly, np.array([np.pi / 2 + 0.05, -0.05, np.pi + np.pi / 12]), 0.8)
+    want = [chain([2, 3, 4], 5), chain([11, 0, 1], 5), chain([5, 6, 7, 8], 5)]
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+    got = _window_chains(poly, np.array([angles[7] + 0.05, np.pi / 12, angles[9]]), 0.2)
+    np.testing.assert_allclose(got, [chain([7], 2), chain([], 2), chain([9], 2)], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(_window_chains(poly, np.array([np.pi / 12]), 0.2), [[axis]])
+    np.testing.assert_allclose(_window_chains(poly, np.array([-np.pi / 12]), 0.3), [chain([11, 0], 3)], atol=1e-12)
+    got = _window_chains(poly, np.array([angles[5] - np.pi]), np.pi - 0.3)
+    np.testing.assert_allclose(got, [chain([6, 7, 8, 9, 10, 11, 0, 1, 2, 3, 4], 12)], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("which", ["sector", "module 3", "1:2"])
+def test_free_play_from_outlines_is_where_the_whole_outlines_touch(which):
+    """free_play_outlines bisects on windows of the outlines (default bracket 0.02 rad, tolerance 1e-9 rad). The
+    whole posed outlines (shapely, no windows) must be apart (overlap <= 1e-12 mm^2, its contact threshold) with
+    gear b turned 0.999 of the returned play either way and overlap at 1.001 of it. Pairs: the non-circular
+    sector (module 0.5), 12-tooth spur gears of module 3 (the windows scale with the module) and 12/24 spur
+    gears (ratio 1/2); angles given as ints give the same; 2 modules closer, where the teeth already overlap at
+    the law, the play is NaN."""
+    from fabricate.gears.mesh import free_play_outlines
+
+    if which == "sector":
+        pair, x = sector_pair(), np.array([0.2, 0.5, 0.77])
+    else:
+        z, module, law = ((12, 12), 3.0, "x") if which == "module 3" else ((12, 24), 1.0, "x/2")
+        spec = GearSpec(teeth=z, module_mm=module, backlash_mm=0.1, compare_methods=False, min_teeth=8)
+        pair = make_gear_pair(FormulaLaw(law), (z[0] + z[1]) * module / 2, (0.0, 2 * np.pi), spec, closed=True,
+                              run_mesh_check=False)
+        x = np.array([0.05, 0.3])
+    a, module = pair.center_distance_mm, pair.module
+    plus, minus = free_play_outlines(pair.outline_a, pair.outline_b, pair.law, a, x, module)
+    for k, xk in enumerate(x):
+        gear_a = posed_outline(pair.outline_a, xk)
+        theta = float(pair.law(np.array([xk]))[0])
+        for play in (plus[k], -minus[k]):
+            assert 5e-4 < abs(play) < 0.01
+            assert gear_a.intersection(posed_outline(pair.outline_b, theta + 0.999 * play, a)).area <= 1e-12
+            assert gear_a.intersection(posed_outline(pair.outline_b, theta + 1.001 * play, a)).area > 1e-12
+    if which != "sector":  # whole radians given as ints are angles all the same
+        ints = free_play_outlines(pair.outline_a, pair.outline_b, pair.law, a, [0, 1], module)
+        floats = free_play_outlines(pair.outline_a, pair.outline_b, pair.law, a, np.array([0.0, 1.0]), module)
+        np.testing.assert_array_equal(ints, floats)
+    close = free_play_outlines(pair.outline_a, pair.outline_b, pair.law, a - 2 * module, x, module)
+    assert np.isnan(close).all()
+    theta = float(pair.law(x[:1])[0])
+    closer = posed_outline(pair.outline_b, theta, a - 2 * module)
+    assert posed_outline(pair.outline_a, x[0]).intersection(closer).area > 0.01
+
+
+def test_unequal_spur_gears_free_play_contacts_and_default_steps():
+    """18/27 spur gears, module 1, backlash 0.1 mm: each flank's free play is j / (2 r_b) = 0.1 / 27 rad at every
+    step (exact involutes; 5e-7 rad, measured 2.1e-7), and the mean teeth in contact is the contact ratio
+    (sqrt(10^2 - (9 cos a)^2) + sqrt(14.5^2 - (13.5 cos a)^2) - 22.5 sin a) / (pi cos a) = 1.580 (within 0.03 with
+    20 steps per tooth of gear b). The default mesh steps turn gear a until gear b has turned once (1.5 turns, no
+    end point: it repeats the start)."""
+    from fabricate.gears.mesh import free_play, mesh_check
+
+    pair = unequal_pair()
+    x = np.linspace(0.0, 3 * np.pi, 540, endpoint=False)
+    plus, minus, count = free_play(pair, x, return_contacts=True)
+    np.testing.assert_allclose(plus, 0.1 / 27, rtol=0, atol=5e-7)
+    np.testing.assert_allclose(minus, 0.1 / 27, rtol=0, atol=5e-7)
+    alpha = np.radians(20.0)
+    ratio = (np.sqrt(100 - (9 * np.cos(alpha)) ** 2) + np.sqrt(14.5**2 - (13.5 * np.cos(alpha)) ** 2)
+             - 22.5 * np.sin(alpha)) / (np.pi * np.cos(alpha))
+    assert np.mean(count) == pytest.approx(ratio, abs=0.03)
+    assert set(np.unique(count)) == {1, 2}
+    mesh = mesh_check(pair)  # spec.mesh_steps = 6
+    np.testing.assert_allclose(mesh.x_a, np.arange(6) * 3 * np.pi / 6, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(mesh.backlash_mm, 0.1, atol=1e-5)
+    np.testing.assert_array_equal(mesh.interference_area_mm2, 0.0)
+
+
+def test_mesh_check_default_steps_of_a_sector_and_given_angles():
+    """A sector is checked from the start to the end of its working range, both ends included; given angles
+    (here a list of ints) are used as float radians."""
+    from fabricate.gears.mesh import mesh_check
+
+    pair = sector_pair()
+    lo, hi = pair.working_range
+    np.testing.assert_allclose(mesh_check(pair, steps=5).x_a, np.linspace(lo, hi, 5), rtol=1e-15)
+    given = mesh_check(pair, x_a_values=[0, 1])
+    assert given.x_a.dtype == np.float64 and given.x_a.tolist() == [0.0, 1.0]
+
+
+def test_free_play_without_a_flank_on_either_gear():
+    """Spur pair with gear a's driving flank 0 and gear b's driving flank 10 removed (as if cut away): the coast
+    flanks are untouched (free_minus bit for bit); on the driving side the play is still j / (2 r) (5e-7 rad)
+    wherever the whole pair had two teeth in contact (the other pair still touches), one contact fewer there,
+    and it opens up where a removed flank was the only one touching."""
+    import warnings
+    from dataclasses import replace
+
+    from fabricate.gears.mesh import free_play
+
+    pair = spur_pair()
+    x = pair.mesh.x_a
+    full_plus, full_minus, full_count = free_play(pair, x, return_contacts=True)
+    cut_a = replace(pair.cut_a, flanks={k: v for k, v in pair.cut_a.flanks.items() if k != 0})
+    cut_b = replace(pair.cut_b, flanks={k: v for k, v in pair.cut_b.flanks.items() if k != 10})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # and no floating-point warnings on the way
+        plus, minus, count = free_play(replace(pair, cut_a=cut_a, cut_b=cut_b), x, return_contacts=True)
+    np.testing.assert_array_equal(minus, full_minus)
+    assert np.all(plus >= full_plus)
+    two = full_count == 2
+    np.testing.assert_allclose(plus[two], 0.1 / 24, rtol=0, atol=5e-7)
+    assert np.all(count <= full_count) and np.any(count[two] == 1)
+    assert np.any(plus > 0.1 / 24 + 1e-3)
+
+
+def test_free_play_of_radial_flank_pairs():
+    """A stand-in pair at x_a = 0 with the law at 0 (gear a's points sit in gear b's frame at g - (a, 0)) whose
+    flanks are radial segments about axis B, so each pair's gap is the angle between them (closed form, 1e-12 rad),
+    near +-pi: driving flanks -2, 0, 2, 4 at 0.05, 0.05 + 1e-6, 0.05 + 4e-6, 0.3 rad, coast flanks -1, 1 at 0.04,
+    0.02 rad. Gear b's flank -2 (its first row) is only its two end points, its flank 3 is missing, its last
+    row short (padded). Free play 0.05 and 0.02 rad, two driving pairs within the 2e-6 rad contact tolerance.
+    Gear a's points beyond gear b's radii lie at a gap of -0.5 rad and must not count; with only those there is no
+    flank pair (NaN)."""
+    import warnings
+    from types import SimpleNamespace
+
+    from fabricate.gears.mesh import free_play
+
+    a = 20.0
+    gaps = {-2: 0.05, -1: 0.04, 0: 0.05 + 1e-6, 1: 0.02, 2: 0.05 + 4e-6, 3: 0.01, 4: 0.3}
+
+    def radial(centre, angle, radii):
+        return np.column_stack([centre + radii * np.cos(angle), radii * np.sin(angle)])
+
+    def stand_in(radii_a):
+        flanks_a, flanks_b = {}, {}
+        for k, gap in gaps.items():
+            beta, sign = 3.05 + 0.02 * k, 1.0 if k % 2 == 0 else -1.0
+            flanks_a[k] = np.vstack([radial(a, beta + sign * gap, radii_a),
+                                     radial(a, beta - sign * 0.5, np.array([3.0, 7.0]))])
+            if k != 3:
+                flanks_b[k] = radial(0.0, beta, {-2: np.array([4.0, 6.0]), 4: np.array([4.0, 5.0, 6.0])}.get(
+                    k, np.linspace(4.0, 6.0, 5)))
+        zero = lambda x: np.zeros_like(np.asarray(x, dtype=float))  # noqa: E731
+        return SimpleNamespace(pitch_model=SimpleNamespace(s_of_x=zero), law=zero, module=1.0, rack_origin=0.0,
+                               closed=False, teeth=(4, 4), center_distance_mm=a,
+                               cut_a=SimpleNamespace(flanks=flanks_a), cut_b=SimpleNamespace(flanks=flanks_b))
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # and no floating-point warnings on the way
+        plus, minus, count = free_play(stand_in(np.array([4.25, 4.75, 5.25, 5.75])), np.zeros(1),
+                                       return_contacts=True)
+    np.testing.assert_allclose([plus[0], minus[0]], [0.05, 0.02], rtol=0, atol=1e-12)
+    assert count.tolist() == [2]
+    plus, minus = free_play(stand_in(np.array([3.5, 6.5])), np.zeros(1))
+    assert np.isnan(plus).all() and np.isnan(minus).all()
+
+
+@cache
+def long_contact_sector():
+    """Sector of equal circular gears, r = 32 mm (64 teeth a turn), 12 deg, addendum 1.3 m (not undercut)."""
+    spec = GearSpec(module_mm=1.0, backlash_mm=0.1, compare_methods=False, pressure_angle_deg=12.0, addendum=1.3,
+                    dedendum=1.6)
+    return make_gear_pair(FormulaLaw("x"), 64.0, (0.0, 0.4), spec, closed=False, run_mesh_check=False)
+
+
+def test_contact_ratio_of_a_long_contact_path():
+    """Equal gears of r = 32 mm at 12 deg with addendum 1.3 m: the path of contact reaches 1.54 p from the pitch
+    point each side, the contact ratio (2 sqrt(33.3^2 - (32 cos a)^2) - 64 sin a) / (pi cos a) = 3.066 is the mean
+    teeth in contact over one pitch (200 steps: within 0.03); the free play is j / (2 r) each way (5e-7 rad)."""
+    from fabricate.gears.mesh import free_play
+
+    pair = long_contact_sector()
+    x = 0.2 + (np.arange(200) / 200 - 0.5) * np.pi / 32
+    plus, minus, count = free_play(pair, x, return_contacts=True)
+    alpha = np.radians(12.0)
+    ratio = (2 * np.sqrt(33.3**2 - (32 * np.cos(alpha)) ** 2) - 64 * np.sin(alpha)) / (np.pi * np.cos(alpha))
+    assert ratio > 3.0
+    assert np.mean(count) == pytest.approx(ratio, abs=0.03)
+    np.testing.assert_allclose(plus, 0.1 / 64, rtol=0, atol=5e-7)
+    np.testing.assert_allclose(minus, 0.1 / 64, rtol=0, atol=5e-7)
+
+
+@pytest.mark.parametrize("closer", [0.8, 3.0])
+def test_mesh_check_of_an_overlapping_module_2_pair_in_chunks(monkeypatch, closer):
+    """Module-2 spur gears 0.8 or 3 mm too close, checked in chunks of 2 steps: the interference area at each step
+    is that of the whole posed outlines (shapely on raw coordinates, rtol 1e-9; the clip window must hold the
+    overlap of teeth 4.5 mm high, out to 5 mm from the pitch point), the free play the unchunked one (negative:
+    the teeth overlap, 0.8 mm closer); no steps give empty arrays."""
+    from dataclasses import replace
+
+    import fabricate.gears.mesh as mesh_module
+
+    pair = module2_pair()
+    close = replace(pair, center_distance_mm=pair.center_distance_mm - closer)
+    x = np.array([0.0, 0.11, 0.3, 0.52, 0.7])
+    monkeypatch.setattr(mesh_module, "MESH_VERTICES_PER_CHUNK", 2 * (len(pair.outline_a) + len(pair.outline_b)))
+    got = mesh_module.mesh_check(close, x_a_values=x)
+    want = [posed_outline(pair.outline_a, xi).intersection(
+        posed_outline(pair.outline_b, float(pair.law(np.array([xi]))[0]), close.center_distance_mm)).area for xi in x]
+    assert min(want) > 0.05
+    np.testing.assert_allclose(got.interference_area_mm2, want, rtol=1e-9)
+    plus, minus = mesh_module.free_play(close, x)
+    np.testing.assert_array_equal(got.free_plus, plus)
+    np.testing.assert_array_equal(got.free_minus, minus)
+    if closer < 1.0:  # (3 mm closer the flanks' radii no longer pair up: NaN at some steps)
+        assert np.all(plus + minus < 0)
+    empty = mesh_module.mesh_check(pair, x_a_values=[])
+    for values in (empty.x_a, empty.free_plus, empty.free_minus, empty.teeth_in_contact, empty.interference_area_mm2):
+        assert values.shape == (0,)
