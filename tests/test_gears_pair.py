@@ -364,3 +364,95 @@ def test_exact_vs_approx_deviation_is_the_largest_outline_distance():
     assert exact.checks["exact_vs_approx_max_deviation_um"] == pytest.approx(expected, rel=1e-9)
     assert exact.report()["exact_vs_approx_max_deviation_um"] == pytest.approx(expected, rel=1e-9)
     assert 0.5 < expected < 20.0
+
+
+# -- tooth counts of a closed pair from the module -------------------------------------------------
+def test_closed_pair_needs_teeth_or_a_module():
+    """A closed pair with neither tooth counts nor a module has nothing to size its teeth: refused naming
+    ``gears.teeth`` and both ways out."""
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw("x"), 20.0, (0.0, TWO_PI), GearSpec(compare_methods=False), closed=True,
+                       run_mesh_check=False)
+    assert info.value.path == "gears.teeth"
+    assert info.value.message == "a closed pair needs teeth = [z_a, z_b] or module_mm"
+
+
+def test_closed_teeth_search_the_nearest_counts_that_close_the_law():
+    """Law x_b = -1.4 x_a at 24 mm: pitch circles of 14 and 10 mm, so module 6.6 mm asks for
+    2 * 14 / 6.6 = 4.24 teeth on gear a; whole counts closing the law are multiples of 7:5, and 3 to 6
+    do not close it: the pair gets 7:5 teeth and the module that fits them, 2 * 14 / 7 = 4 mm."""
+    spec = GearSpec(module_mm=6.6, min_teeth=3, compare_methods=False)
+    pair = make_gear_pair(FormulaLaw("1.4*x"), 24.0, (0.0, TWO_PI), spec, closed=True, run_mesh_check=False)
+    assert pair.teeth == (7, 5)
+    assert pair.module == pytest.approx(2 * 14.0 / 7, rel=1e-9)
+
+
+def test_no_whole_tooth_counts_close_an_irrational_law():
+    """Gear b turns sqrt(2) times per turn of a: no whole counts within 60 of the 28.3 teeth the module asks
+    for (2 r_a / m, r_a = 10 sqrt(2) mm) close it; refused naming ``gears.teeth`` with both numbers."""
+    a = 10.0 * (1.0 + math.sqrt(2.0))  # pitch circles 10 sqrt(2) and 10 mm
+    spec = GearSpec(module_mm=1.0, compare_methods=False)
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw("sqrt(2)*x"), a, (0.0, TWO_PI), spec, closed=True, run_mesh_check=False)
+    assert info.value.path == "gears.teeth"
+    ideal = 2 * 10.0 * math.sqrt(2.0) / 1.0
+    assert f"no whole tooth counts near {ideal:.1f} close the law ({math.sqrt(2.0):.6g} turns" \
+        in info.value.message
+
+
+def test_closed_teeth_take_the_count_nearest_the_module():
+    """Law x_b = -2 x_a at 15 mm (pitch circles 10 and 5 mm), module 20 / 12.9 mm: 12.9 teeth asked for on
+    gear a, and only even counts close the law; 12 is nearer than 14, so 12:6 teeth at module 20 / 12."""
+    spec = GearSpec(module_mm=20.0 / 12.9, min_teeth=3, compare_methods=False)
+    pair = make_gear_pair(FormulaLaw("2*x"), 15.0, (0.0, TWO_PI), spec, closed=True, run_mesh_check=False)
+    assert pair.teeth == (12, 6)
+    assert pair.module == pytest.approx(20.0 / 12, rel=1e-9)
+
+
+def test_closed_teeth_accept_a_law_within_a_millionth_of_closing():
+    """Gear b turns 1.0000002 times per turn of a: 20 / 1.0000002 = 19.999996 teeth is whole within the
+    1e-6 relative tolerance (2e-5 teeth at 20), so the pair gets 20:20 teeth."""
+    spec = GearSpec(module_mm=1.0, compare_methods=False)
+    pair = make_gear_pair(FormulaLaw("1.0000002*x"), 20.0, (0.0, TWO_PI), spec, closed=True,
+                          run_mesh_check=False)
+    assert pair.teeth == (20, 20)
+
+
+@pytest.mark.parametrize(("p", "q", "ideal", "path", "words"), [
+    # the only closing count 121:120 is 60 below the 181 asked for: found, then over the 100-teeth bound
+    (121, 120, 181.2, "gears.module_mm", "need 121 and 120 teeth"),
+    # the only closing count 71:70 is 61 above the 10 asked for: not searched
+    (71, 70, 10.2, "gears.teeth", "no whole tooth counts near 10.2"),
+])
+def test_closed_teeth_search_reaches_60_teeth_either_side(p, q, ideal, path, words):
+    """Gear b turns p / q times per turn of a (p, q coprime): only multiples of p teeth on gear a close the
+    law. The search covers 60 teeth either side of the count the module asks for (2 r_a / m)."""
+    a = 20.0
+    r_a = a * (p / q) / (1 + p / q)
+    spec = GearSpec(module_mm=2 * r_a / ideal, compare_methods=False)
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw(f"({p}/{q})*x"), a, (0.0, TWO_PI), spec, closed=True, run_mesh_check=False)
+    assert info.value.path == path
+    assert words in info.value.message
+
+
+def test_three_closing_teeth_are_refused_as_too_coarse():
+    """Two equal ellipses (e = 0.05, semi-major axis 20 mm, on their foci 40 mm apart) at a module just
+    inside the min_teeth = 3 limit (0.99 * 2 rho_min / 3, rho_min = A (1 - e^2)) ask for 3.04 teeth: the
+    closing count is 3:3, whose module, perimeter / (3 pi) with perimeter 4 A E(e^2), exceeds the limit
+    (an ellipse's perimeter is more than 2 pi rho_min): refused naming the module."""
+    from scipy.special import ellipe
+
+    from fabricate.gears.law import elliptic_law
+
+    e, semi = 0.05, 20.0
+    rho_min, perimeter = semi * (1 - e * e), 4 * semi * ellipe(e * e)
+    module = 0.99 * 2 * rho_min / 3
+    assert 3.0 < perimeter / (math.pi * module) < 3.5
+    spec = GearSpec(module_mm=module, min_teeth=3, compare_methods=False)
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(elliptic_law(e), 2 * semi, (0.0, TWO_PI), spec, closed=True, run_mesh_check=False)
+    assert info.value.path == "gears.module_mm"
+    words = info.value.message.split()
+    assert words[0] == "module" and words[2:4] == ["mm", "too"]
+    assert float(words[1]) == pytest.approx(perimeter / (3 * math.pi), rel=1e-5)  # printed with :g
