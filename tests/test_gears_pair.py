@@ -253,8 +253,9 @@ def test_steps_without_a_flank_pair_are_a_failure():
 
 
 def test_mesh_beyond_the_sector_counts_the_steps_without_teeth():
-    """Turned 0.6 rad before its working range the sector runs out of teeth: the failure counts exactly
-    the steps whose backlash is undefined, and there are some (the spare teeth reach about 0.2 rad)."""
+    """Turned 0.6 rad before its working range the sector runs out of teeth (its first tooth is centred
+    2 pitches, 0.25 rad, before the range): the failure counts exactly the steps whose backlash is
+    undefined, and there are some, but not all."""
     from fabricate.gears.mesh import mesh_check
 
     pair = sector()
