@@ -1,10 +1,11 @@
 """Gear pairs as the pipeline builds them (``fabricate/gears/pair.py``), with expected values from closed forms.
 
-Written to kill mutants of ``fabricate/gears/pair.py`` (see ``tests/benchmarks/mutation_report.md``):
-:func:`build_gear_pairs` takes the centre distance, the names and the closedness from the mechanism's
-coupling; a law that does not close is refused naming ``gears.closed``; ``GearPair.failures`` fires
-exactly when a limit is crossed; ``GearPair.report`` gives the pair's own geometry; the exact-vs-approx
-deviation is the largest point-to-outline distance (against shapely).
+Written to kill mutants of ``fabricate/gears/pair.py`` (``tests/benchmarks/mutation.py``; survivors that
+no output can show are listed in ``tests/benchmarks/mutation/equivalent.toml``): :func:`build_gear_pairs`
+takes the centre distance, the names and the closedness from the mechanism's coupling; a law that does
+not close is refused naming ``gears.closed``; closed pairs get the whole tooth counts nearest the module;
+``GearPair.failures`` fires exactly when a limit is crossed; ``GearPair.report`` gives the pair's own
+geometry; the exact-vs-approx deviation is the largest point-to-outline distance (against shapely).
 
 The mechanisms are small real :class:`~fabricate.mechanism.Mechanism` objects built here (a carrier and
 two gears on the ratio-1 law ``x_b = -x_a``, whose pitch curves are two circles of radius a/2): every
