@@ -8,8 +8,8 @@ not close is refused naming ``gears.closed``; closed pairs get the whole tooth c
 geometry; the exact-vs-approx deviation is the largest point-to-outline distance (against shapely).
 
 The mechanisms are small real :class:`~fabricate.mechanism.Mechanism` objects built here (a carrier and
-two gears on the ratio-1 law ``x_b = -x_a``, whose pitch curves are two circles of radius a/2): every
-expected number follows from the points written below.
+two gears on a constant-ratio law, ``x_b = -x_a`` or ``x_b = -x_a / 2``, whose pitch curves are circles):
+every expected number follows from the points and laws written below.
 """
 
 from __future__ import annotations
