@@ -1146,7 +1146,7 @@ def test_free_play_of_radial_flank_pairs():
                     k, np.linspace(4.0, 6.0, 5)))
         zero = lambda x: np.zeros_like(np.asarray(x, dtype=float))  # noqa: E731
         return SimpleNamespace(pitch_model=SimpleNamespace(s_of_x=zero), law=zero, module=1.0, rack_origin=0.0,
-                               closed=False, teeth=(4, 4), center_distance_mm=a,
+                               closed=False, teeth=(4, 4), center_distance_mm=a, spec=GearSpec(),
                                cut_a=SimpleNamespace(flanks=flanks_a), cut_b=SimpleNamespace(flanks=flanks_b))
 
     with warnings.catch_warnings():
@@ -1182,6 +1182,82 @@ def test_contact_ratio_of_a_long_contact_path():
     assert np.mean(count) == pytest.approx(ratio, abs=0.03)
     np.testing.assert_allclose(plus, 0.1 / 64, rtol=0, atol=5e-7)
     np.testing.assert_allclose(minus, 0.1 / 64, rtol=0, atol=5e-7)
+
+
+def test_no_teeth_in_contact_where_no_flank_pair_is_in_mesh():
+    """The sector turned 0.8..1.2 rad before its working range (0.1..0.9 rad) or 0.8..1.1 rad past it: no flank
+    pair shares a radius (free play NaN both ways), so no teeth are in contact: 0, not every driving flank of the
+    window (their gaps are all inf, and inf <= inf + tolerance; 4 were counted). With steps inside the range,
+    where 1 or 2 pairs touch and their mean is the local contact ratio of the osculating spur pairs (1.695; 1.708
+    measured, within 0.03), the summary gives 0..2 teeth in contact and the contact ratio is the in-range count
+    over all the steps (the steps without a pair add nothing)."""
+    from fabricate.gears.mesh import free_play, mesh_check
+
+    pair = sector_pair()
+    lo, hi = pair.working_range
+    x_out = np.concatenate([np.linspace(lo - 1.2, lo - 0.8, 9), np.linspace(hi + 0.8, hi + 1.1, 7)])
+    plus, minus, count = free_play(pair, x_out, return_contacts=True)
+    assert np.isnan(plus).all() and np.isnan(minus).all()
+    np.testing.assert_array_equal(count, 0)
+    x_in = np.linspace(lo, hi, 161)
+    plus, minus, inside = free_play(pair, x_in, return_contacts=True)
+    assert np.isfinite(plus).all() and set(np.unique(inside)) == {1, 2}
+    assert np.mean(inside) == pytest.approx(pair.checks["contact_ratio"]["mean"], abs=0.03)
+    summary = mesh_check(pair, x_a_values=np.concatenate([x_in, x_out])).summary()
+    assert summary["steps_without_contact_pair"] == len(x_out)
+    assert summary["teeth_in_contact"] == [0, 2]
+    assert summary["contact_ratio_measured"] == pytest.approx(np.sum(inside) / (len(x_in) + len(x_out)), rel=1e-12)
+
+
+@cache
+def long_contact_spur_sector(radius: float, pressure_deg: float):
+    """Sector of equal circular gears of module 1 with the spec's largest addendum, 1.5 m (dedendum 1.75 m)."""
+    spec = GearSpec(module_mm=1.0, backlash_mm=0.1, compare_methods=False, pressure_angle_deg=pressure_deg,
+                    addendum=1.5, dedendum=1.75)
+    return make_gear_pair(FormulaLaw("x"), 2 * radius, (0.0, 0.4), spec, closed=False, run_mesh_check=False)
+
+
+@pytest.mark.parametrize(("radius", "pressure_deg", "tol"), [(34.0, 12.0, 0.03), (50.0, 10.0, 0.04)])
+def test_contact_ratio_of_a_contact_path_beyond_1_6_pitches(radius, pressure_deg, tol):
+    """Equal gears with addendum 1.5 m, not undercut (r above the limit (1.75 - 0.38 (1 - sin a)) / sin^2 a, 33.5 and
+    47.6 mm): r = 34 mm at 12 deg (68 teeth a turn) and r = 50 mm at 10 deg (100 teeth; the spec's smallest angle).
+    The path of contact reaches (sqrt((r + 1.5)^2 - (r cos a)^2) - r sin a) / cos a = 1.74 and 2.07 p from the pitch
+    point along the pitch line, beyond the fixed window of [-1.6 p, +1.9 p] the flanks were once taken from (which
+    measured 3.335 and 3.675). The contact ratio (2 sqrt((r + 1.5)^2 - (r cos a)^2) - 2 r sin a) / (pi cos a) =
+    3.482 and 4.141 is the mean teeth in contact over one pitch (200 steps; measured 3.485 and 4.170): within 0.03,
+    and 0.04 for the larger gears, where a tip leaving its flank tangentially stays within CONTACT_TOLERANCE_RAD of
+    touching a little longer. The free play is j / (2 r) each way (5e-7 rad)."""
+    from fabricate.gears.mesh import free_play
+
+    pair = long_contact_spur_sector(radius, pressure_deg)
+    assert not pair.checks["undercut"] and not pair.checks["self_intersecting_envelope"]
+    alpha = np.radians(pressure_deg)
+    half_path = np.sqrt((radius + 1.5) ** 2 - (radius * np.cos(alpha)) ** 2) - radius * np.sin(alpha)
+    assert half_path / np.cos(alpha) > 1.7 * np.pi  # beyond the old window
+    x = 0.2 + (np.arange(200) / 200 - 0.5) * np.pi / radius
+    plus, minus, count = free_play(pair, x, return_contacts=True)
+    assert np.mean(count) == pytest.approx(2 * half_path / (np.pi * np.cos(alpha)), abs=tol)
+    np.testing.assert_allclose(plus, 0.1 / (2 * radius), rtol=0, atol=5e-7)
+    np.testing.assert_allclose(minus, 0.1 / (2 * radius), rtol=0, atol=5e-7)
+
+
+def test_flank_window_holds_each_flank_of_a_small_closed_gear_once():
+    """4/8-tooth spur gears of module 1 at 14.5 deg (min_teeth 3, bore 0.5 mm; undercut): the window would reach
+    1 / (sin a cos a) m + p = 2.31 p either side (10 flanks), but gear a has only 8: it is kept to 8, reach
+    (2 z - 1.5) p / 4 = 1.625 p. With 10, one of gear a's flanks is taken on two rack lines, the second pairing it
+    with gear b's flank half a turn of gear b away: free_plus -2.89 rad at these steps (x_a = 0.889 + k pi/2),
+    where the outlines do not overlap at all (interference area 0), so the play cannot be negative."""
+    from fabricate.gears.mesh import flank_reach, free_play, interference_areas
+
+    spec = GearSpec(teeth=(4, 8), module_mm=1.0, backlash_mm=0.1, compare_methods=False, min_teeth=3, bore_mm=0.5,
+                    pressure_angle_deg=14.5)
+    pair = make_gear_pair(FormulaLaw("x/2"), 6.0, (0.0, 2 * np.pi), spec, closed=True, run_mesh_check=False)
+    assert flank_reach(pair) == pytest.approx(6.5 * np.pi / 4, rel=1e-12)
+    x = 0.889 + np.arange(4) * np.pi / 2
+    np.testing.assert_array_equal(interference_areas(pair, x), 0.0)
+    plus, minus, count = free_play(pair, x, return_contacts=True)
+    assert np.all(plus > 0.0125) and np.all(minus > 0.0125)  # at least j / (2 r_b)
+    np.testing.assert_array_equal(count, 1)
 
 
 @pytest.mark.parametrize("closer", [0.8, 3.0])
