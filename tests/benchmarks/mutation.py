@@ -66,7 +66,8 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "checks/interference": ("fabricate/checks/interference.py", CHECK_TESTS),
     "checks/distance": ("fabricate/checks/distance.py", CHECK_TESTS),
     # test_checks.py synthesises the seed-000 finger (tens of seconds): the property tests drive the check
-    "checks/gear_mesh": ("fabricate/checks/gear_mesh.py", ["tests/test_gears_properties.py"]),
+    "checks/gear_mesh": ("fabricate/checks/gear_mesh.py",
+                         ["tests/test_gears_properties.py", "tests/test_checks_gear_mesh.py"]),
     "checks/printability": ("fabricate/checks/printability.py", ["tests/test_checks.py"]),
     "parts/profiles": ("fabricate/parts/profiles.py", PARTS_TESTS),
     "parts/build": ("fabricate/parts/build.py", PARTS_TESTS),
