@@ -22,7 +22,7 @@ LAW_TOLERANCE_RAD = 1e-6
 RANGE_TOLERANCE_RAD = 1e-9
 #: Backlash must stay within these multiples of the design backlash (and above zero).
 BACKLASH_BAND = (0.5, 2.0)
-#: Tooth overlap area (mm^2) below this is rounding.
+#: Tooth overlap area (mm^2) at or below this is rounding (a larger one fails).
 AREA_EPS_MM2 = 1e-6
 
 
