@@ -300,6 +300,14 @@ def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
         print(f"{key}: {source} changed since the full run; re-running the survivors of the version that "
               "was measured (run the module again to measure the current one)", flush=True)
         result["note"] = "survivors re-run against the source version of the full run"
+    # the rest of the package as it is now (the new tests may use code added since the full run); only the
+    # measured module keeps the version its mutants were made from
+    for target in (work / "fabricate", work / "mutants" / "fabricate"):
+        for path in (ROOT / "fabricate").rglob("*.py"):
+            rel = path.relative_to(ROOT)
+            if rel.as_posix() != source:
+                (target.parent / rel).parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy2(path, target.parent / rel)
     for target in (work / "tests", work / "mutants" / "tests"):
         shutil.rmtree(target, ignore_errors=True)
         shutil.copytree(ROOT / "tests", target, ignore=shutil.ignore_patterns("__pycache__", ".hypothesis"))
