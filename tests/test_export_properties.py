@@ -676,3 +676,75 @@ def test_read_3mf_reads_every_object_and_checks_each_index():
     objects, problems = read_3mf(model_3mf([("soup", soup_v, soup_f)], "t"))
     assert problems == [] and len(objects["soup"].vertices) == 36
     assert "not watertight" in mesh_problems(objects["soup"])
+
+
+def plain(outline: BulgePath, holes=(), slots=()) -> SlottedPart:
+    return SlottedPart("A", "A", outline, tuple(holes), 3.0, 0.0, 0, "laser", slots=tuple(slots))
+
+
+def rectangle(w: float, h: float, x0: float = 0.0, y0: float = 0.0) -> BulgePath:
+    return BulgePath(np.array([[x0, y0], [x0 + w, y0], [x0 + w, y0 + h], [x0, y0 + h]]), np.zeros(4))
+
+
+def disc(radius: float) -> BulgePath:
+    """A full circle about the origin: two half-circle arcs (bulge 1)."""
+    return BulgePath(np.array([[-radius, 0.0], [radius, 0.0]]), np.array([1.0, 1.0]))
+
+
+def closed_form_height(room: float, text: str) -> float:
+    return float(np.clip(round(min(0.8 * room, 1.6 * room / (0.9 * len(text))), 3), 0.3, 5.0))
+
+
+@pytest.mark.parametrize("name", ["A", "LABEL12"])
+def test_label_height_is_the_closed_form_of_the_room(name):
+    """On a 6 x 20 rectangle the roomiest spots are its centre line (room = half the width, 3 mm): the
+    label sits there with height round(min(0.8 room, 1.6 room / (0.9 len)), 3) exactly. On a disc of
+    radius 3 the room is 3 less at most the 0.05 mm chord sagitta."""
+    spot, height, _ = label_of(dataclasses.replace(plain(rectangle(6.0, 20.0)), name=name))
+    assert spot.x == pytest.approx(3.0, abs=1e-9) and 3.0 <= spot.y <= 17.0
+    assert height == closed_form_height(3.0, name)
+    spot, height, _ = label_of(dataclasses.replace(plain(disc(3.0)), name=name))
+    assert spot.distance(shapely.Point(0.0, 0.0)) <= 0.05
+    assert closed_form_height(2.95, name) - 0.001 <= height <= closed_form_height(3.0, name)
+
+
+def label_cases() -> dict[str, SlottedPart]:
+    four = [Hole(str(k), np.array([sx * 1.6, sy * 1.6]), 0.4, 0.3) for k, (sx, sy) in
+            enumerate([(1, 1), (1, -1), (-1, 1), (-1, -1)])]
+    ell = BulgePath(np.array([[0.0, 0.0], [300.0, 0.0], [300.0, 40.0], [40.0, 40.0], [40.0, 200.0], [0.0, 200.0]]),
+                    np.zeros(6))
+    return {
+        "L-plate": plain(ell),  # pole off the centroid: the search has to refine it
+        "disc-slot": plain(rectangle(12.0, 12.0, -6.0, -6.0), slots=[disc(3.0)]),  # pole between slot and corner
+        "four-holes": plain(rectangle(8.0, 8.0, -4.0, -4.0), holes=four),  # pole between the holes, edges far
+        "off-hole": plain(rectangle(20.0, 20.0), holes=[Hole("H", np.array([6.0, 7.0]), 5.0, 3.0)]),
+    }
+
+
+@pytest.mark.parametrize("case", list(label_cases()))
+def test_label_spot_is_the_roomiest_within_its_tolerance(case):
+    """The label spot lies in the plate (outline less holes and slots, sampled here) with a room (shapely
+    distance to the nearest edge, hole or slot) within 0.05 mm of the largest inscribed circle, and its
+    height is the closed form of that room (to the 0.05 mm tolerance and rounding)."""
+    part = label_cases()[case]
+    plate = plate_region(part)
+    spot, height, text = label_of(part)
+    assert plate.contains(spot)
+    room = plate.boundary.distance(spot)
+    best = shapely.maximum_inscribed_circle(plate, 1e-4).length
+    assert best - 0.05 <= room <= best + 1e-3
+    assert closed_form_height(room - 0.05, text) - 0.001 <= height <= closed_form_height(room + 0.05, text)
+
+
+def test_read_dxf_returns_the_auditors_messages():
+    """A broken drawing (a layer name with '<', an undefined linetype) is reported with the auditor's own
+    messages: the unfixable error and the fix, each naming what is wrong."""
+    from fabricate.export.dxf import document_bytes, new_document, read_dxf
+
+    doc = new_document()
+    doc.modelspace().add_line((0.0, 0.0), (1.0, 1.0), dxfattribs={"layer": "BAD", "linetype": "MISSING"})
+    data = document_bytes(doc).replace(b"\n  8\nBAD\n", b"\n  8\nB<D\n")
+    problems, diameters = read_dxf(data)
+    assert diameters == [] and len(problems) == 2
+    assert problems[0].startswith('Invalid layer name "B<D" in LINE')
+    assert "linetype" in problems[1] and "missing" in problems[1].lower()
