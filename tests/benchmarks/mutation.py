@@ -46,7 +46,7 @@ EQUIVALENT = HERE / "equivalent.toml"
 REPORT = ROOT / "tests" / "benchmarks" / "mutation_report.md"
 
 GEARS_TESTS = ["tests/test_gears_properties.py", "tests/test_gears.py", "tests/test_gears_mesh.py",
-               "tests/test_gears_pair.py"]
+               "tests/test_gears_pair.py", "tests/test_gears_teeth.py"]
 CHECK_TESTS = ["tests/test_checks_properties.py", "tests/test_interference.py"]
 PARTS_TESTS = ["tests/test_parts_properties.py", "tests/test_parts.py"]
 # test_export.py builds every template with both processes (minutes per mutant): not in the mutation run
