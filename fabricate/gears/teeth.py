@@ -211,7 +211,7 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     dense_poly = Polygon(dense)
     budget = max(0.5 * chord_tolerance_mm, chord_tolerance_mm - 0.001)  # leave 1 um for the dense outline
     outline = simplify_ring(dense, budget) if decimate else dense
-    if decimate and not Polygon(outline).is_valid:  # pragma: no cover - tolerance far below tooth features
+    if decimate and not Polygon(outline).is_valid:  # approx cut on a concave stretch: plain DP may cross itself
         simple = shapely.simplify(dense_poly, 0.5 * chord_tolerance_mm, preserve_topology=True)
         outline = _clean_ring(np.asarray(orient(_largest_polygon(simple), 1.0).exterior.coords))
     # tip lands: pieces of the outline lying on the tip curve (a pointed tooth has none)
