@@ -423,7 +423,7 @@ def check_examples() -> list[str]:
 
 def _results_text(results: dict) -> str:
     """results.json: one line per mutant (a reviewable diff, and under 1 MB where indenting every field
-    of every mutant was not); killed mutants keep only their name, function and status."""
+    of every mutant was not); killed and not-reached mutants keep only their name, function and status."""
     lines = ["{"]
     modules = list(results.items())
     for m, (name, value) in enumerate(modules):
@@ -435,7 +435,7 @@ def _results_text(results: dict) -> str:
                 if isinstance(item, list):
                     if key == "mutants":  # a killed mutant's lines are not needed again: keep the file < 1 MB
                         item = [{k: v for k, v in x.items() if k in ("name", "function", "status")}
-                                if x.get("status") in ("killed", "timeout") else x for x in item]
+                                if x.get("status") in ("killed", "timeout", "not checked") else x for x in item]
                     lines.append(f" {json.dumps(key)}: [")
                     lines += [f"  {json.dumps(x, separators=(',', ':'))}" + ("," if i < len(item) - 1 else "")
                               for i, x in enumerate(item)]
@@ -458,6 +458,7 @@ def _save(key: str, result: dict) -> None:
         with os.fdopen(fd, "w") as fh:
             fh.write(_results_text(dict(sorted(current.items(), key=lambda kv: list(MODULES).index(kv[0])
                                                 if kv[0] in MODULES else len(MODULES)))))
+        os.chmod(tmp, 0o644)
         os.replace(tmp, RESULTS)
 
 
