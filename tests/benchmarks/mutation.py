@@ -148,6 +148,34 @@ def write_config(key: str, work: Path) -> None:
     lines = ["[tool.mutmut]"] + [f"{k} = {toml_value(v)}" for k, v in config.items()]
     lines += ["", "[tool.pytest.ini_options]", 'testpaths = ["tests"]', 'addopts = ""', ""]
     (work / "pyproject.toml").write_text("\n".join(lines))
+    for conftest in (work / "tests" / "conftest.py", work / "mutants" / "tests" / "conftest.py"):
+        if conftest.exists() and STATS_PLUGIN_MARK not in conftest.read_text():
+            conftest.write_text(conftest.read_text() + STATS_PLUGIN)
+
+
+STATS_PLUGIN_MARK = "# --- mutation.py: credit every test of a file that touched a function ---"
+#: Appended to the work copy's conftest.py (never the repository's). mutmut maps each function to the tests
+#: that called it while its stats were collected, and runs only those against the function's mutants. A
+#: module-scoped fixture or a ``functools.cache`` helper computes its gear once, in the first test that asks,
+#: so the tests reading the cached gear were never credited and never run (test_gears_teeth's tip-land test
+#: was left out of every ``cut_gear`` mutant this way). After the stats run, every test of a file that touched
+#: a function is credited with it; mutmut still stops at the first failing test.
+STATS_PLUGIN = f"""
+
+{STATS_PLUGIN_MARK}
+def pytest_sessionfinish(session):
+    import os
+    if os.environ.get("MUTANT_UNDER_TEST") != "stats":
+        return
+    from mutmut.state import state
+
+    by_file = {{}}
+    for item in session.items:
+        by_file.setdefault(item.nodeid.split("::")[0], set()).add(item.nodeid)
+    for tests in state().tests_by_mangled_function_name.values():
+        for name in list(tests):
+            tests |= by_file.get(name.split("::")[0], set())
+"""
 
 
 def changed_tokens(diff: str) -> tuple[list[str], list[str]]:
@@ -277,9 +305,11 @@ def run_module(key: str, max_children: int, collect_only: bool = False) -> dict:
             "string_only_skipped": strings, "mutants": rows}
 
 
-def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
+def rerun_survivors(key: str, result: dict, max_children: int, unreached: bool = False) -> dict:
     """Run the survivors of a saved result again in its work copy, with the current tests (after adding a
-    killing test): the mutants are the same as long as the module's source has not changed."""
+    killing test): the mutants are the same as long as the module's source has not changed. With
+    ``unreached``, the mutants an interrupted run never reached are run too (the run finishes where it
+    stopped, without running the killed ones again)."""
     source, tests = MODULES[key]
     work = WORK / key.replace("/", "_")
     if not (work / "mutants" / (source + ".meta")).exists():
@@ -315,16 +345,22 @@ def rerun_survivors(key: str, result: dict, max_children: int) -> dict:
     shutil.copy2(work / "pyproject.toml", work / "mutants" / "pyproject.toml")
     (work / "mutants" / "mutmut-stats.json").unlink(missing_ok=True)  # new tests: map them again
     result = drop_string_only(result)
-    names = [r["name"] for r in result["mutants"] if r["status"] in ("survived", "no tests")]
+    again = ("survived", "no tests", "not checked") if unreached else ("survived", "no tests")
+    names = [r["name"] for r in result["mutants"] if r["status"] in again]
     if names:
         with open(work / "mutmut-rerun.log", "w") as log:
             subprocess.run(["nice", "-n", "10", mutmut_exe(), "run", "--max-children", str(max_children), *names],
                            cwd=work, check=False, stdout=log, stderr=subprocess.STDOUT)
     codes = json.loads((work / "mutants" / (source + ".meta")).read_text())["exit_code_by_key"]
     table = load_equivalents()
+    lines = None
     for r in result["mutants"]:
         if r["name"] in names:
             r["status"] = STATUS.get(codes.get(r["name"]), "suspicious")
+            if r["status"] not in ("killed", "timeout", "not checked") and "old" not in r:
+                # a mutant stored unreached has no lines yet: read them from the work copy
+                lines = saved_diffs(work) if lines is None else lines
+                r["old"], r["new"] = (t.strip() for t in changed_tokens(lines.get(r["name"], "")))
         if r["status"] not in ("killed", "timeout") and "old" in r:
             reason = equivalent_reason(key, r["function"], r["old"], r["new"], table)
             if reason:
@@ -485,6 +521,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="read the results an earlier (interrupted) run of MODULE(s) left, without running")
     parser.add_argument("--survivors", action="store_true",
                         help="re-run only the saved survivors of MODULE(s) with the current tests")
+    parser.add_argument("--unreached", action="store_true",
+                        help="with --survivors: also run the mutants an interrupted run did not reach")
     args = parser.parse_args(argv)
     HERE.mkdir(parents=True, exist_ok=True)
     if args.examples:
@@ -501,7 +539,7 @@ def main(argv: list[str] | None = None) -> int:
     if not args.report:
         for key in keys:
             if args.survivors:
-                results[key] = rerun_survivors(key, results[key], args.max_children)
+                results[key] = rerun_survivors(key, results[key], args.max_children, args.unreached)
             elif args.collect:
                 results[key] = run_module(key, args.max_children, collect_only=True)
             else:
