@@ -47,8 +47,9 @@ REPORT = ROOT / "tests" / "benchmarks" / "mutation_report.md"
 
 GEARS_TESTS = ["tests/test_gears_properties.py", "tests/test_gears.py", "tests/test_gears_mesh.py",
                "tests/test_gears_pair.py", "tests/test_gears_teeth.py"]
-CHECK_TESTS = ["tests/test_checks_properties.py", "tests/test_interference.py"]
-PARTS_TESTS = ["tests/test_parts_properties.py", "tests/test_parts.py"]
+CHECK_TESTS = ["tests/test_checks_properties.py", "tests/test_interference.py",
+               "tests/test_checks_interference.py"]
+PARTS_TESTS = ["tests/test_parts_properties.py", "tests/test_parts.py", "tests/test_parts_build.py"]
 # test_export.py builds every template with both processes (minutes per mutant): not in the mutation run
 EXPORT_TESTS = ["tests/test_export_properties.py"]
 
@@ -73,7 +74,8 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "parts/build": ("fabricate/parts/build.py", PARTS_TESTS),
     "export/dxf": ("fabricate/export/dxf.py", EXPORT_TESTS),
     "export/stl": ("fabricate/export/stl.py", EXPORT_TESTS),
-    "synthesis/kinematic_mapping": ("fabricate/synthesis/five_bar/kinematic_mapping.py", ["tests/test_five_bar.py"]),
+    "synthesis/kinematic_mapping": ("fabricate/synthesis/five_bar/kinematic_mapping.py",
+                                    ["tests/test_five_bar.py", "tests/test_kinematic_mapping.py"]),
 }
 
 #: The six hand-made mutants of issue 15 and the tests that must kill them (``--examples`` checks it).
