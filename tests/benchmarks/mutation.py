@@ -267,9 +267,10 @@ def saved_diffs(work: Path) -> dict[str, str]:
     return json.loads(run.stdout[run.stdout.index("{"):])
 
 
-def run_module(key: str, max_children: int, collect_only: bool = False) -> dict:
+def run_module(key: str, max_children: int, collect_only: bool = False, functions: set[str] | None = None) -> dict:
     """Generate and run one module's mutants; with ``collect_only`` read what an earlier (possibly
-    interrupted) run of the same work copy left: mutants it did not reach are "not checked"."""
+    interrupted) run of the same work copy left: mutants it did not reach are "not checked". With
+    ``functions``, only the mutants of those functions are run and returned (see :func:`merge_functions`)."""
     work = WORK / key.replace("/", "_")
     if collect_only:
         diffs = saved_diffs(work)
@@ -283,7 +284,8 @@ def run_module(key: str, max_children: int, collect_only: bool = False) -> dict:
         if is_string_only(old, new):
             strings += 1
             continue
-        selected[name] = (old, new)
+        if functions is None or function_of(name) in functions:
+            selected[name] = (old, new)
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
     names = sorted(selected)
     if names and not collect_only:
@@ -303,8 +305,31 @@ def run_module(key: str, max_children: int, collect_only: bool = False) -> dict:
         reason = equivalent_reason(key, fn, old, new, table) if status not in ("killed", "not checked") else None
         rows.append({"name": name, "function": fn, "status": "equivalent" if reason else status,
                      "old": old.strip(), "new": new.strip(), "reason": reason})
-    return {"module": key, "source": MODULES[key][0], "tests": MODULES[key][1], "generated": len(diffs),
-            "string_only_skipped": strings, "mutants": rows}
+    result = {"module": key, "source": MODULES[key][0], "tests": MODULES[key][1], "generated": len(diffs),
+              "string_only_skipped": strings, "mutants": rows}
+    if functions is not None:
+        result["all_diffs"] = diffs  # for merge_functions' check; not saved
+    return result
+
+
+def merge_functions(saved: dict, fresh: dict, functions: set[str]) -> dict:
+    """The saved result with the rows of ``functions`` replaced by a fresh run of just those functions (their
+    source changed since the full run). The mutants of the other functions are the same as long as their
+    source is: mutmut numbers a function's mutants from its own text, so a saved survivor of another function
+    must come back with the same change (checked) or the whole module has to run again."""
+    fresh_rows = {r["name"]: r for r in fresh["mutants"]}
+    for r in saved["mutants"]:
+        if function_of(r["name"]) in functions or "old" not in r:
+            continue
+        again = changed_tokens(fresh.get("all_diffs", {}).get(r["name"], ""))
+        if (again[0].strip(), again[1].strip()) != (r["old"], r["new"]):
+            raise SystemExit(f"{saved['module']}: {r['name']} is not the measured mutant any more: "
+                             "run the module again")
+    rows = [r for r in saved["mutants"] if function_of(r["name"]) not in functions] + list(fresh_rows.values())
+    out = dict(saved, mutants=sorted(rows, key=lambda r: r["name"]), generated=fresh["generated"],
+               string_only_skipped=fresh["string_only_skipped"])
+    out["note"] = f"functions {', '.join(sorted(functions))} run again on the current source"
+    return out
 
 
 def rerun_survivors(key: str, result: dict, max_children: int, unreached: bool = False) -> dict:
@@ -523,6 +548,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="read the results an earlier (interrupted) run of MODULE(s) left, without running")
     parser.add_argument("--survivors", action="store_true",
                         help="re-run only the saved survivors of MODULE(s) with the current tests")
+    parser.add_argument("--functions", metavar="F1,F2",
+                        help="run only these functions' mutants (changed since the module's full run) and merge "
+                             "them into its saved result")
     parser.add_argument("--unreached", action="store_true",
                         help="with --survivors: also run the mutants an interrupted run did not reach")
     args = parser.parse_args(argv)
@@ -542,6 +570,10 @@ def main(argv: list[str] | None = None) -> int:
         for key in keys:
             if args.survivors:
                 results[key] = rerun_survivors(key, results[key], args.max_children, args.unreached)
+            elif args.functions:
+                functions = set(args.functions.split(","))
+                fresh = run_module(key, args.max_children, functions=functions)
+                results[key] = merge_functions(results[key], fresh, functions)
             elif args.collect:
                 results[key] = run_module(key, args.max_children, collect_only=True)
             else:
