@@ -1,0 +1,238 @@
+"""Interference sweep: sampling of the worst overlap, parts-layer pins, the naive reference with pins and
+spacers, and the wording and boundaries of the verdict, each against closed-form geometry.
+
+Written to kill mutants of ``fabricate/checks/interference.py`` (see ``tests/benchmarks/mutation_report.md``).
+The solids here are boxes (exact polygons at any chord tolerance) moved by hand-made motions, so every
+overlap area and distance is a product of known lengths; circles are checked against pi r^2 within the
+area an inscribed polygon of sagitta ``tol`` can lose (at most its perimeter times ``tol``).
+"""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from fabricate.checks.interference import (
+    OVERLAP_SAMPLES,
+    PinSolid,
+    naive_interference,
+    pins_from_parts_layer,
+    sweep_interference,
+)
+from fabricate.mechanism import Motion
+from fabricate.parts.model import BulgePath, Hole, Part
+
+TOL = 0.002  # chord tolerance of the polygonised solids, mm
+
+
+def box_part(name: str, body: str, size: tuple[float, float], z: float, thickness: float, *,
+             centre: tuple[float, float] = (0.0, 0.0), holes: tuple[Hole, ...] = ()) -> Part:
+    """A ``size`` rectangle centred on ``centre`` of its body frame, extruded from ``z`` by ``thickness``."""
+    w, h = size
+    cx, cy = centre
+    outline = BulgePath.polyline(np.array([[cx - w / 2, cy - h / 2], [cx + w / 2, cy - h / 2],
+                                           [cx + w / 2, cy + h / 2], [cx - w / 2, cy + h / 2]]))
+    return Part(name, body, outline, holes, thickness, z, 0, "sla")
+
+
+def motion_of(poses_b: np.ndarray, inputs: np.ndarray | None = None) -> Motion:
+    """A bare Motion of bodies 'a' (at rest on the ground pose) and 'b' (``poses_b``), ground 'g'."""
+    n = len(poses_b)
+    inputs = np.arange(n, dtype=np.float64) if inputs is None else np.asarray(inputs, dtype=np.float64)
+    return Motion(inputs=inputs, body_names=("g", "a", "b"), ground="g", free=("a", "b"),
+                  q=np.stack([np.zeros((n, 3)), np.asarray(poses_b, dtype=np.float64)], axis=1),
+                  mechanism=SimpleNamespace(input_unit="deg"))
+
+
+# -- the worst overlap of a long colliding run -------------------------------------------------------
+LEAD = 10  # poses before the run where B stands well clear of A
+RUN = 200  # colliding poses
+
+
+def sliding_boxes(peak: int):
+    """A (20 x 4, z 0..2) at rest; B (20 x 4 shifted +1 in y, z 0.5..2.5) first 30 mm away, then over A
+    with x offset ``0.01 + 0.05 |i - peak|`` at the i-th pose of the run. Overlap = (20 - offset) x 3 (y)
+    x 1.5 (z) mm^3, largest only at ``peak``. Returns (parts, motion, offsets of all poses)."""
+    offsets = np.concatenate([np.full(LEAD, 30.0), 0.01 + 0.05 * np.abs(np.arange(RUN) - peak)])
+    poses_b = np.column_stack([offsets, np.full(len(offsets), 1.0), np.zeros(len(offsets))])
+    parts = [box_part("A", "a", (20.0, 4.0), 0.0, 2.0), box_part("B", "b", (20.0, 4.0), 0.5, 2.0)]
+    return parts, motion_of(poses_b), offsets
+
+
+@pytest.mark.parametrize("peak", [3, 7, 100, 196, RUN - 1])
+def test_worst_overlap_of_a_long_run_is_found_exactly(peak):
+    """Longer runs than OVERLAP_SAMPLES are sampled, then refined next to the worst sample: the reported
+    worst pose and volume must be the true maximum (closed form (20 - 0.01) x 3 x 1.5 mm^3 at the peak,
+    1e-6), wherever it lies: just after the first sample, between the first two, mid-run, between the
+    last two samples, on the last pose. Every evaluated volume equals the closed form at its pose (1e-9),
+    no pose is evaluated twice, and the cost stays bounded: at most OVERLAP_SAMPLES spread samples plus
+    the poses within two sample spacings (ceil(199 / 23) = 9 poses each) of the worst."""
+    parts, motion, offsets = sliding_boxes(peak)
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    (pair,) = result.pairs
+    np.testing.assert_array_equal(pair.collision_indices, np.arange(LEAD, LEAD + RUN))
+    assert pair.max_overlap_index == LEAD + peak
+    assert pair.max_overlap_mm3 == pytest.approx((20.0 - 0.01) * 3.0 * 1.5, abs=1e-6)
+    idx = pair.overlap_indices
+    assert np.all(np.diff(idx) > 0)  # sorted, each pose once
+    assert set(idx) <= set(pair.collision_indices)
+    np.testing.assert_allclose(pair.overlap_mm3, (20.0 - offsets[idx]) * 3.0 * 1.5, atol=1e-9)
+    spacing = math.ceil((RUN - 1) / (OVERLAP_SAMPLES - 1))
+    assert len(idx) <= OVERLAP_SAMPLES + 2 * spacing
+    assert len(idx) < RUN // 4
+    # the report names the worst pose and its volume
+    (row,) = result.report()["collisions"]
+    assert row["input_deg"] == LEAD + peak
+    assert row["volume_mm3"] == pytest.approx((20.0 - 0.01) * 4.5, abs=1e-6)
+    assert row["poses_colliding"] == RUN
+
+
+@pytest.mark.parametrize("run", [OVERLAP_SAMPLES - 1, OVERLAP_SAMPLES])
+def test_short_colliding_run_is_evaluated_at_every_pose(run):
+    """Up to OVERLAP_SAMPLES colliding poses, every one is evaluated (no sampling): the volumes are the
+    closed form at each pose (1e-9) and the worst is the true peak."""
+    peak = run // 3
+    offsets = 0.01 + 0.05 * np.abs(np.arange(run) - peak)
+    poses_b = np.column_stack([offsets, np.full(run, 1.0), np.zeros(run)])
+    parts = [box_part("A", "a", (20.0, 4.0), 0.0, 2.0), box_part("B", "b", (20.0, 4.0), 0.5, 2.0)]
+    (pair,) = sweep_interference(parts, motion_of(poses_b), chord_tolerance_mm=TOL, min_clearance_mm=0.25).pairs
+    np.testing.assert_array_equal(pair.overlap_indices, np.arange(run))
+    np.testing.assert_allclose(pair.overlap_mm3, (20.0 - offsets) * 4.5, atol=1e-9)
+    assert pair.max_overlap_index == peak
+    assert pair.max_overlap_mm3 == pytest.approx((20.0 - 0.01) * 4.5, abs=1e-6)
+
+
+# -- verdict wording and boundaries ------------------------------------------------------------------
+def test_collision_message_lists_each_run_of_inputs_with_unit_and_worst_volume():
+    """B passes over A, stands clear for exactly one pose, and comes back: two runs of colliding inputs
+    (a one-pose gap still splits them). The failure names the pair, both runs in the motion's unit and the
+    worst overlap: (10 - 1) x 2 x 2 = 36 mm^3 at input 15 deg (B 10 x 2 offset 1 mm in x over A's 10 x 4,
+    z overlap 2 mm)."""
+    x = np.array([12.0, 5.0, 1.0, 11.0, 3.0, 2.0, 12.0])  # A spans |x| <= 5, B is 10 wide: overlap 10 - |x|
+    poses_b = np.column_stack([x, np.zeros(7), np.zeros(7)])
+    inputs = np.arange(7) * 5.0
+    parts = [box_part("A", "a", (10.0, 4.0), 0.0, 3.0), box_part("B", "b", (10.0, 2.0), 1.0, 3.0)]
+    result = sweep_interference(parts, motion_of(poses_b, inputs), chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    (pair,) = result.collisions
+    np.testing.assert_array_equal(pair.collision_indices, [1, 2, 4, 5])
+    assert result.input_ranges(pair.collision_indices) == [(5.0, 10.0), (20.0, 25.0)]
+    assert result.failures() == [
+        "interference: A collides with B at input 5..10, 20..25 deg (largest overlap 36.000 mm^3 at 10 deg)"]
+    assert result.report()["collisions"][0]["input_ranges"] == [[5.0, 10.0], [20.0, 25.0]]
+
+
+@pytest.mark.parametrize("use_kernel", [False, True])
+def test_clearance_exactly_at_required_less_tolerance_passes(use_kernel):
+    """The verdict's slack is the chord tolerance, inclusive: boxes exactly 0.25 mm apart pass with a
+    0.375 mm minimum and a 0.125 mm tolerance, and fail 1/64 mm closer with the clearance message (dyadic
+    lengths, so every number is exact in binary)."""
+    for gap, ok in ((0.25, True), (0.25 - 1 / 64, False)):
+        poses_b = np.array([[10.0 + gap, 0.0, 0.0], [12.0, 0.0, 0.0]])
+        parts = [box_part("A", "a", (10.0, 4.0), 0.0, 3.0), box_part("B", "b", (10.0, 4.0), 0.0, 3.0)]
+        result = sweep_interference(parts, motion_of(poses_b, [30.0, 40.0]), chord_tolerance_mm=0.125,
+                                    min_clearance_mm=0.375, use_kernel=use_kernel)
+        (pair,) = result.pairs
+        assert not pair.collides
+        assert pair.min_clearance_mm == pytest.approx(gap, abs=1e-9)
+        assert pair.min_index == 0
+        assert result.passed is ok
+        assert result.report()["pairs"][0]["ok"] is ok
+        if ok:
+            assert result.too_close() == [] and result.failures() == []
+        else:
+            assert result.too_close() == [pair]
+            assert result.failures() == [f"clearance: A and B come within {gap:.3f} mm at input 30 deg; "
+                                         "the process needs 0.375 mm"]
+
+
+# -- pins given as the parts layer's pins ------------------------------------------------------------
+def test_pins_from_parts_layer_take_the_axis_of_their_first_body_hole():
+    """Each parts-layer pin becomes a PinSolid fixed in the first of its bodies, on the centre of that
+    body's hole for the pin's joint (not another joint's hole, not the other body's hole), with the pin's
+    own diameter, z and length; a pin whose first body has no such hole is skipped (the pins after it
+    still count); PinSolids pass through unchanged."""
+    parts = [
+        box_part("B", "b", (10.0, 10.0), 3.3, 3.0, holes=(Hole("J", np.array([-3.0, 1.0]), 2.5, 2.0),)),
+        box_part("A", "a", (30.0, 10.0), 0.0, 3.0, holes=(Hole("K", np.array([9.0, 9.0]), 2.5, 2.0),
+                                                          Hole("J", np.array([5.0, 0.0]), 2.5, 2.0))),
+    ]
+    ready = PinSolid("pin_Q", "Q", "b", np.array([1.0, 2.0]), 1.5, 0.0, 4.0)
+    layer_pins = [
+        ready,
+        SimpleNamespace(joint="X", bodies=("c", "a"), diameter_mm=2.0, length_mm=5.0, z_mm=0.0),  # no hole
+        SimpleNamespace(joint="J", bodies=("a", "b"), diameter_mm=2.2, length_mm=7.5, z_mm=-1.0),
+    ]
+    pins = pins_from_parts_layer(layer_pins, parts)
+    assert len(pins) == 2
+    passed, pin = pins
+    assert passed is ready
+    assert isinstance(pin, PinSolid)
+    assert (pin.name, pin.joint, pin.body) == ("pin_J", "J", "a")
+    assert pin.centre.dtype == np.float64
+    np.testing.assert_array_equal(pin.centre, [5.0, 0.0])
+    assert (pin.diameter_mm, pin.z_mm, pin.length_mm) == (2.2, -1.0, 7.5)
+
+
+def two_plates_on_a_pin(pin_diameter: float, *, washer: bool = False):
+    """Plate A (body a, z 0..3) and plate B (body b, z 3.3..6.3; optionally a washer on joint J carried by
+    b fills the 0.3 mm between them), each with a 2.5 mm hole for joint J at the body origin; B turns 90 deg about J.
+    The parts-layer pin (fixed in a) has ``pin_diameter``; the holes say 2.0 mm."""
+    parts = [box_part("A", "a", (30.0, 10.0), 0.0, 3.0, centre=(10.0, 0.0),
+                      holes=(Hole("J", np.zeros(2), 2.5, 2.0),)),
+             box_part("B", "b", (30.0, 10.0), 3.3, 3.0, centre=(10.0, 0.0),
+                      holes=(Hole("J", np.zeros(2), 2.5, 2.0),))]
+    spacers = []
+    if washer:
+        spacers = [SimpleNamespace(joint="J", body="b", centre=np.zeros(2), inner_diameter_mm=2.5,
+                                   outer_diameter_mm=5.0, z_mm=3.0, length_mm=0.3, washer=True)]
+    th = np.radians(np.linspace(0.0, 90.0, 5))
+    motion = motion_of(np.column_stack([np.zeros(5), np.zeros(5), th]), np.degrees(th))
+    pins = [SimpleNamespace(joint="J", bodies=("a", "b"), diameter_mm=pin_diameter, length_mm=6.3, z_mm=0.0)]
+    return parts, motion, pins, spacers
+
+
+def annulus_mm2(d_out: float, d_in: float) -> tuple[float, float]:
+    """Closed-form annulus area and the most two inscribed polygons of sagitta TOL can change it."""
+    return math.pi / 4.0 * (d_out**2 - d_in**2), 2.0 * math.pi * (d_out + d_in) / 2.0 * TOL
+
+
+def test_parts_layer_pin_sets_the_radial_clearance_of_the_sweep():
+    """A 2.2 mm parts-layer pin in 2.5 mm holes (whose nominal pin is 2.0): the pin pair keeps the radial
+    clearance (2.5 - 2.2) / 2 = 0.15 mm at every pose, within the chord tolerance, so the build fails the
+    0.25 mm minimum on the pin; the pin is fixed in body a, so only B meets it."""
+    parts, motion, pins, _ = two_plates_on_a_pin(2.2)
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25, pins=pins)
+    rows = {(p.a, p.b): p for p in result.pairs}
+    assert set(rows) == {("A", "B"), ("B", "pin_J")}
+    assert result.rigid_pairs == 1
+    pin = rows[("B", "pin_J")]
+    assert pin.relation == "pin"
+    assert 0.15 - TOL - 1e-9 <= pin.min_clearance_mm <= 0.15 + 1e-9
+    assert np.all(np.abs(pin.clearance - 0.15) <= TOL + 1e-9)
+    assert rows[("A", "B")].min_clearance_mm == pytest.approx(0.3, abs=1e-9)
+    assert [(p.a, p.b) for p in result.too_close()] == [("B", "pin_J")]
+
+
+def test_naive_reference_uses_the_given_pins_and_spacers():
+    """An oversized 2.8 mm parts-layer pin in the 2.5 mm holes, with a 0.3 mm washer on B: the naive
+    boolean reference reports, at every pose, the annulus pi/4 (2.8^2 - 2.5^2) times B's 3 mm and times the
+    washer's 0.3 mm (within the area inscribed polygons can lose), nothing between the stacked plates, and
+    the same worst volumes and colliding poses as the sweep on the same input (1e-6)."""
+    parts, motion, pins, spacers = two_plates_on_a_pin(2.8, washer=True)
+    naive = naive_interference(parts, motion, chord_tolerance_mm=TOL, pins=pins, spacers=spacers)
+    assert set(naive) == {("A", "B"), ("A", "washer_J"), ("B", "pin_J"), ("pin_J", "washer_J")}
+    area, slack = annulus_mm2(2.8, 2.5)
+    np.testing.assert_allclose(naive[("B", "pin_J")], area * 3.0, atol=slack * 3.0)
+    np.testing.assert_allclose(naive[("pin_J", "washer_J")], area * 0.3, atol=slack * 0.3)
+    # touching faces (A's top on the washer) give a volume of rounding size only (1e-9)
+    assert np.all(np.abs(naive[("A", "B")]) <= 1e-9) and np.all(np.abs(naive[("A", "washer_J")]) <= 1e-9)
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25, pins=pins,
+                                spacers=spacers)
+    assert {(p.a, p.b) for p in result.pairs} == set(naive)
+    for p in result.pairs:
+        np.testing.assert_array_equal(np.nonzero(naive[(p.a, p.b)] > 1e-6)[0], p.collision_indices)
+        if p.collides:
+            assert p.max_overlap_mm3 == pytest.approx(naive[(p.a, p.b)].max(), abs=1e-6)
