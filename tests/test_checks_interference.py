@@ -236,3 +236,214 @@ def test_naive_reference_uses_the_given_pins_and_spacers():
         np.testing.assert_array_equal(np.nonzero(naive[(p.a, p.b)] > 1e-6)[0], p.collision_indices)
         if p.collides:
             assert p.max_overlap_mm3 == pytest.approx(naive[(p.a, p.b)].max(), abs=1e-6)
+
+
+# -- pins from the parts' holes ----------------------------------------------------------------------
+def test_pins_from_holes_one_per_shared_joint_through_every_part():
+    """One pin per joint whose pin holes are on two or more bodies: fixed in the body of the lowest part
+    (ties by name), on that part's hole centre, with the holes' nominal pin diameter (also 1 mm and
+    below), from the lowest bottom face to the highest top face. A pin hole on one body only (M, listed
+    first) is a mounting hole and makes no pin, nor do screw holes (pin diameter 0) on two bodies."""
+    from fabricate.checks.interference import pins_from_holes
+
+    parts = [
+        box_part("L", "a", (20.0, 6.0), 1.0, 2.0, holes=(Hole("M", np.array([-5.0, 0.0]), 2.5, 2.0),
+                                                         Hole("J", np.array([4.0, 0.0]), 1.4, 1.0),
+                                                         Hole("S", np.array([8.0, 0.0]), 3.0, 0.0))),
+        box_part("U", "b", (20.0, 6.0), 3.5, 2.0, holes=(Hole("J", np.zeros(2), 1.4, 1.0),
+                                                         Hole("S", np.array([1.0, 1.0]), 3.0, 0.0))),
+        box_part("W", "a", (20.0, 6.0), 6.0, 1.0, holes=(Hole("K", np.array([-1.0, -1.0]), 0.9, 0.6),)),
+        box_part("V", "c", (20.0, 6.0), 0.5, 0.5, holes=(Hole("K", np.array([2.0, 2.0]), 0.9, 0.6),)),
+        box_part("Q2", "d", (20.0, 6.0), 0.0, 1.0, holes=(Hole("T", np.array([3.0, 0.0]), 2.5, 2.0),)),
+        box_part("Q1", "e", (20.0, 6.0), 0.0, 1.5, holes=(Hole("T", np.array([0.0, 3.0]), 2.5, 2.0),)),
+    ]
+    pins = {p.name: p for p in pins_from_holes(parts)}
+    assert set(pins) == {"pin_J", "pin_K", "pin_T"}
+    j, k, t = pins["pin_J"], pins["pin_K"], pins["pin_T"]
+    assert (j.joint, j.body, j.diameter_mm, j.z_mm, j.length_mm) == ("J", "a", 1.0, 1.0, 4.5)  # 1.0 .. 3.5 + 2
+    np.testing.assert_array_equal(j.centre, [4.0, 0.0])
+    assert (k.joint, k.body, k.diameter_mm, k.z_mm, k.length_mm) == ("K", "c", 0.6, 0.5, 6.5)  # 0.5 .. 6 + 1
+    np.testing.assert_array_equal(k.centre, [2.0, 2.0])
+    assert (t.joint, t.body, t.diameter_mm, t.z_mm, t.length_mm) == ("T", "e", 2.0, 0.0, 1.5)
+    np.testing.assert_array_equal(t.centre, [0.0, 3.0])
+
+
+def test_one_millimetre_pin_from_the_holes_keeps_its_radial_clearance():
+    """A 1.0 mm pin in 1.4 mm holes (the default pins, from the holes): the pin pair keeps (1.4 - 1.0) / 2
+    = 0.2 mm at every pose within the chord tolerance, and fails a 0.25 mm minimum as too close."""
+    parts = [box_part("A", "a", (30.0, 10.0), 0.0, 2.0, centre=(10.0, 0.0), holes=(Hole("J", np.zeros(2), 1.4, 1.0),)),
+             box_part("B", "b", (30.0, 10.0), 2.3, 2.0, centre=(10.0, 0.0), holes=(Hole("J", np.zeros(2), 1.4, 1.0),))]
+    th = np.radians(np.linspace(0.0, 60.0, 4))
+    result = sweep_interference(parts, motion_of(np.column_stack([np.zeros(4), np.zeros(4), th])),
+                                chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    rows = {(p.a, p.b): p for p in result.pairs}
+    assert set(rows) == {("A", "B"), ("B", "pin_J")}
+    assert np.all(np.abs(rows[("B", "pin_J")].clearance - 0.2) <= TOL + 1e-9)
+    assert [(p.a, p.b) for p in result.too_close()] == [("B", "pin_J")]
+
+
+# -- spacers -----------------------------------------------------------------------------------------
+def test_spacer_items_are_rings_of_the_spacers_not_modelled_as_parts():
+    """Parts-layer tubes and washers become rings (outer circle CCW, bore CW, radii outer/2 and inner/2
+    within the chord tolerance, on the spacer's centre) from z to z + length on their body. Skipped: a
+    spacer already modelled as a spacer part (that body, that joint) and a zero-length one; kept: a
+    0.3 mm washer. A second tube of the same name gets its list index appended."""
+    from fabricate.checks.interference import spacer_items
+    from fabricate.planar import polygon_area
+
+    modelled = Part("sleeve", "b", BulgePath.polyline(np.array([[-2.0, -2.0], [2.0, -2.0], [2.0, 2.0], [-2.0, 2.0]])),
+                    (Hole("J", np.zeros(2), 2.5, 2.0),), 1.0, 3.0, 1, "sla", role="spacer")
+    ns = SimpleNamespace
+    spacers = [
+        ns(joint="J", body="b", centre=np.zeros(2), inner_diameter_mm=2.5, outer_diameter_mm=4.0, z_mm=3.0,
+           length_mm=1.0, washer=False),  # modelled by "sleeve"
+        ns(joint="J", body="a", centre=np.zeros(2), inner_diameter_mm=2.5, outer_diameter_mm=4.0, z_mm=3.0,
+           length_mm=0.0, washer=True),  # nothing to model
+        ns(joint="J", body="a", centre=np.array([1.0, 2.0]), inner_diameter_mm=2.2, outer_diameter_mm=4.0,
+           z_mm=3.0, length_mm=0.3, washer=True),
+        ns(joint="J", body="a", centre=np.array([1.0, 2.0]), inner_diameter_mm=2.2, outer_diameter_mm=5.0,
+           z_mm=3.3, length_mm=2.0),  # no washer attribute: a tube
+        ns(joint="J", body="c", centre=np.zeros(2), inner_diameter_mm=2.2, outer_diameter_mm=5.0, z_mm=5.3,
+           length_mm=2.0, washer=False),
+    ]
+    items = spacer_items(spacers, [modelled], TOL)
+    assert [it.name for it in items] == ["washer_J", "tube_J", "tube_J_4"]
+    assert [it.body for it in items] == ["a", "a", "c"]
+    assert [(it.z0, it.z1) for it in items] == [(3.0, 3.3), (3.3, 5.3), (5.3, 7.3)]
+    for it, sp in zip(items, spacers[2:], strict=True):
+        assert it.kind == "spacer" and it.joints == frozenset({"J"}) and it.gear == "" and it.source is sp
+        outer, bore = it.rings
+        r_out = np.hypot(*(outer - sp.centre).T)
+        r_in = np.hypot(*(bore - sp.centre).T)
+        assert np.all(r_out <= sp.outer_diameter_mm / 2 + 1e-12) and np.all(r_out >= sp.outer_diameter_mm / 2 - TOL)
+        assert np.all(r_in <= sp.inner_diameter_mm / 2 + 1e-12) and np.all(r_in >= sp.inner_diameter_mm / 2 - TOL)
+        assert polygon_area(outer) > 0 > polygon_area(bore)
+
+
+# -- gears in mesh and the report --------------------------------------------------------------------
+def gear_pair(gap: float, gear_b: str = "g1"):
+    """Two gear parts (boxes standing in for the teeth) of gear pair "g1" on bodies a and b, same layer,
+    ``gap`` apart in x at the one pose."""
+    a = Part("G1", "a", BulgePath.polyline(np.array([[-5.0, -2.0], [5.0, -2.0], [5.0, 2.0], [-5.0, 2.0]])), (),
+             3.0, 0.0, 0, "sla", role="gear", gear="g1")
+    b = Part("G2", "b", BulgePath.polyline(np.array([[-5.0, -2.0], [5.0, -2.0], [5.0, 2.0], [-5.0, 2.0]])), (),
+             3.0, 0.0, 0, "sla", role="gear", gear=gear_b)
+    return [a, b], motion_of(np.array([[10.0 + gap, 0.0, 0.0]]))
+
+
+def test_meshing_gears_run_with_backlash_below_the_process_clearance():
+    """Gear parts of one pair 0.05 mm apart (backlash) pass a 0.25 mm process minimum: the pair is
+    "meshing", must keep 0 mm, and is left out of the sweep's minimum clearance (inf: the report writes
+    null, valid JSON). The same parts in different pairs are an ordinary moving pair that fails."""
+    import json
+
+    parts, motion = gear_pair(0.05)
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    (pair,) = result.pairs
+    assert (pair.relation, pair.required_mm) == ("meshing", 0.0)
+    assert pair.min_clearance_mm == pytest.approx(0.05, abs=1e-9)
+    assert result.passed, result.failures()
+    assert result.min_clearance_mm == math.inf
+    report = result.report()
+    assert report["min_clearance_mm"] is None
+    json.dumps(report, allow_nan=False)
+    parts, motion = gear_pair(0.05, gear_b="g2")
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    assert result.pairs[0].relation == "moving" and not result.passed
+    assert result.report()["min_clearance_mm"] == pytest.approx(0.05, abs=1e-9)
+
+
+def test_report_gives_lengths_to_the_micrometre():
+    """report.json rounds lengths to 6 decimals (1 nm): plates stacked 0.1234567 mm apart over each other
+    (clearance = that gap wherever they overlap in plan) report z gap and clearance 0.123457; side by side
+    0.7654321 mm apart on one layer they report 0.765432."""
+    plates = [box_part("A", "a", (10.0, 4.0), 0.0, 3.0), box_part("B", "b", (10.0, 4.0), 3.1234567, 3.0)]
+    result = sweep_interference(plates, motion_of(np.array([[2.0, 0.0, 0.0]])), chord_tolerance_mm=TOL,
+                                min_clearance_mm=0.1)
+    (row,) = result.report()["pairs"]
+    assert row["z_gap_mm"] == 0.123457
+    assert row["min_clearance_mm"] == 0.123457
+    assert result.report()["min_clearance_mm"] == 0.123457
+    side = [box_part("A", "a", (10.0, 4.0), 0.0, 3.0), box_part("B", "b", (10.0, 4.0), 0.0, 3.0)]
+    result = sweep_interference(side, motion_of(np.array([[10.7654321, 0.0, 0.0]])), chord_tolerance_mm=TOL,
+                                min_clearance_mm=0.1)
+    (row,) = result.report()["pairs"]
+    assert row["min_clearance_mm"] == 0.765432 and result.report()["min_clearance_mm"] == 0.765432
+    assert row["z_gap_mm"] == -3.0
+
+
+def test_spacer_part_bears_on_the_parts_of_its_joint():
+    """A spacer modelled as a part (role "spacer", carried by B) fills the 0.5 mm between plates A and B
+    on joint J: it touches A's top face by design, so the pair is "bearing" (must keep 0 mm, may touch)
+    and the build passes with clearance 0; the plates themselves keep their 0.5 mm layer gap."""
+    hole = (Hole("J", np.zeros(2), 2.5, 2.0),)
+    sleeve = Part("sleeve", "b", BulgePath.polyline(np.array([[-2.5, -2.5], [2.5, -2.5], [2.5, 2.5], [-2.5, 2.5]])),
+                  hole, 0.5, 3.0, 1, "sla", role="spacer")
+    parts = [box_part("A", "a", (30.0, 10.0), 0.0, 3.0, centre=(10.0, 0.0), holes=hole), sleeve,
+             box_part("B", "b", (30.0, 10.0), 3.5, 3.0, centre=(10.0, 0.0), holes=hole)]
+    th = np.radians(np.linspace(0.0, 90.0, 4))
+    result = sweep_interference(parts, motion_of(np.column_stack([np.zeros(4), np.zeros(4), th])),
+                                chord_tolerance_mm=TOL, min_clearance_mm=0.25, pins=[])
+    rows = {(p.a, p.b): p for p in result.pairs}
+    assert set(rows) == {("A", "sleeve"), ("A", "B")}
+    assert (rows[("A", "sleeve")].relation, rows[("A", "sleeve")].required_mm) == ("bearing", 0.0)
+    assert rows[("A", "sleeve")].min_clearance_mm == 0.0 and not rows[("A", "sleeve")].collides
+    assert rows[("A", "B")].relation == "joined"
+    assert rows[("A", "B")].min_clearance_mm == pytest.approx(0.5, abs=1e-9)
+    assert result.passed, result.failures()
+    assert result.min_clearance_mm == pytest.approx(0.5, abs=1e-9)  # the bearing pair does not count
+
+
+def washer_and_plate(z_plate: float, *, plate_is_part: bool = True):
+    """A 0.3 mm washer on joint J (body a, z 3.0..3.3, bore 2.2, outside 6 mm) and a plate C on body c with
+    no hole for J, bottom at ``z_plate``, lying over the washer in plan at every pose."""
+    washer = SimpleNamespace(joint="J", body="a", centre=np.zeros(2), inner_diameter_mm=2.2, outer_diameter_mm=6.0,
+                             z_mm=3.0, length_mm=0.3, washer=True)
+    plate = box_part("C", "c", (20.0, 10.0), z_plate, 3.0, holes=(Hole("K", np.array([5.0, 0.0]), 2.5, 2.0),))
+    n = 3
+    motion = Motion(inputs=np.arange(n, dtype=np.float64), body_names=("g", "a", "c"), ground="g", free=("a", "c"),
+                    q=np.stack([np.zeros((n, 3)), np.column_stack([np.linspace(-2, 2, n), np.zeros(n), np.zeros(n)])],
+                               axis=1), mechanism=SimpleNamespace(input_unit="deg"))
+    return [plate], motion, [washer]
+
+
+def test_part_flush_on_a_washer_face_bears_and_a_part_above_it_keeps_the_clearance():
+    """A plate sliding on a washer's end face (z gap exactly 0, not on the washer's joint) is "bearing":
+    touching is its job, the build passes. Lifted 0.2 mm off the face it is an ordinary moving pair: it
+    must keep 0.25 mm, and the 0.2 mm gap (the clearance where they overlap in plan) fails."""
+    parts, motion, spacers = washer_and_plate(3.3)
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25, spacers=spacers, pins=[])
+    (pair,) = result.pairs
+    assert (pair.a, pair.b, pair.relation, pair.required_mm) == ("C", "washer_J", "bearing", 0.0)
+    assert pair.min_clearance_mm == 0.0 and not pair.collides
+    assert result.passed, result.failures()
+    parts, motion, spacers = washer_and_plate(3.5)
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25, spacers=spacers, pins=[])
+    (pair,) = result.pairs
+    assert (pair.relation, pair.required_mm) == ("moving", 0.25)
+    assert pair.min_clearance_mm == pytest.approx(0.2, abs=1e-9)
+    assert result.too_close() == [pair]
+
+
+def test_flush_plates_on_different_joints_must_keep_the_clearance():
+    """Two plates on different bodies and joints, one right on top of the other (z gap 0) and overlapping
+    in plan: they touch (clearance 0, no overlap volume), which is not allowed for moving parts: the
+    verdict fails with a clearance message, not a collision."""
+    parts = [box_part("A", "a", (10.0, 4.0), 0.0, 3.0, holes=(Hole("J", np.zeros(2), 2.5, 2.0),)),
+             box_part("B", "b", (10.0, 4.0), 3.0, 3.0, holes=(Hole("K", np.zeros(2), 2.5, 2.0),))]
+    result = sweep_interference(parts, motion_of(np.array([[3.0, 0.0, 0.0]])), chord_tolerance_mm=TOL,
+                                min_clearance_mm=0.25, pins=[])
+    (pair,) = result.pairs
+    assert (pair.relation, pair.z_gap_mm, pair.min_clearance_mm) == ("moving", 0.0, 0.0)
+    assert not pair.collides
+    assert result.failures() == ["clearance: A and B come within 0.000 mm at input 0 deg; the process needs 0.250 mm"]
+
+
+def test_naive_reference_names_a_degenerate_solid():
+    """A zero-diameter pin has no cross-section: the boolean reference refuses it with a GeometryError
+    that names the solid (pin_J), so the user can find the faulty input."""
+    from fabricate.errors import GeometryError
+
+    parts, motion, pins, _ = two_plates_on_a_pin(0.0)
+    with pytest.raises(GeometryError, match=r"^pin_J: empty cross-section"):
+        naive_interference(parts, motion, chord_tolerance_mm=TOL, pins=pins)
