@@ -124,6 +124,42 @@ def test_under_constrained_mechanism_is_rejected():
                   joints=(Revolute("O", "g", "a"),), gears=(), drivers=(), input_range=(0, 1))
 
 
+def test_four_bar_without_its_driver_is_one_degree_of_freedom_short():
+    """Four bars, four revolutes: 3 x 3 coordinates against 4 x 2 equations, one freedom left undriven
+    (Gruebler's count; the three-body case above cannot tell 3 (n - 1) from 3 / (n - 1))."""
+    mech = make_four_bar()
+    with pytest.raises(SpecError) as err:
+        Mechanism(name="loose", bodies=mech.bodies, ground=mech.ground, joints=mech.joints, gears=(), drivers=(),
+                  input_range=(0, 1))
+    assert err.value.path == "mechanism"
+    assert "under-constrained: 1 degree(s)" in err.value.message
+
+
+@pytest.mark.parametrize(("change", "path", "needle"), [
+    ({"bodies": "twice"}, "mechanism.bodies", "body names must be unique"),
+    ({"ground": "floor"}, "mechanism.ground", "unknown body 'floor'"),
+    ({"joints": "stray"}, "mechanism.joints.O", "unknown body 'palm'"),
+    ({"input_unit": "rad"}, "mechanism.input_unit", "expected 'deg' or 'mm', got 'rad'"),
+])
+def test_bad_mechanism_fields_are_named(change, path, needle):
+    """A bad mechanism names the field (the path a template user looks up) and what was wrong with it."""
+    base = make_four_bar()
+    fields = {"name": "bad", "bodies": base.bodies, "ground": base.ground, "joints": base.joints, "gears": (),
+              "drivers": base.drivers, "input_range": (0, 1), "input_unit": "deg"}
+    if change.get("bodies"):
+        fields["bodies"] = base.bodies + (base.bodies[1],)
+    if change.get("ground"):
+        fields["ground"] = change["ground"]
+    if change.get("joints"):
+        fields["joints"] = (Revolute("O", "ground", "palm"),) + base.joints[1:]
+    if change.get("input_unit"):
+        fields["input_unit"] = change["input_unit"]
+    with pytest.raises(SpecError) as err:
+        Mechanism(**fields)
+    assert err.value.path == path
+    assert needle in err.value.message
+
+
 def test_joint_point_missing_is_named():
     with pytest.raises(SpecError, match="no point 'X'"):
         Mechanism(name="bad", bodies=(Body("g", {"O": (0, 0)}), Body("a", {"O": (0, 0)})), ground="g",
