@@ -447,3 +447,210 @@ def test_naive_reference_names_a_degenerate_solid():
     parts, motion, pins, _ = two_plates_on_a_pin(0.0)
     with pytest.raises(GeometryError, match=r"^pin_J: empty cross-section"):
         naive_interference(parts, motion, chord_tolerance_mm=TOL, pins=pins)
+
+
+# -- pairs one pose settles, and what the clearance curve shows ------------------------------------
+def count_planar_poses(monkeypatch) -> dict[str, int]:
+    """Count the poses handed to the planar engine (distances and overlap areas) during a sweep."""
+    import fabricate.checks.interference as interference
+
+    counts = {"distance": 0, "area": 0}
+
+    def counted(name, fn):
+        def wrapper(oa, ob, rel, *args):
+            counts[name] += len(rel.q)
+            return fn(oa, ob, rel, *args)
+        return wrapper
+
+    monkeypatch.setattr(interference, "planar_clearance", counted("distance", interference.planar_clearance))
+    monkeypatch.setattr(interference, "overlap_areas", counted("area", interference.overlap_areas))
+    return counts
+
+
+def plates_on_an_off_origin_joint(b_poses: np.ndarray):
+    """Plate A (body a, z 0..3) with joint J's 2.5 mm hole at (5, 0); plate B (body b, z 3.3..6.3) with its
+    J hole at (-3, 1) of its frame; a 2 mm parts-layer pin on J fixed in a; a tube on J carried by b
+    (bore 2.5, z 3.0..3.3) between them. Neither hole is at its body's origin."""
+    hole_a, hole_b = np.array([5.0, 0.0]), np.array([-3.0, 1.0])
+    parts = [box_part("A", "a", (30.0, 10.0), 0.0, 3.0, centre=(5.0, 0.0), holes=(Hole("J", hole_a, 2.5, 2.0),)),
+             box_part("B", "b", (30.0, 10.0), 3.3, 3.0, centre=(-3.0, 1.0), holes=(Hole("J", hole_b, 2.5, 2.0),))]
+    pins = [SimpleNamespace(joint="J", bodies=("a", "b"), diameter_mm=2.0, length_mm=6.3, z_mm=0.0)]
+    tube = SimpleNamespace(joint="J", body="b", centre=hole_b, inner_diameter_mm=2.5, outer_diameter_mm=5.0,
+                           z_mm=3.0, length_mm=0.3, washer=False)
+    return parts, motion_of(b_poses), pins, [tube]
+
+
+def test_pin_on_its_hole_axis_keeps_one_clearance_from_one_pose(monkeypatch):
+    """B turns about joint J (its hole stays on A's hole at (5, 0), the holes off both body origins): the
+    pin (fixed in a) lies on the axis of B's hole and of the tube's bore at every pose, so each pin pair
+    has one radial clearance, (2.5 - 2) / 2 mm within the chord tolerance, drawn as a flat exact line and
+    reported at the first input; the stacked pairs (A-B on the 0.3 mm layer gap, A flush on the tube) are
+    settled at their closest pose. Each of these four pairs costs the planar engine one pose, whatever
+    the number of poses."""
+    th = np.radians([0.0, 17.0, 41.0, 66.0, 90.0, 123.0, 150.0])
+    rot = np.stack([np.column_stack([np.cos(th), -np.sin(th)]), np.column_stack([np.sin(th), np.cos(th)])], axis=1)
+    xy = np.array([5.0, 0.0]) - rot @ np.array([-3.0, 1.0])
+    parts, motion, pins, spacers = plates_on_an_off_origin_joint(np.column_stack([xy, th]))
+    counts = count_planar_poses(monkeypatch)
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25, pins=pins,
+                                spacers=spacers)
+    rows = {(p.a, p.b): p for p in result.pairs}
+    assert set(rows) == {("A", "B"), ("A", "tube_J"), ("B", "pin_J"), ("pin_J", "tube_J")}
+    for key in (("B", "pin_J"), ("pin_J", "tube_J")):
+        p = rows[key]
+        assert p.relation == "pin" and p.exact.all()
+        assert np.ptp(p.clearance) == 0.0
+        assert 0.25 - TOL - 1e-9 <= p.min_clearance_mm <= 0.25 + 1e-9
+        assert p.min_index == 0
+    assert rows[("A", "B")].min_clearance_mm == pytest.approx(0.3, abs=1e-9)
+    assert rows[("A", "tube_J")].relation == "bearing" and rows[("A", "tube_J")].min_clearance_mm == 0.0
+    assert result.passed, result.failures()
+    assert counts == {"distance": 2, "area": 2}
+
+
+def test_pin_off_its_hole_axis_is_measured_at_every_pose():
+    """B slides instead of turning: its hole (and the tube's bore) moves e = 0 .. 0.15 mm off the pin's
+    axis, so the radial clearance is (2.5 - 2) / 2 - e at each pose (circles; the inscribed polygons
+    read within the chord tolerance of it): it must be measured pose by pose, not taken from the first.
+    A plate C on B's body without a hole for J stays far from the pin: an ordinary moving pair."""
+    e = np.array([0.0, 0.05, 0.1, 0.15, 0.1])
+    parts, motion, pins, spacers = plates_on_an_off_origin_joint(
+        np.column_stack([8.0 + e, np.full(5, -1.0), np.zeros(5)]))
+    parts.append(box_part("C", "b", (10.0, 10.0), 0.0, 3.0, centre=(60.0, 0.0),
+                          holes=(Hole("K", np.array([60.0, 0.0]), 2.5, 2.0),)))
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.05, pins=pins,
+                                spacers=spacers)
+    rows = {(p.a, p.b): p for p in result.pairs}
+    for key in (("B", "pin_J"), ("pin_J", "tube_J")):
+        p = rows[key]
+        assert p.exact.all()
+        np.testing.assert_allclose(p.clearance, 0.25 - e, atol=TOL + 1e-9)
+        assert p.min_index == 3
+        assert p.kernel_gap_mm == pytest.approx(p.min_clearance_mm, abs=1e-6)
+    assert rows[("C", "pin_J")].relation == "moving" and not rows[("C", "pin_J")].collides
+    assert rows[("C", "pin_J")].min_clearance_mm >= 2.0  # the search length: a lower bound of ~50 mm
+
+
+def stacked_boxes(x: np.ndarray, gap: float):
+    """A (10 x 4, z 0..3) at rest; B (10 x 4, z 3 + gap ..) at (x_i, 3.5): in plan they overlap by
+    (10 - x) x 0.5 where x < 10 and are x - 10 apart otherwise."""
+    parts = [box_part("A", "a", (10.0, 4.0), 0.0, 3.0), box_part("B", "b", (10.0, 4.0), 3.0 + gap, 3.0)]
+    return parts, motion_of(np.column_stack([x, np.full(len(x), 3.5), np.zeros(len(x))]))
+
+
+@pytest.mark.parametrize("gap", [0.3, 0.25])
+def test_stacked_parts_clear_by_their_gap_are_settled_at_the_closest_pose(monkeypatch, gap):
+    """B passes over A's corner on the next layer with a gap that alone meets the 0.25 mm minimum (also
+    exactly at it): the clearance is the gap wherever they overlap in plan (here a corner of 0.5 x 0.5 mm^2
+    at most), so the one pose where the parts come closest settles the pair: minimum = gap, exact there
+    (the kernel agrees) and nowhere else (a lower bound of hypot(gap, planar distance) elsewhere, drawn
+    dotted), with one overlap area and no distance asked of the planar engine."""
+    x = np.array([12.0, 11.0, 9.6, 9.5, 9.7, 11.0, 12.0])
+    parts, motion = stacked_boxes(x, gap)
+    counts = count_planar_poses(monkeypatch)
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    (pair,) = result.pairs
+    true = np.hypot(gap, np.maximum(x - 10.0, 0.0))
+    assert pair.min_index == 3 and pair.exact[3] and pair.exact.sum() == 1
+    assert pair.min_clearance_mm == pytest.approx(gap, abs=1e-9)
+    assert pair.kernel_gap_mm == pytest.approx(gap, abs=1e-6)
+    assert np.all(pair.clearance <= true + 1e-9)
+    assert not pair.collides and len(result.inputs[pair.collision_indices]) == 0  # integer pose indices
+    row = result.report()["pairs"][0]
+    assert row["exact"] is True and row["at_input"] == 3.0
+    assert result.passed, result.failures()
+    assert counts == {"distance": 0, "area": 1}
+
+
+def test_stacked_parts_closer_than_required_are_resolved_at_every_pose():
+    """The same pass with a 0.2 mm layer gap (below the minimum): the curve of a failing pair is exact at
+    every pose, hypot(0.2, planar distance) with the planar distance max(x - 10, 0) by hand (1e-9)."""
+    x = np.array([11.5, 11.0, 9.6, 9.5, 9.7, 10.4, 11.5])
+    parts, motion = stacked_boxes(x, 0.2)
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    (pair,) = result.pairs
+    assert pair.exact.all()
+    np.testing.assert_allclose(pair.clearance, np.hypot(0.2, np.maximum(x - 10.0, 0.0)), atol=1e-9)
+    assert result.too_close() == [pair]
+
+
+def test_stacked_parts_apart_in_plan_keep_the_diagonal_clearance():
+    """Stacked 0.3 mm apart in z and 1 mm apart in plan at every pose (never over each other): the
+    clearance is the diagonal hypot(0.3, 1.0) mm, not the layer gap (1e-9)."""
+    x = np.array([11.0, 11.0, 11.0])
+    parts, motion = stacked_boxes(x, 0.3)
+    (pair,) = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25).pairs
+    assert pair.min_clearance_mm == pytest.approx(math.hypot(0.3, 1.0), abs=1e-9)
+    assert pair.exact.all()
+
+
+@pytest.mark.parametrize("tol", [TOL, 1e-4])
+def test_clear_pair_reports_kernel_gap_and_no_overlap(tol):
+    """Same-layer boxes 1.5, 0.75 and 3.5 mm apart (thin 10 x 1 bars side by side, bounding circles
+    overlapping at every pose): the pair does not collide (empty integer pose arrays that index the
+    inputs, no overlap volume); its minimum 0.75 mm is exact at pose 1 and confirmed by manifold3d's
+    min_gap (1e-6), at any chord tolerance; beyond the 2 mm search length only the search length is known
+    (a lower bound, not exact)."""
+    parts = [box_part("A", "a", (10.0, 1.0), 0.0, 3.0), box_part("B", "b", (10.0, 1.0), 0.0, 3.0)]
+    y = np.array([2.5, 1.75, 4.5])  # edge to edge: y - 1
+    result = sweep_interference(parts, motion_of(np.column_stack([np.zeros(3), y, np.zeros(3)])),
+                                chord_tolerance_mm=tol, min_clearance_mm=0.25)
+    (pair,) = result.pairs
+    assert not pair.collides
+    for idx in (pair.collision_indices, pair.overlap_indices):
+        assert len(idx) == 0 and len(result.inputs[idx]) == 0
+    assert len(pair.overlap_mm3) == 0
+    assert (pair.max_overlap_mm3, pair.max_overlap_index) == (0.0, 0)
+    np.testing.assert_allclose(pair.clearance, [1.5, 0.75, 2.0], atol=1e-9)
+    np.testing.assert_array_equal(pair.exact, [True, True, False])
+    assert (pair.min_index, pair.min_clearance_mm) == (1, pytest.approx(0.75, abs=1e-9))
+    assert pair.kernel_gap_mm == pytest.approx(0.75, abs=1e-6)
+    assert result.report()["pairs"][0]["kernel_gap_mm"] == pytest.approx(0.75, abs=1e-6)
+
+
+def test_collision_volume_without_the_kernel_is_the_planar_product():
+    """With use_kernel=False the worst overlap is the planar overlap area times the z overlap: B (10 x 2,
+    z 1..4) over A (10 x 4, z 0..3) offset 1 mm in x: (10 - 1) x 2 x 2 = 36 mm^3 (1e-9); no kernel gap."""
+    parts = [box_part("A", "a", (10.0, 4.0), 0.0, 3.0), box_part("B", "b", (10.0, 2.0), 1.0, 3.0)]
+    result = sweep_interference(parts, motion_of(np.array([[1.0, 0.0, 0.0], [3.0, 0.0, 0.0]])),
+                                chord_tolerance_mm=TOL, min_clearance_mm=0.25, use_kernel=False)
+    (pair,) = result.pairs
+    assert pair.max_overlap_mm3 == pytest.approx(36.0, abs=1e-9) and pair.max_overlap_index == 0
+    assert pair.kernel_gap_mm is None
+
+
+def test_parts_touching_on_one_layer_touch_but_do_not_collide():
+    """Two boxes on one layer edge to edge (B's left edge on A's right edge, exactly): clearance 0, which
+    fails the minimum as too close, but no overlap volume and no collision."""
+    parts = [box_part("A", "a", (10.0, 4.0), 0.0, 3.0), box_part("B", "b", (10.0, 4.0), 0.0, 3.0)]
+    result = sweep_interference(parts, motion_of(np.array([[10.0, 1.0, 0.0], [12.0, 1.0, 0.0]])),
+                                chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    (pair,) = result.pairs
+    assert not pair.collides and result.collisions == []
+    assert pair.min_clearance_mm == 0.0 and pair.min_index == 0
+    assert result.too_close() == [pair]
+
+
+def test_kernel_confirms_a_clearance_with_a_short_search(monkeypatch):
+    """manifold3d's min_gap is fast only with a short search: the sweep asks it just beyond the planar
+    clearance (here 0.75 mm, boxes side by side), within 0.05 mm of it, and gets the same gap back (1e-6)."""
+    import fabricate.checks.interference as interference
+
+    reaches = []
+
+    class Recorded:
+        def __init__(self, solid):
+            self.solid = solid
+
+        def min_gap(self, other, reach):
+            reaches.append(reach)
+            return self.solid.min_gap(other.solid, reach)
+
+    posed_pair = interference._posed_pair
+    monkeypatch.setattr(interference, "_posed_pair", lambda *args: [Recorded(s) for s in posed_pair(*args)])
+    parts = [box_part("A", "a", (10.0, 1.0), 0.0, 3.0), box_part("B", "b", (10.0, 1.0), 0.0, 3.0)]
+    result = sweep_interference(parts, motion_of(np.array([[0.0, 2.5, 0.0], [0.0, 1.75, 0.0]])),
+                                chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    (pair,) = result.pairs
+    assert pair.kernel_gap_mm == pytest.approx(0.75, abs=1e-6)
+    assert len(reaches) == 1 and 0.75 < reaches[0] <= 0.75 + 0.05
