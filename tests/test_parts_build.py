@@ -1,0 +1,275 @@
+"""Building parts from a mechanism (``fabricate/parts/build.py``) against hand geometry and closed forms.
+
+Gear outlines placed in bodies whose joints sit at hand-picked coordinates (3-4-5 directions, so the
+rotations are exact fractions), slider guide pins and slots against the stroke and the process sizes
+worked out by hand, slotted parts' rings against shapely and the stadium area L w + pi w^2 / 4.
+
+Written to kill mutants of ``fabricate/parts/build.py`` (see ``tests/benchmarks/mutation_report.md``).
+"""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+import shapely
+from test_parts import design_for, spur_like, sun_planet_four_bar
+
+from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
+from fabricate.parts.build import SlottedPart, build_parts, gear_outline_in_body
+from fabricate.parts.model import BulgePath, Hole
+from fabricate.parts.profiles import circle_hull
+from fabricate.parts.spec import PartsSpec
+
+# -- slotted parts: rings for meshing ---------------------------------------------------------------
+
+
+def stadium(a: tuple[float, float], b: tuple[float, float], width: float) -> BulgePath:
+    """Counter-clockwise stadium (slot) of the given width around the segment a-b."""
+    return circle_hull(np.array([a, b], dtype=float), width / 2.0)
+
+
+def signed_area(ring: np.ndarray) -> float:
+    """Shoelace area of a ring (positive when counter-clockwise), written out here."""
+    x, y = ring[:, 0], ring[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def segment_distance(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance of each point (n, 2) to the segment a-b (closed form projection)."""
+    d = b - a
+    t = np.clip((points - a) @ d / float(d @ d), 0.0, 1.0)
+    return np.hypot(*(points - a - t[:, None] * d).T)
+
+
+def test_slotted_part_rings_are_outline_ccw_and_every_cut_cw():
+    """A plate (40 x 20 mm rectangle) with a round hole, a slot given counter-clockwise, the same kind of
+    slot given clockwise and a tiny slot (area 0.52 mm^2, below 1 mm^2): the exporter's rings are the
+    outline counter-clockwise and every cut clockwise (a cut given either way), each slot ring lies on the
+    exact stadium within the chord tolerance, and the plate area shapely computes from the rings is the
+    rectangle minus the hole and the stadia L w + pi w^2 / 4 (closed form; tolerance: chord sagitta x
+    perimeter of every ring)."""
+    tol = 0.01
+    outline = BulgePath.polyline(np.array([[0.0, 0.0], [40.0, 0.0], [40.0, 20.0], [0.0, 20.0]]))
+    ccw = stadium((5.0, 5.0), (15.0, 5.0), 3.0)
+    cw_given = stadium((20.0, 12.0), (20.0, 17.0), 2.0)
+    cw_given = BulgePath(cw_given.vertices[::-1].copy(), -np.roll(cw_given.bulges[::-1], -1))
+    tiny = stadium((30.0, 4.0), (30.4, 4.0), 0.6)
+    assert cw_given.area() < 0 < tiny.area() < 1.0
+    part = SlottedPart(name="plate", body="plate", outline=outline,
+                       holes=(Hole("H", np.array([32.0, 14.0]), 4.0, 3.5),), thickness_mm=2.0, z_mm=0.0,
+                       layer=0, process="laser", slots=(ccw, cw_given, tiny))
+    rings = part.polygons(tol)
+    assert len(rings) == 1 + 1 + 3
+    assert signed_area(rings[0]) > 0
+    assert all(signed_area(r) < 0 for r in rings[1:])
+    slot_specs = [((5.0, 5.0), (15.0, 5.0), 3.0), ((20.0, 17.0), (20.0, 12.0), 2.0), ((30.0, 4.0), (30.4, 4.0), 0.6)]
+    slot_area = 0.0
+    for ring, (a, b, w) in zip(rings[2:], slot_specs, strict=True):
+        a, b = np.array(a), np.array(b)
+        on_curve = segment_distance(ring, a, b)
+        np.testing.assert_allclose(on_curve, w / 2, atol=1e-9)  # every vertex on the exact stadium
+        mids = 0.5 * (ring + np.roll(ring, -1, axis=0))
+        assert np.all(w / 2 - segment_distance(mids, a, b) <= tol + 1e-9)  # no chord further in than the tolerance
+        length = float(np.hypot(*(b - a)))
+        exact = length * w + math.pi * w * w / 4
+        assert abs(signed_area(ring)) == pytest.approx(exact, abs=tol * (2 * length + math.pi * w))
+        slot_area += exact
+    plate = shapely.Polygon(rings[0], rings[1:])
+    assert plate.is_valid
+    expected = 40.0 * 20.0 - math.pi * 4.0 ** 2 / 4 - slot_area
+    assert plate.area == pytest.approx(expected, abs=tol * (120.0 + math.pi * 4.0 + 2 * 10 + 2 * 5 + 0.8 + 6 * math.pi))
+    assert part.area_mm2() == pytest.approx(expected, rel=1e-12)
+
+
+# -- gear outlines in their bodies ------------------------------------------------------------------
+
+#: A marker "outline" in the gear frame and its images under the rotations by the 3-4-5 angles.
+MARKER = np.array([[1.0, 0.0], [0.0, 1.0], [2.0, -1.0]])
+#: rotated by atan2(8, 6): cos 0.6, sin 0.8
+MARKER_68 = np.array([[0.6, 0.8], [-0.8, 0.6], [2.0, 1.0]])
+#: rotated by atan2(-6, 8): cos 0.8, sin -0.6
+MARKER_8M6 = np.array([[0.8, -0.6], [0.6, 0.8], [1.0, -2.0]])
+
+
+def gear_train(carrier_points: dict[str, tuple[float, float]] | None, carrier: str = "arm") -> Mechanism:
+    """Two gears about joints P and Q of an arm; every body's frame puts the joints off its origin.
+
+    ``arm`` (ground) holds P and Q; in it Q - P = (6, 8). ``sun`` turns about P and also carries a point
+    Q with Q - P = (8, -6) in its own frame; ``planet`` turns about Q at (4, 1). ``carrier_points`` replaces
+    the arm's points (None keeps (2, -1) and (8, 7)); with ``carrier=None`` no gear coupling is recorded.
+    """
+    arm = carrier_points if carrier_points is not None else {"P": (2.0, -1.0), "Q": (8.0, 7.0)}
+    gears = () if carrier is None else (GearCoupling("mesh", carrier=carrier, gear_a="sun", gear_b="planet",
+                                                     law=LinearLaw(-1.5), axis_a="P", axis_b="Q"),)
+    return Mechanism(
+        name="gear_train",
+        bodies=(Body("arm", {**arm, "P": (2.0, -1.0)}), Body("sun", {"P": (-3.0, 5.0), "Q": (5.0, -1.0)}),
+                Body("planet", {"Q": (4.0, 1.0)})),
+        ground="arm",
+        joints=(Revolute("P", "arm", "sun"), Revolute("Q", "arm" if "Q" in arm else "sun", "planet")),
+        gears=gears,
+        drivers=(Driver("angle", "sun", "arm"), Driver("angle", "planet", "arm")),
+        input_range=(0.0, 10.0),
+    )
+
+
+def gear_pair() -> SimpleNamespace:
+    return SimpleNamespace(name="mesh", body_a="sun", body_b="planet", axis_a="P", axis_b="Q",
+                           outline_a=MARKER, outline_b=2.0 * MARKER)
+
+
+def test_gear_outline_turns_with_the_line_of_centres_in_the_carrier():
+    """With a carrier that holds both axes, each gear is centred on its own body's axis point and turned
+    by the direction of Q - P in the carrier, (6, 8): the marker maps to axis + (0.6 x - 0.8 y, 0.8 x + 0.6 y)
+    (hand values; the sun's own Q - P, (8, -6), must not be used). Tolerance 1e-12 mm."""
+    mech = gear_train(None)
+    body, axis, placed = gear_outline_in_body(mech, gear_pair(), "a")
+    assert (body, axis) == ("sun", "P")
+    np.testing.assert_allclose(placed, np.array([-3.0, 5.0]) + MARKER_68, atol=1e-12)
+    body, axis, placed = gear_outline_in_body(mech, gear_pair(), "b")
+    assert (body, axis) == ("planet", "Q")
+    np.testing.assert_allclose(placed, np.array([4.0, 1.0]) + 2.0 * MARKER_68, atol=1e-12)
+
+
+@pytest.mark.parametrize("carrier", [None, "planet"], ids=["no_coupling", "carrier_without_both_axes"])
+def test_gear_outline_without_a_usable_carrier_follows_body_a(carrier):
+    """No coupling recorded for the pair, or a carrier that does not hold both axes (here the planet,
+    which has Q but not P): the line of centres is taken in body a, where Q - P = (8, -6), so the marker
+    maps to axis + (0.8 x + 0.6 y, -0.6 x + 0.8 y) (hand values). Tolerance 1e-12 mm."""
+    mech = gear_train({"P": (2.0, -1.0)}, carrier=carrier)
+    _, _, sun = gear_outline_in_body(mech, gear_pair(), "a")
+    np.testing.assert_allclose(sun, np.array([-3.0, 5.0]) + MARKER_8M6, atol=1e-12)
+    _, _, planet = gear_outline_in_body(mech, gear_pair(), "b")
+    np.testing.assert_allclose(planet, np.array([4.0, 1.0]) + 2.0 * MARKER_8M6, atol=1e-12)
+
+
+def test_gear_hub_from_the_gears_table(four_bar, sla_process):
+    """``[gears] hub_diameter_mm = 14``: the planet (outline radius at most 6.4 mm) on the coupler is fused
+    with a 14 mm hub, so the coupler plate covers the disc of radius 7 about A. A design slice with no
+    gears table at all still builds, with the default hub (2 x boss radius = 4.7 mm): then the disc of
+    radius 7 sticks out of the plate. Tolerance: the disc shrunk by 0.01 mm (chord tolerance 0.005)."""
+    mech = sun_planet_four_bar(four_bar)
+    motion = four_bar.sweep(25)
+    pair = SimpleNamespace(name="sun_planet", body_a="ground", body_b="coupler", axis_a="O", axis_b="A",
+                           outline_a=spur_like(9.0, 12, 0.4), outline_b=spur_like(6.0, 8, 0.4))
+    disc = shapely.Point(0.0, 0.0).buffer(7.0 - 0.01, 256)  # A is the coupler's origin
+    design = design_for(sla_process)
+    design.gears = SimpleNamespace(hub_diameter_mm=14.0)
+    hubbed = build_parts(design, mech, motion, [pair], {}).part("coupler")
+    assert shapely.Polygon(hubbed.outline.polygon(0.005)).contains(disc)
+    bare = SimpleNamespace(name="bare", process=sla_process, parts=PartsSpec())
+    plain = build_parts(bare, mech, motion, [pair], {}).part("coupler")
+    assert not shapely.Polygon(plain.outline.polygon(0.005)).contains(disc)
+    assert plain.gear == hubbed.gear == "sun_planet"
+
+
+def test_part_lookup_names_the_missing_part(four_bar, sla_process):
+    """``PartSet.part`` finds a part by its name, and an unknown name raises a KeyError carrying that name
+    (what a user scripting against the part set reads)."""
+    partset = build_parts(design_for(sla_process), four_bar, four_bar.sweep(11), [], {})
+    assert partset.part("rocker").body == "rocker"
+    with pytest.raises(KeyError, match="no_such_part"):
+        partset.part("no_such_part")
+
+
+# -- sliders: guide pins and the slot ---------------------------------------------------------------
+
+#: The slide axis (3, 4) (not a unit vector) and the rod's fixed angle to the ground, rad.
+AXIS, ANGLE = (3.0, 4.0), 0.6
+#: The stroke: the rod's point G runs from 3 mm behind to 5 mm beyond the ground's G along the axis.
+STROKE = (-3.0, 5.0)
+
+
+def tilted_slider(tail_side: float) -> Mechanism:
+    """A push rod alone on a guide: point G of the rod slides along (3, 4) through G = (10, -4) of the
+    ground, the rod turned by 0.6 rad against the ground. The rod has a second point T 15 mm from G along
+    the slide direction (``tail_side`` +1: ahead, -1: behind). The rod is listed first, so it is the
+    first owner of G."""
+    unit = np.array(AXIS) / 5.0
+    c, s = math.cos(ANGLE), math.sin(ANGLE)
+    axis_rod = np.array([c * unit[0] + s * unit[1], -s * unit[0] + c * unit[1]])  # the axis seen from the rod
+    tail = tail_side * 15.0 * axis_rod
+    start = np.array([10.0, -4.0]) + STROKE[0] * unit
+    return Mechanism(
+        name="tilted_slider",
+        bodies=(Body("rod", {"G": (0.0, 0.0), "T": (float(tail[0]), float(tail[1]))}),
+                Body("ground", {"G": (10.0, -4.0)})),
+        ground="ground",
+        joints=(Slider("G", "ground", "rod", AXIS, ANGLE),),
+        gears=(),
+        drivers=(Driver("slide", "rod", "ground", joint="G"),),
+        input_range=STROKE, input_unit="mm",
+        assembly={"rod": (float(start[0]), float(start[1]), ANGLE)},
+    )
+
+
+@pytest.mark.parametrize("tail_side", [1.0, -1.0], ids=["tail_ahead", "tail_behind"])
+def test_slider_guide_pins_and_slot(sla_process, tail_side):
+    """Guide pins and slot of a tilted push rod, against hand geometry.
+
+    - Pin ``G`` sits at the ground's slider point (10, -4); the guide pin ``G_guide`` one boss diameter plus
+      two minimum walls further along the unit axis (0.6, 0.8), on the side away from the rod's other
+      point T: boss radius = (2 + 2 x 0.25 + 0.2) / 2 + max(0.8, 1) = 2.35, spacing 2 x 2.35 + 2 x 0.8 = 6.3.
+    - Over the whole motion (solver poses) both pins stay inside the slot, in the rod's frame.
+    - The slot is the stadium of width hole = 2.7 mm over the stroke (8 mm) plus the spacing:
+      area L w + pi w^2 / 4 with L = 14.3 (closed form); its centre line is where the pins travel.
+    - The rod's rings: outline CCW, hole and slot CW; the plate area = outline - hole - stadium.
+    Tolerances: 1e-9 mm for hand-placed holes, 1e-6 for what goes through the solver.
+    """
+    mech = tilted_slider(tail_side)
+    motion = mech.sweep(33)
+    partset = build_parts(design_for(sla_process), mech, motion, [], {})
+    hole_mm, spacing = 2.0 + 2 * 0.25 + 0.2, 2 * ((2.0 + 2 * 0.25 + 0.2) / 2 + 1.0) + 2 * 0.8
+    ground, rod = partset.part("ground"), partset.part("rod")
+    guides = {h.joint: h for h in ground.holes if not h.joint.startswith("mount_")}
+    assert set(guides) == {"G", "G_guide"}
+    unit = np.array([0.6, 0.8])
+    np.testing.assert_allclose(guides["G"].centre, [10.0, -4.0], atol=1e-9)
+    np.testing.assert_allclose(guides["G_guide"].centre, np.array([10.0, -4.0]) - tail_side * spacing * unit,
+                               atol=1e-9)
+    assert all(h.diameter_mm == pytest.approx(hole_mm, abs=1e-12) for h in guides.values())
+    assert sorted((p.joint, tuple(sorted(p.bodies))) for p in partset.pins) == [
+        ("G", ("ground", "rod")), ("G_guide", ("ground", "rod"))]
+
+    assert rod.role == "rod" and len(rod.slots) == 1
+    slot = rod.slots[0]
+    length = (STROKE[1] - STROKE[0]) + spacing
+    exact = length * hole_mm + math.pi * hole_mm ** 2 / 4
+    assert slot.area() == pytest.approx(exact, abs=1e-6)
+    # where the pins travel, in the rod's frame (solver poses)
+    local = []
+    for pose in motion.pose("rod"):
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        for hole in guides.values():
+            dx, dy = hole.centre - pose[:2]
+            local.append([c * dx + s * dy, -s * dx + c * dy])
+    local = np.array(local)
+    reach = shapely.MultiPoint(local).convex_hull.buffer(hole_mm / 2, 256)
+    slot_poly = shapely.Polygon(slot.polygon(0.001))
+    assert slot_poly.symmetric_difference(reach).area < 1e-2
+    pin_room = slot_poly.buffer(1e-6)
+    assert all(pin_room.contains(shapely.Point(p).buffer(sla_process.pin_diameter_mm / 2, 64)) for p in local)
+
+    rings = rod.polygons(0.005)
+    assert shapely.LinearRing(rings[0]).is_ccw
+    assert not any(shapely.LinearRing(r).is_ccw for r in rings[1:])
+    assert len(rings) == 1 + len(rod.holes) + 1
+    plate = shapely.Polygon(rings[0], rings[1:])
+    expected = rod.outline.area() - len(rod.holes) * math.pi * hole_mm ** 2 / 4 - exact
+    assert plate.area == pytest.approx(expected, abs=0.005 * (bulge_length(rod.outline) + 3 * math.pi * hole_mm
+                                                              + 2 * length))
+    assert rod.area_mm2() == pytest.approx(expected, abs=1e-6)
+
+
+def bulge_length(path: BulgePath) -> float:
+    """Length of a bulge path (chords for lines, r x angle for arcs)."""
+    total = 0.0
+    for i, b in enumerate(path.bulges):
+        chord = float(np.hypot(*(path.vertices[(i + 1) % len(path.vertices)] - path.vertices[i])))
+        theta = 4 * math.atan(abs(float(b)))
+        total += chord if b == 0 else chord / (2 * math.sin(theta / 2)) * theta
+    return total
+
