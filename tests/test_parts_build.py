@@ -17,6 +17,7 @@ import pytest
 import shapely
 from test_parts import design_for, spur_like, sun_planet_four_bar
 
+from fabricate.errors import GeometryError
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
 from fabricate.parts.build import SlottedPart, build_parts, gear_outline_in_body
 from fabricate.parts.model import BulgePath, Hole
@@ -183,15 +184,15 @@ AXIS, ANGLE = (3.0, 4.0), 0.6
 STROKE = (-3.0, 5.0)
 
 
-def tilted_slider(tail_side: float) -> Mechanism:
+def tilted_slider(tail_side: float, across: float = 0.0) -> Mechanism:
     """A push rod alone on a guide: point G of the rod slides along (3, 4) through G = (10, -4) of the
     ground, the rod turned by 0.6 rad against the ground. The rod has a second point T 15 mm from G along
-    the slide direction (``tail_side`` +1: ahead, -1: behind). The rod is listed first, so it is the
-    first owner of G."""
+    the slide direction (``tail_side`` +1: ahead, -1: behind; 0: level with G) and ``across`` mm to the
+    left of the slide line. The rod is listed first, so it is the first owner of G."""
     unit = np.array(AXIS) / 5.0
     c, s = math.cos(ANGLE), math.sin(ANGLE)
     axis_rod = np.array([c * unit[0] + s * unit[1], -s * unit[0] + c * unit[1]])  # the axis seen from the rod
-    tail = tail_side * 15.0 * axis_rod
+    tail = tail_side * 15.0 * axis_rod + across * np.array([-axis_rod[1], axis_rod[0]])
     start = np.array([10.0, -4.0]) + STROKE[0] * unit
     return Mechanism(
         name="tilted_slider",
@@ -216,13 +217,19 @@ def test_slider_guide_pins_and_slot(sla_process, tail_side):
     - Over the whole motion (solver poses) both pins stay inside the slot, in the rod's frame.
     - The slot is the stadium of width hole = 2.7 mm over the stroke (8 mm) plus the spacing:
       area L w + pi w^2 / 4 with L = 14.3 (closed form); its centre line is where the pins travel.
+    - The rod's outline is the convex hull of boss circles (radius 2.35) about its points G and T and about
+      both ends of the pin travel (shapely hull of dense discs, within 0.01 mm^2).
+    - Every pin hole records the nominal 2 mm pin (the interference and strength checks model the pin from
+      it); mounting holes take no pin.
     - The rod's rings: outline CCW, hole and slot CW; the plate area = outline - hole - stadium.
     Tolerances: 1e-9 mm for hand-placed holes, 1e-6 for what goes through the solver.
     """
     mech = tilted_slider(tail_side)
     motion = mech.sweep(33)
     partset = build_parts(design_for(sla_process), mech, motion, [], {})
-    hole_mm, spacing = 2.0 + 2 * 0.25 + 0.2, 2 * ((2.0 + 2 * 0.25 + 0.2) / 2 + 1.0) + 2 * 0.8
+    hole_mm = 2.0 + 2 * 0.25 + 0.2
+    boss = hole_mm / 2 + max(0.8, 2.0 / 2)
+    spacing = 2 * boss + 2 * 0.8
     ground, rod = partset.part("ground"), partset.part("rod")
     guides = {h.joint: h for h in ground.holes if not h.joint.startswith("mount_")}
     assert set(guides) == {"G", "G_guide"}
@@ -231,6 +238,8 @@ def test_slider_guide_pins_and_slot(sla_process, tail_side):
     np.testing.assert_allclose(guides["G_guide"].centre, np.array([10.0, -4.0]) - tail_side * spacing * unit,
                                atol=1e-9)
     assert all(h.diameter_mm == pytest.approx(hole_mm, abs=1e-12) for h in guides.values())
+    assert all(h.pin_diameter_mm == 2.0 for h in guides.values())
+    assert all(h.pin_diameter_mm == 0.0 for h in ground.holes if h.joint.startswith("mount_"))
     assert sorted((p.joint, tuple(sorted(p.bodies))) for p in partset.pins) == [
         ("G", ("ground", "rod")), ("G_guide", ("ground", "rod"))]
 
@@ -252,6 +261,14 @@ def test_slider_guide_pins_and_slot(sla_process, tail_side):
     assert slot_poly.symmetric_difference(reach).area < 1e-2
     pin_room = slot_poly.buffer(1e-6)
     assert all(pin_room.contains(shapely.Point(p).buffer(sla_process.pin_diameter_mm / 2, 64)) for p in local)
+    # the rod plate: hull of the bosses about its own points and about both ends of the pin travel
+    c, s = math.cos(ANGLE), math.sin(ANGLE)
+    along = local @ np.array([c * 0.6 + s * 0.8, -s * 0.6 + c * 0.8])  # the unit axis seen from the rod
+    travel_ends = local[[np.argmin(along), np.argmax(along)]]
+    bosses = [shapely.Point(p).buffer(boss, 1024) for p in [*travel_ends, *mech.body("rod").points.values()]]
+    hull = shapely.union_all(bosses).convex_hull
+    assert rod.outline.area() == pytest.approx(hull.area, abs=1e-2)
+    assert all(h.pin_diameter_mm == 2.0 for h in rod.holes)
 
     rings = rod.polygons(0.005)
     assert shapely.LinearRing(rings[0]).is_ccw
@@ -273,3 +290,12 @@ def bulge_length(path: BulgePath) -> float:
         total += chord if b == 0 else chord / (2 * math.sin(theta / 2)) * theta
     return total
 
+
+
+def test_a_slot_that_would_cut_into_a_rod_point_is_refused(sla_process):
+    """A rod point T 2 mm beside the slide line, level with G: the guide slot (2.7 mm wide) along the line
+    would cut into T's 2.7 mm hole whichever side the guide pin goes, so the build stops and names the
+    slider, the rod and the point (the user has to move one of them)."""
+    mech = tilted_slider(0.0, across=2.0)
+    with pytest.raises(GeometryError, match=r"slider G: the guide slot in 'rod' runs into its point 'T'"):
+        build_parts(design_for(sla_process), mech, mech.sweep(9), [], {})
