@@ -299,3 +299,36 @@ def test_a_slot_that_would_cut_into_a_rod_point_is_refused(sla_process):
     mech = tilted_slider(0.0, across=2.0)
     with pytest.raises(GeometryError, match=r"slider G: the guide slot in 'rod' runs into its point 'T'"):
         build_parts(design_for(sla_process), mech, mech.sweep(9), [], {})
+
+
+# -- a curved fingertip pad and a gear on one body --------------------------------------------------
+
+def test_curved_pad_and_gear_fuse_into_one_plate(four_bar, sla_process):
+    """The coupler of the sun/planet four-bar carries the planet (about A) and a curved pad: the circular
+    segment of the circle of radius 36 about its point C = (40, 36) cut off by the chord from B = (40, 0) to
+    E = (76, 36). Its plate is the union of the hull of the bosses (radius 2.35) about A, B, C, E, the pad
+    segment (the quarter disc beyond the chord x - y = 40), the planet outline (axis at A, turned by 0: A - O
+    lies on +x in the crank) and its hub (diameter 2 x 2.35 = 4.7), each built here with shapely on dense
+    circles. Tolerance: chord tolerance 0.005 mm x boundary length (~1.0 mm^2; the pad alone adds ~256 mm^2)."""
+    bodies = tuple(Body("coupler", {**b.points, "C": (40.0, 36.0), "E": (76.0, 36.0)}) if b.name == "coupler" else b
+                   for b in four_bar.bodies)
+    padded = Mechanism(name="padded", bodies=bodies, ground=four_bar.ground, joints=four_bar.joints, gears=(),
+                       drivers=four_bar.drivers, input_range=four_bar.input_range, assembly=four_bar.assembly)
+    motion = padded.sweep(13)
+    mech = sun_planet_four_bar(padded)  # the gear record only places the gears (as in tests/test_parts.py)
+    planet = spur_like(6.0, 8, 0.4)
+    pair = SimpleNamespace(name="sun_planet", body_a="ground", body_b="coupler", axis_a="O", axis_b="A",
+                           outline_a=spur_like(9.0, 12, 0.4), outline_b=planet)
+    hints = {"pads": {"coupler": {"point": "C", "arc": ["B", "E"]}}}
+    coupler = build_parts(design_for(sla_process), mech, motion, [pair], hints).part("coupler")
+    boss = (2.0 + 2 * 0.25 + 0.2) / 2 + 1.0
+    points = [(0.0, 0.0), (40.0, 0.0), (40.0, 36.0), (76.0, 36.0)]
+    hull = shapely.union_all([shapely.Point(p).buffer(boss, 1024) for p in points]).convex_hull
+    beyond_chord = shapely.Polygon([(40.0, 0.0), (76.0, 36.0), (140.0, -28.0)])  # the side x - y > 40
+    segment = shapely.Point(40.0, 36.0).buffer(36.0, 4096).intersection(beyond_chord)
+    hub = shapely.Point(0.0, 0.0).buffer(2 * boss / 2, 1024)
+    expected = shapely.union_all([hull, segment, shapely.Polygon(planet), hub])
+    plate = shapely.Polygon(coupler.outline.polygon(0.005))
+    chords = 0.005 * expected.length  # inscribed chords lose at most sagitta x boundary length
+    assert plate.area == pytest.approx(expected.area, abs=chords)
+    assert plate.symmetric_difference(expected).area < chords
