@@ -1,0 +1,475 @@
+"""Planar kinematic mapping and dyad-family tracing (fabricate.synthesis.five_bar.kinematic_mapping).
+
+Fast and independent of the paper's finger (tests/test_five_bar.py synthesises it in a slow fixture).
+Expected values come from closed forms written out here (Bottema & Roth's image coordinates, explicit
+rotation matrices, circles through hand-picked points, conics solved by hand), from a dyad built by hand
+(four poses of a body whose moving point ``b`` runs on a circle about ``c``), or from a brute-force scan of
+the circle-point curve that does not use the kinematic mapping at all. Tolerances are stated at each
+assert.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fabricate.synthesis.five_bar import kinematic_mapping as km
+
+displacement = st.tuples(st.floats(-200, 200), st.floats(-200, 200), st.floats(-3.1, 3.1))
+point = st.tuples(st.floats(-100, 100), st.floats(-100, 100))
+
+
+def rot(angle: float) -> np.ndarray:
+    return np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
+
+
+def textbook_image(a: float, b: float, phi: float) -> np.ndarray:
+    """Bottema & Roth / McCarthy: image of the rotation ``phi`` followed by the translation ``(a, b)``."""
+    s, c = math.sin(phi / 2), math.cos(phi / 2)
+    return np.array([a / 2 * s - b / 2 * c, a / 2 * c + b / 2 * s, s, c])
+
+
+# -- image coordinates -------------------------------------------------------------------------------
+
+
+@settings(max_examples=60, deadline=None)
+@given(displacement)
+def test_image_is_the_textbook_formula_and_fixes_the_pole(d):
+    """The image of (e, f, v) is Bottema & Roth's formula, and (Z1/Z3, Z2/Z3) is the pole (fixed point).
+
+    The pole check is geometric: the point ``P`` with ``R(v) P + (e, f) = P`` is computed here from the
+    rotation matrix, not from the module (tolerance 1e-9 mm on displacements up to 200 mm).
+    """
+    e, f, v = d
+    z = km.image_coordinates(np.array([d]))
+    assert z.shape == (1, 4)
+    assert np.allclose(z[0], textbook_image(e, f, v), rtol=0, atol=1e-12)
+    if abs(math.sin(v / 2)) > 1e-3:
+        pole = np.linalg.solve(np.eye(2) - rot(v), np.array([e, f]))
+        assert np.allclose(z[0, :2] / z[0, 2], pole, rtol=1e-9, atol=1e-9)
+
+
+def test_image_of_several_displacements_is_one_row_each():
+    """An (n, 3) input gives n image rows in the input order (checked against the textbook formula)."""
+    ds = [(10.0, -4.0, 0.3), (0.0, 0.0, 0.0), (-7.5, 2.0, -2.0)]
+    z = km.image_coordinates(np.array(ds))
+    assert z.shape == (3, 4)
+    for row, d in zip(z, ds, strict=True):
+        assert np.allclose(row, textbook_image(*d), rtol=0, atol=1e-15)
+    # the identity maps to (0, 0, 0, 1)
+    assert np.array_equal(z[1], [0.0, 0.0, 0.0, 1.0])
+
+
+def test_image_is_computed_in_double_precision_for_float32_poses():
+    """Poses stored as float32 (exactly representable values) still give float64 images accurate to
+    1e-14: the precision of the result must not drop to the input's storage type (float32 arithmetic
+    would be off by ~1e-7 relative)."""
+    d32 = np.array([[123.456, -98.765, 1.234], [0.1, 0.2, -2.9]], dtype=np.float32)
+    z = km.image_coordinates(d32)
+    assert z.dtype == np.float64
+    for row, d in zip(z, d32.astype(np.float64), strict=True):
+        assert np.allclose(row, textbook_image(*d), rtol=0, atol=1e-14)
+
+
+def test_displacement_from_image_is_computed_in_double_precision_for_float32_images():
+    """A float32 image (exact values) inverts in float64: e, f, v from the matrix of eq 3 evaluated here
+    in double precision, to 1e-12 (float32 arithmetic would be off by ~1e-5 mm)."""
+    z32 = np.array([[12.25, -7.5, 0.375, 0.875], [-40.125, 3.0625, -0.5, 0.25]], dtype=np.float32)
+    back = km.displacement_from_image(z32)
+    assert back.dtype == np.float64
+    for row, z in zip(back, z32.astype(np.float64), strict=True):
+        z1, z2, z3, z4 = z
+        h = z3 * z3 + z4 * z4
+        expected = (2 * (z1 * z3 + z2 * z4) / h, 2 * (z2 * z3 - z1 * z4) / h, 2 * math.atan2(z3, z4))
+        assert np.allclose(row, expected, rtol=1e-12, atol=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(displacement, st.floats(0.05, 20.0), st.sampled_from([1.0, -1.0]), point)
+def test_scaled_image_maps_points_like_the_rotation_matrix(d, scale, sign, q):
+    """Any nonzero multiple of the image (also negative: Z and -Z are the same displacement) maps a
+    moving point to ``R(v) q + (e, f)`` with R written out here (tolerance 1e-9 mm)."""
+    e, f, v = d
+    z = sign * scale * textbook_image(e, f, v)
+    expected = rot(v) @ np.array(q) + np.array([e, f])
+    assert np.allclose(km.map_points(z, np.array(q)), expected, rtol=0, atol=1e-9)
+    back = km.displacement_from_image(z)[0]
+    assert np.allclose(back[:2], [e, f], rtol=0, atol=1e-9)
+    assert abs(math.remainder(back[2] - v, 2 * math.pi)) < 1e-12
+
+
+# -- circle vectors and the side conditions -----------------------------------------------------------
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.floats(-10.0, 10.0), min_size=8, max_size=8))
+def test_side_condition_forms_are_the_quadratics_of_eq7(p):
+    """``p^T S p`` of the two symmetric forms equals eq 7 written out here for any 8-vector (1e-9)."""
+    p = np.array(p)
+    s1, s2 = km.side_condition_forms()
+    assert np.array_equal(s1, s1.T) and np.array_equal(s2, s2.T)
+    q1 = p[0] * p[5] + p[1] * p[4] - p[2] * p[3]
+    q2 = 2 * p[0] * p[6] - p[1] * p[3] - p[2] * p[4]
+    assert abs(p @ s1 @ p - q1) < 1e-9 and abs(p @ s2 @ p - q2) < 1e-9
+    assert np.allclose(km.side_conditions(p), [q1, q2], rtol=0, atol=1e-9)
+    assert np.allclose(km.side_conditions(np.array([p, 2 * p])), [[q1, q2], [4 * q1, 4 * q2]], atol=1e-8)
+
+
+def test_dyad_from_vector_decodes_a_batch():
+    """A stack of circle vectors decodes row by row to the centres and circle points they were built from
+    (1e-12 mm), whatever the scale and sign of each row."""
+    dyads = [((1.0, 2.0), (-3.0, 4.0), 5.0), ((-40.0, 7.5), (12.0, -0.5), 30.0)]
+    ps = np.array([k * km.circle_vector(np.array(c), np.array(b), r) for k, (c, b, r) in zip((1.0, -3.0), dyads,
+                                                                                            strict=True)])
+    centre, moving = km.dyad_from_vector(ps)
+    assert centre.shape == (2, 2) and moving.shape == (2, 2)
+    assert np.allclose(centre, [c for c, _, _ in dyads], atol=1e-12)
+    assert np.allclose(moving, [b for _, b, _ in dyads], atol=1e-12)
+
+
+# -- conic intersections ------------------------------------------------------------------------------
+
+
+def circle_conic(cx: float, cy: float, r: float) -> np.ndarray:
+    """Symmetric matrix of ``(x - cx)^2 + (y - cy)^2 - r^2`` in homogeneous (x, y, 1)."""
+    return np.array([[1.0, 0.0, -cx], [0.0, 1.0, -cy], [-cx, -cy, cx * cx + cy * cy - r * r]])
+
+
+def affine(points: list[np.ndarray]) -> np.ndarray:
+    return np.array(sorted((x[0] / x[2], x[1] / x[2]) for x in points))
+
+
+def test_two_circles_meet_in_their_two_real_points_only():
+    """Circles of radius 1 about (0, 0) and (1, 0) meet at (1/2, +-sqrt(3)/2); their other two common
+    points are the complex circular points, which must not be returned. Tolerance 1e-12."""
+    found = km.conic_intersections(circle_conic(0.0, 0.0, 1.0), circle_conic(1.0, 0.0, 1.0))
+    assert len(found) == 2
+    for x in found:
+        assert abs(np.linalg.norm(x) - 1.0) < 1e-12
+    assert np.allclose(affine(found), [[0.5, -math.sqrt(3) / 2], [0.5, math.sqrt(3) / 2]], rtol=0, atol=1e-12)
+
+
+def test_disjoint_circles_have_no_real_intersection():
+    """Circles of radius 1 about (0, 0) and (5, 0) do not meet: no point is returned."""
+    assert km.conic_intersections(circle_conic(0.0, 0.0, 1.0), circle_conic(5.0, 0.0, 1.0)) == []
+
+
+def test_a_line_pair_meets_a_circle_in_four_points():
+    """The degenerate conic ``x y = 0`` (the two axes) meets the circle of radius 2 about (1, 1) where
+    solved by hand: x = 0 gives y = 1 +- sqrt(3), y = 0 gives x = 1 +- sqrt(3). Tolerance 1e-10."""
+    axes = np.array([[0.0, 0.5, 0.0], [0.5, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    r3 = math.sqrt(3.0)
+    expected = np.array(sorted([(0.0, 1 - r3), (0.0, 1 + r3), (1 - r3, 0.0), (1 + r3, 0.0)]))
+    found = km.conic_intersections(circle_conic(1.0, 1.0, 2.0), axes)
+    assert len(found) == 4
+    assert np.allclose(affine(found), expected, rtol=0, atol=1e-10)
+
+
+def test_ellipse_and_hyperbola_points_are_found_to_full_precision_at_any_scale():
+    """``x^2 + 4 y^2 = 4`` and ``x y = 1/2`` meet at x^2 in {2 +- sqrt(3)} (x^4 - 4 x^2 + 1 = 0, solved
+    with numpy.roots here), y = 1 / (2 x). Both conics scaled by a common 1e6 or 1e-6 give the same
+    points, accurate to 1e-12 (Newton polishing; the raw pencil solution is less accurate)."""
+    ellipse = np.diag([1.0, 4.0, -4.0])
+    hyperbola = np.array([[0.0, 0.5, 0.0], [0.5, 0.0, 0.0], [0.0, 0.0, -0.5]])
+    xs = list(np.roots([1.0, 0.0, -4.0, 0.0, 1.0]).real)
+    expected = np.array(sorted((x, 1 / (2 * x)) for x in xs))
+    for scale in (1.0, 1e6, 1e-6):
+        found = km.conic_intersections(scale * ellipse, scale * hyperbola)
+        assert len(found) == 4
+        assert np.allclose(affine(found), expected, rtol=0, atol=1e-12)
+
+
+# -- a four-pose problem with a dyad built by hand ----------------------------------------------------
+
+#: The hand-built dyad: moving point B (moving frame) on a circle of radius R about the fixed centre C.
+C_TRUE, B_TRUE, R_TRUE = np.array([10.0, 5.0]), np.array([-20.0, 8.0]), 30.0
+
+
+@lru_cache(maxsize=1)
+def four_pose_problem() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Four poses (e, f, v) of a body whose point B_TRUE lies on the circle (C_TRUE, R_TRUE) at the
+    angles t: ``R(v) B + (e, f) = C + R (cos t, sin t)`` solved for (e, f) by hand. Returns the poses,
+    the constraint matrix M and the 8 x 4 basis of the four smallest eigenvalues of M^T M."""
+    poses = []
+    for v, t in zip((0.1, 0.5, 0.9, 1.3), (0.2, 0.7, 1.3, 1.8), strict=True):
+        e, f = C_TRUE + R_TRUE * np.array([math.cos(t), math.sin(t)]) - rot(v) @ B_TRUE
+        poses.append((e, f, v))
+    poses = np.array(poses)
+    m = km.constraint_matrix(km.image_coordinates(poses))
+    _, vectors = km.family_basis(m)
+    return poses, m, vectors[:, :4]
+
+
+def concyclic(poses: np.ndarray, b: np.ndarray) -> float:
+    """Scale-free determinant that vanishes iff the four positions of moving point b are concyclic."""
+    world = np.array([rot(v) @ b + (e, f) for e, f, v in poses])
+    rows = np.column_stack([np.sum(world ** 2, axis=1), world, np.ones(4)])
+    return float(np.linalg.det(rows) / np.prod(np.linalg.norm(rows, axis=1)))
+
+
+def true_kappa() -> float:
+    """kappa = w4 / w1 of the hand-built dyad in the family basis (a projection, not a solve)."""
+    _, _, basis4 = four_pose_problem()
+    w = basis4.T @ km.circle_vector(C_TRUE, B_TRUE, R_TRUE)
+    return float(w[3] / w[0])
+
+
+def test_family_basis_spans_the_hand_built_dyad():
+    """Four poses leave a 4-dimensional null space of M^T M (eigenvalues ascending, unit eigenvectors)
+    that contains the hand-built dyad's circle vector (relative residual 1e-9)."""
+    _, m, basis4 = four_pose_problem()
+    values, vectors = km.family_basis(m)
+    assert values.shape == (8,) and np.all(np.diff(values) >= 0)
+    assert np.allclose(vectors.T @ vectors, np.eye(8), atol=1e-12)
+    assert np.all(np.abs(values[:4]) < 1e-12 * values[-1]) and values[4] > 1e-9 * values[-1]
+    p = km.circle_vector(C_TRUE, B_TRUE, R_TRUE)
+    assert np.linalg.norm(p - basis4 @ (basis4.T @ p)) < 1e-9 * np.linalg.norm(p)
+
+
+def test_solve_at_kappa_finds_the_hand_built_dyad():
+    """At the kappa of the hand-built dyad, one unit solution is +-p/|p| (1e-9), and it decodes to the
+    dyad's centre and circle point (1e-6 mm); every solution lies in the basis span with w4 = kappa w1
+    and meets eq 7 (1e-9)."""
+    _, m, basis4 = four_pose_problem()
+    kappa = true_kappa()
+    p_true = km.circle_vector(C_TRUE, B_TRUE, R_TRUE)
+    p_true = p_true / np.linalg.norm(p_true)
+    solutions = km.solve_at_kappa(basis4, kappa)
+    assert 1 <= len(solutions) <= 4
+    for p in solutions:
+        assert abs(np.linalg.norm(p) - 1.0) < 1e-12
+        w = basis4.T @ p
+        assert np.linalg.norm(basis4 @ w - p) < 1e-9
+        assert abs(w[3] - kappa * w[0]) < 1e-9
+        assert np.all(np.abs(km.side_conditions(p)) < 1e-9)
+    best = max(solutions, key=lambda q: abs(float(q @ p_true)))
+    assert min(np.linalg.norm(best - p_true), np.linalg.norm(best + p_true)) < 1e-9
+    centre, moving = km.dyad_from_vector(best)
+    assert np.allclose(centre, C_TRUE, atol=1e-6) and np.allclose(moving, B_TRUE, atol=1e-6)
+
+
+def test_traced_family_samples_cot_omega_and_holds_exact_dyads():
+    """trace_family samples kappa = cot(omega) at the open-interval omegas written out here; every
+    sample is a unit circle vector with M p = 0 and eq 7 (1e-9 relative), its centre and circle point are
+    decoded from p, and its circle point makes the four positions concyclic (determinant computed here,
+    without the kinematic mapping). Branch ids are 0, 1, 2, ... in order of first appearance, and
+    consecutive samples of a branch are close (|cos| >= 0.9)."""
+    poses, m, basis4 = four_pose_problem()
+    samples = 60
+    fam = km.trace_family(basis4, samples)
+    omegas = [math.pi * (k + 1) / (samples + 1) for k in range(samples)]
+    allowed = np.array([math.cos(o) / math.sin(o) for o in omegas])
+    n = len(fam.kappa)
+    assert n >= samples
+    assert fam.kappa.dtype == np.float64 and fam.branch.dtype.kind == "i"
+    assert fam.p.shape == (n, 8) and fam.centre.shape == (n, 2) and fam.point.shape == (n, 2)
+    # each omega contributes its solutions with |p1| >= 1e-9, all of them (counted with solve_at_kappa)
+    counts = [sum(abs(p[0]) >= 1e-9 for p in km.solve_at_kappa(basis4, k)) for k in allowed]
+    expected = np.repeat(allowed, counts)
+    assert fam.kappa.shape == expected.shape and np.allclose(fam.kappa, expected, rtol=1e-12, atol=1e-12)
+    assert np.all(np.diff(np.arctan2(1.0, fam.kappa)) >= -1e-12)  # in omega order
+    assert np.allclose(np.linalg.norm(fam.p, axis=1), 1.0, atol=1e-12)
+    assert np.max(np.abs(m @ fam.p.T)) < 1e-9 * np.abs(m).max()
+    assert np.max(np.abs(km.side_conditions(fam.p))) < 1e-9
+    assert np.allclose(fam.centre, -fam.p[:, 3:5] / fam.p[:, :1], rtol=1e-12, atol=1e-9)
+    assert np.allclose(fam.point, -fam.p[:, 1:3] / fam.p[:, :1], rtol=1e-12, atol=1e-9)
+    assert max(abs(concyclic(poses, b)) for b in fam.point) < 1e-9
+    first_seen = list(dict.fromkeys(fam.branch.tolist()))
+    assert first_seen == list(range(len(first_seen)))
+    for label in first_seen:
+        ps = fam.p[fam.branch == label]
+        assert np.all(np.abs(np.sum(ps[1:] * ps[:-1], axis=1)) >= 0.9)
+
+
+def test_trace_family_drops_slider_solutions_below_the_centre_weight():
+    """Solutions with |p1| below min_centre_weight are dropped (|p1| is computed here from p); with the
+    weight at 0 nothing is dropped, so the default family is the weight-0 family minus those rows."""
+    _, _, basis4 = four_pose_problem()
+    everything = km.trace_family(basis4, 40, min_centre_weight=0.0)
+    weights = np.abs(everything.p[:, 0])
+    cut = float(np.median(weights))
+    kept = km.trace_family(basis4, 40, min_centre_weight=cut)
+    assert np.all(np.abs(kept.p[:, 0]) >= cut)
+    assert len(kept.kappa) == int(np.sum(weights >= cut))
+    default = km.trace_family(basis4, 40)
+    assert len(default.kappa) == int(np.sum(weights >= 1e-9))
+
+
+def brute_force_circle_points(poses: np.ndarray, box: float, lines: int) -> np.ndarray:
+    """Circle points b in [-box, box]^2 found by scanning horizontal and vertical lines for sign changes of
+    the concyclicity determinant and refining each by bisection (no kinematic mapping involved)."""
+    found = []
+    ts = np.linspace(-box, box, 401)
+    for swap in (False, True):
+        for u in np.linspace(-box, box, lines):
+            def at(t: float, u: float = u, swap: bool = swap) -> np.ndarray:
+                return np.array([u, t]) if swap else np.array([t, u])
+            values = np.array([concyclic(poses, at(t)) for t in ts])
+            for i in np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0):
+                lo, hi, f_lo = ts[i], ts[i + 1], values[i]
+                for _ in range(40):
+                    mid = 0.5 * (lo + hi)
+                    f_mid = concyclic(poses, at(mid))
+                    if np.sign(f_mid) == np.sign(f_lo):
+                        lo, f_lo = mid, f_mid
+                    else:
+                        hi = mid
+                found.append(at(0.5 * (lo + hi)))
+    return np.array(found)
+
+
+def circle_point(p: np.ndarray) -> np.ndarray:
+    """The circle point b = -(p2, p3) / p1 of eq 6 (mm), written out here."""
+    return -p[:, 1:3] / p[:, :1]
+
+
+def test_refined_family_covers_the_brute_force_circle_point_curve():
+    """refine_family with a 1 mm step on the circle point inside a 30 mm box brings every circle point of
+    the brute-force scan in the box within 0.5 mm of a sample (the 80-sample trace alone misses some by
+    more than 5 mm); inserted samples are exact dyads (M p = 0, 1e-9 relative), decoded from p, and the
+    result is in omega order."""
+    poses, m, basis4 = four_pose_problem()
+    fam = km.trace_family(basis4, 80)
+    box = 30.0
+    keep = np.all(np.abs(circle_point(fam.p)) <= box, axis=1)
+    refined = km.refine_family(basis4, fam, circle_point, keep, max_step=1.0)
+    assert np.max(np.abs(m @ refined.p.T)) < 1e-9 * np.abs(m).max()
+    assert np.allclose(refined.point, circle_point(refined.p), rtol=1e-12, atol=1e-9)
+    assert np.allclose(refined.centre, -refined.p[:, 3:5] / refined.p[:, :1], rtol=1e-12, atol=1e-9)
+    assert np.all(np.diff(np.arctan2(1.0, refined.kappa)) >= 0.0)
+    scan = brute_force_circle_points(poses, box, 11)
+    assert len(scan) >= 10
+    assert max(np.min(np.linalg.norm(fam.point - target, axis=1)) for target in scan) > 5.0
+    assert max(np.min(np.linalg.norm(refined.point - target, axis=1)) for target in scan) < 0.5
+
+
+def test_refine_family_inserts_evenly_in_kappa_where_a_kept_branch_jumps():
+    """Each gap of a branch with an end in keep and a jump g > max_step gets min(max_inserts,
+    ceil(g / max_step) - 1) samples at evenly spaced kappa (a prefix of them if the branch is lost at a
+    turning point), each continuing the branch (|cos| >= 0.99 to its neighbour); gaps outside keep or
+    below max_step get none. The expected kappas are computed here from the traced samples."""
+    _, _, basis4 = four_pose_problem()
+    fam = km.trace_family(basis4, 40)
+    order = np.argsort(np.arctan2(1.0, fam.kappa), kind="stable")
+    fam = km._take(fam, order)
+    keep = np.all(np.abs(circle_point(fam.p)) <= 30.0, axis=1)
+    for step, max_inserts in ((1.0, 200), (0.5, 3)):
+        refined = km.refine_family(basis4, fam, circle_point, keep, max_step=step, max_inserts=max_inserts)
+        assert len(refined.kappa) > len(fam.kappa)
+        pos = circle_point(fam.p)
+        inserted_total = 0
+        for label in np.unique(fam.branch):
+            idx = np.flatnonzero(fam.branch == label)
+            mine = refined.branch == label
+            for j, k in zip(idx[:-1], idx[1:], strict=True):
+                lo, hi = sorted((fam.kappa[j], fam.kappa[k]))
+                between = np.flatnonzero(mine & (refined.kappa > lo) & (refined.kappa < hi))
+                gap = float(np.linalg.norm(pos[k] - pos[j]))
+                if not (keep[j] or keep[k]) or gap <= step:
+                    assert between.size == 0
+                    continue
+                count = min(max_inserts, math.ceil(gap / step) - 1)
+                expected = [fam.kappa[j] + (fam.kappa[k] - fam.kappa[j]) * (i + 1) / (count + 1)
+                            for i in range(count)]
+                got = refined.kappa[between]
+                assert 0 < got.size <= count
+                assert np.allclose(np.sort(got), np.sort(expected[:got.size]), rtol=0, atol=1e-12)
+                chain = refined.p[np.sort(np.concatenate([between, np.flatnonzero(mine & np.isin(
+                    refined.kappa, [fam.kappa[j], fam.kappa[k]]))]))]
+                assert np.all(np.abs(np.sum(chain[1:] * chain[:-1], axis=1)) >= 0.99)
+                inserted_total += got.size
+        assert inserted_total == len(refined.kappa) - len(fam.kappa)
+
+
+def test_refine_family_leaves_a_family_outside_keep_untouched():
+    """With no sample in keep nothing is inserted: the same samples come back, in omega order."""
+    _, _, basis4 = four_pose_problem()
+    fam = km.trace_family(basis4, 30)
+    n = len(fam.kappa)
+    backwards = np.lexsort((np.arange(n), -np.arctan2(1.0, fam.kappa)))  # omega descending, ties kept
+    out = km.refine_family(basis4, km._take(fam, backwards), circle_point, np.zeros(n, bool), 1e-3)
+    for name in ("kappa", "branch", "p", "centre", "point"):
+        assert np.array_equal(getattr(out, name), getattr(fam, name)), name
+
+
+def bracket_of_true_dyad(fam: km.DyadFamily) -> tuple[int, int]:
+    """Indices of the consecutive samples of the hand-built dyad's branch whose kappas bracket its kappa."""
+    p_true = km.circle_vector(C_TRUE, B_TRUE, R_TRUE)
+    j = int(np.argmax(np.abs(fam.p @ p_true)))
+    idx = np.flatnonzero(fam.branch == fam.branch[j])
+    k_true = true_kappa()
+    for lo, hi in zip(idx[:-1], idx[1:], strict=True):
+        if (fam.kappa[lo] - k_true) * (fam.kappa[hi] - k_true) < 0:
+            return int(lo), int(hi)
+    raise AssertionError("no bracket")
+
+
+def centre_x_error(p: np.ndarray) -> float:
+    """x of the centre (eq 6, written out) minus the hand-built centre's x, mm."""
+    return float(-p[3] / p[0] - C_TRUE[0])
+
+
+def test_bisection_on_a_branch_lands_on_the_hand_built_dyad():
+    """Bisecting x(centre) - C_TRUE.x between the traced samples of the hand-built dyad's branch that
+    bracket it returns the dyad itself: centre and circle point within 1e-6 mm, kappa within 1e-9,
+    whichever end of the bracket is given first."""
+    _, _, basis4 = four_pose_problem()
+    fam = km.trace_family(basis4, 80)
+    lo, hi = bracket_of_true_dyad(fam)
+    assert centre_x_error(fam.p[lo]) * centre_x_error(fam.p[hi]) < 0
+    for a, b in ((lo, hi), (hi, lo)):
+        kappa, p = km.bisect_on_branch(basis4, centre_x_error, fam.kappa[a], fam.p[a], fam.kappa[b], fam.p[b])
+        assert abs(kappa - true_kappa()) < 1e-9
+        centre, moving = km.dyad_from_vector(p)
+        assert np.allclose(centre, C_TRUE, atol=1e-6) and np.allclose(moving, B_TRUE, atol=1e-6)
+
+
+def test_a_short_bisection_returns_the_better_end_of_its_last_bracket():
+    """With 0-4 iterations the result is the end of the last bracket with the smaller |func|. Expected
+    from a brute-force scan: the branch's solutions at the 2^n + 1 evenly spaced kappas of the bracket
+    (each the solution closest in direction to the hand-built dyad), the sign change among them, and the
+    better of its two ends (kappa exact to 1e-12, p to 1e-9 up to sign)."""
+    _, _, basis4 = four_pose_problem()
+    fam = km.trace_family(basis4, 80)
+    lo, hi = bracket_of_true_dyad(fam)
+    k0, k1 = fam.kappa[lo], fam.kappa[hi]
+    p_true = km.circle_vector(C_TRUE, B_TRUE, R_TRUE)
+    for iterations in range(5):
+        n = 2 ** iterations
+        grid = [k0 + (k1 - k0) * i / n for i in range(n + 1)]
+        ps = [fam.p[lo]] + [max(km.solve_at_kappa(basis4, k), key=lambda q: abs(float(q @ p_true)))
+                            for k in grid[1:-1]] + [fam.p[hi]]
+        fs = [centre_x_error(q) for q in ps]
+        i = next(i for i in range(n) if fs[i] * fs[i + 1] <= 0)
+        best = i if abs(fs[i]) <= abs(fs[i + 1]) else i + 1
+        kappa, p = km.bisect_on_branch(basis4, centre_x_error, k0, fam.p[lo], k1, fam.p[hi], iterations=iterations)
+        assert abs(kappa - grid[best]) < 1e-12
+        assert min(np.linalg.norm(p - ps[best]), np.linalg.norm(p + ps[best])) < 1e-9
+
+
+def unit(angle: float) -> np.ndarray:
+    return np.array([math.cos(angle), math.sin(angle), 0.0])
+
+
+def test_branch_matching_pairs_each_solution_with_its_closest_previous_branch():
+    """Greedy matching by |cos|: solutions 0.1 rad from branch 7 and 0.2 rad from branch 3 (signs
+    ignored) take those labels even when the other branch is also within the 0.9 cosine threshold
+    (cos 0.3 = 0.955); a branch is used once; a solution farther than acos(0.9) = 0.451 rad from every
+    free branch starts a new one (-1). Angles chosen here so the cosines are known in closed form."""
+    previous = [(unit(0.0), 7), (unit(0.3), 3)]
+    assert km._match_branches([unit(0.1), -unit(0.5)], previous) == [7, 3]
+    assert km._match_branches([-unit(0.5), unit(0.1)], previous) == [3, 7]
+    # one solution near both branches: it keeps the closer one only
+    assert km._match_branches([unit(0.05)], previous) == [7]
+    assert km._match_branches([unit(0.26)], previous) == [3]
+    # the closer solution wins the branch; the other one, 0.46 rad from branch 3, starts a new branch
+    assert km._match_branches([unit(-0.16), unit(-0.02)], previous) == [-1, 7]
+    assert km._match_branches([unit(1.0), unit(2.0)], previous) == [-1, -1]
+    assert km._match_branches([unit(0.0)], []) == [-1]
+    assert km._match_branches([], previous) == []
+    # the threshold is a parameter: at 0.99 (8.1 degrees) a 0.2 rad neighbour is not matched
+    assert km._match_branches([unit(0.5)], previous, min_dot=0.99) == [-1]
