@@ -169,16 +169,29 @@ def test_a_line_pair_meets_a_circle_in_four_points():
     assert np.allclose(affine(found), expected, rtol=0, atol=1e-10)
 
 
+def test_a_line_pair_given_first_meets_the_circle_in_the_same_four_points():
+    """Regression: with the degenerate conic first, the pencil member at lam = 0 is that line pair itself;
+    its lines must be met with the other conic (before the fix no point was returned). Same hand-solved
+    points as above, tolerance 1e-10."""
+    axes = np.array([[0.0, 0.5, 0.0], [0.5, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    r3 = math.sqrt(3.0)
+    expected = np.array(sorted([(0.0, 1 - r3), (0.0, 1 + r3), (1 - r3, 0.0), (1 + r3, 0.0)]))
+    found = km.conic_intersections(axes, circle_conic(1.0, 1.0, 2.0))
+    assert len(found) == 4
+    assert np.allclose(affine(found), expected, rtol=0, atol=1e-10)
+
+
 def test_ellipse_and_hyperbola_points_are_found_to_full_precision_at_any_scale():
     """``x^2 + 4 y^2 = 4`` and ``x y = 1/2`` meet at x^2 in {2 +- sqrt(3)} (x^4 - 4 x^2 + 1 = 0, solved
-    with numpy.roots here), y = 1 / (2 x). Both conics scaled by a common 1e6 or 1e-6 give the same
-    points, accurate to 1e-12 (Newton polishing; the raw pencil solution is less accurate)."""
+    with numpy.roots here), y = 1 / (2 x). A conic's matrix is only defined up to scale: scaling both, or
+    each on its own by up to 1e8 (regression: a hyperbola 1e4 times smaller than the ellipse was taken for
+    a degenerate conic and nothing was found), gives the same points, accurate to 1e-12."""
     ellipse = np.diag([1.0, 4.0, -4.0])
     hyperbola = np.array([[0.0, 0.5, 0.0], [0.5, 0.0, 0.0], [0.0, 0.0, -0.5]])
     xs = list(np.roots([1.0, 0.0, -4.0, 0.0, 1.0]).real)
     expected = np.array(sorted((x, 1 / (2 * x)) for x in xs))
-    for scale in (1.0, 1e6, 1e-6):
-        found = km.conic_intersections(scale * ellipse, scale * hyperbola)
+    for s1, s2 in ((1.0, 1.0), (1e6, 1e6), (1e-6, 1e-6), (1.0, 1e-4), (1e3, 1e-5), (1e-8, 1.0), (1.0, 1e-8)):
+        found = km.conic_intersections(s1 * ellipse, s2 * hyperbola)
         assert len(found) == 4
         assert np.allclose(affine(found), expected, rtol=0, atol=1e-12)
 

@@ -152,10 +152,12 @@ def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
     -----
     A real root ``lam`` of ``det(c1 + lam c2) = 0`` gives a degenerate conic of the pencil; when it is
     indefinite it is a pair of real lines through every real intersection point, and each line meets
-    ``c1`` in the roots of a quadratic.
+    ``c1`` (``c2`` when ``|lam| < 1``: on the lines ``c1 = -lam c2``, and at ``lam = 0`` the lines lie in
+    ``c1``) in the roots of a quadratic. Each conic is normalised on its own, so the result does not depend
+    on their scales.
     """
-    scale = max(np.abs(c1).max(), np.abs(c2).max(), 1e-300)
-    c1, c2 = c1 / scale, c2 / scale
+    # each conic is only defined up to scale: normalise them separately, so that neither looks degenerate
+    c1, c2 = c1 / max(np.abs(c1).max(), 1e-300), c2 / max(np.abs(c2).max(), 1e-300)
     # the cubic through four exact samples of det(c1 + lam c2)
     coefficients = _CUBIC_FIT @ np.linalg.det(c1[None] + _CUBIC_SAMPLES[:, None, None] * c2[None])
     if abs(coefficients[0]) < 1e-14:  # c2 itself degenerate: it is the member at infinity
@@ -174,11 +176,13 @@ def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
         if values[1] * values[2] >= 0.0:
             continue  # a definite (point) or double-line member: try another root
         w1, w2 = np.sqrt(abs(values[1])), np.sqrt(abs(values[2]))
+        # on the lines c1 = -lam c2: meet them with the conic farther from the member (c1 itself at lam = 0)
+        other = c2 if abs(lam) < 1.0 else c1
         for line in (w1 * vectors[:, 1] + w2 * vectors[:, 2], w1 * vectors[:, 1] - w2 * vectors[:, 2]):
             basis = _line_basis(line)
-            a = basis[0] @ c1 @ basis[0]
-            b = basis[0] @ c1 @ basis[1]
-            c = basis[1] @ c1 @ basis[1]
+            a = basis[0] @ other @ basis[0]
+            b = basis[0] @ other @ basis[1]
+            c = basis[1] @ other @ basis[1]
             disc = b * b - a * c
             if disc < 0.0:
                 continue
