@@ -15,6 +15,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import shapely
+from conftest import make_four_bar
 from test_parts import design_for, spur_like, sun_planet_four_bar
 
 from fabricate.errors import GeometryError
@@ -332,3 +333,60 @@ def test_curved_pad_and_gear_fuse_into_one_plate(four_bar, sla_process):
     chords = 0.005 * expected.length  # inscribed chords lose at most sagitta x boundary length
     assert plate.area == pytest.approx(expected.area, abs=chords)
     assert plate.symmetric_difference(expected).area < chords
+
+
+# -- a pin through a skipped layer: printed spacer, roles, heights, BOM -----------------------------
+
+def test_printed_spacer_roles_heights_and_bill_of_materials(sla_process):
+    """A compact four-bar (crank 12, coupler 25, rocker 20, ground 25 mm) with 10 mm wide links on SLA: the
+    bosses crowd each other, so some pin skips layers. Checked against the stack by hand (t = 3, g = 0.3):
+
+    - every body part sits at z = layer x (t + g), carries the process and its role (ground / link);
+    - a pin between layers lo and hi with nothing in between gets a spacer of (hi - lo) (t + g) - t; when
+      that is at least a plate thick it is printed as a part ``spacer_<pin>`` in the first body's frame: a
+      disc of the boss diameter (10 mm) about the pin, bored 2.7 mm for the 2 mm pin, from z = lo (t + g) + t;
+    - the BOM (two copies) lists every part twice, the two mounting screws per copy, no purchased spacer
+      (it is printed), one washer per pin joining neighbouring layers; a ``copies`` hint of None means one set.
+    """
+    t, g = 3.0, 0.3
+    mech = make_four_bar(12.0, 25.0, 20.0, 25.0)
+    motion = mech.sweep(61)
+    design = design_for(sla_process, PartsSpec(link_width_mm=10.0))
+    partset = build_parts(design, mech, motion, [], {"copies": 2})
+    layers = partset.layers
+    for part in partset.body_parts():
+        assert part.z_mm == pytest.approx(layers[part.body] * (t + g), abs=1e-12)
+        assert part.process == "sla"
+        assert part.role == ("ground" if part.body == "ground" else "link")
+    spacers = [p for p in partset.parts if p.role == "spacer"]
+    expected_spacers = {}
+    for joint in mech.joints:
+        lo, hi = sorted((layers[joint.body_a], layers[joint.body_b]))
+        length = (hi - lo) * (t + g) - t
+        if length >= t:
+            expected_spacers[f"spacer_{joint.name}"] = (joint, lo, length)
+    assert expected_spacers, "the crowded four-bar must skip a layer somewhere"
+    assert sorted(p.name for p in spacers) == sorted(expected_spacers)
+    for part in spacers:
+        joint, lo, length = expected_spacers[part.name]
+        assert part.body == joint.body_a and part.process == "sla"
+        centre = mech.body(joint.body_a).point(joint.name)
+        assert part.thickness_mm == pytest.approx(length, abs=1e-12)
+        assert part.z_mm == pytest.approx(lo * (t + g) + t, abs=1e-12)
+        assert part.layer == lo + 1
+        ring = shapely.Polygon(part.outline.polygon(0.001))
+        assert ring.area == pytest.approx(math.pi * 5.0 ** 2, abs=2 * math.pi * 5.0 * 0.001)
+        assert ring.centroid.distance(shapely.Point(centre)) < 1e-9
+        (hole,) = part.holes
+        assert hole.joint == joint.name and hole.diameter_mm == pytest.approx(2.7, abs=1e-12)
+        assert hole.pin_diameter_mm == 2.0
+        np.testing.assert_allclose(hole.centre, centre, atol=1e-12)
+    bom = partset.bom
+    rows = {r["item"]: r for r in bom if r["kind"] == "printed part"}
+    assert set(rows) == {p.name for p in partset.parts} and all(r["qty"] == 2 for r in rows.values())
+    assert [r["qty"] for r in bom if r["kind"] == "screw"] == [2 * 2]
+    assert not [r for r in bom if r["kind"] == "spacer"]
+    neighbours = sum(abs(layers[j.body_a] - layers[j.body_b]) == 1 for j in mech.joints)
+    assert sum(r["qty"] for r in bom if r["kind"] == "washer") == 2 * neighbours
+    single = build_parts(design, mech, motion, [], {"copies": None})
+    assert single.copies == 1 and all(r["qty"] == 1 for r in single.bom if r["kind"] == "printed part")
