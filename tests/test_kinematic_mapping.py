@@ -312,6 +312,36 @@ def test_trace_family_drops_slider_solutions_below_the_centre_weight():
     assert len(default.kappa) == int(np.sum(weights >= 1e-9))
 
 
+def test_a_branch_keeps_its_label_while_its_solution_moves_little():
+    """Between consecutive omega samples, a solution and a previous one that are each other's closest
+    (in |cos|, and at least 0.9) carry the same branch label: the greedy matching can pair neither with
+    anything closer. The paper's curves are drawn and searched along these labels. Cosines computed here
+    from the returned p."""
+    _, _, basis4 = four_pose_problem()
+    fam = km.trace_family(basis4, 60)
+    kappas = list(dict.fromkeys(fam.kappa.tolist()))
+    checked = 0
+    for before, after in zip(kappas[:-1], kappas[1:], strict=True):
+        i_prev, i_next = np.flatnonzero(fam.kappa == before), np.flatnonzero(fam.kappa == after)
+        dots = np.abs(fam.p[i_next] @ fam.p[i_prev].T)
+        for a in range(len(i_next)):
+            b = int(np.argmax(dots[a]))
+            if dots[a, b] >= 0.9 and int(np.argmax(dots[:, b])) == a:
+                assert fam.branch[i_next[a]] == fam.branch[i_prev[b]]
+                checked += 1
+    assert checked >= len(kappas)  # about two continuing branches per sample
+
+
+def test_a_family_without_solutions_is_empty_with_the_documented_shapes():
+    """With a centre weight above any unit vector's |p1| every solution is dropped: the family is empty,
+    with shapes (0,), (0,), (0, 8), (0, 2), (0, 2) and float kappa / int branch ids."""
+    _, _, basis4 = four_pose_problem()
+    fam = km.trace_family(basis4, 10, min_centre_weight=2.0)
+    assert fam.kappa.shape == (0,) and fam.kappa.dtype == np.float64
+    assert fam.branch.shape == (0,) and fam.branch.dtype.kind == "i"
+    assert fam.p.shape == (0, 8) and fam.centre.shape == (0, 2) and fam.point.shape == (0, 2)
+
+
 def brute_force_circle_points(poses: np.ndarray, box: float, lines: int) -> np.ndarray:
     """Circle points b in [-box, box]^2 found by scanning horizontal and vertical lines for sign changes of
     the concyclicity determinant and refining each by bisection (no kinematic mapping involved)."""
@@ -370,8 +400,14 @@ def test_refine_family_inserts_evenly_in_kappa_where_a_kept_branch_jumps():
     order = np.argsort(np.arctan2(1.0, fam.kappa), kind="stable")
     fam = km._take(fam, order)
     keep = np.all(np.abs(circle_point(fam.p)) <= 30.0, axis=1)
-    for step, max_inserts in ((1.0, 200), (0.5, 3)):
-        refined = km.refine_family(basis4, fam, circle_point, keep, max_step=step, max_inserts=max_inserts)
+    near = np.zeros_like(keep)
+    near[int(np.argmax(np.abs(fam.p @ km.circle_vector(C_TRUE, B_TRUE, R_TRUE))))] = True
+    # the last case: a 1 micron step leaves more than 200 inserts to a gap, and 200 is the default cap
+    for step, max_inserts, kept in ((1.0, 200, keep), (0.5, 3, keep), (1e-3, None, near)):
+        keep = kept
+        kwargs = {} if max_inserts is None else {"max_inserts": max_inserts}
+        max_inserts = 200 if max_inserts is None else max_inserts
+        refined = km.refine_family(basis4, fam, circle_point, keep, max_step=step, **kwargs)
         assert len(refined.kappa) > len(fam.kappa)
         pos = circle_point(fam.p)
         inserted_total = 0
