@@ -393,8 +393,9 @@ def test_refined_family_covers_the_brute_force_circle_point_curve():
 def test_refine_family_inserts_evenly_in_kappa_where_a_kept_branch_jumps():
     """Each gap of a branch with an end in keep and a jump g > max_step gets min(max_inserts,
     ceil(g / max_step) - 1) samples at evenly spaced kappa (a prefix of them if the branch is lost at a
-    turning point), each continuing the branch (|cos| >= 0.99 to its neighbour); gaps outside keep or
-    below max_step get none. The expected kappas are computed here from the traced samples."""
+    turning point), each continuing the branch (|cos| >= 0.99 to its neighbour, same sign as the sample
+    it follows); gaps outside keep or below max_step get none. The expected kappas are computed here from
+    the traced samples."""
     _, _, basis4 = four_pose_problem()
     fam = km.trace_family(basis4, 40)
     order = np.argsort(np.arctan2(1.0, fam.kappa), kind="stable")
@@ -408,7 +409,7 @@ def test_refine_family_inserts_evenly_in_kappa_where_a_kept_branch_jumps():
         kwargs = {} if max_inserts is None else {"max_inserts": max_inserts}
         max_inserts = 200 if max_inserts is None else max_inserts
         refined = km.refine_family(basis4, fam, circle_point, keep, max_step=step, **kwargs)
-        assert len(refined.kappa) > len(fam.kappa)
+        assert len(refined.kappa) > len(fam.kappa) and refined.branch.dtype.kind == "i"
         pos = circle_point(fam.p)
         inserted_total = 0
         for label in np.unique(fam.branch):
@@ -430,6 +431,8 @@ def test_refine_family_inserts_evenly_in_kappa_where_a_kept_branch_jumps():
                 chain = refined.p[np.sort(np.concatenate([between, np.flatnonzero(mine & np.isin(
                     refined.kappa, [fam.kappa[j], fam.kappa[k]]))]))]
                 assert np.all(np.abs(np.sum(chain[1:] * chain[:-1], axis=1)) >= 0.99)
+                # inserted vectors keep the sign of the sample they continue (no flips along the branch)
+                assert np.all(np.sum(chain[1:-1] * chain[:-2], axis=1) > 0.0)
                 inserted_total += got.size
         assert inserted_total == len(refined.kappa) - len(fam.kappa)
 
