@@ -166,6 +166,7 @@ def test_gear_hub_from_the_gears_table(four_bar, sla_process):
     plain = build_parts(bare, mech, motion, [pair], {}).part("coupler")
     assert not shapely.Polygon(plain.outline.polygon(0.005)).contains(disc)
     assert plain.gear == hubbed.gear == "sun_planet"
+    assert hubbed.role == "gear"  # a moving body carrying a gear is a gear part
 
 
 def test_part_lookup_names_the_missing_part(four_bar, sla_process):
@@ -345,15 +346,20 @@ def test_printed_spacer_roles_heights_and_bill_of_materials(sla_process):
     - a pin between layers lo and hi with nothing in between gets a spacer of (hi - lo) (t + g) - t; when
       that is at least a plate thick it is printed as a part ``spacer_<pin>`` in the first body's frame: a
       disc of the boss diameter (10 mm) about the pin, bored 2.7 mm for the 2 mm pin, from z = lo (t + g) + t;
-    - the BOM (two copies) lists every part twice, the two mounting screws per copy, no purchased spacer
-      (it is printed), one washer per pin joining neighbouring layers; a ``copies`` hint of None means one set.
+    - the BOM (two copies) lists every part twice, the two mounting screws (M2.5, as asked) per copy, no
+      purchased spacer (it is printed), one washer per pin joining neighbouring layers; a ``copies`` hint of
+      None means one set.
     """
     t, g = 3.0, 0.3
     mech = make_four_bar(12.0, 25.0, 20.0, 25.0)
     motion = mech.sweep(61)
-    design = design_for(sla_process, PartsSpec(link_width_mm=10.0))
+    design = design_for(sla_process, PartsSpec(link_width_mm=10.0, mounting_hole_mm=2.5))
     partset = build_parts(design, mech, motion, [], {"copies": 2})
     layers = partset.layers
+    # what the exporters read from the part set: the process and its plate, gap, kerf and chord tolerance
+    assert (partset.process, partset.thickness_mm, partset.layer_gap_mm, partset.kerf_mm) == ("sla", t, g, 0.0)
+    assert partset.chord_tolerance_mm == 0.005
+    assert (partset.copies, dict(partset.hints), partset.warnings) == (2, {"copies": 2}, ())
     for part in partset.body_parts():
         assert part.z_mm == pytest.approx(layers[part.body] * (t + g), abs=1e-12)
         assert part.process == "sla"
@@ -384,9 +390,27 @@ def test_printed_spacer_roles_heights_and_bill_of_materials(sla_process):
     bom = partset.bom
     rows = {r["item"]: r for r in bom if r["kind"] == "printed part"}
     assert set(rows) == {p.name for p in partset.parts} and all(r["qty"] == 2 for r in rows.values())
-    assert [r["qty"] for r in bom if r["kind"] == "screw"] == [2 * 2]
+    assert [(r["item"], r["qty"]) for r in bom if r["kind"] == "screw"] == [("screw M2.5", 2 * 2)]
     assert not [r for r in bom if r["kind"] == "spacer"]
     neighbours = sum(abs(layers[j.body_a] - layers[j.body_b]) == 1 for j in mech.joints)
     assert sum(r["qty"] for r in bom if r["kind"] == "washer") == 2 * neighbours
     single = build_parts(design, mech, motion, [], {"copies": None})
     assert single.copies == 1 and all(r["qty"] == 1 for r in single.bom if r["kind"] == "printed part")
+
+
+def test_gaps_thinner_than_a_plate_stay_washers(sla_process):
+    """SLA prints a spacer only when it is at least a plate (3 mm) thick and buys the thinner ones as washers.
+    With a 2 mm layer gap the gaps between neighbouring layers are 2 mm: washers in the BOM (one per pin
+    joining neighbouring layers), not printed parts; the pin skipping layers gets a printed spacer at least
+    a plate thick ((hi - lo) (t + g) - t by hand)."""
+    import dataclasses
+
+    mech = make_four_bar(12.0, 25.0, 20.0, 25.0)
+    process = dataclasses.replace(sla_process, layer_gap_mm=2.0)
+    partset = build_parts(design_for(process, PartsSpec(link_width_mm=10.0)), mech, mech.sweep(61), [], {})
+    t, layers = process.thickness_mm, partset.layers
+    skips = {j.name: abs(layers[j.body_a] - layers[j.body_b]) for j in mech.joints}
+    printed = {p.name: p.thickness_mm for p in partset.parts if p.role == "spacer"}
+    assert printed == pytest.approx({f"spacer_{n}": k * (t + 2.0) - t for n, k in skips.items() if k > 1})
+    (washers,) = [r for r in partset.bom if r["kind"] == "washer"]
+    assert washers["length_mm"] == pytest.approx(2.0) and washers["qty"] == sum(k == 1 for k in skips.values())
