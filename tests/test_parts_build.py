@@ -18,7 +18,7 @@ import shapely
 from conftest import make_four_bar
 from test_parts import design_for, spur_like, sun_planet_four_bar
 
-from fabricate.errors import GeometryError
+from fabricate.errors import GeometryError, SpecError
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
 from fabricate.parts.build import SlottedPart, build_parts, gear_outline_in_body
 from fabricate.parts.model import BulgePath, Hole
@@ -414,3 +414,20 @@ def test_gaps_thinner_than_a_plate_stay_washers(sla_process):
     assert printed == pytest.approx({f"spacer_{n}": k * (t + 2.0) - t for n, k in skips.items() if k > 1})
     (washers,) = [r for r in partset.bom if r["kind"] == "washer"]
     assert washers["length_mm"] == pytest.approx(2.0) and washers["qty"] == sum(k == 1 for k in skips.values())
+
+
+def test_overlapping_holes_are_refused_wherever_the_body_frame_sits(sla_process):
+    """The four-bar with the crank's frame at the middle of the crank (O at (-7.5, 0), A at (7.5, 0)): a 15 mm
+    pin makes the two 15.7 mm holes 15 mm apart run into each other, so the build refuses naming the pin
+    field and both holes; the frame's origin must not matter (the holes are 15 mm apart, not 0)."""
+    import dataclasses
+
+    base = make_four_bar()
+    th = math.radians(60.0)
+    bodies = tuple(Body("crank", {"O": (-7.5, 0.0), "A": (7.5, 0.0)}) if b.name == "crank" else b for b in base.bodies)
+    mech = Mechanism(name="centred", bodies=bodies, ground=base.ground, joints=base.joints, gears=(),
+                     drivers=base.drivers, input_range=base.input_range,
+                     assembly={**base.assembly, "crank": (7.5 * math.cos(th), 7.5 * math.sin(th), th)})
+    fat = dataclasses.replace(sla_process, pin_diameter_mm=15.0)
+    with pytest.raises(SpecError, match=r"process.pin_diameter_mm: 15 mm pins: holes O and A of part crank"):
+        build_parts(design_for(fat), mech, mech.sweep(11), [], {})
