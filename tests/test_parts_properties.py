@@ -149,6 +149,19 @@ def test_hull_of_three_circles_is_triangle_plus_band_plus_disc():
     np.testing.assert_allclose(d, r, atol=1e-12)
 
 
+@pytest.mark.parametrize("factor", [1.0, 1.5, 3.0, -0.5])
+def test_offset_of_one_circle_by_its_radius_or_more_grows_it(factor):
+    """One circle (r = 1.7779..., found by hypothesis) offset by r, 1.5 r, 3 r and -r/2 is the circle of radius
+    r (1 + factor): area pi r^2 (1 + factor)^2, centre kept (the orientation test once polygonised the path at
+    the offset distance: at a tolerance >= r the circle became a chord of area -6e-14 and the offset went
+    inwards, to area 0)."""
+    r = 1.7779459526761254
+    centre = np.array([17.796331749077204, 21.5])
+    out = offset_path(circle_hull(centre[None, :], np.array([r])), factor * r)
+    assert out.area() == pytest.approx(math.pi * (r * (1 + factor)) ** 2, rel=1e-12)
+    np.testing.assert_allclose(out.vertices.mean(axis=0), centre, atol=1e-12)
+
+
 @pytest.mark.parametrize("d", [0.04, -0.04])
 def test_offset_of_a_small_hull_keeps_unit_normals(d):
     """The pear scaled to a twentieth (radii 0.2 and 0.1 mm, 0.6 mm apart; every segment shorter than 1 mm):

@@ -205,6 +205,8 @@ def offset_path(path: BulgePath, distance_mm: float) -> BulgePath:
     n_out = n_start
     dot = np.clip(np.einsum("ij,ij->i", n_in, n_out), -0.95, 1.0)
     shift = (n_in + n_out) / (1.0 + dot)[:, None]
-    if polygon_area(path.polygon(max(1e-3, abs(distance_mm)))) < 0:
+    # the exact signed area: a polygon of the path at a chord tolerance near the radius (one circle offset by
+    # its own radius) degenerates to a chord whose area is rounding noise of either sign
+    if path.area() < 0:
         shift = -shift
     return BulgePath(path.vertices + distance_mm * shift, path.bulges.copy())
