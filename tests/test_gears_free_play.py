@@ -178,6 +178,19 @@ def test_a_point_at_the_bottom_radius_of_gear_b_first_flank_uses_the_angle_there
     assert np.isnan(minus[0])
 
 
+def test_a_point_at_the_bottom_radius_of_a_later_flank_row_is_compared():
+    """The same flanks as flank 2 of both gears, gear b also holding a flank 0 (so flank 2 is a later row of its
+    table): the point at radius exactly 1.25 is compared as on the first row, free_plus 0.927 (1e-12 rad). It
+    was once dropped (its search key's left neighbour was the previous row), giving NaN."""
+    flank_b = np.vstack([radial(0.0, [1.25]), radial(0.1, [2.0]), radial(0.2, [3.0])])
+    flanks_a = {2: np.vstack([[[0.75, 1.0]], radial(1.2, [2.0, 3.0])])}
+    s = np.array([-np.pi / 2 + np.pi])  # the pitch point moved by one pitch, p = pi * module = 2 pi
+    for flanks_b in ({2: flank_b}, {0: flank_b, 2: flank_b}):
+        plus, minus = free_play(duck_pair(flanks_a, flanks_b), s)
+        assert plus[0] == pytest.approx(np.arctan2(1.0, 0.75), abs=1e-12), sorted(flanks_b)
+        assert np.isnan(minus[0])
+
+
 def test_contact_count_includes_the_closest_pair_whatever_the_tolerance(monkeypatch):
     """Driving (even) flanks 0 and 2 of gear a at 0.3 rad, flank 4 at 0.3 + 1e-3, gear b's at 0: two pairs touch
     together. The count is of pairs within the tolerance of the closest, bound included: with the tolerance 0

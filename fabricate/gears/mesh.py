@@ -226,6 +226,9 @@ def free_play(pair: Any, x_a: np.ndarray, return_contacts: bool = False) -> tupl
     inside = (rho >= lo_r) & (rho <= hi_r) & ok[..., None] & np.isfinite(rho)
     key = np.where(inside, rho, lo_r) + rb[..., None] * 1e6
     idx = np.clip(np.searchsorted(key_b, key), 1, len(key_b) - 1)
+    # a point exactly at a row's lowest radius lands on that row's first key, whose left neighbour is the
+    # previous row: interpolate from that key to the next instead (w = 0 gives its angle)
+    idx = np.where((key_b[idx] == key) & (idx < len(key_b) - 1), idx + 1, idx)
     k0, k1 = key_b[idx - 1], key_b[idx]
     w = np.clip((key - k0) / np.where(k1 > k0, k1 - k0, 1.0), 0.0, 1.0)
     phi_on_b = phi_b[idx - 1] + w * (phi_b[idx] - phi_b[idx - 1])
