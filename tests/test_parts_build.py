@@ -20,8 +20,20 @@ from test_parts import design_for, spur_like, sun_planet_four_bar
 
 from fabricate.errors import GeometryError, SpecError
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
-from fabricate.parts.build import SlottedPart, build_parts, gear_outline_in_body
-from fabricate.parts.model import BulgePath, Hole
+from fabricate.parts.build import (
+    CONFLICT_CHORD_MM,
+    SlottedPart,
+    _check_pin_webs,
+    _guide_spacing,
+    _segment_distance,
+    build_parts,
+    gear_outline_in_body,
+    merge_coincident_pins,
+    overlapping_cuts,
+    pad_segment,
+    swept_region,
+)
+from fabricate.parts.model import BulgePath, Hole, Part
 from fabricate.parts.profiles import circle_hull
 from fabricate.parts.spec import PartsSpec
 
@@ -431,3 +443,264 @@ def test_overlapping_holes_are_refused_wherever_the_body_frame_sits(sla_process)
     fat = dataclasses.replace(sla_process, pin_diameter_mm=15.0)
     with pytest.raises(SpecError, match=r"process.pin_diameter_mm: 15 mm pins: holes O and A of part crank"):
         build_parts(design_for(fat), mech, mech.sweep(11), [], {})
+
+
+# -- distances, guide side, overlapping cuts ------------------------------------------------------
+
+@pytest.mark.parametrize(("point", "ends", "expected"), [
+    ((0.25, 1.0), ((0.0, 0.0), (0.5, 0.0)), 1.0),  # beside a short (0.5 mm) segment: perpendicular
+    ((0.1, -0.3), ((0.0, 0.0), (0.2, 0.0)), 0.3),
+    ((-0.3, 0.4), ((0.0, 0.0), (0.5, 0.0)), 0.5),  # behind the first end: distance to that end
+    ((0.8, 0.4), ((0.0, 0.0), (0.5, 0.0)), 0.5),  # beyond the second end
+    ((4.0, 7.0), ((1.0, 3.0), (1.0, 3.0)), 5.0),  # a segment of zero length is its point
+    ((2.0, 9.0), ((-3.0, 4.0), (7.0, -1.0)), 3.0 * math.sqrt(5.0)),  # beside a long tilted segment
+])
+def test_segment_distance_matches_the_closed_form(point, ends, expected):
+    """The distance of a point to a segment: the perpendicular distance where the foot falls on the
+    segment, the distance to the nearer end otherwise, the distance to the point for a zero-length
+    segment (hand values: 3-4-5 triangles; for the tilted case |(5, 5) x (10, -5)| / sqrt 125 = 3 sqrt 5).
+    Short segments (< 1 mm) included. Tolerance 1e-12 mm."""
+    got = _segment_distance(np.array(point), np.array(ends))
+    assert got == pytest.approx(expected, abs=1e-12)
+
+
+def slot_clearance(others: list[tuple[float, float]], rod_point: np.ndarray, axis: np.ndarray,
+                   s_min: float, s_max: float, e: float) -> float:
+    """Clearance (mm) of the rod's other points from where two guide pins travel in the rod (one at the
+    slider point, one e mm further along the axis in the reference body), by shapely."""
+    travel = [rod_point - (s - off) * axis for s in (s_min, s_max) for off in (0.0, e)]
+    segment = shapely.MultiPoint(travel).convex_hull
+    return min(segment.distance(shapely.Point(p)) for p in others)
+
+
+@pytest.mark.parametrize(("others", "s_min", "s_max"), [
+    ([(8.0, 3.0)], 0.0, 5.0),  # beside the + side's extension only: the - side is clear of it
+    ([(-8.0, 3.0)], 0.0, 5.0),
+    ([(0.5, 3.0)], 0.0, 5.0),  # near the stroke's front end: the - side keeps it 3.04 mm away, + 3 mm
+    ([(0.1, 3.0)], 0.0, 0.5),  # a stroke shorter than 1 mm
+    ([(-5.5, 3.0)], 0.0, 5.0),
+    ([(2.0, 1.0), (-9.0, 0.5)], -1.0, 3.0),
+])
+@pytest.mark.parametrize("turn", [0.0, math.atan2(4.0, 3.0)], ids=["axis_x", "axis_34"])
+def test_guide_pin_goes_on_the_side_keeping_the_slot_clear(others, s_min, s_max, turn):
+    """The second guide pin goes at +spacing or -spacing along the slide axis, whichever keeps the slot
+    (the travel of both pins in the rod) further from the rod's other points; the clearances are
+    computed here with shapely from the pins' travel, and the chosen side's clearance is the larger one
+    (each case below differs by more than 1e-3 mm). The scene is given along x and turned by atan2(4, 3)
+    about the slider point (3, -2)."""
+    spacing = 6.3
+    rod_point = np.array([3.0, -2.0])
+    c, s = math.cos(turn), math.sin(turn)
+    rot = np.array([[c, -s], [s, c]])
+    axis = rot @ np.array([1.0, 0.0])
+    placed = [tuple(rod_point + rot @ np.array(p)) for p in others]
+    rod = Body("rod", {"G": tuple(rod_point), **{f"P{k}": p for k, p in enumerate(placed)}})
+    plus = slot_clearance(placed, rod_point, axis, s_min, s_max, spacing)
+    minus = slot_clearance(placed, rod_point, axis, s_min, s_max, -spacing)
+    assert abs(plus - minus) > 1e-3
+    expected = spacing if plus > minus else -spacing
+    assert _guide_spacing(rod, "G", rod_point, axis, s_min, s_max, spacing) == expected
+
+
+def test_guide_pin_side_ties_and_a_rod_without_other_points():
+    """Other points mirror-placed so both sides clear them by exactly 2 mm: the first side (+spacing) is
+    kept (the build does not flip on float noise). A side that clears by 1e-9 mm or less more than the
+    other is a tie too, a side clearing by 2e-9 mm more wins. A rod with no other point takes +spacing."""
+    axis, g = np.array([1.0, 0.0]), np.zeros(2)
+    mirrored = Body("rod", {"G": (0.0, 0.0), "P": (8.0, 0.0), "Q": (-12.0, 0.0)})  # slots [-4, 6] / [-10, 0]
+    assert _guide_spacing(mirrored, "G", g, axis, 0.0, 4.0, 6.0) == 6.0
+    for extra, side in ((1e-9, 6.0), (2e-9, -6.0)):
+        # P beside the + extension only, Q beside the - extension only: clearances 3 and 3 + extra
+        rod = Body("rod", {"G": (0.0, 0.0), "P": (3.0, 3.0), "Q": (-7.0, 3.0 + extra)})
+        assert _guide_spacing(rod, "G", g, axis, 0.0, 4.0, 6.0) == side
+    assert _guide_spacing(Body("rod", {"G": (0.0, 0.0)}), "G", g, axis, 0.0, 4.0, 6.0) == 6.0
+
+
+def test_overlapping_cuts_name_exactly_the_holes_that_meet():
+    """Holes of one part run into each other when their centres are closer than the sum of their radii;
+    the warning names both holes (in the part's order) and the overlap (sum of radii - distance, by hand),
+    and names every slot a hole cuts into (distance of the hole's centre to the exact stadium less than
+    its radius). Touching (zero web) is not an overlap. A part with nothing in the way gives no warning.
+
+    Plate ``p``: A (10, 10) d 4 and B (12.5, 10) d 3 overlap by 1 mm; C (10, 14) d 4 touches A (distance 4);
+    D (30, 10) d 2 and E (31.5, 10.5) d 1.2 overlap by 1.6 - sqrt(2.5) mm. Plate ``q`` with the slot
+    (0, 0)-(40, 0), 2 mm wide: F (5, 1.8) d 2 runs in from the side (0.8 mm from the edge), G (41.9, 0) d 2 into
+    the round end (0.9 mm from the arc; a coarse polygon of the arc, three chords, would put it 1.03 mm
+    away), H (15, 0) d 1 sits in it, J (20, 2) d 2 touches the edge, K (30, 2.5) d 2 and
+    L (-2.5, 0) d 2 clear it by 0.5 mm."""
+    holes = (Hole("A", np.array([10.0, 10.0]), 4.0), Hole("B", np.array([12.5, 10.0]), 3.0),
+             Hole("C", np.array([10.0, 14.0]), 4.0), Hole("D", np.array([30.0, 10.0]), 2.0),
+             Hole("E", np.array([31.5, 10.5]), 1.2))
+    in_slot = (Hole("F", np.array([5.0, 1.8]), 2.0), Hole("G", np.array([41.9, 0.0]), 2.0),
+               Hole("H", np.array([15.0, 0.0]), 1.0), Hole("J", np.array([20.0, 2.0]), 2.0),
+               Hole("K", np.array([30.0, 2.5]), 2.0), Hole("L", np.array([-2.5, 0.0]), 2.0))
+    outline = BulgePath.polyline(np.array([[-5.0, -5.0], [45.0, -5.0], [45.0, 20.0], [-5.0, 20.0]]))
+    plate = Part(name="p", body="p", outline=outline, holes=holes, thickness_mm=3.0, z_mm=0.0, layer=0,
+                 process="sla")
+    slotted = SlottedPart(name="q", body="q", outline=outline, holes=in_slot, thickness_mm=3.0, z_mm=0.0,
+                          layer=1, process="sla", slots=(stadium((0.0, 0.0), (40.0, 0.0), 2.0),))
+    clean = Part(name="r", body="r", outline=outline, holes=holes[:1] + holes[3:4], thickness_mm=3.0, z_mm=0.0,
+                 layer=2, process="sla")
+    found = overlapping_cuts([plate, slotted, clean])
+    de = 1.6 - math.sqrt(1.5 ** 2 + 0.5 ** 2)
+    assert found == [
+        "part p: holes A and B overlap by 1.000 mm; move the joints apart or use a smaller pin",
+        f"part p: holes D and E overlap by {de:.3f} mm; move the joints apart or use a smaller pin",
+        "part q: hole F runs into a guide slot",
+        "part q: hole G runs into a guide slot",
+        "part q: hole H runs into a guide slot",
+    ]
+
+
+# -- the region the moving bodies sweep -------------------------------------------------------------
+
+def placed_union(outlines: dict[str, BulgePath], motion, indices) -> shapely.Geometry:
+    """Union (shapely) of each outline, polygonised at the conflict chord tolerance, placed at the given
+    pose indices: x' = R(theta) x + (px, py), written out with cos and sin."""
+    shapes = []
+    for body, path in outlines.items():
+        ring = path.polygon(CONFLICT_CHORD_MM)
+        for x, y, th in motion.pose(body)[list(indices)]:
+            c, s = math.cos(th), math.sin(th)
+            shapes.append(shapely.Polygon(np.column_stack([c * ring[:, 0] - s * ring[:, 1] + x,
+                                                           s * ring[:, 0] + c * ring[:, 1] + y])))
+    return shapely.union_all(shapes)
+
+
+def test_swept_region_is_the_union_of_the_outlines_at_every_pose():
+    """A crank turned from 60 to 150 degrees over 13 poses and its coupler: the swept region is the
+    union of each body's outline placed at every pose, the first and last (the extremes) included;
+    compared with an independent shapely union (symmetric difference below 1e-6 mm^2). With no bodies
+    the region is an empty polygon (area 0)."""
+    mech = make_four_bar(start_deg=60.0, end_deg=150.0)
+    motion = mech.sweep(13)
+    outlines = {"crank": stadium((0.0, 0.0), (15.0, 0.0), 4.7), "coupler": stadium((0.0, 0.0), (40.0, 0.0), 4.7)}
+    region = swept_region(outlines, motion)
+    expected = placed_union(outlines, motion, range(13))
+    assert region.area == pytest.approx(expected.area, abs=1e-6)
+    assert region.symmetric_difference(expected).area < 1e-6
+    # the first and the last pose matter here: leaving either out loses area
+    assert placed_union(outlines, motion, range(1, 13)).area < expected.area - 1.0
+    assert placed_union(outlines, motion, range(12)).area < expected.area - 1.0
+    empty = swept_region({}, motion)
+    assert isinstance(empty, shapely.Polygon) and empty.is_empty and empty.area == 0.0
+
+
+def test_swept_region_samples_ninety_poses_evenly_on_a_long_sweep():
+    """On a sweep of 181 poses the region is sampled at 90 poses spread evenly over the sweep, the first
+    and the last included (index round(k x 180 / 89), k = 0..89); compared with an independent union at
+    exactly those poses (symmetric difference below 1e-6 mm^2, while 91 or 50 poses differ by more)."""
+    mech = make_four_bar(start_deg=60.0, end_deg=420.0)
+    motion = mech.sweep(181)
+    outlines = {"coupler": stadium((0.0, 0.0), (40.0, 0.0), 4.7)}
+    region = swept_region(outlines, motion)
+    picks = {round(k * 180 / 89) for k in range(90)}
+    assert len(picks) == 90
+    expected = placed_union(outlines, motion, sorted(picks))
+    assert region.symmetric_difference(expected).area < 1e-6
+    for other in (91, 50):
+        alt = placed_union(outlines, motion, sorted({round(k * 180 / (other - 1)) for k in range(other)}))
+        assert alt.symmetric_difference(expected).area > 1e-4
+
+
+# -- fingertip pad segments -------------------------------------------------------------------------
+
+@pytest.mark.parametrize("reverse", [False, True], ids=["ccw_ends", "cw_ends"])
+@pytest.mark.parametrize("radius", [1.0, 36.0])
+def test_pad_segment_is_ccw_whichever_way_the_ends_are_given(radius, reverse):
+    """A quarter circle about (3, -2) from the end on +x to the end on +y (or the same two ends given the
+    other way round): the ring is counter-clockwise (shoelace area > 0), every vertex lies on the chord's
+    ends or the exact circle (1e-9 mm), on the far side of the chord, and its area is the circular
+    segment r^2 (pi/2 - 1) / 2 (closed form; inscribed chords lose at most sagitta x arc length). The
+    small case (r = 1, area 0.285 mm^2) is below 1 mm^2."""
+    tol = 0.005
+    centre = np.array([3.0, -2.0])
+    ends = [centre + (radius, 0.0), centre + (0.0, radius)]
+    start, end = ends[::-1] if reverse else ends
+    ring = pad_segment(centre, start, end, tol)
+    exact = 0.5 * radius ** 2 * (math.pi / 2 - 1.0)
+    area = signed_area(ring)
+    assert exact - tol * radius * math.pi / 2 <= area <= exact + 1e-12
+    rel = ring - centre
+    on_circle = np.abs(np.hypot(rel[:, 0], rel[:, 1]) - radius) < 1e-9
+    assert on_circle.all()  # the chord's ends are on the circle too
+    assert np.all(rel[:, 0] + rel[:, 1] >= radius - 1e-9)  # beyond the chord x + y = r
+    # the arc is split evenly and finely enough: sagitta of each piece within the tolerance
+    chords = np.hypot(*np.diff(ring, axis=0).T)
+    assert np.all(radius - np.sqrt(radius ** 2 - (chords / 2) ** 2) <= tol + 1e-12)
+
+
+def test_pad_segment_ends_must_be_on_one_circle():
+    """The two chord ends must be equally far from the centre, within 1e-6 of the radius (1e-6 mm below a
+    1 mm radius); a radius mismatch of exactly that much is still accepted. Both ends at the centre
+    (radius 0) are refused. Hand cases about the origin along the axes, so the radii are exact."""
+    centre = np.zeros(2)
+
+    def quarter(r0: float, r1: float) -> np.ndarray:
+        return pad_segment(centre, np.array([r0, 0.0]), np.array([0.0, r1]), 0.005)
+
+    quarter(36.0, 36.0 + 1e-5)  # 2.8e-7 relative: accepted
+    with pytest.raises(GeometryError, match="not one circle"):
+        quarter(36.0, 36.0 + 5e-5)  # 1.4e-6 relative
+    quarter(0.5, 0.5 + 0.5e-6)
+    with pytest.raises(GeometryError, match="not one circle"):
+        quarter(0.5, 0.5 + 1.5e-6)  # below 1 mm the allowance is 1e-6 mm, not relative
+    r0, r1 = 10.013580322265625, 10.013590335845947  # differ by exactly fl(1e-6 x r0)
+    assert abs(r1 - r0) == 1e-6 * r0
+    quarter(r0, r1)
+    with pytest.raises(GeometryError, match="not one circle"):
+        pad_segment(centre, centre, centre, 0.005)
+
+
+# -- compound hinges -------------------------------------------------------------------------------
+
+def test_pins_merge_only_where_their_holes_coincide():
+    """Joints J (palm-a) and Jr (palm-b) whose holes in the palm are 0.3 mm apart along x, or 0.4 mm
+    along y, stay two pins with their own holes; holes 3e-10 mm apart along each axis (solver noise) are
+    one spot: one pin ``J+Jr`` through palm, a and b, with one palm hole (the first seen)."""
+    joints = [("J", ("palm", "a")), ("Jr", ("palm", "b"))]
+    for offset in ((0.3, 0.0), (0.0, 0.4)):
+        other = np.array([1.0, 2.0]) + offset
+        holes = [("J", "palm", np.array([1.0, 2.0])), ("J", "a", np.zeros(2)),
+                 ("Jr", "palm", other), ("Jr", "b", np.zeros(2))]
+        pins, out = merge_coincident_pins(joints, holes)
+        assert pins == joints
+        assert [(n, b) for n, b, _ in out] == [("J", "palm"), ("J", "a"), ("Jr", "palm"), ("Jr", "b")]
+    noisy = np.array([1.0 + 3e-10, 2.0 - 3e-10])
+    holes = [("J", "palm", np.array([1.0, 2.0])), ("J", "a", np.zeros(2)), ("Jr", "palm", noisy),
+             ("Jr", "b", np.zeros(2))]
+    pins, out = merge_coincident_pins(joints, holes)
+    assert pins == [("J+Jr", ("palm", "a", "b"))]
+    assert [(n, b) for n, b, _ in out] == [("J+Jr", "palm"), ("J+Jr", "a"), ("J+Jr", "b")]
+    np.testing.assert_array_equal(out[0][2], [1.0, 2.0])
+
+
+# -- holes that run into each other ----------------------------------------------------------------
+
+def plate_with(holes: tuple[Hole, ...]) -> Part:
+    outline = BulgePath.polyline(np.array([[-5.0, -5.0], [20.0, -5.0], [20.0, 5.0], [-5.0, 5.0]]))
+    return Part(name="plate", body="plate", outline=outline, holes=holes, thickness_mm=3.0, z_mm=0.0, layer=0,
+                process="sla")
+
+
+def test_touching_or_overlapping_pin_holes_are_refused(sla_process):
+    """With wall 0.5, clearance 0.25 and no hole compensation (min pin 1.5 mm), holes O (0, 0) and A
+    (2.5, 0) of 2.5 mm touch (web 0): refused, naming the holes in the part's order and the largest pin
+    that leaves the wall: 2.5 - 0.5 - 2 x 0.25 = 1.5 mm, exactly the process's smallest pin, so it is
+    offered. Holes 0.9 mm apart leave room for no pin of the process (largest -0.1 mm). Two joint names
+    through one hole (merged pins, distance 0) and mounting holes are not checked against each other."""
+    import dataclasses
+
+    process = dataclasses.replace(sla_process, min_wall_mm=0.5, hole_compensation_mm=0.0, min_pin_mm=1.5)
+    far = Hole("B", np.array([12.0, 0.0]), 2.5, 2.0)
+    touching = plate_with((Hole("O", np.zeros(2), 2.5, 2.0), Hole("A", np.array([2.5, 0.0]), 2.5, 2.0), far))
+    with pytest.raises(SpecError, match=r"holes O and A of part plate are 2.5 mm apart and would leave 0 mm of "
+                                        r"wall between them \(the process needs 0.5 mm\); at most 1.5 mm$"):
+        _check_pin_webs([touching], process)
+    close = plate_with((Hole("O", np.zeros(2), 2.5, 2.0), Hole("A", np.array([0.0, 0.9]), 2.5, 2.0), far))
+    with pytest.raises(SpecError, match=r"holes O and A of part plate are 0.9 mm apart .*; no pin of the "
+                                        r"process fits; move the joints apart$"):
+        _check_pin_webs([close], process)
+    merged = plate_with((Hole("J", np.array([3.0, 1.0]), 2.5, 2.0), Hole("Jr", np.array([3.0, 1.0]), 2.5, 2.0),
+                         Hole("mount_1", np.array([4.0, 1.0]), 2.5), far))
+    _check_pin_webs([merged], process)  # no error
