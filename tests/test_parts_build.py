@@ -704,3 +704,104 @@ def test_touching_or_overlapping_pin_holes_are_refused(sla_process):
     merged = plate_with((Hole("J", np.array([3.0, 1.0]), 2.5, 2.0), Hole("Jr", np.array([3.0, 1.0]), 2.5, 2.0),
                          Hole("mount_1", np.array([4.0, 1.0]), 2.5), far))
     _check_pin_webs([merged], process)  # no error
+
+
+# -- layers: clearance between bodies, spacers on a compound pin ------------------------------------
+
+def world(pose: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Body-frame points (n, 2) placed at a pose (x, y, theta), written out with cos and sin."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    return np.column_stack([c * points[:, 0] - s * points[:, 1] + pose[0],
+                            s * points[:, 0] + c * points[:, 1] + pose[1]])
+
+
+def test_layering_sees_bodies_and_spacers_within_the_running_clearance(sla_process, monkeypatch):
+    """The default four-bar with 24.76 mm wide links, the crank turning from 358 to 362 degrees over 61
+    poses (so the bodies hardly move between samples). The crank (O-A) and the rocker (D-B) share no pin;
+    their centre segments come 25 mm apart at the closest (shapely; A and D at crank angle 360), so their
+    plates (stadia of radius 12.38 mm) come 0.24 mm apart, inside the 0.25 mm running clearance: the
+    conflict graph the layering colours joins them, and they get different layers.
+
+    The pin crossings (a body passing over the spacer that would fill skipped layers of a pin) are, for
+    every pin (first body a, second body b) and every other body c, exactly the triples (a, b, c) where c's
+    plate comes within the clearance of the spacer disc (boss radius about the pin) at some pose; computed
+    here with shapely on the plates (0.001 mm polygons) in the world. Pairs measured between 0.25 and 0.35 mm
+    (where the 0.05 mm conflict outlines may decide either way) are not judged; at least one pair lies below
+    0.25 and the rest beyond 0.35. (Conflict graph and crossings are read by wrapping the layer functions.)"""
+    import fabricate.parts.build as build
+
+    seen = {}
+
+    def spy(name, fn):
+        def wrapped(*args, **kwargs):
+            seen[name] = fn(*args, **kwargs)
+            return seen[name]
+        monkeypatch.setattr(build, name, wrapped)
+
+    spy("conflict_graph", build.conflict_graph)
+    spy("pin_crossings", build.pin_crossings)
+    mech = make_four_bar(start_deg=358.0, end_deg=362.0)
+    motion = mech.sweep(61)
+    o, a = motion.point("O", "crank"), motion.point("A", "crank")
+    d, b = motion.point("D", "rocker"), motion.point("B", "rocker")
+    crank = [shapely.LineString([o[i], a[i]]) for i in range(61)]
+    rocker = [shapely.LineString([d[i], b[i]]) for i in range(61)]
+    assert min(c.distance(r) for c, r in zip(crank, rocker, strict=True)) == pytest.approx(25.0, abs=1e-6)
+    width = 24.76
+    plates = [c.buffer(width / 2, 128).distance(r.buffer(width / 2, 128)) for c, r in zip(crank, rocker, strict=True)]
+    assert min(plates) == pytest.approx(0.24, abs=1e-3)
+    partset = build_parts(design_for(sla_process, PartsSpec(link_width_mm=width)), mech, motion, [], {})
+    assert "rocker" in seen["conflict_graph"]["crank"]
+    assert partset.layers["crank"] != partset.layers["rocker"]
+
+    boss = width / 2
+    outlines = {p.body: p.outline.polygon(0.001) for p in partset.body_parts()}
+    near, judged = set(), set()
+    for joint in mech.joints:
+        first, second = joint.body_a, joint.body_b
+        centre = mech.body(first).point(joint.name)
+        for other in mech.body_names:
+            if other in (first, second):
+                continue
+            gap = min(shapely.Point(world(pa, centre[None, :])[0]).buffer(boss, 128).distance(
+                shapely.Polygon(world(pc, outlines[other])))
+                for pa, pc in zip(motion.pose(first), motion.pose(other), strict=True))
+            if gap < 0.25:
+                near.add((first, second, other))
+            if not 0.25 <= gap <= 0.35:
+                judged.add((first, second, other))
+    assert near
+    assert {t for t in seen["pin_crossings"] if t in judged} == near
+    assert set(seen["pin_crossings"]) <= {(j.body_a, j.body_b, c) for j in mech.joints for c in mech.body_names
+                                          if c not in (j.body_a, j.body_b)}
+
+
+def flapped_four_bar() -> Mechanism:
+    """The default four-bar plus a flap turning with the crank about the ground's point Or, which sits
+    on O: joints O (ground-crank) and Or (ground-flap) share one spot of the ground, a compound hinge
+    through ground, crank and flap."""
+    base = make_four_bar()
+    bodies = tuple(Body("ground", {**b.points, "Or": (0.0, 0.0)}) if b.name == "ground" else b for b in base.bodies)
+    return Mechanism(name="flapped", bodies=(*bodies, Body("flap", {"Or": (0.0, 0.0), "F": (10.0, 0.0)})),
+                     ground="ground", joints=(*base.joints, Revolute("Or", "ground", "flap")), gears=(),
+                     drivers=(*base.drivers, Driver("angle", "flap", "ground")), input_range=base.input_range,
+                     assembly={**base.assembly, "flap": base.assembly["crank"]})
+
+
+def test_printed_spacers_on_one_compound_pin_are_numbered_bottom_up(sla_process, monkeypatch):
+    """A compound hinge through ground, crank and flap, with the stack forced (the layer ordering is
+    replaced here) to ground 0, coupler 1, crank 2, rocker 3, flap 4: the compound pin ``O+Or`` skips a
+    layer twice, so it carries two printed spacers, named ``spacer_O_Or_1`` (from z = t = 3) and
+    ``spacer_O_Or_2`` (from z = 2 (t + g) + t = 9.6), each (t + 2 g) = 3.6 mm long (by hand, t = 3,
+    g = 0.3); the pins B (layers 1-3) and D (0-3) carry one printed spacer each, named without a number;
+    A (layers 2 and 1) takes a washer."""
+    import fabricate.parts.build as build
+
+    forced = {"ground": 0, "coupler": 1, "crank": 2, "rocker": 3, "flap": 4}
+    monkeypatch.setattr(build, "order_layers", lambda layers, crossings: dict(forced))
+    mech = flapped_four_bar()
+    partset = build_parts(design_for(sla_process), mech, mech.sweep(13), [], {})
+    assert partset.layers == forced
+    spacers = {p.name: (p.z_mm, p.thickness_mm) for p in partset.parts if p.role == "spacer"}
+    assert spacers == {"spacer_O_Or_1": pytest.approx((3.0, 3.6)), "spacer_O_Or_2": pytest.approx((9.6, 3.6)),
+                       "spacer_B": pytest.approx((6.3, 3.6)), "spacer_D": pytest.approx((3.0, 6.9))}
