@@ -348,6 +348,25 @@ def test_curved_pad_and_gear_fuse_into_one_plate(four_bar, sla_process):
     assert plate.symmetric_difference(expected).area < chords
 
 
+def test_a_pad_arc_flatter_than_the_chord_tolerance_is_just_its_bosses(four_bar, sla_process):
+    """A pad arc of 0.01 rad on a 10 mm circle about C = (30, 10) of the coupler (chord 0.1 mm, sagitta
+    0.125 um < the 5 um chord tolerance): its segment is the chord itself, so the plate is the hull of the
+    bosses about A, B, C, E1, E2 (built here with shapely on dense circles; tolerance 0.005 mm x boundary
+    length). It once failed with shapely's bare ValueError (a two-point ring)."""
+    a = 0.01
+    pts = {"C": (30.0, 10.0), "E1": (40.0, 10.0), "E2": (30.0 + 10 * math.cos(a), 10.0 + 10 * math.sin(a))}
+    bodies = tuple(Body("coupler", {**b.points, **pts}) if b.name == "coupler" else b for b in four_bar.bodies)
+    mech = Mechanism(name="flat_pad", bodies=bodies, ground=four_bar.ground, joints=four_bar.joints, gears=(),
+                     drivers=four_bar.drivers, input_range=four_bar.input_range, assembly=four_bar.assembly)
+    hints = {"pads": {"coupler": {"point": "C", "arc": ["E1", "E2"]}}}
+    coupler = build_parts(design_for(sla_process), mech, mech.sweep(7), [], hints).part("coupler")
+    boss = (2.0 + 2 * 0.25 + 0.2) / 2 + 1.0
+    points = [(0.0, 0.0), (40.0, 0.0), *pts.values()]
+    expected = shapely.union_all([shapely.Point(p).buffer(boss, 1024) for p in points]).convex_hull
+    plate = shapely.Polygon(coupler.outline.polygon(0.005))
+    assert plate.symmetric_difference(expected).area < 0.005 * expected.length
+
+
 # -- a pin through a skipped layer: printed spacer, roles, heights, BOM -----------------------------
 
 def test_printed_spacer_roles_heights_and_bill_of_materials(sla_process):
@@ -786,6 +805,46 @@ def flapped_four_bar() -> Mechanism:
                      ground="ground", joints=(*base.joints, Revolute("Or", "ground", "flap")), gears=(),
                      drivers=(*base.drivers, Driver("angle", "flap", "ground")), input_range=base.input_range,
                      assembly={**base.assembly, "flap": base.assembly["crank"]})
+
+
+def test_spacer_check_gets_each_compound_pin_in_its_own_body_frame(sla_process, monkeypatch):
+    """The flapped four-bar with the crank's frame moved off its pin (O at (3, 1) in the crank, same link): every
+    pin handed to the spacer-crossing check, placed with its body a's poses, is at the pin's world position
+    over the whole motion (1e-9 mm), for the compound pin's pairs (crank, flap) too (they were once given the
+    pin in the first body's frame, the ground's, so the check looked for the crank-flap spacer 3.2 mm off)."""
+    import fabricate.parts.build as build
+
+    base = flapped_four_bar()
+    shift = np.array([3.0, 1.0])
+    bodies = tuple(Body("crank", {k: tuple(np.asarray(v) + shift) for k, v in b.points.items()})
+                   if b.name == "crank" else b for b in base.bodies)
+    x, y, th = base.assembly["crank"]
+    origin = np.array([x, y]) - np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]]) @ shift
+    mech = Mechanism(name="flapped_shifted", bodies=bodies, ground="ground", joints=base.joints, gears=(),
+                     drivers=base.drivers, input_range=base.input_range,
+                     assembly={**base.assembly, "crank": (float(origin[0]), float(origin[1]), th)})
+    motion = mech.sweep(13)
+    seen = []
+    real = build.pin_crossings
+
+    def spy(outlines, world_poses, pins, *args):
+        seen.extend(pins)
+        return real(outlines, world_poses, pins, *args)
+
+    monkeypatch.setattr(build, "pin_crossings", spy)
+    build_parts(design_for(sla_process), mech, motion, [], {})
+    pairs = {(a, b) for _, a, b in seen}
+    assert {("ground", "crank"), ("ground", "flap"), ("crank", "flap")} <= pairs
+    world_pin = {frozenset(("ground", "crank")): motion.point("O", "ground"),
+                 frozenset(("ground", "flap")): motion.point("Or", "ground"),
+                 frozenset(("crank", "flap")): motion.point("O", "ground")}
+    for centre, a, b in seen:
+        if frozenset((a, b)) not in world_pin:
+            continue
+        pose = motion.pose(a)
+        c, s_ = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+        placed = np.column_stack([c * centre[0] - s_ * centre[1], s_ * centre[0] + c * centre[1]]) + pose[:, :2]
+        np.testing.assert_allclose(placed, world_pin[frozenset((a, b))], atol=1e-9, err_msg=f"{a}-{b}")
 
 
 def test_printed_spacers_on_one_compound_pin_are_numbered_bottom_up(sla_process, monkeypatch):

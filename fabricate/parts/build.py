@@ -303,7 +303,9 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
         if "arc" in pad:  # a curved face: the circular segment between two named points on the circle
             ends = [mechanism.body(body).point(name) for name in pad["arc"]]
             circles[body] += [(ends[0], radius), (ends[1], radius)]
-            fused_polys[body].append(pad_segment(centre, ends[0], ends[1], tol))
+            segment = pad_segment(centre, ends[0], ends[1], tol)
+            if len(segment) >= 3:  # an arc within the chord tolerance of its chord adds nothing to the hull
+                fused_polys[body].append(segment)
         else:
             circles[body].append((centre, max(r_pad, radius)))
 
@@ -338,7 +340,8 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
     same = [(p.body_a, p.body_b) for p in gear_pairs]
     layers = assign_layers(graph, list(mechanism.body_names), same)
     # a pin through skipped layers carries a spacer: keep bodies that sweep over it out of that range
-    crossings = pin_crossings(coarse, poses, [(holes_at[(bodies[0], name)], a, b) for name, bodies in pin_joints
+    # each pair's pin in the frame of its own body a (on a compound pin that is not always bodies[0])
+    crossings = pin_crossings(coarse, poses, [(holes_at[(a, name)], a, b) for name, bodies in pin_joints
                                               for i, a in enumerate(bodies) for b in bodies[i + 1:]],
                               radius, process.running_clearance_mm + CONFLICT_CHORD_MM)
     layers = order_layers(layers, crossings)
