@@ -12,7 +12,7 @@ Keys (all optional)
                          which every link section and hole keeps ``[checks] min_safety_factor`` at the
                          design load (``[load]``); the chosen width is in the report.
 ``boss_wall_mm``         float > 0. Radial wall around every pin hole. Absent: max(process min wall,
-                         0.75 × pin diameter) so bosses are never thinner than the process allows.
+                         0.5 × pin diameter) so bosses are never thinner than the process allows.
 ``hub_diameter_mm``      float > 0. Hub of a gear fused to its body. Absent: ``[gears] hub_diameter_mm``
                          or the boss diameter.
 ``pad_radius_mm``        float > 0. Fingertip pad radius; overrides the synthesis hint.
