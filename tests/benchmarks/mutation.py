@@ -46,10 +46,11 @@ EQUIVALENT = HERE / "equivalent.toml"
 REPORT = ROOT / "tests" / "benchmarks" / "mutation_report.md"
 
 GEARS_TESTS = ["tests/test_gears_properties.py", "tests/test_gears.py", "tests/test_gears_mesh.py",
-               "tests/test_gears_pair.py", "tests/test_gears_teeth.py"]
+               "tests/test_gears_pair.py", "tests/test_gears_teeth.py", "tests/test_gears_free_play.py"]
 CHECK_TESTS = ["tests/test_checks_properties.py", "tests/test_interference.py",
                "tests/test_checks_interference.py"]
-PARTS_TESTS = ["tests/test_parts_properties.py", "tests/test_parts.py", "tests/test_parts_build.py"]
+PARTS_TESTS = ["tests/test_parts_properties.py", "tests/test_parts.py", "tests/test_parts_build.py",
+               "tests/test_parts_mounting.py"]
 # test_export.py builds every template with both processes (minutes per mutant): not in the mutation run
 EXPORT_TESTS = ["tests/test_export_properties.py"]
 
@@ -76,6 +77,14 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "export/stl": ("fabricate/export/stl.py", EXPORT_TESTS),
     "synthesis/kinematic_mapping": ("fabricate/synthesis/five_bar/kinematic_mapping.py",
                                     ["tests/test_five_bar.py", "tests/test_kinematic_mapping.py"]),
+    # the other synthesis methods' numeric kernels: the six-bar's Burmester curves and its vectorised
+    # statics, the underactuated finger's kinematics and statics, the compliant gripper's force model
+    "synthesis/burmester": ("fabricate/synthesis/watt_six_bar/burmester.py",
+                            ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py"]),
+    "synthesis/six_bar_statics": ("fabricate/synthesis/watt_six_bar/statics.py",
+                                  ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py"]),
+    "synthesis/underactuated_model": ("fabricate/synthesis/underactuated/model.py", ["tests/test_underactuated.py"]),
+    "synthesis/compliant_model": ("fabricate/synthesis/compliant/model.py", ["tests/test_compliant.py"]),
 }
 
 #: The six hand-made mutants of issue 15 and the tests that must kill them (``--examples`` checks it).
@@ -332,11 +341,14 @@ def merge_functions(saved: dict, fresh: dict, functions: set[str]) -> dict:
     return out
 
 
-def rerun_survivors(key: str, result: dict, max_children: int, unreached: bool = False) -> dict:
+def rerun_survivors(key: str, result: dict, max_children: int, unreached: bool = False,
+                    timeouts: bool = False) -> dict:
     """Run the survivors of a saved result again in its work copy, with the current tests (after adding a
     killing test): the mutants are the same as long as the module's source has not changed. With
     ``unreached``, the mutants an interrupted run never reached are run too (the run finishes where it
-    stopped, without running the killed ones again)."""
+    stopped, without running the killed ones again). With ``timeouts``, the mutants judged timeouts are run
+    again under the current CPU limit (``timeout_constant``): a run cut short before its tests could finish at
+    unmutated speed is not a kill."""
     source, tests = MODULES[key]
     work = WORK / key.replace("/", "_")
     if not (work / "mutants" / (source + ".meta")).exists():
@@ -373,6 +385,7 @@ def rerun_survivors(key: str, result: dict, max_children: int, unreached: bool =
     (work / "mutants" / "mutmut-stats.json").unlink(missing_ok=True)  # new tests: map them again
     result = drop_string_only(result)
     again = ("survived", "no tests", "not checked") if unreached else ("survived", "no tests")
+    again += ("timeout",) if timeouts else ()
     names = [r["name"] for r in result["mutants"] if r["status"] in again]
     if names:
         with open(work / "mutmut-rerun.log", "w") as log:
@@ -415,7 +428,8 @@ def summarise(result: dict) -> dict:
     rate = killed / (run - eq) if run > eq else float("nan")
     return {"run": run, "killed": killed, "survived": count.get("survived", 0), "no_tests": count.get("no tests", 0),
             "equivalent": eq, "other": run - killed - eq - count.get("survived", 0) - count.get("no tests", 0),
-            "not_checked": count.get("not checked", 0), "rate": rate}
+            "not_checked": count.get("not checked", 0), "rate": rate, "timeouts": count.get("timeout", 0),
+            "floor": (killed - count.get("timeout", 0)) / (run - eq) if run > eq else float("nan")}
 
 
 def write_report(results: dict) -> str:
@@ -423,17 +437,19 @@ def write_report(results: dict) -> str:
              "Measured with `python tests/benchmarks/mutation.py MODULE...` (mutmut 3, one module per run, each "
              "module's own test files; see the script's docstring). String-only mutants (messages, names) are "
              "not run. Kill rate = (killed + timeout) / (run - equivalent); survivors without a covering test "
-             "count as survivors.", "",
-             "| module | generated | string-only (not run) | run | killed | survived | no tests | equivalent "
-             "| kill rate | not reached |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "count as survivors. \"of which timeouts\": killed by the CPU limit (2 x 2 x (the tests' time + "
+             "`timeout_constant`)); \"floor\": the kill rate if every timeout had survived.", "",
+             "| module | generated | string-only (not run) | run | killed | of which timeouts | survived | no tests "
+             "| equivalent | kill rate | floor | not reached |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for key in MODULES:
         if key not in results:
             continue
         res = results[key]
         s = summarise(res)
         lines.append(f"| {key} | {res['generated']} | {res['string_only_skipped']} | {s['run']} | {s['killed']} "
-                     f"| {s['survived']} | {s['no_tests']} | {s['equivalent']} | {100 * s['rate']:.1f}% "
-                     f"| {s['not_checked']} |")
+                     f"| {s['timeouts']} | {s['survived']} | {s['no_tests']} | {s['equivalent']} "
+                     f"| {100 * s['rate']:.1f}% | {100 * s['floor']:.1f}% | {s['not_checked']} |")
     missing = [k for k in MODULES if k not in results]
     if missing:
         lines += ["", "Not run yet: " + ", ".join(missing) + "."]
@@ -553,6 +569,8 @@ def main(argv: list[str] | None = None) -> int:
                              "them into its saved result")
     parser.add_argument("--unreached", action="store_true",
                         help="with --survivors: also run the mutants an interrupted run did not reach")
+    parser.add_argument("--timeouts", action="store_true",
+                        help="with --survivors: also run the timeouts again under the current CPU limit")
     args = parser.parse_args(argv)
     HERE.mkdir(parents=True, exist_ok=True)
     if args.examples:
@@ -569,7 +587,8 @@ def main(argv: list[str] | None = None) -> int:
     if not args.report:
         for key in keys:
             if args.survivors:
-                results[key] = rerun_survivors(key, results[key], args.max_children, args.unreached)
+                results[key] = rerun_survivors(key, results[key], args.max_children, args.unreached,
+                                               args.timeouts)
             elif args.functions:
                 functions = set(args.functions.split(","))
                 fresh = run_module(key, args.max_children, functions=functions)
