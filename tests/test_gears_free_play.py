@@ -185,7 +185,8 @@ def test_a_point_at_the_bottom_radius_of_a_later_flank_row_is_compared():
     flank_b = np.vstack([radial(0.0, [1.25]), radial(0.1, [2.0]), radial(0.2, [3.0])])
     flanks_a = {2: np.vstack([[[0.75, 1.0]], radial(1.2, [2.0, 3.0])])}
     s = np.array([-np.pi / 2 + np.pi])  # the pitch point moved by one pitch, p = pi * module = 2 pi
-    for flanks_b in ({2: flank_b}, {0: flank_b, 2: flank_b}):
+    short = flank_b[:2]  # rows of two points: the last row's lowest key is the table's second to last
+    for flanks_b in ({2: flank_b}, {0: flank_b, 2: flank_b}, {0: short, 2: short}):
         plus, minus = free_play(duck_pair(flanks_a, flanks_b), s)
         assert plus[0] == pytest.approx(np.arctan2(1.0, 0.75), abs=1e-12), sorted(flanks_b)
         assert np.isnan(minus[0])
