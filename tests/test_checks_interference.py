@@ -654,3 +654,92 @@ def test_kernel_confirms_a_clearance_with_a_short_search(monkeypatch):
     (pair,) = result.pairs
     assert pair.kernel_gap_mm == pytest.approx(0.75, abs=1e-6)
     assert len(reaches) == 1 and 0.75 < reaches[0] <= 0.75 + 0.05
+
+
+# -- the result's own fields and the report's rounding ---------------------------------------------
+def test_without_the_kernel_no_solid_is_built_and_no_kernel_gap_is_reported(monkeypatch):
+    """use_kernel=False keeps manifold3d out of the sweep: no solid is posed (the kernel's entry point is
+    patched to fail), the clear pair has no kernel gap (None in the pair and in the report row) and its
+    minimum is the planar one, 0.75 mm between bars side by side (1e-9)."""
+    import fabricate.checks.interference as interference
+
+    def no_kernel(*args):
+        raise AssertionError("the kernel was asked with use_kernel=False")
+
+    monkeypatch.setattr(interference, "_posed_pair", no_kernel)
+    parts = [box_part("A", "a", (10.0, 1.0), 0.0, 3.0), box_part("B", "b", (10.0, 1.0), 0.0, 3.0)]
+    result = sweep_interference(parts, motion_of(np.array([[0.0, 2.5, 0.0], [0.0, 1.75, 0.0]])),
+                                chord_tolerance_mm=TOL, min_clearance_mm=0.25, use_kernel=False)
+    (pair,) = result.pairs
+    assert pair.kernel_gap_mm is None
+    assert result.report()["pairs"][0]["kernel_gap_mm"] is None
+    assert (pair.min_index, pair.min_clearance_mm) == (1, pytest.approx(0.75, abs=1e-9))
+
+
+def test_default_search_length_is_four_times_a_large_minimum():
+    """Without a search length the sweep resolves planar distances up to max(DEFAULT_SEARCH_MM, 4 x the
+    minimum clearance); with a minimum of DEFAULT_SEARCH_MM that is 4 x DEFAULT_SEARCH_MM (8 mm). Bars side by
+    side 0.875 x and 1.125 x that far apart: the nearer distance is exact, the farther one reads the
+    search length as a lower bound (1e-9). The result carries the minimum and the search length asked
+    for, and the report the minimum."""
+    from fabricate.checks.interference import DEFAULT_SEARCH_MM
+
+    minimum = DEFAULT_SEARCH_MM
+    search = 4.0 * minimum
+    assert search > DEFAULT_SEARCH_MM
+    gaps = np.array([0.875, 1.125]) * search
+    parts = [box_part("A", "a", (10.0, 1.0), 0.0, 3.0), box_part("B", "b", (10.0, 1.0), 0.0, 3.0)]
+    result = sweep_interference(parts, motion_of(np.column_stack([np.zeros(2), 1.0 + gaps, np.zeros(2)])),
+                                chord_tolerance_mm=TOL, min_clearance_mm=minimum)
+    assert result.search_length_mm == search
+    assert result.min_clearance_required_mm == minimum
+    assert result.report()["required_clearance_mm"] == minimum
+    (pair,) = result.pairs
+    np.testing.assert_allclose(pair.clearance, [gaps[0], search], atol=1e-9)
+    np.testing.assert_array_equal(pair.exact, [True, False])
+
+
+def test_given_search_length_and_minimum_are_the_results_fields():
+    """An explicit search length (3 mm) and minimum clearance (0.4 mm) come back
+    unchanged in the result (and the minimum in the report); bars 3.5 mm apart are beyond the search: a
+    lower bound of 3 mm, not exact."""
+    parts = [box_part("A", "a", (10.0, 1.0), 0.0, 3.0), box_part("B", "b", (10.0, 1.0), 0.0, 3.0)]
+    result = sweep_interference(parts, motion_of(np.array([[0.0, 4.5, 0.0]])), chord_tolerance_mm=TOL,
+                                min_clearance_mm=0.4, search_length_mm=3.0)
+    assert result.search_length_mm == 3.0
+    assert result.min_clearance_required_mm == 0.4
+    assert result.report()["required_clearance_mm"] == 0.4
+    (pair,) = result.pairs
+    assert pair.clearance[0] == pytest.approx(3.0, abs=1e-9) and not pair.exact[0]
+
+
+@pytest.mark.parametrize("dtype", [np.int64, np.float32])
+def test_inputs_come_back_as_float64(dtype):
+    """The result's inputs are float64 whatever the motion holds (integer degrees, float32), with the same
+    values: 0, 15, 30 here (exact in both)."""
+    motion = motion_of(np.array([[12.0, 0.0, 0.0]] * 3))
+    motion = Motion(inputs=np.array([0, 15, 30], dtype=dtype), body_names=motion.body_names, ground=motion.ground,
+                    free=motion.free, q=motion.q, mechanism=motion.mechanism)
+    parts = [box_part("A", "a", (10.0, 4.0), 0.0, 3.0), box_part("B", "b", (10.0, 4.0), 0.0, 3.0)]
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    assert result.inputs.dtype == np.float64
+    np.testing.assert_array_equal(result.inputs, [0.0, 15.0, 30.0])
+
+
+def test_report_rounds_kernel_gap_and_overlap_volume_to_six_decimals():
+    """report.json's kernel gap and overlap volume are rounded to 6 decimals like its other lengths: bars
+    (10 x 1, one layer) 0.7654321 mm apart report a kernel gap of 0.765432; 10 x 1 x 1 boxes overlapping by
+    0.12345678 mm in x overlap by 0.12345678 mm^3 (manifold3d's boolean, far within 1e-7 of it for boxes),
+    reported as 0.123457."""
+    bars = [box_part("A", "a", (10.0, 1.0), 0.0, 3.0), box_part("B", "b", (10.0, 1.0), 0.0, 3.0)]
+    result = sweep_interference(bars, motion_of(np.array([[0.0, 1.7654321, 0.0]])), chord_tolerance_mm=TOL,
+                                min_clearance_mm=0.25)
+    (row,) = result.report()["pairs"]
+    assert row["kernel_gap_mm"] == 0.765432
+    cubes = [box_part("A", "a", (10.0, 1.0), 0.0, 1.0), box_part("B", "b", (10.0, 1.0), 0.0, 1.0)]
+    result = sweep_interference(cubes, motion_of(np.array([[10.0 - 0.12345678, 0.0, 0.0]])),
+                                chord_tolerance_mm=TOL, min_clearance_mm=0.25)
+    (pair,) = result.collisions
+    assert pair.max_overlap_mm3 == pytest.approx(0.12345678, abs=1e-9)
+    (row,) = result.report()["collisions"]
+    assert row["volume_mm3"] == 0.123457
