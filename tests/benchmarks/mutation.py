@@ -64,7 +64,8 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "gears/mesh": ("fabricate/gears/mesh.py", GEARS_TESTS),
     "gears/pair": ("fabricate/gears/pair.py", GEARS_TESTS),
     "gears/checks": ("fabricate/gears/checks.py", GEARS_TESTS),
-    "mechanism": ("fabricate/mechanism.py", ["tests/test_mechanism_properties.py", "tests/test_mechanism.py"]),
+    "mechanism": ("fabricate/mechanism.py", ["tests/test_mechanism_properties.py", "tests/test_mechanism.py",
+                                            "tests/test_mechanism_solver.py"]),
     "checks/interference": ("fabricate/checks/interference.py", CHECK_TESTS),
     "checks/distance": ("fabricate/checks/distance.py", CHECK_TESTS),
     # test_checks.py synthesises the seed-000 finger (tens of seconds): the property tests drive the check
