@@ -1,0 +1,369 @@
+"""The pose solver's core (Newton, first-pose assembly, continuation, step guard) against closed forms.
+
+Every expected value here is written independently of fabricate.mechanism: circle intersections by hand,
+slider/crank geometry, angle laws. Tolerances are stated per test.
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from fabricate.errors import LockupError, SpecError
+from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
+from tests.conftest import make_four_bar
+
+
+def _meet(c1, r1, c2, r2, left=True):
+    """Intersection of circle (c1, r1) and circle (c2, r2) on the left (or right) of c1 -> c2."""
+    c1, c2 = np.asarray(c1, dtype=float), np.asarray(c2, dtype=float)
+    dx, dy = c2 - c1
+    d = math.hypot(dx, dy)
+    a = (r1 * r1 - r2 * r2 + d * d) / (2.0 * d)
+    h = math.sqrt(r1 * r1 - a * a)
+    ex, ey = dx / d, dy / d
+    sign = 1.0 if left else -1.0
+    return np.array([c1[0] + a * ex - sign * h * ey, c1[1] + a * ey + sign * h * ex])
+
+
+def _four_bar_b(crank, coupler, rocker, ground, theta_deg, left=True):
+    """Coupler-rocker joint B of the four-bar O-A-B-D (ground O-D on +x) at crank angle theta_deg."""
+    th = math.radians(theta_deg)
+    a = (crank * math.cos(th), crank * math.sin(th))
+    return _meet(a, coupler, (ground, 0.0), rocker, left)
+
+
+def _scaled_four_bar(k: float) -> Mechanism:
+    """conftest's crank-rocker (15, 40, 30, 40) with every length multiplied by ``k``."""
+    return make_four_bar(crank=15.0 * k, coupler=40.0 * k, rocker=30.0 * k, ground=40.0 * k)
+
+
+# -- redundant (over-constrained) mechanisms: the non-square Jacobian path -------------------------------------
+
+def _double_parallelogram(start_deg: float = 20.0, end_deg: float = 160.0) -> Mechanism:
+    """Parallelogram four-bar O-A-B-D (crank = rocker = 15, coupler = ground = 40) with a third parallel
+    link E-C (E at x = 20 on the ground, C at x = 20 on the coupler): 6 revolutes + 1 driver = 13 equations
+    in 12 unknowns, consistent (Gruebler mobility 0 before the driver, yet it moves)."""
+    r, g = 15.0, 40.0
+    th = math.radians(start_deg)
+    ax, ay = r * math.cos(th), r * math.sin(th)
+    return Mechanism(
+        name="double_parallelogram",
+        bodies=(Body("ground", {"O": (0.0, 0.0), "D": (g, 0.0), "E": (20.0, 0.0)}),
+                Body("crank", {"O": (0.0, 0.0), "A": (r, 0.0)}),
+                Body("coupler", {"A": (0.0, 0.0), "B": (g, 0.0), "C": (20.0, 0.0)}),
+                Body("rocker", {"D": (0.0, 0.0), "B": (r, 0.0)}),
+                Body("link", {"E": (0.0, 0.0), "C": (r, 0.0)})),
+        ground="ground",
+        joints=(Revolute("O", "ground", "crank"), Revolute("A", "crank", "coupler"),
+                Revolute("B", "coupler", "rocker"), Revolute("D", "ground", "rocker"),
+                Revolute("E", "ground", "link"), Revolute("C", "coupler", "link")),
+        gears=(), drivers=(Driver("angle", "crank", "ground"),),
+        input_range=(start_deg, end_deg),
+        # a rough guess: Newton (least squares here) must pull it onto the parallelogram
+        assembly={"crank": (0.0, 0.0, th + 0.05), "coupler": (ax + 0.3, ay - 0.2, 0.04),
+                  "rocker": (g, 0.0, th - 0.05), "link": (20.0, 0.0, th + 0.03)},
+    )
+
+
+def test_redundant_parallelogram_follows_closed_form():
+    """An over-constrained (13 x 12) but consistent double parallelogram assembles from a rough guess and
+    sweeps 20 -> 160 deg (short of the folded, singular pose at 180): the coupler stays parallel to the ground
+    and A = 15 (cos s, sin s), within 1e-9."""
+    mech = _double_parallelogram()
+    motion = mech.sweep(np.linspace(20.0, 160.0, 15))  # 10 degree input steps
+    th = np.radians(motion.inputs)
+    a = np.column_stack([15.0 * np.cos(th), 15.0 * np.sin(th)])
+    assert np.max(np.abs(motion.pose("coupler")[:, 2])) < 1e-9
+    assert np.max(np.hypot(*(motion.point("A", "coupler") - a).T)) < 1e-9
+    assert np.max(np.hypot(*(motion.point("C", "coupler") - a - [20.0, 0.0]).T)) < 1e-9
+    assert np.max(np.abs(motion.pose("link")[:, 2] - th)) < 1e-9
+    assert np.max(np.abs(motion.pose("rocker")[:, 2] - th)) < 1e-9
+
+
+def test_redundant_parallelogram_sweeps_backwards():
+    """The least-squares continuation also runs with a decreasing input (160 -> 20 deg, 20 deg steps)."""
+    mech = _double_parallelogram(start_deg=160.0, end_deg=20.0)
+    motion = mech.sweep(np.linspace(160.0, 20.0, 8))
+    th = np.radians(motion.inputs)
+    assert np.max(np.abs(motion.pose("rocker")[:, 2] - th)) < 1e-9
+    assert np.max(np.abs(motion.pose("coupler")[:, 2])) < 1e-9
+
+
+def test_inconsistent_redundant_constraints_lock_up_at_the_start():
+    """A crank pinned to the ground at two points cannot turn: driving it gives a LockupError carrying
+    the first input (least squares leaves a residual of the order of the step, far above tolerance)."""
+    mech = Mechanism(
+        name="pinned_twice",
+        bodies=(Body("ground", {"O": (0.0, 0.0), "P": (0.8, 0.0)}), Body("crank", {"O": (0.0, 0.0), "P": (0.8, 0.0)})),
+        ground="ground",
+        joints=(Revolute("O", "ground", "crank"), Revolute("P", "ground", "crank")),
+        gears=(), drivers=(Driver("angle", "crank", "ground", law=LinearLaw(1.0, -5.0)),),
+        input_range=(5.0, 6.0), input_unit="mm", assembly={"crank": (0.0, 0.0, 0.0)})
+    with pytest.raises(LockupError) as info:
+        mech.sweep(np.array([5.0, 6.0]))
+    assert info.value.input_value == 5.0
+
+
+def test_locked_input_span_below_a_micro_unit_still_reports_lockup():
+    """The smallest step is relative to the span plus an absolute 1e-12: a span of 1e-6 input units on a
+    locked mechanism still ends in a LockupError at its start (not an endless crawl)."""
+    mech = Mechanism(
+        name="pinned_twice",
+        bodies=(Body("ground", {"O": (0.0, 0.0), "P": (0.8, 0.0)}), Body("crank", {"O": (0.0, 0.0), "P": (0.8, 0.0)})),
+        ground="ground",
+        joints=(Revolute("O", "ground", "crank"), Revolute("P", "ground", "crank")),
+        gears=(), drivers=(Driver("angle", "crank", "ground", law=LinearLaw(1.0, -2.0)),),
+        input_range=(2.0, 2.000001), input_unit="mm", assembly={"crank": (0.0, 0.0, 0.0)})
+    with pytest.raises(LockupError) as info:
+        mech.sweep(np.array([2.0, 2.000001]))
+    assert info.value.input_value == 2.0
+
+
+# -- scale ------------------------------------------------------------------------------------------------------
+
+def test_metre_scale_four_bar_solves_to_scaled_tolerance():
+    """A four-bar 1000 x larger (links of 15-40 m, in mm) sweeps and closes its loop: B matches the circle
+    intersection to 1e-8 relative to the size (the residual tolerance grows with the mechanism)."""
+    k = 1000.0
+    mech = _scaled_four_bar(k)
+    motion = mech.sweep(np.linspace(60.0, 420.0, 37))
+    b = motion.point("B", "rocker")
+    expected = np.array([_four_bar_b(15 * k, 40 * k, 30 * k, 40 * k, s) for s in motion.inputs])
+    assert np.max(np.hypot(*(b - expected).T)) < 1e-8 * 40.0 * k
+    assert np.max(np.abs(np.hypot(*(motion.point("B", "coupler") - motion.point("A")).T) - 40.0 * k)) < 1e-8 * k
+
+
+# -- direction and repeated inputs --------------------------------------------------------------------------------
+
+def test_four_bar_swept_downwards_matches_closed_form():
+    """Continuation with a decreasing input (420 -> 60 deg in 30 deg steps) stays on the upper branch."""
+    mech = make_four_bar(start_deg=420.0, end_deg=60.0)
+    motion = mech.sweep(np.linspace(420.0, 60.0, 13))
+    expected = np.array([_four_bar_b(15, 40, 30, 40, s) for s in motion.inputs])
+    assert np.max(np.hypot(*(motion.point("B", "rocker") - expected).T)) < 1e-9
+    assert np.allclose(motion.pose("crank")[:, 2], np.radians(motion.inputs), atol=1e-12)
+
+
+def test_sweep_through_zero_input_both_ways():
+    """Inputs symmetric about zero (-40 -> 40 -> -40 deg) are followed like any other."""
+    mech = make_four_bar(start_deg=-40.0, end_deg=40.0)
+    inputs = np.array([-40.0, 40.0, -40.0])
+    motion = mech.sweep(inputs)
+    expected = np.array([_four_bar_b(15, 40, 30, 40, s) for s in inputs])
+    assert np.max(np.hypot(*(motion.point("B", "rocker") - expected).T)) < 1e-9
+
+
+def test_repeated_input_keeps_the_pose():
+    """Equal consecutive inputs give the same pose (a zero-length continuation)."""
+    mech = make_four_bar()
+    motion = mech.sweep(np.array([60.0, 100.0, 100.0, 100.0, 90.0]))
+    q = motion.q
+    assert np.array_equal(q[1], q[2]) and np.array_equal(q[2], q[3])
+    expected = _four_bar_b(15, 40, 30, 40, 90.0)
+    assert np.hypot(*(motion.point("B", "rocker")[4] - expected)) < 1e-9
+
+
+def test_steep_law_far_from_zero_input():
+    """The smallest allowed step depends on the span of the inputs, not on their magnitude: a crank turned
+    by 20 rad per input unit around s = 10000 follows theta = 20 (s - 10000) over s in [10000, 10000.1]
+    (2 rad, so about ten guarded steps of 0.01 input units)."""
+    law = LinearLaw(20.0, -200000.0)
+    mech = Mechanism(
+        name="steep", bodies=(Body("ground", {"O": (0.0, 0.0)}), Body("crank", {"O": (0.0, 0.0), "A": (10.0, 0.0)})),
+        ground="ground", joints=(Revolute("O", "ground", "crank"),), gears=(),
+        drivers=(Driver("angle", "crank", "ground", law=law),), input_range=(10000.0, 10000.1), input_unit="mm",
+        assembly={"crank": (0.0, 0.0, 0.0)})
+    motion = mech.sweep(np.array([10000.0, 10000.1]))
+    assert motion.pose("crank")[1, 2] == pytest.approx(20.0 * (10000.1 - 10000.0), abs=1e-9)
+
+
+# -- assembly errors ------------------------------------------------------------------------------------------------
+
+def test_missing_assembly_guess_is_named():
+    """A free body without an assembly guess is a SpecError at mechanism.assembly.<body>."""
+    base = make_four_bar()
+    assembly = dict(base.assembly)
+    del assembly["rocker"]
+    mech = Mechanism(name="no_guess", bodies=base.bodies, ground=base.ground, joints=base.joints, gears=(),
+                     drivers=base.drivers, input_range=base.input_range, assembly=assembly)
+    with pytest.raises(SpecError) as err:
+        mech.sweep(3)
+    assert err.value.path == "mechanism.assembly.rocker"
+    assert err.value.message == "missing assembly guess for body"
+
+
+def test_unassemblable_first_pose_reports_its_input():
+    """A non-Grashof four-bar whose crank starts beyond its limit (|A - D| > coupler + rocker at 150 deg)
+    cannot assemble: LockupError with the first input (150) as input_value."""
+    base = make_four_bar(crank=25.0, coupler=30.0, rocker=20.0, ground=40.0, start_deg=0.0, end_deg=180.0)
+    assert math.hypot(25 * math.cos(math.radians(150)) - 40, 25 * math.sin(math.radians(150))) > 50.0
+    mech = Mechanism(name="stuck", bodies=base.bodies, ground=base.ground, joints=base.joints, gears=(),
+                     drivers=base.drivers, input_range=(150.0, 180.0), assembly=base.assembly)
+    with pytest.raises(LockupError) as info:
+        mech.sweep(np.array([150.0, 180.0]))
+    assert info.value.input_value == 150.0
+    assert "stuck: cannot assemble the first pose" in info.value.message
+
+
+def test_exact_rationals_are_accepted_as_guesses_and_axes():
+    """Assembly guesses and slider axes given as fractions.Fraction are read as floats: a slide-driven
+    block on the axis (3/5, 4/5) sits at s * (0.6, 0.8), within 1e-12."""
+    axis = (Fraction(3, 5), Fraction(4, 5))
+    mech = Mechanism(
+        name="rational",
+        bodies=(Body("ground", {"S": (0.0, 0.0)}), Body("block", {"S": (0.0, 0.0)})),
+        ground="ground", joints=(Slider("S", "ground", "block", axis=axis),), gears=(),
+        drivers=(Driver("slide", "block", "ground", joint="S"),), input_range=(0.0, 10.0), input_unit="mm",
+        assembly={"block": (Fraction(1, 10), Fraction(-1, 10), Fraction(1, 50))})
+    motion = mech.sweep(np.array([0.0, 4.0, 10.0]))
+    expected = np.outer(motion.inputs, [0.6, 0.8])
+    assert np.max(np.abs(motion.point("S", "block") - expected)) < 1e-12
+    assert np.max(np.abs(motion.pose("block")[:, 2])) < 1e-12
+
+
+# -- drivers measured from a moving body ----------------------------------------------------------------------------
+
+def _four_bar_driven_at_a(psi0_deg: float, psi1_deg: float) -> Mechanism:
+    """Crank-rocker (15, 40, 30, 40) driven by the coupler's angle relative to the crank, psi (deg)."""
+    psi = math.radians(psi0_deg)
+    th, b = _driven_at_a_closed_form(psi)
+    a = np.array([15.0 * math.cos(th), 15.0 * math.sin(th)])
+    return Mechanism(
+        name="driven_at_a",
+        bodies=(Body("ground", {"O": (0.0, 0.0), "D": (40.0, 0.0)}),
+                Body("crank", {"O": (0.0, 0.0), "A": (15.0, 0.0)}),
+                Body("coupler", {"A": (0.0, 0.0), "B": (40.0, 0.0)}),
+                Body("rocker", {"D": (0.0, 0.0), "B": (30.0, 0.0)})),
+        ground="ground",
+        joints=(Revolute("O", "ground", "crank"), Revolute("A", "crank", "coupler"),
+                Revolute("B", "coupler", "rocker"), Revolute("D", "ground", "rocker")),
+        gears=(), drivers=(Driver("angle", "coupler", "crank"),), input_range=(psi0_deg, psi1_deg),
+        assembly={"crank": (0.0, 0.0, th + 0.02), "coupler": (a[0], a[1], th + psi - 0.02),
+                  "rocker": (40.0, 0.0, math.atan2(b[1], b[0] - 40.0) + 0.02)})
+
+
+def _driven_at_a_closed_form(psi: float) -> tuple[float, np.ndarray]:
+    """Crank angle and B for relative angle psi: B = R(theta) (15 + 40 cos psi, 40 sin psi), so |OB| is
+    fixed by psi and B is where the circle |OB| meets the rocker circle about D (upper intersection)."""
+    local = np.array([15.0 + 40.0 * math.cos(psi), 40.0 * math.sin(psi)])
+    b = _meet((0.0, 0.0), float(np.hypot(*local)), (40.0, 0.0), 30.0, left=True)
+    theta = math.atan2(b[1], b[0]) - math.atan2(local[1], local[0])
+    return theta, b
+
+
+def test_angle_driver_relative_to_a_moving_body():
+    """A driver measured from a moving reference (coupler relative to crank) follows the closed form:
+    theta_coupler - theta_crank = psi exactly (1e-12) and B, the crank angle as derived by hand (1e-9)."""
+    mech = _four_bar_driven_at_a(-60.0, -120.0)
+    motion = mech.sweep(np.linspace(-60.0, -120.0, 7))
+    psi = np.radians(motion.inputs)
+    assert np.max(np.abs(motion.relative_angle("coupler", "crank") - psi)) < 1e-12
+    for i, p in enumerate(psi):
+        theta, b = _driven_at_a_closed_form(float(p))
+        assert math.remainder(motion.pose("crank")[i, 2] - theta, 2 * math.pi) == pytest.approx(0.0, abs=1e-9)
+        assert np.hypot(*(motion.point("B", "rocker")[i] - b)) < 1e-9
+
+
+# -- degenerate sizes -------------------------------------------------------------------------------------------
+
+def test_ground_only_mechanism_has_an_empty_motion():
+    """A mechanism of its ground alone (no unknowns, no equations) sweeps to zero free bodies."""
+    mech = Mechanism(name="frame", bodies=(Body("ground", {"O": (0.0, 0.0)}),), ground="ground", joints=(),
+                     gears=(), drivers=(), input_range=(0.0, 1.0))
+    motion = mech.sweep(4)
+    assert motion.q.shape == (4, 0, 3)
+    assert np.array_equal(motion.pose("ground"), np.zeros((4, 3)))
+
+
+# -- Newton's acceptance test and iteration budget, on a constraint with a double root ------------------------------
+#
+# A disc pinned to the ground whose "gear" law to the ground is a * x**2: the constraint 0 = a * theta**2 has a
+# double root at 0, so Newton halves theta each iteration (exactly, in floating point, for powers of two) and the
+# residual a * theta_k**2 = a * theta_0**2 / 4**k falls by four per iteration: the iteration where it first drops
+# below the tolerance is known in advance.
+
+class _Parabola:
+    """law(x) = a * x**2 - c with its derivatives (the Law protocol)."""
+
+    def __init__(self, a: float, c: float = 0.0) -> None:
+        self.a, self.c = a, c
+
+    def __call__(self, x, nu: int = 0):
+        x = np.asarray(x, dtype=np.float64)
+        if nu == 0:
+            return self.a * x * x - self.c
+        return 2.0 * self.a * x if nu == 1 else np.full_like(x, 2.0 * self.a)
+
+
+def _disc(law, guess, disc_point=(0.0, 0.0), marker=1.0) -> Mechanism:
+    """Disc pinned at O, coupled to the ground by 0 = law(theta_disc); ``marker`` sets the size (scale)."""
+    return Mechanism(
+        name="disc", bodies=(Body("ground", {"O": (0.0, 0.0), "M": (marker, 0.0)}), Body("disc", {"O": disc_point})),
+        ground="ground", joints=(Revolute("O", "ground", "disc"),),
+        gears=(GearCoupling("square", "ground", "disc", "ground", law),), drivers=(), input_range=(0.0, 1.0),
+        input_unit="mm", assembly={"disc": guess})
+
+
+def test_linear_convergence_accepted_on_the_last_iteration():
+    """a = 2e6, theta_0 = 0.5: residual after k halvings is 5e5 / 4**k, first below 1e-12 at k = 30, the last
+    allowed iteration; the pose is accepted (theta = 0.5 / 2**30 within 1e-15)."""
+    motion = _disc(_Parabola(2e6), (0.0, 0.0, 0.5)).sweep(np.array([0.0]))
+    assert motion.pose("disc")[0, 2] == pytest.approx(0.5 / 2**30, abs=1e-15)
+
+
+def test_newton_gives_up_after_thirty_iterations():
+    """a = 8e6, theta_0 = 0.5: the residual 2e6 / 4**k is still 1.7e-12 > 1e-12 after 30 iterations, so the
+    first pose is a LockupError (the budget is 30 Newton iterations)."""
+    with pytest.raises(LockupError) as info:
+        _disc(_Parabola(8e6), (0.0, 0.0, 0.5)).sweep(np.array([0.0]))
+    assert "cannot assemble" in info.value.message
+
+
+def _exact_tolerance_marker() -> float:
+    """A size that makes the residual tolerance exactly 2**-39 (1e-12 per unit of size)."""
+    scale = 2.0**-39 / 1e-12
+    assert 1e-12 * scale == 2.0**-39 and scale > 1.0
+    return scale
+
+
+def test_residual_equal_to_tolerance_is_not_accepted_inside_the_loop():
+    """a = 2**21, theta_0 = 1/2, tolerance 2**-39: the residual 2**(19 - 2k) equals the tolerance at k = 29,
+    which is not *below* it, so one more iteration runs: theta = 2**-31 exactly."""
+    motion = _disc(_Parabola(2.0**21), (0.0, 0.0, 0.5), marker=_exact_tolerance_marker()).sweep(np.array([0.0]))
+    assert motion.pose("disc")[0, 2] == 2.0**-31
+
+
+def test_residual_equal_to_tolerance_after_the_budget_is_a_failure():
+    """a = 2**23, theta_0 = 1/2, tolerance 2**-39: the residual 2**(21 - 2k) reaches the tolerance exactly
+    after the 30th iteration; not below it, so the first pose is a LockupError."""
+    with pytest.raises(LockupError):
+        _disc(_Parabola(2.0**23), (0.0, 0.0, 0.5), marker=_exact_tolerance_marker()).sweep(np.array([0.0]))
+
+
+def test_exactly_singular_jacobian_at_the_guess_is_a_failure():
+    """A singular Jacobian gives no Newton step and counts as failure (not success, not a least-squares
+    step): a disc pinned by its point (1, 0), with 0 = theta**2 - 0.01, guessed at theta = 0 where the
+    coupling row is exactly zero, is a LockupError although roots theta = +-0.1 exist nearby."""
+    mech = _disc(_Parabola(1.0, 0.01), (-1.0, 0.1, 0.0), disc_point=(1.0, 0.0))
+    with pytest.raises(LockupError) as info:
+        mech.sweep(np.array([0.0]))
+    assert info.value.input_value == 0.0
+    # the same mechanism from a regular guess finds the root: theta = 0.1, disc point (1, 0) at the origin
+    ok = _disc(_Parabola(1.0, 0.01), (-1.0, 0.1, 0.2), disc_point=(1.0, 0.0)).sweep(np.array([0.0]))
+    assert ok.pose("disc")[0, 2] == pytest.approx(0.1, abs=1e-12)
+    assert np.max(np.abs(ok.point("O", "disc")[0])) < 1e-12
+
+
+def test_coupling_of_a_body_with_itself():
+    """The coupling residual and its derivative hold when one body plays two roles: gear_a = gear_b = disc
+    with law(x) = 0.6 - x gives theta = 0.6 - theta, i.e. theta = 0.3 (1e-12), from a guess of 0."""
+    mech = Mechanism(
+        name="self", bodies=(Body("ground", {"O": (0.0, 0.0)}), Body("disc", {"O": (0.0, 0.0)})), ground="ground",
+        joints=(Revolute("O", "ground", "disc"),),
+        gears=(GearCoupling("self", "ground", "disc", "disc", LinearLaw(-1.0, 0.6)),), drivers=(),
+        input_range=(0.0, 1.0), input_unit="mm", assembly={"disc": (0.0, 0.0, 0.0)})
+    assert mech.sweep(np.array([0.0])).pose("disc")[0, 2] == pytest.approx(0.3, abs=1e-12)
