@@ -367,3 +367,19 @@ def test_coupling_of_a_body_with_itself():
         gears=(GearCoupling("self", "ground", "disc", "disc", LinearLaw(-1.0, 0.6)),), drivers=(),
         input_range=(0.0, 1.0), input_unit="mm", assembly={"disc": (0.0, 0.0, 0.0)})
     assert mech.sweep(np.array([0.0])).pose("disc")[0, 2] == pytest.approx(0.3, abs=1e-12)
+
+
+# -- step guard and tangent predictor -------------------------------------------------------------------------------
+
+def test_large_input_step_near_change_point_stays_on_branch():
+    """A crank-rocker close to Grashof's change point (8.6 + 28.75 = 37.35 against 17.8 + 19.75 = 37.55), whose
+    two assembly branches pass close to each other, asked for one 120 deg input step on its lower branch:
+    the step must be subdivided (no body turning 0.3 rad or more per accepted step) and predicted along the
+    tangent, landing on the lower-branch closed form within 1e-9, like a 1-degree sweep does."""
+    lengths = (8.6, 17.8, 19.75, 28.75)
+    mech = make_four_bar(*lengths, start_deg=80.0, end_deg=200.0, upper=False)
+    coarse = mech.sweep(np.array([80.0, 200.0]))
+    fine = mech.sweep(121)
+    expected = _four_bar_b(*lengths, 200.0, left=False)
+    assert np.hypot(*(coarse.point("B", "rocker")[1] - expected)) < 1e-9
+    assert np.max(np.abs(coarse.q[1] - fine.q[-1])) < 1e-9
