@@ -367,6 +367,36 @@ def test_a_pad_arc_flatter_than_the_chord_tolerance_is_just_its_bosses(four_bar,
     assert plate.symmetric_difference(expected).area < 0.005 * expected.length
 
 
+def test_a_pad_arc_of_two_chords_adds_its_triangle(four_bar, sla_process):
+    """At the largest chord tolerance (1 mm) a pad arc of 0.9 rad on a 36 mm circle about C = (20, -36) splits
+    into two chords (each sagitta 36 (1 - cos 0.225) = 0.91 mm <= 1 < 3.58 mm for one chord): its segment is
+    the triangle of the chord ends and the arc's midpoint, whose apex stands 3.58 mm off the chord, beyond the
+    2.35 mm bosses (6.6 mm^2 of it beyond their hull, by shapely on dense circles). The plate holds the whole
+    triangle and the apex is on its outline (1e-6 mm): at this tolerance the bosses themselves are coarse
+    polygons, so the plate is not compared with dense circles."""
+    import dataclasses
+
+    process = dataclasses.replace(sla_process, chord_tolerance_mm=1.0)
+    centre, r, half = np.array([20.0, -36.0]), 36.0, 0.45
+    start = centre + r * np.array([math.sin(-half), -math.cos(-half)])
+    end = centre + r * np.array([math.sin(half), -math.cos(half)])
+    mid = centre + r * np.array([0.0, -1.0])
+    pts = {"C": tuple(centre), "E1": tuple(start), "E2": tuple(end)}
+    bodies = tuple(Body("coupler", {**b.points, **pts}) if b.name == "coupler" else b for b in four_bar.bodies)
+    mech = Mechanism(name="two_chord_pad", bodies=bodies, ground=four_bar.ground, joints=four_bar.joints, gears=(),
+                     drivers=four_bar.drivers, input_range=four_bar.input_range, assembly=four_bar.assembly)
+    hints = {"pads": {"coupler": {"point": "C", "arc": ["E1", "E2"]}}}
+    coupler = build_parts(design_for(process), mech, mech.sweep(7), [], hints).part("coupler")
+    boss = (2.0 + 2 * 0.25 + 0.2) / 2 + 1.0
+    points = [(0.0, 0.0), (40.0, 0.0), *pts.values()]
+    hull = shapely.union_all([shapely.Point(p).buffer(boss, 1024) for p in points]).convex_hull
+    triangle = shapely.Polygon([start, mid, end])
+    assert triangle.difference(hull).area > 5.0  # the triangle matters (6.6 mm^2 beyond the bosses)
+    plate = shapely.Polygon(coupler.outline.polygon(0.005))
+    assert plate.buffer(1e-6).contains(triangle)  # the arc's midpoint, on the pad's true arc, is on the plate
+    assert plate.exterior.distance(shapely.Point(mid)) < 1e-6
+
+
 # -- a pin through a skipped layer: printed spacer, roles, heights, BOM -----------------------------
 
 def test_printed_spacer_roles_heights_and_bill_of_materials(sla_process):
