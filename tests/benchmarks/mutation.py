@@ -81,7 +81,7 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     # the other synthesis methods' numeric kernels: the six-bar's Burmester curves and its vectorised
     # statics, the underactuated finger's kinematics and statics, the compliant gripper's force model
     "synthesis/burmester": ("fabricate/synthesis/watt_six_bar/burmester.py",
-                            ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py"]),
+                            ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py", "tests/test_burmester.py"]),
     "synthesis/six_bar_statics": ("fabricate/synthesis/watt_six_bar/statics.py",
                                   ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py"]),
     "synthesis/underactuated_model": ("fabricate/synthesis/underactuated/model.py", ["tests/test_underactuated.py"]),
