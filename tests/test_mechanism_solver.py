@@ -383,3 +383,43 @@ def test_large_input_step_near_change_point_stays_on_branch():
     expected = _four_bar_b(*lengths, 200.0, left=False)
     assert np.hypot(*(coarse.point("B", "rocker")[1] - expected)) < 1e-9
     assert np.max(np.abs(coarse.q[1] - fine.q[-1])) < 1e-9
+
+
+def _slider_rocker(axis, d_point, s0: float, s1: float) -> Mechanism:
+    """A block slid along ``axis`` through the origin (slide driver) carries pin P; coupler P-B (19.4) and
+    rocker D-B (18.9) close the loop. Links have their frames at mid-length (local points +-L/2), so the
+    size scale is 9.7 and the per-step translation guard 0.3 * 9.7 = 2.91 mm binds before the 0.3 rad one."""
+    big_l, big_r = 19.4, 18.9
+    axis_v, d = np.asarray(axis, dtype=float), np.asarray(d_point, dtype=float)
+    p = s0 * axis_v
+    b = _meet(p, big_l, d, big_r, left=True)
+
+    def frame(p0, p1, length):
+        ang = math.atan2(p1[1] - p0[1], p1[0] - p0[0])
+        return (p0[0] + length / 2 * math.cos(ang), p0[1] + length / 2 * math.sin(ang), ang)
+
+    return Mechanism(
+        name="slider_rocker",
+        bodies=(Body("ground", {"S": (0.0, 0.0), "D": tuple(d_point)}),
+                Body("block", {"S": (0.0, 0.0), "P": (0.0, 0.0)}),
+                Body("coupler", {"P": (-big_l / 2, 0.0), "B": (big_l / 2, 0.0)}),
+                Body("rocker", {"D": (-big_r / 2, 0.0), "B": (big_r / 2, 0.0)})),
+        ground="ground",
+        joints=(Slider("S", "ground", "block", axis), Revolute("P", "block", "coupler"),
+                Revolute("B", "coupler", "rocker"), Revolute("D", "ground", "rocker")),
+        gears=(), drivers=(Driver("slide", "block", "ground", joint="S"),), input_range=(s0, s1), input_unit="mm",
+        assembly={"block": (p[0], p[1], 0.0), "coupler": frame(p, b, big_l), "rocker": frame(d, b, big_r)})
+
+
+@pytest.mark.parametrize(("axis", "d_point"), [((1.0, 0.0), (4.9, -0.6)), ((0.0, 1.0), (0.6, 4.9))])
+def test_large_slide_step_is_subdivided_by_translation(axis, d_point):
+    """One 18.75 mm slide step (6.4 x the 2.91 mm translation guard, along x or, the same mechanism turned
+    90 deg, along y) is subdivided and stays on the branch it was assembled on: B matches the circle
+    intersection within 1e-9, as a 0.25 mm sweep does."""
+    s0, s1 = 5.65, -13.1
+    mech = _slider_rocker(axis, d_point, s0, s1)
+    coarse = mech.sweep(np.array([s0, s1]))
+    fine = mech.sweep(np.linspace(s0, s1, 76))
+    expected = _meet(s1 * np.asarray(axis), 19.4, d_point, 18.9, left=True)
+    assert np.hypot(*(coarse.point("B", "rocker")[1] - expected)) < 1e-9
+    assert np.max(np.abs(coarse.q[1] - fine.q[-1])) < 1e-9
