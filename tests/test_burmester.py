@@ -1,0 +1,250 @@
+"""Generalized Burmester curves (fabricate.synthesis.watt_six_bar.burmester): closed-form checks.
+
+Cubic root finding against polynomials built from their roots, distances against curves made of a circle
+and a line (distance known in closed form), partners against the dyad's constant-length condition, and
+the dtype / scale / warning promises of the small helpers. Expected values never come from the function
+under test.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import warnings
+
+import numpy as np
+
+from fabricate.synthesis.watt_six_bar.burmester import (
+    CubicCurve,
+    PlaneMotion,
+    _polish,
+    cubic_real_roots,
+    distance_to_curve,
+    dyad_curve,
+    ground_motion,
+    plane_motion,
+    sample_curve,
+)
+
+
+def _from_roots(*roots: float) -> np.ndarray:
+    """Coefficients (c0, c1, c2, c3) of the monic cubic prod (y - r), lowest power first."""
+    a, b, c = roots
+    return np.array([-a * b * c, a * b + b * c + c * a, -(a + b + c), 1.0])
+
+
+def _rot(theta: float) -> np.ndarray:
+    return np.array([[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]])
+
+
+def _tensor(poly: dict[tuple[int, int], float]) -> np.ndarray:
+    """Symmetric tensor S with S_jkl v_j v_k v_l = sum coef x^a y^b for ``poly = {(a, b): coef}``, a + b <= 3."""
+    s = np.zeros((3, 3, 3))
+    for (a, b), coef in poly.items():
+        idx = (0,) * a + (1,) * b + (2,) * (3 - a - b)
+        perms = set(itertools.permutations(idx))
+        for p in perms:
+            s[p] += coef / len(perms)
+    return s
+
+
+def _times(p: dict[tuple[int, int], float], q: dict[tuple[int, int], float]) -> dict[tuple[int, int], float]:
+    out: dict[tuple[int, int], float] = {}
+    for (a, b), u in p.items():
+        for (c, d), w in q.items():
+            out[(a + c, b + d)] = out.get((a + c, b + d), 0.0) + u * w
+    return out
+
+
+def _circle(cx: float, cy: float, r: float) -> dict[tuple[int, int], float]:
+    return {(2, 0): 1.0, (0, 2): 1.0, (1, 0): -2.0 * cx, (0, 1): -2.0 * cy, (0, 0): cx * cx + cy * cy - r * r}
+
+
+def _curve(poly: dict[tuple[int, int], float]) -> CubicCurve:
+    return CubicCurve(tensor=_tensor(poly), rows=np.zeros((3, 3, 3)))
+
+
+# --- cubic_real_roots ---------------------------------------------------------------------------------
+
+
+def test_three_real_roots_sorted_at_any_scale() -> None:
+    """(y - 1)(y - 2)(y + 3) gives -3, 1, 2 ascending however the row is scaled (1e-3, 1, 1e3); 1e-12."""
+    base = _from_roots(1.0, 2.0, -3.0)
+    rows = np.stack([base * 1e-3, base, base * 1e3, -base])
+    got = cubic_real_roots(rows)
+    np.testing.assert_allclose(got, np.tile([-3.0, 1.0, 2.0], (4, 1)), rtol=0, atol=1e-12)
+
+
+def test_one_real_root_goes_to_first_column() -> None:
+    """(y - 2)(y^2 + 1): the complex pair is dropped, 2 in column 0 and NaN in 1, 2; batch shape kept."""
+    row = np.array([-2.0, 1.0, -2.0, 1.0])  # (y - 2)(y^2 + 1) = y^3 - 2y^2 + y - 2
+    got = cubic_real_roots(np.stack([row, 5.0 * row]).reshape(2, 1, 4))
+    assert got.shape == (2, 1, 3)
+    np.testing.assert_allclose(got[..., 0], 2.0, rtol=0, atol=1e-12)
+    assert np.isnan(got[..., 1:]).all()
+
+
+def test_lower_degree_rows() -> None:
+    """c3 = 0: a quadratic y^2 - 1 gives -1, 1 (sorted, NaN last); a linear y - 2 gives 2; 1e-12."""
+    got = cubic_real_roots(np.array([[-1.0, 0.0, 1.0, 0.0], [-2.0, 1.0, 0.0, 0.0], [6.0, -5.0, 1.0, 0.0]]))
+    np.testing.assert_allclose(got[0, :2], [-1.0, 1.0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got[1, 0], 2.0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got[2, :2], [2.0, 3.0], rtol=0, atol=1e-12)
+    assert np.isnan(got[0, 2]) and np.isnan(got[1, 1:]).all() and np.isnan(got[2, 2])
+
+
+def test_negligible_leading_coefficients_are_dropped_relative_to_the_row() -> None:
+    """c3 = 1e-14 of the largest coefficient counts as zero: y^2 - 1 (+1e-14 y^3) gives -1, 1 and no huge
+    root near -1e14, whatever the overall scale of the row (1e-3, 1, 1e3); 1e-12."""
+    row = np.array([-1.0, 0.0, 1.0, 1e-14])
+    got = cubic_real_roots(np.stack([row * 1e-3, row, row * 1e3]))
+    np.testing.assert_allclose(got[:, :2], np.tile([-1.0, 1.0], (3, 1)), rtol=0, atol=1e-12)
+    assert np.isnan(got[:, 2]).all()
+
+
+def test_leading_coefficient_threshold_is_exclusive() -> None:
+    """A leading coefficient of exactly 1e-12 of the row's largest still counts as vanished (the test is
+    ``> 1e-12``): y^2 - 1 + 1e-12 y^3 gives -1, 1 and no root near -1e12; 1e-9."""
+    got = cubic_real_roots(np.array([[-1.0, 0.0, 1.0, 1e-12]]))
+    np.testing.assert_allclose(got[0, :2], [-1.0, 1.0], rtol=0, atol=1e-9)
+    assert np.isnan(got[0, 2])
+
+
+def test_complex_roots_of_a_quadratic_are_dropped() -> None:
+    """y^2 + 1/4 (roots +-i/2) and y^2 + 1e-18 (roots +-1e-9 i, imaginary part at the 1e-9 tolerance,
+    exclusive) have no real roots: all NaN."""
+    got = cubic_real_roots(np.array([[0.25, 0.0, 1.0, 0.0], [1e-18, 0.0, 1.0, 0.0]]))
+    assert np.isnan(got).all()
+
+
+def test_zero_and_nan_rows_give_nan_and_leave_others_alone() -> None:
+    """An all-zero row and a row with a NaN coefficient give NaN roots without raising; the other rows of
+    the batch keep their roots (1e-12)."""
+    rows = np.array([[0.0, 0.0, 0.0, 0.0], [np.nan, 0.0, 0.0, 1.0], _from_roots(1.0, 2.0, -3.0)])
+    got = cubic_real_roots(rows)
+    assert np.isnan(got[:2]).all()
+    np.testing.assert_allclose(got[2], [-3.0, 1.0, 2.0], rtol=0, atol=1e-12)
+
+
+def test_polish_recovers_roots_given_to_1e_5() -> None:
+    """Two Newton steps from roots off by 1e-5 (well inside the 1e-3 step guard) reach 1e-12: quadratic
+    convergence needs the exact derivative c1 + 2 c2 y + 3 c3 y^2."""
+    c = np.stack([_from_roots(1.0, 2.0, -3.0), 2.0 * _from_roots(-0.5, 4.0, 7.0)])
+    exact = np.array([[-3.0, 1.0, 2.0], [-0.5, 4.0, 7.0]])
+    got = _polish(exact + np.array([1e-5, -1e-5, 1e-5]), c)
+    np.testing.assert_allclose(got, exact, rtol=0, atol=1e-12)
+
+
+# --- dyad_curve / partners ----------------------------------------------------------------------------
+
+
+def _moving_plane() -> PlaneMotion:
+    """Positions 2, 3 rotate and translate; position 4 is a pure translation by (3, 1)."""
+    angles = [0.0, 0.3, -0.5, 0.0]
+    trans = [[0.0, 0.0], [1.0, 2.0], [-2.0, 0.5], [3.0, 1.0]]
+    return PlaneMotion(np.stack([_rot(a) for a in angles]), np.array(trans))
+
+
+def test_dyad_curve_of_a_plane_with_itself_is_zero_without_warnings() -> None:
+    """A dyad joining a plane to itself imposes nothing: all rows vanish and the curve tensor is exactly
+    zero (finite, no division warning from the unit-scale normalisation)."""
+    motion = _moving_plane()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        curve = dyad_curve(motion, motion)
+    assert np.array_equal(curve.tensor, np.zeros((3, 3, 3)))
+
+
+def test_dyad_curve_tensor_has_unit_largest_entry_for_small_motions() -> None:
+    """Small displacements (0.01 mm, 0.001 rad) give a raw determinant tensor far below 1; the curve is
+    still scaled to largest |entry| = 1 (1e-12)."""
+    angles = np.array([0.0, 1e-3, -2e-3, 1.5e-3])
+    origins = np.array([[0.0, 0.0], [0.01, 0.0], [0.0, 0.01], [-0.01, 0.005]])
+    curve = dyad_curve(ground_motion(), plane_motion(origins, angles))
+    assert abs(np.max(np.abs(curve.tensor)) - 1.0) < 1e-12
+
+
+def test_partners_keep_the_dyad_length_and_ignore_the_rest_of_the_batch() -> None:
+    """Partner Y of a curve point X (ground to moving plane) keeps |X - (R_i Y + t_i)| = |X - Y| at
+    positions 2..4 (1e-9 relative), and is the same (1e-12 relative) when computed alone or together with a
+    far point (1e12 mm, where the pure-translation position's row stays O(1) and the other rows are huge)."""
+    moving = _moving_plane()
+    curve = dyad_curve(ground_motion(), moving)
+    sample = sample_curve(curve, np.array([1.5]))
+    x = sample.points()[0, 0]
+    assert np.isfinite(x).all()
+    alone = curve.partners(x[None])[0]
+    together = curve.partners(np.stack([x, 1e12 * np.array([-1.0, 3.0])]))[0]
+    np.testing.assert_allclose(together, alone, rtol=1e-12)
+    length = np.hypot(*(x - alone))
+    for i in range(1, 4):
+        moved = moving.rotations[i] @ alone + moving.translations[i]
+        assert abs(np.hypot(*(x - moved)) - length) < 1e-9 * max(length, 1.0)
+
+
+def test_partner_at_infinity_raises_no_warning() -> None:
+    """A point whose (Y, 1) null vector is (0, 1, 0) (partner at infinity) gives a non-finite partner
+    without a divide or invalid RuntimeWarning."""
+    rows = np.zeros((3, 3, 3))
+    rows[0, :, 2] = [1.0, 0.0, 0.0]
+    rows[1, :, 2] = [0.0, 0.0, 1.0]
+    rows[2, :, 2] = [1.0, 0.0, 1.0]
+    curve = CubicCurve(tensor=np.zeros((3, 3, 3)), rows=rows)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        y = curve.partners(np.array([[0.0, 0.0]]))
+    assert not np.isfinite(y).all()
+
+
+# --- motions ------------------------------------------------------------------------------------------
+
+
+def test_apply_returns_float64_for_integer_motion_and_points() -> None:
+    """An integer-valued motion applied to integer points gives float64 positions (callers write NaN into
+    them) equal to R_i X + t_i."""
+    rot = np.array([[[1, 0], [0, 1]], [[0, -1], [1, 0]], [[-1, 0], [0, -1]], [[0, 1], [-1, 0]]])
+    trans = np.array([[0, 0], [1, 2], [3, 4], [5, 6]])
+    motion = PlaneMotion(rot, trans)
+    got = motion.apply(np.array([2, 1]))
+    assert got.dtype == np.float64
+    np.testing.assert_array_equal(got, [[2.0, 1.0], [0.0, 4.0], [1.0, 3.0], [6.0, 4.0]])
+
+
+def test_plane_motion_rounds_extended_precision_origins_to_float64() -> None:
+    """Origins in extended precision give the same float64 translations as the float64-rounded origins."""
+    origins = np.array([[0.0, 0.0], [1.0, 2.0], [-1.0, 3.0], [2.0, -1.0]]) + 1.0 / 3.0
+    angles = np.array([0.0, 0.2, -0.3, 0.5])
+    ext = plane_motion(origins.astype(np.longdouble) + np.longdouble(1e-17), angles)
+    ref = plane_motion((origins.astype(np.longdouble) + np.longdouble(1e-17)).astype(np.float64), angles)
+    assert ext.translations.dtype == np.float64
+    np.testing.assert_array_equal(ext.translations, ref.translations)
+
+
+# --- distance_to_curve --------------------------------------------------------------------------------
+
+
+def test_distance_to_a_vertical_line_found_by_the_y_grid() -> None:
+    """Circle (x+20)^2 + y^2 = 25 times the line x = 10, from the origin: the line (distance 10, foot
+    (10, 0)) is nearer than the circle (15). Lines of constant x never meet x = 10, only y lines do; 1e-9."""
+    curve = _curve(_times(_circle(-20.0, 0.0, 5.0), {(1, 0): 1.0, (0, 0): -10.0}))
+    dist, foot = distance_to_curve(curve, np.array([0.0, 0.0]))
+    assert abs(dist - 10.0) < 1e-9
+    np.testing.assert_allclose(foot, [10.0, 0.0], rtol=0, atol=1e-9)
+
+
+def test_distance_to_a_horizontal_line_found_by_the_x_grid() -> None:
+    """Circle x^2 + (y+20)^2 = 25 times the line y = 10, from the origin: distance 10 at (0, 10), the
+    circle is 15 away; 1e-9."""
+    curve = _curve(_times(_circle(0.0, -20.0, 5.0), {(0, 1): 1.0, (0, 0): -10.0}))
+    dist, foot = distance_to_curve(curve, np.array([0.0, 0.0]))
+    assert abs(dist - 10.0) < 1e-9
+    np.testing.assert_allclose(foot, [0.0, 10.0], rtol=0, atol=1e-9)
+
+
+def test_distance_to_a_small_oval_between_coarse_grid_lines() -> None:
+    """A circle of radius 0.25 centred at (0.5, 0) times the line x = 10, from the origin: distance 0.25
+    (foot (0.25, 0)) to the small circle, not 10 to the line; the fine grid must reach it; 1e-9."""
+    curve = _curve(_times(_circle(0.5, 0.0, 0.25), {(1, 0): 1.0, (0, 0): -10.0}))
+    dist, foot = distance_to_curve(curve, np.array([0.0, 0.0]))
+    assert abs(dist - 0.25) < 1e-9
+    np.testing.assert_allclose(foot, [0.25, 0.0], rtol=0, atol=1e-6)
