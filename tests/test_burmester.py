@@ -21,7 +21,9 @@ from fabricate.synthesis.watt_six_bar.burmester import (
     cubic_real_roots,
     distance_to_curve,
     dyad_curve,
+    grid_in_range,
     ground_motion,
+    in_box,
     plane_motion,
     sample_curve,
 )
@@ -224,27 +226,170 @@ def test_plane_motion_rounds_extended_precision_origins_to_float64() -> None:
 
 
 def test_distance_to_a_vertical_line_found_by_the_y_grid() -> None:
-    """Circle (x+20)^2 + y^2 = 25 times the line x = 10, from the origin: the line (distance 10, foot
-    (10, 0)) is nearer than the circle (15). Lines of constant x never meet x = 10, only y lines do; 1e-9."""
-    curve = _curve(_times(_circle(-20.0, 0.0, 5.0), {(1, 0): 1.0, (0, 0): -10.0}))
+    """Circle (x+20)^2 + y^2 = 25 times the line x = 10.01, from the origin: the line (distance 10.01, foot
+    (10.01, 0)) is nearer than the circle (15). Lines of constant x never meet the line (10.01 lies between
+    grid values, so rounding noise cannot fake a crossing), only lines of constant y do; 1e-9."""
+    curve = _curve(_times(_circle(-20.0, 0.0, 5.0), {(1, 0): 1.0, (0, 0): -10.01}))
     dist, foot = distance_to_curve(curve, np.array([0.0, 0.0]))
-    assert abs(dist - 10.0) < 1e-9
-    np.testing.assert_allclose(foot, [10.0, 0.0], rtol=0, atol=1e-9)
+    assert abs(dist - 10.01) < 1e-9
+    np.testing.assert_allclose(foot, [10.01, 0.0], rtol=0, atol=1e-9)
 
 
 def test_distance_to_a_horizontal_line_found_by_the_x_grid() -> None:
-    """Circle x^2 + (y+20)^2 = 25 times the line y = 10, from the origin: distance 10 at (0, 10), the
-    circle is 15 away; 1e-9."""
-    curve = _curve(_times(_circle(0.0, -20.0, 5.0), {(0, 1): 1.0, (0, 0): -10.0}))
+    """Circle x^2 + (y+20)^2 = 25 times the line y = 10.01 (between grid values), from the origin:
+    distance 10.01 at (0, 10.01), the circle is 15 away; 1e-9."""
+    curve = _curve(_times(_circle(0.0, -20.0, 5.0), {(0, 1): 1.0, (0, 0): -10.01}))
     dist, foot = distance_to_curve(curve, np.array([0.0, 0.0]))
-    assert abs(dist - 10.0) < 1e-9
-    np.testing.assert_allclose(foot, [0.0, 10.0], rtol=0, atol=1e-9)
+    assert abs(dist - 10.01) < 1e-9
+    np.testing.assert_allclose(foot, [0.0, 10.01], rtol=0, atol=1e-9)
 
 
 def test_distance_to_a_small_oval_between_coarse_grid_lines() -> None:
-    """A circle of radius 0.25 centred at (0.5, 0) times the line x = 10, from the origin: distance 0.25
-    (foot (0.25, 0)) to the small circle, not 10 to the line; the fine grid must reach it; 1e-9."""
-    curve = _curve(_times(_circle(0.5, 0.0, 0.25), {(1, 0): 1.0, (0, 0): -10.0}))
+    """A circle of radius 0.25 centred at (0.5, 0) times the line x = 10.01, from the origin: distance 0.25
+    (foot (0.25, 0)) to the small circle, not 10.01 to the line; the fine grid must reach it; 1e-9."""
+    curve = _curve(_times(_circle(0.5, 0.0, 0.25), {(1, 0): 1.0, (0, 0): -10.01}))
     dist, foot = distance_to_curve(curve, np.array([0.0, 0.0]))
     assert abs(dist - 0.25) < 1e-9
     np.testing.assert_allclose(foot, [0.25, 0.0], rtol=0, atol=1e-6)
+
+
+def test_distance_default_span_is_40_mm() -> None:
+    """A small circle (r 0.4) centred at (40.5, 40.5) lies outside the 40 mm window of x and y lines around
+    the origin, so the default search only finds the line x = 200 (distance 200, 1e-9); with span=41 the
+    circle is found (distance |(40.5, 40.5)| - 0.4; 1e-4, the projection onto so small a circle seen from
+    57 mm converges slowly)."""
+    curve = _curve(_times(_circle(40.5, 40.5, 0.4), {(1, 0): 1.0, (0, 0): -200.0}))
+    dist, _ = distance_to_curve(curve, np.array([0.0, 0.0]))
+    assert abs(dist - 200.0) < 1e-9
+    dist41, _ = distance_to_curve(curve, np.array([0.0, 0.0]), span=41.0)
+    assert abs(dist41 - (math.hypot(40.5, 40.5) - 0.4)) < 1e-4
+
+
+def test_distance_to_a_curve_without_real_points_is_inf_at_the_float_point() -> None:
+    """x^2 + y^2 + 1 has no real point: (inf, point) with the point as float64 even if given as integers."""
+    dist, foot = distance_to_curve(_curve({(2, 0): 1.0, (0, 2): 1.0, (0, 0): 1.0}), np.array([3, 4]))
+    assert dist == math.inf
+    assert foot.dtype == np.float64
+    np.testing.assert_array_equal(foot, [3.0, 4.0])
+
+
+def test_gradient_matches_closed_form() -> None:
+    """Gradient of P = ((x-1)^2 + y^2 - 4)(x + 2y - 3) against the hand-derived partials (1e-12 relative)."""
+    curve = _curve(_times(_circle(1.0, 0.0, 2.0), {(1, 0): 1.0, (0, 1): 2.0, (0, 0): -3.0}))
+    pts = np.array([[0.5, -1.0], [2.0, 3.0], [-4.0, 0.25]])
+    x, y = pts.T
+    q, lin = (x - 1.0) ** 2 + y**2 - 4.0, x + 2.0 * y - 3.0
+    expected = np.stack([2.0 * (x - 1.0) * lin + q, 2.0 * y * lin + 2.0 * q], axis=-1)
+    np.testing.assert_allclose(curve.gradient(pts), expected, rtol=1e-12)
+    np.testing.assert_allclose(curve.evaluate(pts), q * lin, rtol=1e-12)
+
+
+def test_y_polynomials_of_integer_abscissae_match_float() -> None:
+    """Integer x (here 3e6 mm, whose cube overflows int64) gives the same coefficients as float x (1e-12)."""
+    curve = _curve(_times(_circle(1.0, 0.0, 2.0), {(1, 0): 1.0, (0, 1): 2.0, (0, 0): -3.0}))
+    x = np.array([3_000_000, -7])
+    np.testing.assert_allclose(curve.y_polynomials(x), curve.y_polynomials(x.astype(float)), rtol=1e-12)
+
+
+def test_in_box_is_closed_on_every_side() -> None:
+    """Points on each edge of the box are inside; just outside each edge, and NaN, are outside."""
+    box = np.array([0.0, 2.0, -1.0, 1.0])
+    inside = np.array([[0.0, 0.0], [2.0, 0.0], [1.0, -1.0], [1.0, 1.0]])
+    outside = np.array([[-1e-9, 0.0], [2.0 + 1e-9, 0.0], [1.0, -1.0 - 1e-9], [1.0, 1.0 + 1e-9], [np.nan, 0.0]])
+    assert in_box(inside, box).all()
+    assert not in_box(outside, box).any()
+
+
+def test_grid_in_range_rounds_to_1e_9() -> None:
+    """Grid values are rounded to 9 decimals: a start of 0.1234567891234 prints as 0.123456789."""
+    got = grid_in_range(0.1234567891234, 1.0, 0.25)
+    np.testing.assert_array_equal(got, [0.123456789, 0.373456789, 0.623456789, 0.873456789])
+
+
+def test_float32_and_integer_coefficients_are_solved_in_float64() -> None:
+    """(y - 1)(y - 2)(y + 3) given as float32 or int64 gives -3, 1, 2 to 1e-12 (no float32 arithmetic)."""
+    base = _from_roots(1.0, 2.0, -3.0)
+    for row in (base.astype(np.float32), base.astype(np.int64)):
+        np.testing.assert_allclose(cubic_real_roots(row[None]), [[-3.0, 1.0, 2.0]], rtol=0, atol=1e-12)
+
+
+def test_close_roots_and_double_root() -> None:
+    """Roots 0, 0.1, 0.2 (discriminant 4e-6, still three) come back sorted (1e-12); a double root
+    (y - 1)^2 (y + 2) (discriminant 0) counts as the single-root case: one root (-2 or 1, 1e-6), NaN in
+    columns 1, 2."""
+    got = cubic_real_roots(np.stack([_from_roots(0.0, 0.1, 0.2), _from_roots(1.0, 1.0, -2.0)]))
+    np.testing.assert_allclose(got[0], [0.0, 0.1, 0.2], rtol=0, atol=1e-12)
+    assert min(abs(got[1, 0] + 2.0), abs(got[1, 0] - 1.0)) < 1e-6
+    assert np.isnan(got[1, 1:]).all()
+
+
+def test_polish_at_small_and_large_scales() -> None:
+    """Newton polish from 1e-5 errors where |P'| < 1 (roots 0.1, 0.2, 0.3) and from 1e-4 errors at roots
+    1000, 2000, 3000 (step guard 1e-3 (1 + |y|)) reaches 1e-12 relative."""
+    small = np.array([0.1, 0.2, 0.3])
+    got = _polish(small + 1e-5, _from_roots(*small)[None])
+    np.testing.assert_allclose(got[0], small, rtol=1e-12)
+    large = np.array([1000.0, 2000.0, 3000.0])
+    got = _polish(large + 1e-4, _from_roots(*large)[None])
+    np.testing.assert_allclose(got[0], large, rtol=1e-12)
+
+
+def test_polish_keeps_estimates_whose_newton_step_is_too_long() -> None:
+    """A Newton step longer than 1e-3 (1 + |y|) means a near-double root: the estimate is returned unchanged
+    (y = 0.0015 on y^3 - 9y, step ~0.0015; y = 0.0051 between the roots 0 and 0.01 of y (y - 0.01)(y - 5),
+    step ~0.12). Where P' vanishes (triple roots of y^3 and (y - 2000)^3, and y = 0 on y^3 + 1e-30) the
+    estimate is kept too, without divide or invalid warnings."""
+    c = np.stack([np.array([0.0, -9.0, 0.0, 1.0]), _from_roots(0.0, 0.01, 5.0), _from_roots(0.0, 0.0, 0.0),
+                  _from_roots(2000.0, 2000.0, 2000.0), np.array([1e-30, 0.0, 0.0, 1.0])])
+    roots = np.array([[0.0015], [0.0051], [0.0], [2000.0], [0.0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        got = _polish(roots, c)
+    np.testing.assert_array_equal(got, roots)
+
+
+def test_sample_curve_of_a_batch_matches_single_curves() -> None:
+    """Sampling two dyad curves at once (x given as integers, n = 3) gives, curve by curve, the same
+    ordinates and partners as sampling each alone (1e-12), and float64 abscissae."""
+    origins = np.array([[[0.0, 0.0], [1.0, 2.0], [-2.0, 0.5], [3.0, 1.0]],
+                        [[0.0, 1.0], [2.0, 2.0], [-1.0, 0.5], [2.0, -1.0]]])
+    angles = np.array([[0.0, 0.3, -0.5, 0.2], [0.1, 0.4, -0.2, 0.6]])
+    batch = dyad_curve(ground_motion((2,)), plane_motion(origins, angles))
+    x = np.array([-1, 0, 2])
+    both = sample_curve(batch, x)
+    assert both.x.dtype == np.float64 and both.x.shape == (2, 3)
+    for k in range(2):
+        one = sample_curve(dyad_curve(ground_motion(), plane_motion(origins[k], angles[k])), x.astype(float))
+        np.testing.assert_allclose(both.y[k], one.y, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(both.partner[k], one.partner, rtol=1e-12, atol=1e-12)
+
+
+def test_partners_are_invariant_to_a_huge_row_scale() -> None:
+    """The partner system is homogeneous: rows scaled by 1e160 give the same partners (1e-12 relative)."""
+    curve = dyad_curve(ground_motion(), _moving_plane())
+    pts = sample_curve(curve, np.array([1.5, -2.0])).points()[:, 0]
+    ref = curve.partners(pts)
+    big = CubicCurve(tensor=curve.tensor, rows=curve.rows * 1e160).partners(pts)
+    assert np.isfinite(ref).all()
+    np.testing.assert_allclose(big, ref, rtol=1e-12)
+
+
+def test_partners_of_a_nearly_rank_one_system_are_nan() -> None:
+    """A system with singular values (2, 1e-9, 0), second/first = 5e-10 below the 1e-9 rank threshold, has
+    no unique partner: NaN."""
+    rows = np.zeros((3, 3, 3))
+    rows[0, :, 2] = [1.0, 1.0, 0.0]
+    rows[1, :, 2] = [1.0, 1.0, 0.0]
+    rows[2, :, 2] = [0.0, 0.0, 1e-9]
+    y = CubicCurve(tensor=np.zeros((3, 3, 3)), rows=rows).partners(np.array([[0.0, 0.0]]))
+    assert np.isnan(y).all()
+
+
+def test_plane_motion_rounds_extended_precision_angles_to_float64() -> None:
+    """Angles in extended precision give float64 rotations equal to those of the float64-rounded angles."""
+    origins = np.array([[0.0, 0.0], [1.0, 2.0], [-1.0, 3.0], [2.0, -1.0]])
+    angles = np.array([0.0, 0.2, -0.3, 0.5]).astype(np.longdouble) + np.longdouble(1e-19)
+    ext = plane_motion(origins, angles)
+    ref = plane_motion(origins, angles.astype(np.float64))
+    assert ext.rotations.dtype == np.float64 and ext.translations.dtype == np.float64
+    np.testing.assert_array_equal(ext.rotations, ref.rotations)
