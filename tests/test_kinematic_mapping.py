@@ -541,3 +541,189 @@ def test_branch_matching_pairs_each_solution_with_its_closest_previous_branch():
     assert km._match_branches([], previous) == []
     # the threshold is a parameter: at 0.99 (8.1 degrees) a 0.2 rad neighbour is not matched
     assert km._match_branches([unit(0.5)], previous, min_dot=0.99) == [-1]
+
+
+# -- double precision for float32 inputs, scale invariance, tangency, the Newton polish -----------------
+
+
+def test_circle_vector_is_computed_in_double_precision_for_float32_input():
+    """A float32 centre and circle point (exact float32 values) give the float64 vector of eq 6 written
+    out here in double precision: p = (1, -x, -y, -cx, -cy, cx y - cy x, (cx x + cy y) / 2,
+    (cx^2 + cy^2 - r^2 + x^2 + y^2) / 4), to 1e-12 relative (float32 arithmetic is off by ~1e-7)."""
+    c32 = np.array([123.456, -98.765], dtype=np.float32)
+    b32 = np.array([-12.345, 67.891], dtype=np.float32)
+    r = 37.123
+    for centre, point_ in ((c32, b32), (c32, b32.astype(np.float64)), (c32.astype(np.float64), b32)):
+        p = km.circle_vector(centre, point_, r)
+        assert p.dtype == np.float64
+        cx, cy = (float(v) for v in c32)
+        x, y = (float(v) for v in b32)
+        expected = [1.0, -x, -y, -cx, -cy, cx * y - cy * x, (cx * x + cy * y) / 2,
+                    (cx * cx + cy * cy - r * r + x * x + y * y) / 4]
+        assert np.allclose(p, expected, rtol=1e-12, atol=0)
+
+
+def test_dyad_from_vector_divides_in_double_precision_for_float32_input():
+    """A float32 circle vector (exact values) decodes in float64: centre -(p4, p5) / p1 and point
+    -(p2, p3) / p1 computed here in double precision, to 1e-14 relative (1/3 in float32 is off by 1e-8)."""
+    p32 = np.array([3.0, 1.0, -2.0, 7.0, 5.0, 0.0, 0.0, 0.0], dtype=np.float32)
+    centre, moving = km.dyad_from_vector(p32)
+    assert centre.dtype == np.float64 and moving.dtype == np.float64
+    assert np.allclose(centre, [-7.0 / 3.0, -5.0 / 3.0], rtol=1e-14, atol=0)
+    assert np.allclose(moving, [-1.0 / 3.0, 2.0 / 3.0], rtol=1e-14, atol=0)
+
+
+def test_map_points_is_computed_in_double_precision_for_float32_images():
+    """A float32 image (exact values) maps points like the float64 matrix of eq 3 evaluated here
+    (1e-12 mm); float32 arithmetic would be off by ~1e-5 mm."""
+    z32 = np.array([12.3, -7.7, 0.3, 0.9], dtype=np.float32)
+    q = np.array([[10.1, -3.3], [-45.6, 78.9]])
+    z1, z2, z3, z4 = (float(v) for v in z32)
+    h = z3 * z3 + z4 * z4
+    rot_ = np.array([[z4 * z4 - z3 * z3, -2 * z4 * z3], [2 * z4 * z3, z4 * z4 - z3 * z3]]) / h
+    shift = np.array([2 * (z1 * z3 + z2 * z4), 2 * (z2 * z3 - z1 * z4)]) / h
+    moved = km.map_points(z32, q)
+    assert moved.dtype == np.float64
+    assert np.allclose(moved, q @ rot_.T + shift, rtol=0, atol=1e-12)
+
+
+def test_map_points_returns_float64_whatever_the_type_of_the_points():
+    """Points given as float32, integers or long double are taken as float64: the result is float64 and
+    equal (1e-12 mm) to mapping the same points given as float64 (R(v) q + (e, f), v = 0.5, e = 3, f = -2)."""
+    z = textbook_image(3.0, -2.0, 0.5)
+    q = np.array([[1.0, 2.0], [-3.0, 4.0]])
+    expected = q @ rot(0.5).T + np.array([3.0, -2.0])
+    for typed in (q.astype(np.float32), q.astype(np.int64), q.astype(np.longdouble)):
+        moved = km.map_points(z, typed)
+        assert moved.dtype == np.float64
+        assert np.allclose(moved, expected, rtol=0, atol=1e-12)
+
+
+def test_constraint_matrix_is_computed_in_double_precision_for_float32_images():
+    """A float32 image (exact values) gives the float64 row of eq 11 written out here, to 1e-12
+    relative; products formed in float32 would be off by ~1e-7."""
+    z32 = np.array([[12.3, -7.7, 0.3, 0.9], [-1.1, 2.2, -0.7, 0.6]], dtype=np.float32)
+    m = km.constraint_matrix(z32)
+    assert m.dtype == np.float64 and m.shape == (2, 8)
+    for row, z in zip(m, z32.astype(np.float64), strict=True):
+        z1, z2, z3, z4 = z
+        expected = [z1 * z1 + z2 * z2, z1 * z3 - z2 * z4, z2 * z3 + z1 * z4, z1 * z3 + z2 * z4,
+                    z2 * z3 - z1 * z4, z3 * z4, z3 * z3 - z4 * z4, z3 * z3 + z4 * z4]
+        assert np.allclose(row, expected, rtol=1e-12, atol=0)
+
+
+def test_side_conditions_are_computed_in_double_precision_for_float32_vectors():
+    """A float32 8-vector (exact values) gives the float64 values of eq 7 written out here, to 1e-12
+    relative (float32 products and differences would be off by ~1e-7)."""
+    p32 = np.array([1.1, -2.3, 3.7, 0.9, -4.1, 5.3, 0.7, 2.9], dtype=np.float32)
+    p = p32.astype(np.float64)
+    q1 = p[0] * p[5] + p[1] * p[4] - p[2] * p[3]
+    q2 = 2 * p[0] * p[6] - p[1] * p[3] - p[2] * p[4]
+    values = km.side_conditions(p32)
+    assert values.dtype == np.float64
+    assert np.allclose(values, [q1, q2], rtol=1e-12, atol=0)
+
+
+def test_negated_circle_meets_the_axes_in_its_four_axis_points():
+    """A conic is defined up to any nonzero scale, also a negative one: ``-(x^2 + y^2 - 1)`` and the axes
+    ``x y = 0`` meet at (+-1, 0) and (0, +-1). Each returned point is a unit vector on both conics
+    (1e-12) and the affine points are those four (1e-12)."""
+    circle = -np.diag([1.0, 1.0, -1.0])
+    axes = np.array([[0.0, 0.5, 0.0], [0.5, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    found = km.conic_intersections(circle, axes)
+    assert len(found) == 4
+    for x in found:
+        assert abs(np.linalg.norm(x) - 1.0) < 1e-12
+        assert abs(x @ circle @ x) < 1e-12 and abs(x @ axes @ x) < 1e-12
+    assert np.allclose(affine(found), [[-1.0, 0.0], [0.0, -1.0], [0.0, 1.0], [1.0, 0.0]], rtol=0, atol=1e-12)
+
+
+def test_a_nearly_degenerate_parabola_keeps_its_point_near_the_origin():
+    """The parabola ``y w = x^2 + d w^2`` with d = 1e-100 meets the axes ``x y = 0`` at (0, d) and at its
+    point at infinity (0 : 1 : 0) (on y = 0, ``x^2 = -d`` has no real root). The finite point is found
+    (as a unit vector, 1e-12, with y / w = d to 1e-12 relative): its homogeneous coordinates are
+    (0, d, 1), huge when scaled so that w is small."""
+    d = 1e-100
+    parabola = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -0.5], [0.0, -0.5, d]])
+    axes = np.array([[0.0, 0.5, 0.0], [0.5, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    found = km.conic_intersections(parabola, axes)
+    assert len(found) == 2
+    for x in found:
+        assert abs(np.linalg.norm(x) - 1.0) < 1e-12
+    finite = [x for x in found if abs(x[2]) > 0.5]
+    at_infinity = [x for x in found if abs(x[2]) <= 0.5]
+    assert len(finite) == 1 and len(at_infinity) == 1
+    assert finite[0][0] == 0.0 and abs(finite[0][1] / finite[0][2] - d) < 1e-12 * d
+    assert np.allclose(np.abs(at_infinity[0]), [0.0, 1.0, 0.0], rtol=0, atol=1e-12)
+
+
+def test_a_circle_tangent_to_a_line_of_the_pair_gives_the_point_of_contact():
+    """The circle ``(x - 1)^2 + y^2 = 1`` touches the line x = 0 at the origin; with the line pair
+    ``x w = 0`` (x = 0 and the line at infinity, which meets the circle only in the complex circular
+    points) the only real common point is the origin, a double root of the line's quadratic. It must be
+    returned (every returned point is the origin, to 1e-12), not dropped as if the discriminant were
+    negative."""
+    circle = circle_conic(1.0, 0.0, 1.0)
+    xw = np.array([[0.0, 0.0, 0.5], [0.0, 0.0, 0.0], [0.5, 0.0, 0.0]])
+    found = km.conic_intersections(circle, xw)
+    assert len(found) >= 1
+    for x in found:
+        assert np.allclose(np.abs(x), [0.0, 0.0, 1.0], rtol=0, atol=1e-12)
+
+
+def test_ellipse_and_hyperbola_with_a_vanishing_quadratic_pencil_coefficient():
+    """``x^2 + 4 y^2 = 3`` and ``x^2 - y^2 = 1`` meet at (+-sqrt(1.4), +-sqrt(0.4)) (subtracting: 5 y^2 = 2).
+    Their pencil ``det(c1 + lam c2) = -(1 + lam)(4 - lam)(-3 - lam)`` has a vanishing lam^2 coefficient
+    (1 - 4 + 3), while c2 itself is regular: all four points are found, to 1e-12."""
+    found = km.conic_intersections(np.diag([1.0, 4.0, -3.0]), np.diag([1.0, -1.0, -1.0]))
+    a, b = math.sqrt(1.4), math.sqrt(0.4)
+    assert len(found) == 4
+    assert np.allclose(affine(found), [[-a, -b], [-a, b], [a, -b], [a, b]], rtol=0, atol=1e-12)
+
+
+def test_line_basis_is_orthonormal_on_the_line_at_any_scale():
+    """``_line_basis`` returns two unit, orthogonal points on the line (1e-12), and a line's coefficients are
+    homogeneous: scaling it gives the same basis (1e-12), up to 8e153 for the line x + y = 0 (whose
+    cross products then still have squares summing below the float64 limit)."""
+    cases = [(np.array([3.0, -4.0, 1.0]), 1e150), (np.array([1.0, 1.0, 0.0]), 8e153),
+             (np.array([0.2, -7.0, 5.0]), 1e150)]
+    for line, big in cases:
+        unit_line = line / np.linalg.norm(line)
+        for scale in (1.0, 1e-3, big):
+            e, f = km._line_basis(scale * line)
+            assert abs(np.linalg.norm(e) - 1.0) < 1e-12 and abs(np.linalg.norm(f) - 1.0) < 1e-12
+            assert abs(e @ f) < 1e-12
+            assert abs(e @ unit_line) < 1e-12 and abs(f @ unit_line) < 1e-12
+            assert np.allclose(np.array([e, f]), km._line_basis(line), rtol=0, atol=1e-12)
+
+
+def newton_on_sphere(c1: np.ndarray, c2: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """One Newton step of ``x^T c x = 0`` for both conics with the step orthogonal to x, then x / |x|."""
+    jac = np.array([2 * c1 @ x, 2 * c2 @ x, x])
+    step = np.linalg.solve(jac, np.array([-(x @ c1 @ x), -(x @ c2 @ x), 0.0]))
+    y = x + step
+    return y / np.linalg.norm(y)
+
+
+def test_polish_returns_to_a_transversal_intersection():
+    """From a unit vector 1e-4 away from the intersection (1/2, sqrt(3)/2) of the unit circles about (0, 0)
+    and (1, 0), the default polish lands on the exact point to 1e-12 (Newton converges quadratically)."""
+    c1, c2 = circle_conic(0.0, 0.0, 1.0), circle_conic(1.0, 0.0, 1.0)
+    exact = np.array([0.5, math.sqrt(3) / 2, 1.0])
+    exact /= np.linalg.norm(exact)
+    start = exact + 1e-4 * np.array([1.0, -2.0, 0.5])
+    start /= np.linalg.norm(start)
+    x = km._polish(c1, c2, start)
+    assert np.allclose(x * np.sign(x[2]), exact, rtol=0, atol=1e-12)
+
+
+def test_polish_does_two_newton_steps_by_default():
+    """The default of ``steps`` is 2: from a start 0.05 away (not converged after two steps), the result
+    equals two Newton steps on the sphere written out here (1e-14), and differs from three."""
+    c1, c2 = circle_conic(0.0, 0.0, 1.0), circle_conic(1.0, 0.0, 1.0)
+    start = np.array([0.5, math.sqrt(3) / 2, 1.0]) + 0.05 * np.array([1.0, -2.0, 0.5])
+    start /= np.linalg.norm(start)
+    two = newton_on_sphere(c1, c2, newton_on_sphere(c1, c2, start))
+    three = newton_on_sphere(c1, c2, two)
+    assert np.linalg.norm(two - three) > 1e-9
+    assert np.allclose(km._polish(c1, c2, start), two, rtol=0, atol=1e-14)
