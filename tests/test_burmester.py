@@ -393,3 +393,17 @@ def test_plane_motion_rounds_extended_precision_angles_to_float64() -> None:
     ref = plane_motion(origins, angles.astype(np.float64))
     assert ext.rotations.dtype == np.float64 and ext.translations.dtype == np.float64
     np.testing.assert_array_equal(ext.rotations, ref.rotations)
+
+
+def test_partners_of_a_zero_system_or_at_infinity_are_nan():
+    """The docstring's promise: NaN where the null space is not unique or Y is at infinity. Rows that vanish
+    exactly (every Y is a partner): NaN, not (0, 0). Rows whose null vector at (0, 0) is (0, 1, 0), a point at
+    infinity: NaN, not +-inf."""
+    zero = CubicCurve(tensor=np.zeros((3, 3, 3)), rows=np.zeros((3, 3, 3)))
+    assert np.all(np.isnan(zero.partners(np.array([[1.0, 2.0]]))))
+    rows = np.zeros((3, 3, 3))
+    rows[0, :, 2] = (1.0, 0.0, 0.0)
+    rows[1, :, 2] = (0.0, 0.0, 1.0)
+    rows[2, :, 2] = (1.0, 0.0, 1.0)
+    curve = CubicCurve(tensor=np.zeros((3, 3, 3)), rows=rows)
+    assert np.all(np.isnan(curve.partners(np.array([[0.0, 0.0]]))))

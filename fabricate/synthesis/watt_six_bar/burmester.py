@@ -161,8 +161,9 @@ class CubicCurve:
         null = vt[..., -1, :]
         with np.errstate(divide="ignore", invalid="ignore"):
             y = null[..., :2] / null[..., 2:3]
-            # rank 1 (both lower singular values ~0) means a whole line of partners: not a dyad
-            degenerate = sv[..., 1] < 1e-9 * sv[..., 0]
+            # rank 1 (both lower singular values ~0) means a whole line of partners: not a dyad; a zero system
+            # (every row vanishes: sv all 0) has every Y as partner; a null vector with w = 0 is at infinity
+            degenerate = (sv[..., 1] <= 1e-9 * sv[..., 0]) | ~np.all(np.isfinite(y), axis=-1)
         y[degenerate] = np.nan
         return y
 
