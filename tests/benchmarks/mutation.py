@@ -81,7 +81,8 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     # the other synthesis methods' numeric kernels: the six-bar's Burmester curves and its vectorised
     # statics, the underactuated finger's kinematics and statics, the compliant gripper's force model
     "synthesis/burmester": ("fabricate/synthesis/watt_six_bar/burmester.py",
-                            ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py", "tests/test_burmester.py"]),
+                            ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py",
+                             "tests/test_burmester.py"]),
     "synthesis/six_bar_statics": ("fabricate/synthesis/watt_six_bar/statics.py",
                                   ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py"]),
     "synthesis/underactuated_model": ("fabricate/synthesis/underactuated/model.py", ["tests/test_underactuated.py"]),
@@ -514,7 +515,7 @@ def _results_text(results: dict) -> str:
                 sep = "," if f < len(fields) - 1 else ""
                 if isinstance(item, list):
                     if key == "mutants":  # a killed mutant's lines are not needed again: keep the file < 1 MB
-                        item = [{k: v for k, v in x.items() if k in ("name", "function", "status")}
+                        item = [[x["name"].rsplit(".", 1)[-1], x["status"]]
                                 if x.get("status") in ("killed", "timeout", "not checked") else x for x in item]
                     lines.append(f" {json.dumps(key)}: [")
                     lines += [f"  {json.dumps(x, separators=(',', ':'))}" + ("," if i < len(item) - 1 else "")
@@ -528,12 +529,23 @@ def _results_text(results: dict) -> str:
     return "\n".join(lines + ["}"]) + "\n"
 
 
+def _load_results() -> dict:
+    """results.json with the compact rows (``[name without the module path, status]``) expanded again."""
+    results = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
+    for value in results.values():
+        if isinstance(value, dict) and "mutants" in value:
+            prefix = value["source"].removesuffix(".py").replace("/", ".") + "."
+            value["mutants"] = [{"name": prefix + x[0], "function": function_of(x[0]), "status": x[1]}
+                                if isinstance(x, list) else x for x in value["mutants"]]
+    return results
+
+
 def _save(key: str, result: dict) -> None:
     """Write one module's result into results.json, re-reading it first: runs of other modules (on the other
     core) may have saved theirs since this run started."""
     fd, tmp = tempfile.mkstemp(dir=HERE, prefix=".results.", suffix=".tmp")
     with _results_lock():
-        current = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
+        current = _load_results()
         current[key] = result
         with os.fdopen(fd, "w") as fh:
             fh.write(_results_text(dict(sorted(current.items(), key=lambda kv: list(MODULES).index(kv[0])
@@ -580,7 +592,7 @@ def main(argv: list[str] | None = None) -> int:
                                           + "\n".join(table) + "\n")
         return 0 if all("| killed |" in row for row in table) else 1
     HERE.mkdir(parents=True, exist_ok=True)
-    results = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
+    results = _load_results()
     keys = list(MODULES) if args.all else args.modules
     unknown = [k for k in keys if k not in MODULES]
     if unknown:
