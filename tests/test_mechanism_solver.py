@@ -93,16 +93,22 @@ def test_redundant_parallelogram_sweeps_backwards():
     assert np.max(np.abs(motion.pose("coupler")[:, 2])) < 1e-9
 
 
-def test_inconsistent_redundant_constraints_lock_up_at_the_start():
-    """A crank pinned to the ground at two points cannot turn: driving it gives a LockupError carrying
-    the first input (least squares leaves a residual of the order of the step, far above tolerance)."""
-    mech = Mechanism(
+def pinned_twice(offset: float, input_range: tuple[float, float]) -> Mechanism:
+    """A crank pinned to the ground at O and at P (0.8 mm apart): locked; its angle is driven by
+    theta = s + offset over ``input_range``."""
+    return Mechanism(
         name="pinned_twice",
         bodies=(Body("ground", {"O": (0.0, 0.0), "P": (0.8, 0.0)}), Body("crank", {"O": (0.0, 0.0), "P": (0.8, 0.0)})),
         ground="ground",
         joints=(Revolute("O", "ground", "crank"), Revolute("P", "ground", "crank")),
-        gears=(), drivers=(Driver("angle", "crank", "ground", law=LinearLaw(1.0, -5.0)),),
-        input_range=(5.0, 6.0), input_unit="mm", assembly={"crank": (0.0, 0.0, 0.0)})
+        gears=(), drivers=(Driver("angle", "crank", "ground", law=LinearLaw(1.0, offset)),),
+        input_range=input_range, input_unit="mm", assembly={"crank": (0.0, 0.0, 0.0)})
+
+
+def test_inconsistent_redundant_constraints_lock_up_at_the_start():
+    """A crank pinned to the ground at two points cannot turn: driving it gives a LockupError carrying
+    the first input (least squares leaves a residual of the order of the step, far above tolerance)."""
+    mech = pinned_twice(-5.0, (5.0, 6.0))
     with pytest.raises(LockupError) as info:
         mech.sweep(np.array([5.0, 6.0]))
     assert info.value.input_value == 5.0
@@ -111,13 +117,7 @@ def test_inconsistent_redundant_constraints_lock_up_at_the_start():
 def test_locked_input_span_below_a_micro_unit_still_reports_lockup():
     """The smallest step is relative to the span plus an absolute 1e-12: a span of 1e-6 input units on a
     locked mechanism still ends in a LockupError at its start (not an endless crawl)."""
-    mech = Mechanism(
-        name="pinned_twice",
-        bodies=(Body("ground", {"O": (0.0, 0.0), "P": (0.8, 0.0)}), Body("crank", {"O": (0.0, 0.0), "P": (0.8, 0.0)})),
-        ground="ground",
-        joints=(Revolute("O", "ground", "crank"), Revolute("P", "ground", "crank")),
-        gears=(), drivers=(Driver("angle", "crank", "ground", law=LinearLaw(1.0, -2.0)),),
-        input_range=(2.0, 2.000001), input_unit="mm", assembly={"crank": (0.0, 0.0, 0.0)})
+    mech = pinned_twice(-2.0, (2.0, 2.000001))
     with pytest.raises(LockupError) as info:
         mech.sweep(np.array([2.0, 2.000001]))
     assert info.value.input_value == 2.0

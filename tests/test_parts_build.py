@@ -348,6 +348,15 @@ def test_curved_pad_and_gear_fuse_into_one_plate(four_bar, sla_process):
     assert plate.symmetric_difference(expected).area < chords
 
 
+def coupler_with_arc_pad(four_bar: Mechanism, process, pts: dict) -> Part:
+    """The four-bar's coupler part with points C, E1, E2 added and a pad arc about C from E1 to E2."""
+    bodies = tuple(Body("coupler", {**b.points, **pts}) if b.name == "coupler" else b for b in four_bar.bodies)
+    mech = Mechanism(name="arc_pad", bodies=bodies, ground=four_bar.ground, joints=four_bar.joints, gears=(),
+                     drivers=four_bar.drivers, input_range=four_bar.input_range, assembly=four_bar.assembly)
+    hints = {"pads": {"coupler": {"point": "C", "arc": ["E1", "E2"]}}}
+    return build_parts(design_for(process), mech, mech.sweep(7), [], hints).part("coupler")
+
+
 def test_a_pad_arc_flatter_than_the_chord_tolerance_is_just_its_bosses(four_bar, sla_process):
     """A pad arc of 0.01 rad on a 10 mm circle about C = (30, 10) of the coupler (chord 0.1 mm, sagitta
     0.125 um < the 5 um chord tolerance): its segment is the chord itself, so the plate is the hull of the
@@ -355,11 +364,7 @@ def test_a_pad_arc_flatter_than_the_chord_tolerance_is_just_its_bosses(four_bar,
     length). It once failed with shapely's bare ValueError (a two-point ring)."""
     a = 0.01
     pts = {"C": (30.0, 10.0), "E1": (40.0, 10.0), "E2": (30.0 + 10 * math.cos(a), 10.0 + 10 * math.sin(a))}
-    bodies = tuple(Body("coupler", {**b.points, **pts}) if b.name == "coupler" else b for b in four_bar.bodies)
-    mech = Mechanism(name="flat_pad", bodies=bodies, ground=four_bar.ground, joints=four_bar.joints, gears=(),
-                     drivers=four_bar.drivers, input_range=four_bar.input_range, assembly=four_bar.assembly)
-    hints = {"pads": {"coupler": {"point": "C", "arc": ["E1", "E2"]}}}
-    coupler = build_parts(design_for(sla_process), mech, mech.sweep(7), [], hints).part("coupler")
+    coupler = coupler_with_arc_pad(four_bar, sla_process, pts)
     boss = (2.0 + 2 * 0.25 + 0.2) / 2 + 1.0
     points = [(0.0, 0.0), (40.0, 0.0), *pts.values()]
     expected = shapely.union_all([shapely.Point(p).buffer(boss, 1024) for p in points]).convex_hull
@@ -382,11 +387,7 @@ def test_a_pad_arc_of_two_chords_adds_its_triangle(four_bar, sla_process):
     end = centre + r * np.array([math.sin(half), -math.cos(half)])
     mid = centre + r * np.array([0.0, -1.0])
     pts = {"C": tuple(centre), "E1": tuple(start), "E2": tuple(end)}
-    bodies = tuple(Body("coupler", {**b.points, **pts}) if b.name == "coupler" else b for b in four_bar.bodies)
-    mech = Mechanism(name="two_chord_pad", bodies=bodies, ground=four_bar.ground, joints=four_bar.joints, gears=(),
-                     drivers=four_bar.drivers, input_range=four_bar.input_range, assembly=four_bar.assembly)
-    hints = {"pads": {"coupler": {"point": "C", "arc": ["E1", "E2"]}}}
-    coupler = build_parts(design_for(process), mech, mech.sweep(7), [], hints).part("coupler")
+    coupler = coupler_with_arc_pad(four_bar, process, pts)
     boss = (2.0 + 2 * 0.25 + 0.2) / 2 + 1.0
     points = [(0.0, 0.0), (40.0, 0.0), *pts.values()]
     hull = shapely.union_all([shapely.Point(p).buffer(boss, 1024) for p in points]).convex_hull
