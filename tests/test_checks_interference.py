@@ -439,14 +439,19 @@ def test_flush_plates_on_different_joints_must_keep_the_clearance():
     assert result.failures() == ["clearance: A and B come within 0.000 mm at input 0 deg; the process needs 0.250 mm"]
 
 
-def test_naive_reference_names_a_degenerate_solid():
-    """A zero-diameter pin has no cross-section: the boolean reference refuses it with a GeometryError
-    that names the solid (pin_J), so the user can find the faulty input."""
+@pytest.mark.parametrize("check", ["naive", "sweep"])
+def test_a_degenerate_solid_is_named(check):
+    """A part of zero width has no cross-section: the boolean reference and the sweep both refuse it
+    with a GeometryError that names the solid (B), so the user can find the faulty input."""
     from fabricate.errors import GeometryError
 
-    parts, motion, pins, _ = two_plates_on_a_pin(0.0)
-    with pytest.raises(GeometryError, match=r"^pin_J: empty cross-section"):
-        naive_interference(parts, motion, chord_tolerance_mm=TOL, pins=pins)
+    parts, motion, pins, _ = two_plates_on_a_pin(2.0)
+    parts[1] = box_part("B", "b", (30.0, 0.0), 3.3, 3.0, centre=(10.0, 0.0))
+    with pytest.raises(GeometryError, match=r"^B: empty cross-section"):
+        if check == "naive":
+            naive_interference(parts, motion, chord_tolerance_mm=TOL, pins=pins)
+        else:
+            sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.1, pins=pins)
 
 
 # -- pairs one pose settles, and what the clearance curve shows ------------------------------------
@@ -743,3 +748,38 @@ def test_report_rounds_kernel_gap_and_overlap_volume_to_six_decimals():
     assert pair.max_overlap_mm3 == pytest.approx(0.12345678, abs=1e-9)
     (row,) = result.report()["collisions"]
     assert row["volume_mm3"] == 0.123457
+
+
+# -- arguments that are not solids -------------------------------------------------------------------
+@pytest.mark.parametrize("diameter", [0.0, -2.0, math.nan])
+def test_a_pin_without_a_positive_diameter_is_refused_by_name(diameter):
+    """A zero pin has no outline and a negative one is a mirrored circle: the sweep names the pin's
+    field (a SpecError, a ValueError) instead of failing inside numpy or checking a phantom solid."""
+    from fabricate.errors import SpecError
+
+    parts, motion, pins, _ = two_plates_on_a_pin(diameter)
+    with pytest.raises(SpecError, match=r"pins\.pin_J\.diameter_mm"):
+        sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.1, pins=pins)
+
+
+@pytest.mark.parametrize("field, kwargs", [
+    ("chord_tolerance_mm", {"chord_tolerance_mm": 0.0}),
+    ("min_clearance_mm", {"min_clearance_mm": -0.1}),
+    ("search_length_mm", {"search_length_mm": -1.0}),
+])
+def test_sweep_arguments_out_of_range_are_refused_by_name(field, kwargs):
+    from fabricate.errors import SpecError
+
+    parts, motion, pins, _ = two_plates_on_a_pin(2.0)
+    args = {"chord_tolerance_mm": TOL, "min_clearance_mm": 0.1, "pins": pins} | kwargs
+    with pytest.raises(SpecError, match=field):
+        sweep_interference(parts, motion, **args)
+
+
+def test_a_washer_whose_outside_is_not_outside_its_bore_is_refused():
+    from fabricate.errors import SpecError
+
+    parts, motion, pins, spacers = two_plates_on_a_pin(2.0, washer=True)
+    bad = [SimpleNamespace(**(vars(spacers[0]) | {"outer_diameter_mm": 2.5}))]
+    with pytest.raises(SpecError, match=r"spacers\[0\]\.outer_diameter_mm"):
+        sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.1, pins=pins, spacers=bad)

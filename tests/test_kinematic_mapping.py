@@ -197,6 +197,49 @@ def test_ellipse_and_hyperbola_points_are_found_to_full_precision_at_any_scale()
         assert np.allclose(affine(found), expected, rtol=0, atol=1e-12)
 
 
+def projective(points: list[np.ndarray]) -> np.ndarray:
+    """Unit homogeneous points with the sign fixed (largest entry positive), sorted: sign-free compare."""
+    fixed = [x / np.linalg.norm(x) * np.sign(x[np.argmax(np.abs(x))]) for x in points]
+    return np.array(sorted(tuple(x) for x in fixed))
+
+
+def test_a_line_through_two_points_of_a_line_pair_meets_it_at_both_basis_points():
+    """The line z = 0 spanned by e = (1, 0, 0) and f = (0, 1, 0) meets the axes ``x y = 0`` exactly at e
+    and f: there a = c = 0 and only b is not zero (before the fix no point was returned). Exact."""
+    axes = np.array([[0.0, 0.5, 0.0], [0.5, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    found = km.line_meets_conic(np.eye(3)[:2], axes)
+    assert len(found) == 2
+    np.testing.assert_array_equal(projective(found), [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
+
+
+@pytest.mark.parametrize("exponent", [-300, -200, -160, -100, -20, 0, 20, 100, 160, 300])
+def test_line_meets_conic_at_any_scale_of_the_conic(exponent):
+    """``x^2 - 3 y^2 = 0`` (scaled by 10^exponent) meets the line z = 0 at (sqrt(3), +-1, 0) / 2. Scales
+    down to 1e-160 used to underflow b^2 - ac (at 1e-200 to 0: one wrong point, e, twice) and up to 1e160 to overflow
+    it (1e160: a c = -inf, no point); each point must be the hand-solved one to 1e-15 and never a zero vector."""
+    conic = 10.0**exponent * np.diag([1.0, -3.0, 0.0])
+    found = km.line_meets_conic(np.eye(3)[:2], conic)
+    assert len(found) == 2
+    for x in found:
+        assert abs(np.linalg.norm(x) - 1.0) < 1e-15
+    expected = projective([np.array([math.sqrt(3.0), -1.0, 0.0]), np.array([math.sqrt(3.0), 1.0, 0.0])])
+    np.testing.assert_allclose(projective(found), expected, rtol=0, atol=1e-15)
+
+
+def test_line_meets_conic_with_a_basis_point_on_it_and_at_a_tangent():
+    """e = (1, 0, 0) lies on ``y (x - y) = 0`` (a = 0): the points are e and (1, 1, 0). The line z = 0
+    touches ``y^2 = 0`` at e only (a = b = 0, a double root): e, twice. ``x^2 + y^2 = 0`` has no real
+    point on it, and ``z^2 = 0`` contains the whole line (no isolated points). Exact up to one rounding."""
+    conic = np.array([[0.0, 0.5, 0.0], [0.5, -1.0, 0.0], [0.0, 0.0, 0.0]])
+    found = km.line_meets_conic(np.eye(3)[:2], conic)
+    s = 1.0 / math.sqrt(2.0)
+    np.testing.assert_allclose(projective(found), [[s, s, 0.0], [1.0, 0.0, 0.0]], rtol=0, atol=1e-15)
+    double = km.line_meets_conic(np.eye(3)[:2], np.diag([0.0, 1.0, 0.0]))
+    np.testing.assert_array_equal(projective(double), [[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    assert km.line_meets_conic(np.eye(3)[:2], np.diag([1.0, 1.0, 0.0])) == []
+    assert km.line_meets_conic(np.eye(3)[:2], np.diag([0.0, 0.0, 1.0])) == []  # the line lies in it
+
+
 # -- a four-pose problem with a dyad built by hand ----------------------------------------------------
 
 #: The hand-built dyad: moving point B (moving frame) on a circle of radius R about the fixed centre C.

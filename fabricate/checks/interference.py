@@ -37,8 +37,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fabricate.checks.distance import Outline, RelativePoses, overlap_areas, planar_clearance
+from fabricate.errors import GeometryError, SpecError
 from fabricate.mechanism import Motion
 from fabricate.parts.model import Part, circle_polygon
+from fabricate.planar import polygon_area
 
 #: Planar clearances beyond this (mm) are not resolved exactly (curves show a lower bound there).
 DEFAULT_SEARCH_MM = 2.0
@@ -308,7 +310,17 @@ def pins_from_parts_layer(pins: Sequence[object], parts: Sequence[Part]) -> list
     return out
 
 
+def _positive(path: str, value: float) -> None:
+    # a zero pin has no outline (the distance kernel's bounding box is empty) and a negative one is a
+    # mirrored circle: neither is a solid, so say which field is wrong instead of checking nonsense
+    if not (math.isfinite(value) and value > 0.0):
+        raise SpecError(path, f"must be a finite number > 0, got {value!r}")
+
+
 def pin_items(pins: Sequence[PinSolid], chord_tolerance_mm: float) -> list[SweepItem]:
+    for p in pins:
+        _positive(f"pins.{p.name}.diameter_mm", float(p.diameter_mm))
+        _positive(f"pins.{p.name}.length_mm", float(p.length_mm))
     return [SweepItem(p.name, p.body, "pin",
                       (circle_polygon(p.centre, p.diameter_mm, chord_tolerance_mm),),
                       float(p.z_mm), float(p.z_mm + p.length_mm), frozenset([p.joint]), "", p)
@@ -324,6 +336,10 @@ def spacer_items(spacers: Sequence[object], parts: Sequence[Part], chord_toleran
     for k, sp in enumerate(spacers):
         if (sp.body, sp.joint) in modelled or sp.length_mm <= 0.0:
             continue
+        _positive(f"spacers[{k}].inner_diameter_mm", float(sp.inner_diameter_mm))
+        if not float(sp.outer_diameter_mm) > float(sp.inner_diameter_mm):
+            raise SpecError(f"spacers[{k}].outer_diameter_mm",
+                            f"must exceed inner_diameter_mm ({sp.inner_diameter_mm!r}), got {sp.outer_diameter_mm!r}")
         centre = np.asarray(sp.centre, dtype=np.float64)
         rings = (circle_polygon(centre, sp.outer_diameter_mm, chord_tolerance_mm),
                  circle_polygon(centre, sp.inner_diameter_mm, chord_tolerance_mm, clockwise=True))
@@ -357,6 +373,14 @@ def _is_spacer(item: SweepItem) -> bool:
     return item.kind == "spacer" or getattr(item.source, "role", "") == "spacer"
 
 
+def _outline(item: SweepItem) -> Outline:
+    # the same words as the boolean reference's extrusion (parts/solids.py), not shapely's ring error
+    outer = np.asarray(item.rings[0], dtype=np.float64) if item.rings else np.zeros((0, 2))
+    if len(outer) < 3 or not polygon_area(outer) > 0.0:
+        raise GeometryError(f"{item.name}: empty cross-section")
+    return Outline(list(item.rings))
+
+
 # -- the sweep -------------------------------------------------------------------------------------
 def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance_mm: float,
                        min_clearance_mm: float, pins: Sequence[PinSolid] | None = None,
@@ -386,6 +410,11 @@ def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
     -------
     InterferenceResult
     """
+    _positive("chord_tolerance_mm", float(chord_tolerance_mm))
+    if not (math.isfinite(float(min_clearance_mm)) and float(min_clearance_mm) >= 0.0):
+        raise SpecError("min_clearance_mm", f"must be a finite number >= 0, got {min_clearance_mm!r}")
+    if search_length_mm is not None:
+        _positive("search_length_mm", float(search_length_mm))
     pins = pins_from_holes(parts) if pins is None else pins_from_parts_layer(pins, parts)
     search = float(search_length_mm or max(DEFAULT_SEARCH_MM, 4.0 * min_clearance_mm))
     items = (part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
@@ -404,7 +433,7 @@ def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
                 continue
             for it in (a, b):
                 if it.name not in outlines:
-                    outlines[it.name] = Outline(list(it.rings))
+                    outlines[it.name] = _outline(it)
             required = 0.0 if relation in ("meshing", "bearing") else float(min_clearance_mm)
             results.append(_sweep_pair(a, b, outlines[a.name], outlines[b.name], poses[a.body], poses[b.body],
                                        relation, required, search, solids if use_kernel else None,

@@ -20,6 +20,7 @@ Everything here is pure numpy; lengths in mm, angles in radians.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -179,23 +180,49 @@ def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
         # on the lines c1 = -lam c2: meet them with the conic farther from the member (c1 itself at lam = 0)
         other = c2 if abs(lam) < 1.0 else c1
         for line in (w1 * vectors[:, 1] + w2 * vectors[:, 2], w1 * vectors[:, 1] - w2 * vectors[:, 2]):
-            basis = _line_basis(line)
-            a = basis[0] @ other @ basis[0]
-            b = basis[0] @ other @ basis[1]
-            c = basis[1] @ other @ basis[1]
-            disc = b * b - a * c
-            if disc < 0.0:
-                continue
-            root = np.sqrt(disc)
-            if abs(a) >= abs(c):
-                pairs = [((-b + root) / a, 1.0), ((-b - root) / a, 1.0)] if a != 0 else []
-            else:
-                pairs = [(1.0, (-b + root) / c), (1.0, (-b - root) / c)]
-            for s, t in pairs:
-                x = s * basis[0] + t * basis[1]
-                points.append(_polish(c1, c2, x / np.linalg.norm(x)))
+            points.extend(_polish(c1, c2, x) for x in line_meets_conic(_line_basis(line), other))
         break
     return [x for x in points if abs(x @ c1 @ x) < 1e-8 and abs(x @ c2 @ x) < 1e-8]
+
+
+def line_meets_conic(basis: np.ndarray, conic: np.ndarray) -> list[np.ndarray]:
+    """Real points where the projective line spanned by ``basis`` meets the conic ``x^T C x = 0``.
+
+    Parameters
+    ----------
+    basis : (2, 3) array
+        Two homogeneous points spanning the line.
+    conic : (3, 3) symmetric array
+
+    Returns
+    -------
+    list of (3,) unit vectors
+        None when the roots are complex or the whole line lies in the conic; a tangent point twice.
+
+    Notes
+    -----
+    With ``x = s e + t f`` the conic is ``a s^2 + 2 b st + c t^2 = 0``. Its roots are taken as the
+    homogeneous pairs ``(q, a)`` and ``(c, q)`` with ``q = -(b + sign(b) sqrt(b^2 - ac))``: no division,
+    so a coefficient ``a`` or ``c`` of any size (zero included, when ``e`` or ``f`` lies on the conic)
+    gives the right point, and the two roots never cancel. The coefficients are scaled to unit size
+    first, so ``b^2`` neither overflows nor underflows.
+    """
+    e, f = np.asarray(basis, dtype=np.float64)
+    abc = np.array([e @ conic @ e, e @ conic @ f, f @ conic @ f])
+    scale = np.abs(abc).max()
+    if not scale > 0.0:
+        return []  # the line lies in the (degenerate) conic: no isolated points
+    a, b, c = abc / scale
+    disc = b * b - a * c
+    if disc < 0.0:
+        return []
+    q = -(b + math.copysign(math.sqrt(disc), b))
+    roots = [s * e + t * f for s, t in ((q, a), (c, q))]
+    norms = [float(np.linalg.norm(x)) for x in roots]
+    if min(norms) == 0.0:  # q = 0 with a = 0 or c = 0: a double root at e or f, carried by the other pair
+        k = int(np.argmax(norms))
+        roots, norms = [roots[k]] * 2, [norms[k]] * 2
+    return [x / n for x, n in zip(roots, norms, strict=True)]
 
 
 def _line_basis(line: np.ndarray) -> np.ndarray:
