@@ -64,6 +64,7 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "gears/mesh": ("fabricate/gears/mesh.py", GEARS_TESTS),
     "gears/pair": ("fabricate/gears/pair.py", GEARS_TESTS),
     "gears/checks": ("fabricate/gears/checks.py", GEARS_TESTS),
+    "gears/spec": ("fabricate/gears/spec.py", ["tests/test_gears_spec.py", "tests/test_spec.py"]),
     "mechanism": ("fabricate/mechanism.py", ["tests/test_mechanism_properties.py", "tests/test_mechanism.py",
                                             "tests/test_mechanism_solver.py"]),
     "checks/interference": ("fabricate/checks/interference.py", CHECK_TESTS),
@@ -71,7 +72,10 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     # test_checks.py synthesises the seed-000 finger (tens of seconds): the property tests drive the check
     "checks/gear_mesh": ("fabricate/checks/gear_mesh.py",
                          ["tests/test_gears_properties.py", "tests/test_checks_gear_mesh.py"]),
-    "checks/printability": ("fabricate/checks/printability.py", ["tests/test_checks.py"]),
+    "checks/printability": ("fabricate/checks/printability.py",
+                            ["tests/test_checks_printability.py", "tests/test_checks.py"]),
+    # run_checks and CheckReport (checks/__init__.py): what gates a build and what report.json says of it
+    "checks/run": ("fabricate/checks/__init__.py", ["tests/test_checks.py"]),
     "parts/profiles": ("fabricate/parts/profiles.py", PARTS_TESTS),
     "parts/build": ("fabricate/parts/build.py", PARTS_TESTS),
     "export/dxf": ("fabricate/export/dxf.py", EXPORT_TESTS),
@@ -86,7 +90,8 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "synthesis/six_bar_statics": ("fabricate/synthesis/watt_six_bar/statics.py",
                                   ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py"]),
     "synthesis/underactuated_model": ("fabricate/synthesis/underactuated/model.py", ["tests/test_underactuated.py"]),
-    "synthesis/compliant_model": ("fabricate/synthesis/compliant/model.py", ["tests/test_compliant.py"]),
+    "synthesis/compliant_model": ("fabricate/synthesis/compliant/model.py",
+                                  ["tests/test_compliant.py", "tests/test_compliant_model.py"]),
 }
 
 #: The six hand-made mutants of issue 15 and the tests that must kill them (``--examples`` checks it).
