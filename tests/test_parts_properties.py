@@ -10,6 +10,8 @@ import math
 import numpy as np
 import pytest
 import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from fabricate.parts.build import derive_sizes
 from fabricate.parts.model import BulgePath
@@ -231,3 +233,40 @@ def test_hull_of_an_internally_tangent_circle_is_the_outer_circle(phi, r2):
     hull = circle_hull(centres, np.array([5.0, r2]))
     assert hull.area() == pytest.approx(math.pi * 25.0, rel=1e-12)
     np.testing.assert_allclose(np.hypot(*hull.vertices.T), 5.0, rtol=1e-12)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.floats(-3.0, 3.0).filter(lambda b: abs(b) > 1e-3), st.floats(-30.0, 30.0), st.floats(-30.0, 30.0))
+def test_bulge_path_distance_is_the_distance_to_its_true_arc(bulge, px, py):
+    """BulgePath.distance of a one-arc path (a D shape: the arc from (-5, 0) to (5, 0) with ``bulge`` and the
+    chord back) equals the smallest distance to 200 001 points sampled on the true arc and the chord, within
+    the spacing of those samples (< 1e-3 mm here). Arcs of either sense up to |bulge| = 3 (an included angle
+    of 4 atan 3 = 300 deg), points on every side of them."""
+    path = BulgePath(np.array([[-5.0, 0.0], [5.0, 0.0]]), np.array([bulge, 0.0]))
+    theta = 4.0 * math.atan(bulge)
+    radius = 10.0 / (2.0 * abs(math.sin(theta / 2.0)))
+    centre = np.array([0.0, math.copysign(1.0, theta) * radius * math.cos(theta / 2.0)])
+    a0 = math.atan2(-centre[1], -5.0 - centre[0])
+    angles = a0 + np.linspace(0.0, theta, 200_001)
+    arc = centre + radius * np.column_stack([np.cos(angles), np.sin(angles)])
+    chord = np.column_stack([np.linspace(5.0, -5.0, 20_001), np.zeros(20_001)])
+    samples = np.concatenate([arc, chord])
+    p = np.array([px, py])
+    brute = float(np.min(np.hypot(*(samples - p).T)))
+    spacing = max(radius * abs(theta) / 200_000, 10.0 / 20_000)
+    got = path.distance(p)
+    assert got <= brute + 1e-12
+    assert got >= brute - spacing
+
+
+def test_bulge_path_distance_closed_forms():
+    """A unit square (distance to the nearest side or corner) and a full disc made of two semicircles of
+    radius 2 about 0 (|  |p| - 2 |): inside, outside, at the centre (2) and on the curve (0). 1e-12."""
+    square = BulgePath.polyline(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]))
+    assert square.distance(np.array([0.5, 0.2])) == pytest.approx(0.2, abs=1e-12)
+    assert square.distance(np.array([2.0, 2.0])) == pytest.approx(math.sqrt(2.0), abs=1e-12)
+    assert square.distance(np.array([0.5, -3.0])) == pytest.approx(3.0, abs=1e-12)
+    disc = BulgePath(np.array([[2.0, 0.0], [-2.0, 0.0]]), np.array([1.0, 1.0]))
+    for point, expected in (((0.0, 0.0), 2.0), ((0.3, -0.4), 1.5), ((3.0, 4.0), 3.0), ((0.0, -2.0), 0.0),
+                            ((-1.2, 1.6), 0.0)):
+        assert disc.distance(np.array(point)) == pytest.approx(expected, abs=1e-12)

@@ -16,8 +16,10 @@ Checks against the process profile (:class:`fabricate.spec.ProcessSpec`):
   rectangle, either way round) and are no taller than the build height; laser parts fit the sheet and
   are as thick as it (spacers are tubes, not cut from the sheet).
 
-Distances are taken on the polygonised plates (vertices on the exact curves, chords inside), which
-can only understate a web, by at most the chord tolerance; that tolerance is the verdict's slack.
+Webs around holes are exact (circle to circle, hole to the outline's true lines and arcs); the files
+are polygonised at the chord tolerance (chords inside the outline's arcs, holes' polygons inside their
+circles), so the verdict allows that tolerance as its slack. Thin features are taken on the polygonised
+plate.
 """
 
 from __future__ import annotations
@@ -74,16 +76,28 @@ class PrintabilityResult:
 
 
 def hole_walls(part: Part, chord_tolerance_mm: float) -> list[tuple[str, float]]:
-    """Web (mm) around every hole of ``part``: distance from the hole to the nearest other ring
-    (outline, other holes, slots), as (joint, web) pairs."""
-    rings = part.polygons(chord_tolerance_mm)
-    lines = [shapely.LinearRing(r) for r in rings]
+    """Web (mm) around every hole of ``part``, as (joint, web) pairs: the distance from the hole to the
+    nearest other boundary (the outline, another hole), negative where they overlap.
+
+    Exact up to rounding: the web to another hole is ``|c_k - c_j| - r_j - r_k`` and the web to the outline
+    is measured to its true lines and arcs (:meth:`BulgePath.distance`). Polygons would overstate both —
+    the other hole's inscribed polygon and a concave arc's chords lie in the void, up to the chord sagitta
+    away — so a web under the limit could pass. ``chord_tolerance_mm`` only polygonises the outline to tell
+    whether a hole's centre is inside the plate at all.
+    """
+    outer = part.polygons(chord_tolerance_mm)[0]
+    plate = shapely.Polygon(outer)
     out = []
-    for k, hole in enumerate(part.holes, start=1):
-        others = [line for j, line in enumerate(lines) if j != k]
-        centre = shapely.Point(np.asarray(hole.centre, dtype=np.float64))
-        web = min(float(line.distance(centre)) for line in others) - 0.5 * hole.diameter_mm
-        out.append((hole.joint, web))
+    for k, hole in enumerate(part.holes):
+        centre = np.asarray(hole.centre, dtype=np.float64)
+        to_outline = part.outline.distance(centre)
+        if not plate.covers(shapely.Point(centre)):
+            to_outline = -to_outline  # a hole centred outside the plate: no web at all
+        webs = [to_outline - 0.5 * hole.diameter_mm]
+        webs += [float(np.hypot(*(centre - np.asarray(other.centre, dtype=np.float64))))
+                 - 0.5 * other.diameter_mm - 0.5 * hole.diameter_mm
+                 for j, other in enumerate(part.holes) if j != k]
+        out.append((hole.joint, min(webs)))
     return out
 
 

@@ -57,6 +57,42 @@ class BulgePath:
                 out.append(arc_points(p0, p1, b, chord_tolerance_mm)[1:-1])
         return np.concatenate(out, axis=0)
 
+    def distance(self, point: np.ndarray) -> float:
+        """Exact distance (mm) from ``point`` (2,) to the path: to its straight segments and true arcs.
+
+        A polygon of the path (chords inside its arcs) would overstate the distance to a concave arc by
+        up to the chord sagitta; this is what wall checks measure against.
+        """
+        p = np.asarray(point, dtype=np.float64)
+        n = len(self.vertices)
+        best = math.inf
+        for i in range(n):
+            p0, p1 = self.vertices[i], self.vertices[(i + 1) % n]
+            b = float(self.bulges[i])
+            chord_vec = p1 - p0
+            chord2 = float(chord_vec @ chord_vec)
+            if chord2 == 0.0:
+                best = min(best, float(np.hypot(*(p - p0))))
+                continue
+            if b == 0.0:
+                t = min(1.0, max(0.0, float((p - p0) @ chord_vec) / chord2))
+                best = min(best, float(np.hypot(*(p - p0 - t * chord_vec))))
+                continue
+            theta = 4.0 * math.atan(b)
+            chord = math.sqrt(chord2)
+            radius = chord / (2.0 * abs(math.sin(theta / 2.0)))
+            normal = np.array([-chord_vec[1], chord_vec[0]]) / chord
+            centre = 0.5 * (p0 + p1) + math.copysign(1.0, theta) * normal * (radius * math.cos(theta / 2.0))
+            rel = p - centre
+            a0 = math.atan2(p0[1] - centre[1], p0[0] - centre[0])
+            # how far round the arc (in its own sense) the point's direction lies
+            turn = (math.copysign(1.0, theta) * (math.atan2(rel[1], rel[0]) - a0)) % (2.0 * math.pi)
+            if turn <= abs(theta):
+                best = min(best, abs(float(np.hypot(*rel)) - radius))
+            else:
+                best = min(best, float(np.hypot(*(p - p0))), float(np.hypot(*(p - p1))))
+        return best
+
     def area(self) -> float:
         """Exact signed area (mm^2): polygon area plus the circular segments of the arcs."""
         area = polygon_area(self.vertices)
