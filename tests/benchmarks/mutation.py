@@ -89,7 +89,8 @@ MODULES: dict[str, tuple[str, list[str]]] = {
                              "tests/test_burmester.py"]),
     "synthesis/six_bar_statics": ("fabricate/synthesis/watt_six_bar/statics.py",
                                   ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py"]),
-    "synthesis/underactuated_model": ("fabricate/synthesis/underactuated/model.py", ["tests/test_underactuated.py"]),
+    "synthesis/underactuated_model": ("fabricate/synthesis/underactuated/model.py",
+                                      ["tests/test_underactuated.py", "tests/test_underactuated_model.py"]),
     "synthesis/compliant_model": ("fabricate/synthesis/compliant/model.py",
                                   ["tests/test_compliant.py", "tests/test_compliant_model.py"]),
 }

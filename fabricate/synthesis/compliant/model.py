@@ -35,6 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from fabricate.errors import SpecError
+
 #: N·mm per degree -> N·mm per radian (the paper's k·180/pi).
 DEG_PER_RAD = 180.0 / np.pi
 
@@ -220,6 +222,7 @@ class ContactPath:
     state: FingerState
     geom: GripperGeometry
     can_radius: float
+    mu: float
 
 
 def contact_path(geom: GripperGeometry, can_radius: float, mu: float, n: int = 721,
@@ -242,7 +245,7 @@ def contact_path(geom: GripperGeometry, can_radius: float, mu: float, n: int = 7
         stop += 1
     keep = slice(first, stop)
     sub = FingerState(*(getattr(st, f)[keep] for f in FingerState.__dataclass_fields__))
-    return ContactPath(phi2=phi2[keep], state=sub, geom=geom, can_radius=can_radius)
+    return ContactPath(phi2=phi2[keep], state=sub, geom=geom, can_radius=can_radius, mu=float(mu))
 
 
 @dataclass(frozen=True)
@@ -269,7 +272,18 @@ def hover_force_on_path(path: ContactPath, springs: Springs, mu: float) -> np.nd
 def solve_grasp(path: ContactPath, springs: Springs, load: Load) -> Grasp | None:
     """The paper's procedure: find the stroke where the hover force first reaches F_n2 (eqs 5-7,
     8-10), then the static force F_n1 at that stroke (eqs 3-4). None if it is never reached, if it
-    is reached with a hinge on its stop (first sample) or with the rod pulling."""
+    is reached with a hinge on its stop (first sample) or with the rod pulling.
+
+    Raises
+    ------
+    SpecError
+        ``load.mu`` is not the friction the path was sampled with: the path's validity (the hover
+        determinant > 0) depends on it, and off the path the root search can land on that determinant's
+        pole (a hover force of 1e11 N was returned).
+    """
+    if load.mu != path.mu:
+        raise SpecError("load.mu", f"the contact path was sampled with mu = {path.mu:g}, the load has "
+                                   f"mu = {load.mu:g}; sample the path with the load's friction")
     if len(path.phi2) < 2:
         return None
     fn2 = load.hover_force
