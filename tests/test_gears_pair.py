@@ -458,3 +458,47 @@ def test_three_closing_teeth_are_refused_as_too_coarse():
     words = info.value.message.split()
     assert words[0] == "module" and words[2:4] == ["mm", "too"]
     assert float(words[1]) == pytest.approx(perimeter / (3 * math.pi), rel=1e-5)  # printed with :g
+
+
+# -- make_gear_pair's own input checks ---------------------------------------------------------------
+@pytest.mark.parametrize("working_range", [(1.0, 1.0), (2.0, 1.0), (math.nan, 1.0), (0.0, math.inf),
+                                           (-math.inf, 1.0), (0.0, math.nan)])
+def test_a_working_range_that_is_not_a_finite_lo_below_hi_is_refused(working_range):
+    """Empty, reversed or non-finite working ranges are refused before anything is cut, naming
+    ``gears.<name>.working_range`` and the range given."""
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw("x"), 20.0, working_range, GearSpec(module_mm=1.0, compare_methods=False),
+                       closed=False, name="mesh_q", run_mesh_check=False)
+    assert info.value.path == "gears.mesh_q.working_range"
+    assert info.value.message == f"expected a finite range lo < hi, got {working_range}"
+
+
+@pytest.mark.parametrize("distance", [0.0, -5.0, math.inf, math.nan])
+def test_a_centre_distance_that_is_not_positive_and_finite_is_refused(distance):
+    """A zero, negative or non-finite centre distance is refused naming ``gears.<name>.center_distance_mm``."""
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw("x"), distance, (0.0, 1.0), GearSpec(module_mm=1.0, compare_methods=False),
+                       closed=False, name="mesh_q", run_mesh_check=False)
+    assert info.value.path == "gears.mesh_q.center_distance_mm"
+    assert info.value.message == f"expected a positive distance, got {float(distance)}"
+
+
+def test_a_small_centre_distance_is_accepted():
+    """0.5 mm is a positive distance (the check is > 0, not >= 1): it passes the input check and is then
+    refused for what it is — pitch radii of 0.25 mm cannot carry module-0.05 teeth — naming the law or the
+    module, never the centre distance."""
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw("x"), 0.5, (0.0, 1.0), GearSpec(module_mm=0.05, compare_methods=False),
+                       closed=False, name="mesh_q", run_mesh_check=False)
+    assert info.value.path != "gears.mesh_q.center_distance_mm"
+
+
+def test_a_law_that_is_not_monotonic_over_the_range_is_refused_naming_it():
+    """x_b = sin(x_a) has ratio -cos(x_a), which changes sign at pi/2: over (0, 3) the law is refused
+    naming ``gears.<name>.law``; the ratio is sampled at 1025 points including both ends, so a sign change
+    just inside the upper end, (0, pi/2 + 1e-3), is refused too."""
+    for hi in (3.0, math.pi / 2 + 1e-3):
+        with pytest.raises(SpecError) as info:
+            make_gear_pair(FormulaLaw("sin(x)"), 20.0, (0.0, hi), GearSpec(module_mm=1.0, compare_methods=False),
+                           closed=False, name="mesh_q", run_mesh_check=False)
+        assert info.value.path == "gears.mesh_q.law"
