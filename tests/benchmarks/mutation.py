@@ -75,7 +75,7 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "checks/printability": ("fabricate/checks/printability.py",
                             ["tests/test_checks_printability.py", "tests/test_checks.py"]),
     # run_checks and CheckReport (checks/__init__.py): what gates a build and what report.json says of it
-    "checks/run": ("fabricate/checks/__init__.py", ["tests/test_checks.py"]),
+    "checks/run": ("fabricate/checks/__init__.py", ["tests/test_checks_run.py", "tests/test_checks.py"]),
     "parts/profiles": ("fabricate/parts/profiles.py", PARTS_TESTS),
     "parts/build": ("fabricate/parts/build.py", PARTS_TESTS),
     "export/dxf": ("fabricate/export/dxf.py", EXPORT_TESTS),
