@@ -13,6 +13,7 @@ import math
 import warnings
 
 import numpy as np
+import pytest
 
 from fabricate.synthesis.watt_six_bar.burmester import (
     CubicCurve,
@@ -137,6 +138,18 @@ def test_polish_recovers_roots_given_to_1e_5() -> None:
     np.testing.assert_allclose(got, exact, rtol=0, atol=1e-12)
 
 
+def test_polish_guards_are_exclusive_at_their_thresholds() -> None:
+    """Both guards of the Newton polish are strict, like the leading-coefficient test of cubic_real_roots:
+    at y = 0 on 1e-18 + 1e-14 y + y^3, P' is exactly 1e-14, which counts as vanished (``> 1e-14``), so the
+    estimate is kept although the step (1e-4) would be short; on 1e-3 + y + y^3 the step P/P' is exactly
+    1e-3 = 1e-3 (1 + |y|), the longest step refused (``<``). At y = 0 Horner's scheme gives P = c0 and P' = c1
+    with no rounding, and 1e-3 / 1 and 1e-3 * (1 + 0) are the same double, so the thresholds are hit exactly;
+    the expected result is the unchanged estimate, bit for bit."""
+    c = np.array([[1e-18, 1e-14, 0.0, 1.0], [1e-3, 1.0, 0.0, 1.0]])
+    roots = np.zeros((2, 1))
+    np.testing.assert_array_equal(_polish(roots, c), roots)
+
+
 # --- dyad_curve / partners ----------------------------------------------------------------------------
 
 
@@ -196,6 +209,52 @@ def test_partner_at_infinity_raises_no_warning() -> None:
         warnings.simplefilter("error")
         y = curve.partners(np.array([[0.0, 0.0]]))
     assert not np.isfinite(y).all()
+
+
+def _rows_at_origin(m: np.ndarray) -> np.ndarray:
+    """Row matrices whose system at X = (0, 0) is ``m`` (only the constant monomial column is set)."""
+    rows = np.zeros((3, 3, 3))
+    rows[:, :, 2] = m
+    return rows
+
+
+def test_partner_rank_test_is_relative_to_the_largest_singular_value() -> None:
+    """The rows (1, 0, -1), (1, 0, -1), (1, d, -1 - 2d) all annihilate (1, 2, 1) exactly (d a power of two, so
+    every entry and product is exact): the partner is Y = (1, 2). Their singular values are about
+    (2.449, 1.414 d, 0), so second / first = 5.4e-10 for d = 2^-30 (below the documented 1e-9: nearly rank one,
+    NaN) and 4.3e-9 for d = 2^-27 (a unique partner, (1, 2) to 1e-6; the null vector's conditioning is
+    eps / 4.3e-9 ~ 5e-8). The verdict does not change when the rows are scaled by 1e-6 or 1e6. numpy's SVD
+    confirms the ratios independently."""
+    point = np.array([[0.0, 0.0]])
+    for power, unique in ((30, False), (27, True)):
+        d = 2.0**-power
+        m = np.array([[1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [1.0, d, -1.0 - 2.0 * d]])
+        np.testing.assert_array_equal(m @ [1.0, 2.0, 1.0], 0.0)
+        sv = np.linalg.svd(m, compute_uv=False)
+        assert (sv[1] / sv[0] > 1e-9) == unique
+        for scale in (1.0, 1e-6, 1e6):
+            y = CubicCurve(tensor=np.zeros((3, 3, 3)), rows=_rows_at_origin(scale * m)).partners(point)
+            if unique:
+                np.testing.assert_allclose(y, [[1.0, 2.0]], rtol=0, atol=1e-6)
+            else:
+                assert np.isnan(y).all()
+
+
+def test_a_partner_at_infinity_leaves_the_other_points_of_the_batch_alone() -> None:
+    """Rows A + x B (no y dependence): at X = (0, 0) the system A has null vector (0, 1, 0), a partner at
+    infinity (NaN); at X = (1, 0) the system A + B = [(1, 0, -1), (0, 1, -2), (1, 1, -3)] (third row the sum
+    of the others, rank 2) has null vector (1, 2, 1), partner (1, 2) by hand. Asked together, the first
+    point's NaN must not spread to the second (1e-12)."""
+    a = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0]])
+    b = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, -3.0], [0.0, 1.0, -4.0]])
+    rows = _rows_at_origin(a)
+    rows[:, :, 0] = b
+    curve = CubicCurve(tensor=np.zeros((3, 3, 3)), rows=rows)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        y = curve.partners(np.array([[0.0, 0.0], [1.0, 0.0]]))
+    assert np.isnan(y[0]).all()
+    np.testing.assert_allclose(y[1], [1.0, 2.0], rtol=0, atol=1e-12)
 
 
 # --- motions ------------------------------------------------------------------------------------------
@@ -263,6 +322,65 @@ def test_distance_default_span_is_40_mm() -> None:
     assert abs(dist - 200.0) < 1e-9
     dist41, _ = distance_to_curve(curve, np.array([0.0, 0.0]), span=41.0)
     assert abs(dist41 - (math.hypot(40.5, 40.5) - 0.4)) < 1e-4
+
+
+def test_distance_far_from_the_origin_to_a_circle() -> None:
+    """Only the offset from the point matters, not where the origin is: from P = (250, -180) to the circle of
+    radius 20 centred at P + (18.1, 24.13) (times the far line x = 1000), the distance is
+    |(18.1, 24.13)| - 20 (closed form) and the foot is P + (1 - 20 / |(18.1, 24.13)|) (18.1, 24.13); 1e-9. The
+    refinement converges here (point nearer the circle than its radius), so the result is exact to rounding
+    and far more accurate than the 0.02 mm grid alone."""
+    point = np.array([250.0, -180.0])
+    offset = np.array([18.1, 24.13])
+    centre_distance = math.hypot(*offset)
+    curve = _curve(_times(_circle(*(point + offset), 20.0), {(1, 0): 1.0, (0, 0): -1000.0}))
+    dist, foot = distance_to_curve(curve, point)
+    assert abs(dist - (centre_distance - 20.0)) < 1e-9
+    np.testing.assert_allclose(foot, point + (1.0 - 20.0 / centre_distance) * offset, rtol=0, atol=1e-9)
+
+
+def test_distance_far_from_the_origin_to_a_vertical_line() -> None:
+    """The y-grid case of test_distance_to_a_vertical_line_found_by_the_y_grid moved to P = (137.3, -64.9): circle
+    of radius 5 centred at P - (20, 0) (15 away) times the line x = P_x + 10.01 (10.01 away, foot P + (10.01, 0),
+    closed form). Which grid's sample is nearer must be judged by the distance to P, not to the origin; 1e-9."""
+    point = np.array([137.3, -64.9])
+    curve = _curve(_times(_circle(point[0] - 20.0, point[1], 5.0), {(1, 0): 1.0, (0, 0): -(point[0] + 10.01)}))
+    dist, foot = distance_to_curve(curve, point)
+    assert abs(dist - 10.01) < 1e-9
+    np.testing.assert_allclose(foot, point + [10.01, 0.0], rtol=0, atol=1e-9)
+
+
+def test_distance_where_the_refinement_does_not_settle_keeps_a_curve_point() -> None:
+    """From P = (120, -75) to a circle of radius r = 10 whose centre C is 20.5 away (distance d = 10.5 > r):
+    sliding along the tangent multiplies the angular error by d / r = 1.05 per iteration, so the projection
+    wanders and must be rejected. Whatever happens, the returned foot must be a point of the curve
+    (| |foot - C| - r | < 1e-9) at the returned distance (1e-12), and the distance may not undercut the exact
+    20.5 - 10 (1e-9) nor exceed it by more than the grid allows: a sample within h sqrt(2) / 2 = 0.0141 mm
+    of arc (h = 0.02 mm) is at most D s^2 / (2 r d) = 2e-5 mm farther. The tensor is only defined up to scale
+    (CubicCurve docstring), so scaling it by 1e-12 must give the same answer (1e-12 relative)."""
+    point = np.array([120.0, -75.0])
+    centre = point + 20.5 * np.array([math.cos(0.3), math.sin(0.3)])
+    base = _tensor(_times(_circle(*centre, 10.0), {(1, 0): 1.0, (0, 0): -(point[0] + 500.0)}))
+    results = []
+    for scale in (1.0, 1e-12):
+        dist, foot = distance_to_curve(CubicCurve(tensor=scale * base, rows=np.zeros((3, 3, 3))), point)
+        assert abs(math.hypot(*(foot - centre)) - 10.0) < 1e-9
+        assert abs(math.hypot(*(foot - point)) - dist) < 1e-12
+        assert 10.5 - 1e-9 <= dist <= 10.5 + 2e-5
+        results.append(dist)
+    np.testing.assert_allclose(results[1], results[0], rtol=1e-12)
+
+
+def test_distance_to_a_cusp() -> None:
+    """y^2 = x^3 seen from (-5, 0): along the curve |X - P|^2 = (x + 5)^2 + x^3 grows for x >= 0, so the nearest
+    point is the cusp (0, 0) at distance 5 exactly, where the gradient vanishes. The refinement must stop there
+    quietly (no division warning) and return (5, (0, 0)); 1e-12."""
+    curve = _curve({(0, 2): 1.0, (3, 0): -1.0})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        dist, foot = distance_to_curve(curve, np.array([-5.0, 0.0]))
+    assert abs(dist - 5.0) < 1e-12
+    np.testing.assert_allclose(foot, [0.0, 0.0], rtol=0, atol=1e-12)
 
 
 def test_distance_to_a_curve_without_real_points_is_inf_at_the_float_point() -> None:
@@ -407,3 +525,18 @@ def test_partners_of_a_zero_system_or_at_infinity_are_nan():
     rows[2, :, 2] = (1.0, 0.0, 1.0)
     curve = CubicCurve(tensor=np.zeros((3, 3, 3)), rows=rows)
     assert np.all(np.isnan(curve.partners(np.array([[0.0, 0.0]]))))
+
+
+@pytest.mark.parametrize("roots", [(5.0, 5.0, 5.00001), (3.0, 3.000001, 3.000003), (-2.0, -2.0, -2.0 + 1e-6)])
+def test_clustered_roots_stay_sorted_and_near_the_cluster(roots):
+    """Regression (found by helper-28): near a triple root the Newton polish walked up to its 1e-3 (1 + |y|)
+    guard away from the roots on rounding noise (4.8e-3 off for (5, 5, 5.00001)) and returned them out of
+    order. The roots of (y - a)(y - b)(y - c) must come back ascending (the documented order), each within
+    1e-4 (1 + |a|) of the cluster (a triple root is only determined to about eps^(1/3) of its size)."""
+    a, b, c = roots
+    coefficients = np.array([-a * b * c, a * b + b * c + c * a, -(a + b + c), 1.0])
+    got = cubic_real_roots(coefficients[None])[0]
+    finite = got[np.isfinite(got)]
+    assert len(finite) >= 1
+    assert np.all(np.diff(finite) >= 0.0)
+    assert np.all(np.abs(finite - np.mean(roots)) < 1e-4 * (1.0 + abs(a)))

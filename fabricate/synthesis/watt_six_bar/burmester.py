@@ -231,8 +231,8 @@ def cubic_real_roots(coefficients: np.ndarray) -> np.ndarray:
         res = np.full((len(cc), 3), np.nan)
         res[three] = real[three]
         res[~three, 0] = single[~three]
-        res = _polish(res, cc)
-        out[cubic] = res
+        # polished roots of a tight cluster may cross: the documented order is ascending (NaN last)
+        out[cubic] = np.sort(_polish(res, cc), axis=1)
     rest = np.flatnonzero(ok & ~cubic)
     for k in rest:  # rare: degree drops at this x
         r = np.roots(c[k, ::-1][np.argmax(np.abs(c[k, ::-1]) > 1e-12):])
@@ -249,8 +249,13 @@ def _polish(roots: np.ndarray, c: np.ndarray, steps: int = 2) -> np.ndarray:
         dp = c[:, 1:2] + y * (2.0 * c[:, 2:3] + 3.0 * y * c[:, 3:4])
         with np.errstate(divide="ignore", invalid="ignore"):
             step = np.where(np.abs(dp) > 1e-14, p / dp, 0.0)
-        # a Newton step larger than the root spacing would mean a near-double root: keep the eigenvalue
-        roots = np.where(np.abs(step) < 1e-3 * (1.0 + np.abs(y)), y - step, y)
+        # a Newton step larger than the root spacing would mean a near-double root: keep the eigenvalue;
+        # near a multiple root Newton can also walk away (up to that limit) while |p| grows: keep only
+        # steps that reduce the residual
+        trial = y - step
+        p_trial = c[:, 0:1] + trial * (c[:, 1:2] + trial * (c[:, 2:3] + trial * c[:, 3:4]))
+        better = np.abs(p_trial) < np.abs(p)
+        roots = np.where((np.abs(step) < 1e-3 * (1.0 + np.abs(y))) & better, trial, y)
     return roots
 
 
