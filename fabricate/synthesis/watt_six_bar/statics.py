@@ -103,7 +103,8 @@ def assemble(batch: SixBarBatch, theta1: np.ndarray) -> SixBarPoses:
     """Positions of every joint for inputs ``theta1`` (S,) rad, on the branch of position 1.
 
     ``margin`` is the smaller of the two loops' normalised (h / r)^2: zero at a toggle, negative
-    where a loop cannot close (positions there are not meaningful).
+    where a loop cannot close (positions there are not meaningful) and at every input of a mechanism whose
+    position 1 is itself a toggle (no branch to keep).
     """
     theta1 = np.asarray(theta1, dtype=np.float64)
     rot = rotation(theta1 - batch.theta1_start)  # (S, 2, 2) about a0 = origin
@@ -127,7 +128,10 @@ def assemble(batch: SixBarBatch, theta1: np.ndarray) -> SixBarPoses:
                                       side2)
     distal_turn = _angle(b - e) - _angle(b1 - e1)
     c = e + np.einsum("nsij,nsj->nsi", rotation(distal_turn), np.broadcast_to(batch.c - e1, d.shape))
-    return SixBarPoses(a=a, b=b, c=c, d=d, e=e, f=f, d0=d0, margin=np.minimum(margin1, margin2))
+    margin = np.minimum(margin1, margin2)
+    # position 1 on a toggle (d, f, d0 or a, b, e collinear) names no branch: every position is unmeaningful
+    margin = np.where((side1 == 0.0) | (side2 == 0.0), -1.0, margin)
+    return SixBarPoses(a=a, b=b, c=c, d=d, e=e, f=f, d0=d0, margin=margin)
 
 
 def _angle(v: np.ndarray) -> np.ndarray:
