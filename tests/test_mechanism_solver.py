@@ -93,6 +93,96 @@ def test_redundant_parallelogram_sweeps_backwards():
     assert np.max(np.abs(motion.pose("coupler")[:, 2])) < 1e-9
 
 
+def _parallel_links_with_roller(start_deg: float, end_deg: float) -> Mechanism:
+    """The parallelogram four-bar of :func:`_double_parallelogram` with two parallel links (E0-C0 at x = 10, E1-C1
+    at x = 25) and an idle roller pinned at its centre to the ground's R = (20, -10), which no equation turns:
+    9 revolutes (18 rows) + 1 driver = 19 equations in 18 unknowns (6 bodies). The count passes (the two
+    redundant links make up for the roller's free turn) but the Jacobian has rank 17 (15 for the linkage, 2 for
+    the roller's pin): over-determined and rank-deficient at once."""
+    r, g = 15.0, 40.0
+    th = math.radians(start_deg)
+    ax, ay = r * math.cos(th), r * math.sin(th)
+    ground = {"O": (0.0, 0.0), "D": (g, 0.0), "R": (20.0, -10.0)}
+    coupler = {"A": (0.0, 0.0), "B": (g, 0.0)}
+    links, joints = [], [Revolute("O", "ground", "crank"), Revolute("A", "crank", "coupler"),
+                         Revolute("B", "coupler", "rocker"), Revolute("D", "ground", "rocker"),
+                         Revolute("R", "ground", "roller")]
+    assembly = {"crank": (0.0, 0.0, th + 0.05), "coupler": (ax + 0.3, ay - 0.2, 0.04), "rocker": (g, 0.0, th - 0.05),
+                "roller": (20.0, -10.0, 0.7)}
+    for k, x in enumerate((10.0, 25.0)):
+        ground[f"E{k}"], coupler[f"C{k}"] = (x, 0.0), (x, 0.0)
+        links.append(Body(f"link{k}", {f"E{k}": (0.0, 0.0), f"C{k}": (r, 0.0)}))
+        joints += [Revolute(f"E{k}", "ground", f"link{k}"), Revolute(f"C{k}", "coupler", f"link{k}")]
+        assembly[f"link{k}"] = (x, 0.0, th + 0.03)
+    return Mechanism(
+        name="parallel_links_with_roller",
+        bodies=(Body("ground", ground), Body("crank", {"O": (0.0, 0.0), "A": (r, 0.0)}), Body("coupler", coupler),
+                Body("rocker", {"D": (0.0, 0.0), "B": (r, 0.0)}), *links, Body("roller", {"R": (0.0, 0.0)})),
+        ground="ground", joints=tuple(joints), gears=(), drivers=(Driver("angle", "crank", "ground"),),
+        input_range=(start_deg, end_deg), assembly=assembly)
+
+
+def test_redundant_and_rank_deficient_system_sweeps():
+    """A parallelogram with two extra parallel links and an idle roller (19 x 18 Jacobian of rank 17) assembles
+    and sweeps 20 -> 160 deg in 20 degree steps: the linkage follows the closed form (coupler parallel to the
+    ground, rocker and links at the crank angle, within 1e-9) and the roller stays on its pin at (20, -10)
+    (1e-12). No equation sees the roller's angle and the least-squares steps are minimum-norm, so it keeps its
+    assembly angle 0.7 rad (1e-12)."""
+    mech = _parallel_links_with_roller(20.0, 160.0)
+    motion = mech.sweep(np.linspace(20.0, 160.0, 8))
+    th = np.radians(motion.inputs)
+    assert np.max(np.abs(motion.pose("coupler")[:, 2])) < 1e-9
+    for body in ("rocker", "link0", "link1"):
+        assert np.max(np.abs(motion.pose(body)[:, 2] - th)) < 1e-9, body
+    a = np.column_stack([15.0 * np.cos(th), 15.0 * np.sin(th)])
+    assert np.max(np.hypot(*(motion.point("A", "coupler") - a).T)) < 1e-9
+    assert np.max(np.abs(motion.pose("roller") - [20.0, -10.0, 0.7])) < 1e-12
+
+
+class _Cubic:
+    """law(x) = x**3 - 3 x with its derivatives: increasing for |x| > 1, a fold (law' = 0) at x = +-1."""
+
+    def __call__(self, x, nu: int = 0):
+        x = np.asarray(x, dtype=np.float64)
+        if nu == 0:
+            return x ** 3 - 3.0 * x
+        return 3.0 * x * x - 3.0 if nu == 1 else 6.0 * x
+
+
+def _twin_cubic_train(x0: float) -> Mechanism:
+    """A wheel pinned at O coupled to a driven disc at P by two identical couplings (twin gear trains side by
+    side), theta_disc = law(theta_wheel) with law(x) = x**3 - 3 x; the disc's angle is the input (rad,
+    input unit mm). 2 revolutes + 2 couplings + 1 driver = 7 equations in 6 unknowns (one redundant): the
+    least-squares path. Assembled with the wheel at x0 on the branch x > 1."""
+    law = _Cubic()
+    return Mechanism(
+        name="twin_cubic",
+        bodies=(Body("ground", {"O": (0.0, 0.0), "P": (10.0, 0.0)}), Body("wheel", {"O": (0.0, 0.0)}),
+                Body("disc", {"P": (0.0, 0.0)})),
+        ground="ground", joints=(Revolute("O", "ground", "wheel"), Revolute("P", "ground", "disc")),
+        gears=(GearCoupling("left", "ground", "wheel", "disc", law),
+               GearCoupling("right", "ground", "wheel", "disc", law)),
+        drivers=(Driver("angle", "disc", "ground"),), input_range=(float(law(x0)), 1.0), input_unit="mm",
+        assembly={"wheel": (0.0, 0.0, x0), "disc": (10.0, 0.0, float(law(x0)))})
+
+
+@pytest.mark.parametrize("x0", [1.04, 1.05, 1.06, 1.07, 1.08])
+def test_redundant_continuation_moves_away_from_a_fold(x0):
+    """Twin cubic couplings, the wheel assembled just past the fold (x0 = 1.04 .. 1.08), the input raised in one
+    step to s1 = law(1.5) = -1.125. On the branch x > 1 the law increases, so the wheel turns on to the largest
+    root of x**3 - 3 x - s1 = (x - 1.5) (x**2 + 1.5 x - 0.75), x = 1.5 (1e-9 rad), not to the middle one,
+    (sqrt(5.25) - 1.5) / 2 = 0.396. At the start the middle branch is only 0.08 .. 0.16 rad away, across the
+    fold, inside the 0.3 rad step guard: the predictor must lead away from the fold, along the tangent
+    d x / d s = 1 / law'(x) > 0, or the continuation slips onto that branch (the least-squares path has no
+    orientation check to notice)."""
+    law = _Cubic()
+    s1 = float(law(1.5))
+    assert s1 == -1.125
+    motion = _twin_cubic_train(x0).sweep(np.array([float(law(x0)), s1]))
+    assert motion.pose("wheel")[1, 2] == pytest.approx(1.5, abs=1e-9)
+    assert motion.pose("disc")[1, 2] == pytest.approx(s1, abs=1e-12)
+
+
 def pinned_twice(offset: float, input_range: tuple[float, float]) -> Mechanism:
     """A crank pinned to the ground at O and at P (0.8 mm apart): locked; its angle is driven by
     theta = s + offset over ``input_range``."""
@@ -383,6 +473,23 @@ def test_large_input_step_near_change_point_stays_on_branch():
     expected = _four_bar_b(*lengths, 200.0, left=False)
     assert np.hypot(*(coarse.point("B", "rocker")[1] - expected)) < 1e-9
     assert np.max(np.abs(coarse.q[1] - fine.q[-1])) < 1e-9
+
+
+def test_half_turn_in_one_step_a_tenth_of_a_millimetre_from_the_change_point():
+    """A crank-rocker 0.1 mm short of Grashof's change point (crank 10.1, coupler 38.6, rocker 49.2, ground 20.8:
+    10.1 + 49.2 = 59.3 against 38.6 + 20.8 = 59.4), whose branches pass within a fraction of a degree of each
+    other, asked for one 180 degree input step (110 -> -70 deg) on its lower branch. A crank-rocker has no
+    singular pose, so no LockupError may come, and B must be on the lower-branch circle intersection within
+    1e-9 mm, where a 1 degree sweep ends too: the accepted steps may grow only so fast that each one's
+    predictor still lands on this branch."""
+    lengths = (10.1, 38.6, 49.2, 20.8)
+    assert 10.1 + 49.2 == pytest.approx(38.6 + 20.8 - 0.1, abs=1e-12)
+    mech = make_four_bar(*lengths, start_deg=110.0, end_deg=-70.0, upper=False)
+    coarse = mech.sweep(np.array([110.0, -70.0]))
+    fine = mech.sweep(181)
+    expected = _four_bar_b(*lengths, -70.0, left=False)
+    assert np.hypot(*(coarse.point("B", "rocker")[1] - expected)) < 1e-9
+    assert np.hypot(*(fine.point("B", "rocker")[-1] - expected)) < 1e-9
 
 
 def _slider_rocker(axis, d_point, s0: float, s1: float) -> Mechanism:

@@ -895,3 +895,100 @@ def test_printed_spacers_on_one_compound_pin_are_numbered_bottom_up(sla_process,
     spacers = {p.name: (p.z_mm, p.thickness_mm) for p in partset.parts if p.role == "spacer"}
     assert spacers == {"spacer_O_Or_1": pytest.approx((3.0, 3.6)), "spacer_O_Or_2": pytest.approx((9.6, 3.6)),
                        "spacer_B": pytest.approx((6.3, 3.6)), "spacer_D": pytest.approx((3.0, 6.9))}
+
+
+# -- a body that just clears (or not) a pin's spacer; a guide pin in a guide slot ----------------------------
+
+def stop_arm(gap: float) -> Mechanism:
+    """A crank (O-A, 15 mm) turning a full circle about the ground's O, and a stop arm pinned at the ground's
+    P = 25 u, held at the fixed angle phi = pi / 48 (a second driver with a zero-slope law), u = (cos phi,
+    sin phi). The arm's other point Q is at 2 r + ``gap`` along u from O (r = 2.35, the SLA boss radius), so
+    the arm's end boss is ``gap`` mm from a boss-sized spacer disc about O. The direction phi lies halfway
+    between two corners of the 48-gon the spacer check draws around the spacer. Bodies listed ground, arm,
+    crank: the colouring stacks them 0, 1, 2 unless something moves the arm."""
+    phi = math.pi / 48
+    u = np.array([math.cos(phi), math.sin(phi)])
+    q = 2 * 2.35 + gap
+    return Mechanism(
+        name="stop_arm",
+        bodies=(Body("ground", {"O": (0.0, 0.0), "P": (25.0 * u[0], 25.0 * u[1])}),
+                Body("arm", {"P": (0.0, 0.0), "Q": (q - 25.0, 0.0)}),
+                Body("crank", {"O": (0.0, 0.0), "A": (15.0, 0.0)})),
+        ground="ground",
+        joints=(Revolute("O", "ground", "crank"), Revolute("P", "ground", "arm")), gears=(),
+        drivers=(Driver("angle", "crank", "ground"), Driver("angle", "arm", "ground", law=LinearLaw(0.0, phi))),
+        input_range=(0.0, 360.0), assembly={"crank": (0.0, 0.0, 0.0), "arm": (25.0 * u[0], 25.0 * u[1], phi)})
+
+
+@pytest.mark.parametrize(("gap", "crosses"), [(0.22, True), (0.40, False)])
+def test_a_body_within_the_running_clearance_of_a_spacer_is_kept_off_its_layers(sla_process, monkeypatch, gap,
+                                                                                 crosses):
+    """The stop arm's plate ends ``gap`` mm from the spacer (boss radius 2.35 mm about the crank pin O) that
+    would fill the layers pin O skips (shapely on the 0.001 mm outline: within 1e-4 mm of ``gap``). All three
+    bodies conflict (two pins; the crank sweeps over the arm), so they take three layers, ground 0, arm 1,
+    crank 2 by body order: pin O skips the arm's layer. At 0.22 mm, inside the 0.25 mm running clearance (and
+    0.03 mm outside what the 0.05 mm conflict outlines could lose), the arm would rub on that spacer: the
+    spacer check must report (ground, crank, arm) and the arm must not sit between the ground's and the
+    crank's layers. At 0.40 mm (beyond the clearance plus the outlines' 0.05 mm) nothing is reported and the
+    stack stays as coloured. The arm does not move (margin between samples 0)."""
+    import fabricate.parts.build as build
+
+    seen = []
+    real = build.pin_crossings
+
+    def spy(*args):
+        seen.extend(real(*args))
+        return seen
+
+    monkeypatch.setattr(build, "pin_crossings", spy)
+    mech = stop_arm(gap)
+    motion = mech.sweep(73)
+    partset = build_parts(design_for(sla_process), mech, motion, [], {})
+    pose = motion.pose("arm")
+    assert np.ptp(pose, axis=0) == pytest.approx([0.0, 0.0, 0.0], abs=1e-12)
+    plate = shapely.Polygon(world(pose[0], partset.part("arm").outline.polygon(0.001)))
+    assert shapely.Point(0.0, 0.0).buffer(2.35, 1024).distance(plate) == pytest.approx(gap, abs=1e-4)
+    layers = partset.layers
+    lo, hi = sorted((layers["ground"], layers["crank"]))
+    assert sorted(layers.values()) == [0, 1, 2]
+    if crosses:
+        assert seen == [("ground", "crank", "arm")]
+        assert not lo < layers["arm"] < hi, layers
+    else:
+        assert seen == []
+        assert layers == {"ground": 0, "arm": 1, "crank": 2}
+
+
+def stacked_rods(height: float) -> Mechanism:
+    """Rod 1 slides along x on the ground (its point S1 through the ground's S1 at the origin, stroke 0 .. 10
+    mm); rod 1 carries point S2 at (-5, ``height``), the guide of rod 2, which slides on rod 1 along (0, -1),
+    half as far as rod 1 (a second driver, law 0.5 s)."""
+    return Mechanism(
+        name="stacked_rods",
+        bodies=(Body("ground", {"S1": (0.0, 0.0)}), Body("rod1", {"S1": (0.0, 0.0), "S2": (-5.0, height)}),
+                Body("rod2", {"S2": (0.0, 0.0)})),
+        ground="ground",
+        joints=(Slider("S1", "ground", "rod1", (1.0, 0.0)), Slider("S2", "rod1", "rod2", (0.0, -1.0))), gears=(),
+        drivers=(Driver("slide", "rod1", "ground", joint="S1"),
+                 Driver("slide", "rod2", "rod1", joint="S2", law=LinearLaw(0.5, 0.0))),
+        input_range=(0.0, 10.0), input_unit="mm", assembly={"rod1": (0.0, 0.0, 0.0), "rod2": (-5.0, height, 0.0)})
+
+
+@pytest.mark.parametrize(("height", "warned"), [(4.0, True), (10.0, False)])
+def test_a_guide_pin_in_the_guiding_rods_own_slot_is_a_warning_of_the_part_set(sla_process, height, warned):
+    """Rod 1 runs on two guide pins of the ground (its slot) and holds the two guide pins of rod 2. By hand
+    (SLA: hole 2.7 mm, boss radius 2.35, guide spacing 2 x 2.35 + 2 x 0.8 = 6.3 mm): rod 2's second guide pin
+    sits in rod 1 at S2 + 6.3 (0, -1) = (-5, h - 6.3); rod 1's slot is the 2.7 mm wide stadium along y = 0
+    over x in [-10, 6.3]. At h = 4 that hole (radius 1.35) is 2.3 mm from the slot's centre line, less than
+    1.35 + 1.35: it runs into the slot, so the part set, which is still built, carries exactly the warning
+    naming rod 1 and the hole. At h = 10 it is 3.7 mm away: no warning. (The build's own refusal only looks
+    at rod points, and S2 itself is h mm from the line.)"""
+    mech = stacked_rods(height)
+    partset = build_parts(design_for(sla_process), mech, mech.sweep(11), [], {})
+    rod1 = partset.part("rod1")
+    holes = {h.joint: h.centre for h in rod1.holes}
+    np.testing.assert_allclose(holes["S2_guide"], [-5.0, height - 6.3], atol=1e-12)
+    (slot,) = rod1.slots
+    assert slot.area() == pytest.approx(16.3 * 2.7 + math.pi * 2.7 ** 2 / 4, abs=1e-9)
+    expected = ("part rod1: hole S2_guide runs into a guide slot",) if warned else ()
+    assert partset.warnings == expected
