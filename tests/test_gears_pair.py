@@ -425,6 +425,9 @@ def test_closed_teeth_accept_a_law_within_a_millionth_of_closing():
     (121, 120, 181.2, "gears.module_mm", "need 121 and 120 teeth"),
     # the only closing count 71:70 is 61 above the 10 asked for: not searched
     (71, 70, 10.2, "gears.teeth", "no whole tooth counts near 10.2"),
+    # the closing counts 122:121 and 244:242 are 61 below and 61 above the 183 asked for: neither is searched
+    # (were 122 found, the refusal would be the 100-teeth bound's, naming the module)
+    (122, 121, 183.0, "gears.teeth", "no whole tooth counts near 183.0"),
 ])
 def test_closed_teeth_search_reaches_60_teeth_either_side(p, q, ideal, path, words):
     """Gear b turns p / q times per turn of a (p, q coprime): only multiples of p teeth on gear a close the
@@ -502,3 +505,345 @@ def test_a_law_that_is_not_monotonic_over_the_range_is_refused_naming_it():
             make_gear_pair(FormulaLaw("sin(x)"), 20.0, (0.0, hi), GearSpec(module_mm=1.0, compare_methods=False),
                            closed=False, name="mesh_q", run_mesh_check=False)
         assert info.value.path == "gears.mesh_q.law"
+
+
+# -- resource bounds: teeth per gear and mesh-check work -------------------------------------------
+def closed_circles(spec: GearSpec, center_distance: float, formula: str = "x", name: str = "pair", **kwargs):
+    """A closed pair on the constant-ratio law ``x_b = -k x_a`` (pitch circles of radii a k / (1 + k) and
+    a / (1 + k)), over the turn from 0, without the mesh check."""
+    return make_gear_pair(FormulaLaw(formula), center_distance, (0.0, TWO_PI), spec, closed=True, name=name,
+                          run_mesh_check=False, **kwargs)
+
+
+def test_mesh_step_bound_refuses_naming_mesh_steps_and_the_largest_count():
+    """21 + 21 teeth at 7200 mesh steps is 302400 tooth-steps, over the bound of 300000 (``bounds``): refused
+    naming ``gears.mesh_steps``, with the product, the time estimate (3.5e-5 s per tooth-step) and the most
+    steps 42 teeth allow, 300000 // 42 = 7142 (exact message)."""
+    from fabricate.bounds import MAX_MESH_STEP_TEETH, MESH_SECONDS_PER_TOOTH_STEP
+
+    with pytest.raises(SpecError) as info:
+        closed_circles(GearSpec(teeth=(21, 21), mesh_steps=7200, compare_methods=False), 50.0)
+    assert info.value.path == "gears.mesh_steps"
+    work = 7200 * 42
+    assert work == 302400 > MAX_MESH_STEP_TEETH
+    assert info.value.message == (f"7200 steps × 42 teeth = 302400 tooth-steps, over the bound of 300000 (about "
+                                  f"{MESH_SECONDS_PER_TOOTH_STEP * work:.0f} s estimated); at most "
+                                  f"{300000 // 42} steps")
+    assert 300000 // 42 == 7142
+
+
+def test_mesh_step_bound_accepts_exactly_the_bound():
+    """25 + 25 teeth at 6000 steps is exactly 300000 tooth-steps: at the bound, not over it, so the pair is
+    cut (50 mm between equal circles: module 2 * 25 / 25 = 2 mm)."""
+    pair = closed_circles(GearSpec(teeth=(25, 25), mesh_steps=6000, compare_methods=False), 50.0,
+                          chord_tolerance_mm=0.05)
+    assert pair.teeth == (25, 25)
+    assert pair.module == pytest.approx(2.0, rel=1e-9)
+
+
+def test_tooth_bound_accepts_exactly_100_teeth():
+    """Equal circles of radius 50 mm (a = 100 mm) at module 1 mm hold 2 * 50 / 1 = 100 teeth each: exactly the
+    100-teeth bound, so the pair is cut with 100:100 teeth (and 100 tips on each outline)."""
+    pair = closed_circles(GearSpec(module_mm=1.0, compare_methods=False), 100.0, chord_tolerance_mm=0.05)
+    assert pair.teeth == (100, 100)
+    assert pair.module == pytest.approx(1.0, rel=1e-9)
+    assert tips(pair.outline_a, 50.5) == tips(pair.outline_b, 50.5) == 100
+
+
+def test_tooth_bound_refuses_101_teeth_naming_the_module():
+    """At module 0.99 mm the 50 mm circles ask for 100 / 0.99 = 101.01 teeth: 101:101 close the law but are
+    over the 100-teeth bound; refused naming ``gears.module_mm`` (the template gave the module), with the
+    module of 101 teeth, 100 / 101 mm, and the smallest module that fits, 100 / 101 * 101 / 100 = 1 mm."""
+    with pytest.raises(SpecError) as info:
+        closed_circles(GearSpec(module_mm=0.99, compare_methods=False), 100.0)
+    assert info.value.path == "gears.module_mm"
+    assert info.value.message == ("the pitch curves need 101 and 101 teeth at module 0.99 mm, over the bound of "
+                                  "100 teeth per gear; use a module of at least 1 mm")
+
+
+def test_tooth_bound_refuses_101_teeth_given_naming_the_teeth():
+    """Tooth counts given by the template (101:101, past the template parser) are refused naming
+    ``gears.teeth``, the field the template set."""
+    with pytest.raises(SpecError) as info:
+        closed_circles(GearSpec(teeth=(101, 101), compare_methods=False), 100.0)
+    assert info.value.path == "gears.teeth"
+    assert info.value.message.startswith("the pitch curves need 101 and 101 teeth at module 0.99 mm")
+
+
+# -- closure tolerance of given tooth counts ---------------------------------------------------------
+def test_given_teeth_close_the_law_within_a_millionth_of_its_turns():
+    """Teeth 40:10 against a law turning gear b 4.000002 times: off by 2e-6 turns, 5e-7 of the 4 turns,
+    inside the 1e-6 relative tolerance: the pair is cut with the teeth given. (A tolerance of 1e-6 / turns,
+    2.5e-7 turns here, would refuse it.)"""
+    pair = closed_circles(GearSpec(teeth=(40, 10), compare_methods=False), 50.0, formula="4.000002*x",
+                          chord_tolerance_mm=0.05)
+    assert pair.teeth == (40, 10)
+    assert pair.module == pytest.approx(2 * 40.0 / 40, rel=1e-5)  # pitch circle of gear a: 50 * 4 / 5 = 40 mm
+
+
+def test_given_teeth_off_by_more_than_a_millionth_of_the_turns_are_refused():
+    """Teeth 10:40 against a law turning gear b 0.2500005 times: off by 5e-7 turns, 2e-6 of the 0.25 turns,
+    outside the 1e-6 relative tolerance (a tolerance of 1e-6 / turns, 4e-6 turns here, would accept it):
+    refused naming ``gears.teeth`` with the counts that would close the law, 10 / 0.2500005 = 39.99992."""
+    with pytest.raises(SpecError) as info:
+        closed_circles(GearSpec(teeth=(10, 40), compare_methods=False), 50.0, formula="0.2500005*x")
+    assert info.value.path == "gears.teeth"
+    assert info.value.message == (f"teeth 10:40 give 0.25 turns of b per turn of a but the law gives "
+                                  f"{0.2500005:.6g}; use teeth [10, {10 / 0.2500005:.6g}] or a law that closes")
+
+
+# -- the ratio must repeat over gear b's turn ------------------------------------------------------------
+def test_law_whose_ratio_does_not_repeat_over_gear_b_is_refused():
+    """x_b = -(2 x + 0.1 sin x) turns gear b exactly twice per turn of a (teeth 20:10 agree), but gear b
+    closes after pi of gear a and the ratio 2 + 0.1 cos x does not repeat after pi (it changes by 0.2):
+    refused naming ``gears.<name>.law`` with gear b's turn in degrees of a (exact message)."""
+    with pytest.raises(SpecError) as info:
+        closed_circles(GearSpec(teeth=(20, 10), compare_methods=False), 15.0, formula="2*x + 0.1*sin(x)",
+                       name="mesh_q")
+    assert info.value.path == "gears.mesh_q.law"
+    assert info.value.message == ("the law does not close gear b: its ratio does not repeat after gear b's turn "
+                                  "(180.00 deg of a); use a law periodic over that angle")
+
+
+@pytest.mark.parametrize(("c", "closes"), [(5e-8, True), (1.5e-7, False)])
+def test_ratio_repeats_within_1e7_of_the_largest_ratio(c, closes):
+    """Ratio 2 + c cos x against itself half a turn on: it changes by up to 2c (at x = 0, a grid point),
+    the tolerance is 1e-7 of the largest ratio 2 + c. c = 5e-8 changes it by 1e-7 < 2e-7: cut (a tolerance of
+    1e-7 / (2 + c) would refuse it); c = 1.5e-7 by 3e-7 > 2e-7: refused. Teeth 20:10 at 15 mm (module 1)."""
+    spec = GearSpec(teeth=(20, 10), compare_methods=False)
+    if closes:
+        pair = closed_circles(spec, 15.0, formula=f"2*x + {c!r}*sin(x)", chord_tolerance_mm=0.05)
+        assert pair.teeth == (20, 10)
+    else:
+        with pytest.raises(SpecError) as info:
+            closed_circles(spec, 15.0, formula=f"2*x + {c!r}*sin(x)")
+        assert info.value.path == "gears.pair.law"
+        assert info.value.message.startswith("the law does not close gear b")
+
+
+# -- min_teeth: the module that would give enough teeth ------------------------------------------------
+@pytest.mark.parametrize(("formula", "teeth"), [("2*x", (12, 6)), ("0.5*x", (6, 12))])
+def test_too_few_teeth_are_refused_with_the_module_that_gives_min_teeth(formula, teeth):
+    """A closed pair whose smaller gear has 6 teeth, below min_teeth = 8, is refused naming ``gears.teeth``
+    with the largest module giving the smaller gear 8 teeth (exact message). At 15 mm with ratio 2 gear a's
+    pitch circle is 20 mm across and b, the smaller, gets half of a's teeth: 20 pi / (pi * 8 * 2) = 1.25 mm;
+    with ratio 1/2 gear a is 10 mm across and is itself the smaller: 10 pi / (pi * 8) = 1.25 mm."""
+    with pytest.raises(SpecError) as info:
+        closed_circles(GearSpec(teeth=teeth, compare_methods=False), 15.0, formula=formula)
+    assert info.value.path == "gears.teeth"
+    assert info.value.message == "6 teeth is below min_teeth = 8: use at least 8 teeth (module <= 1.25 mm)"
+
+
+# -- sectors: teeth follow from the range and the module ------------------------------------------------
+def small_sector(spec: GearSpec, **kwargs):
+    """A ratio-1 sector at 20 mm (pitch circles of radius 10 mm) over 0.5 rad (5 mm of pitch arc)."""
+    return make_gear_pair(FormulaLaw("x"), 20.0, (0.0, 0.5), spec, closed=False, name="mesh_q",
+                          run_mesh_check=False, chord_tolerance_mm=0.05, **kwargs)
+
+
+def test_sector_refuses_tooth_counts_naming_the_teeth():
+    """Tooth counts apply to closed pairs only: a sector given teeth is refused naming ``gears.teeth`` with
+    both ways out (exact message)."""
+    with pytest.raises(SpecError) as info:
+        small_sector(GearSpec(teeth=(10, 10), compare_methods=False))
+    assert info.value.path == "gears.teeth"
+    assert info.value.message == ("tooth counts apply to closed pairs; a sector's teeth follow from its working "
+                                  "range and module (leave teeth out or set closed = true)")
+
+
+def test_sector_without_a_module_is_cut_at_half_a_millimetre():
+    """No module in the template: a sector gets the SLA-sized 0.5 mm. Its teeth then follow in closed form:
+    5 mm of arc is 5 / (0.5 pi) = 3.18 pitches; gear a's teeth sit at whole pitches from -2.25 to 3.18 + 2.25
+    pitches (1.25 + 1 spare tooth each side), -2..5: 8 teeth; gear b's half a pitch off, -1.5..4.5: 7 teeth."""
+    pair = small_sector(GearSpec(compare_methods=False))
+    assert pair.module == 0.5
+    assert pair.teeth == (8, 7)
+
+
+@pytest.mark.parametrize(("module", "hub"), [(1.2, 2.0 + 4 * 1.2), (0.25, 2.0 + 2.0)])
+def test_sector_hub_is_the_larger_of_bore_plus_2_mm_and_bore_plus_4_modules(module, hub):
+    """With neither hub nor bore in the template the bore is the 2 mm SLA pin and the hub diameter
+    max(bore + 2 mm, bore + 4 m): 6.8 mm at module 1.2, 4 mm at module 0.25. The sector's outline is closed
+    by that hub disk: its nearest point to the axis lies on the hub circle, within the 0.05 mm chord
+    tolerance."""
+    pair = small_sector(GearSpec(module_mm=module, compare_methods=False))
+    assert pair.hub_diameter_mm == pytest.approx(hub, rel=1e-12)
+    assert (pair.bore_a_mm, pair.bore_b_mm) == (2.0, 2.0)
+    for outline in (pair.outline_a, pair.outline_b):
+        assert 0.5 * hub - 0.05 <= np.min(np.hypot(*outline.T)) <= 0.5 * hub + 1e-9
+
+
+def test_sector_hub_given_by_the_template_is_kept():
+    """A template's hub diameter (9 mm) is used as given: the attribute and the hub circle of the outlines."""
+    pair = small_sector(GearSpec(module_mm=1.0, hub_diameter_mm=9.0, compare_methods=False))
+    assert pair.hub_diameter_mm == 9.0
+    for outline in (pair.outline_a, pair.outline_b):
+        assert 4.5 - 0.05 <= np.min(np.hypot(*outline.T)) <= 4.5 + 1e-9
+
+
+def test_backlash_up_to_a_quarter_pitch_is_cut_and_beyond_is_refused():
+    """The backlash may be at most a quarter of the circular pitch (pi m / 4 = 0.785 mm at module 1): exactly
+    that is cut, 0.79 mm is refused naming ``gears.backlash_mm`` with the limit (exact message)."""
+    limit = 0.25 * (math.pi * 1.0)
+    pair = small_sector(GearSpec(module_mm=1.0, backlash_mm=limit, compare_methods=False))
+    assert pair.spec.backlash_mm == limit and pair.teeth == (6, 6)
+    with pytest.raises(SpecError) as info:
+        small_sector(GearSpec(module_mm=1.0, backlash_mm=0.79, compare_methods=False))
+    assert info.value.path == "gears.backlash_mm"
+    assert info.value.message == "backlash 0.79 mm is too large for module 1 mm; use backlash_mm <= 0.785"
+
+
+@pytest.mark.parametrize(("center", "module"), [(20.0, 1.0), (2.0, 0.1)])
+def test_law_that_fails_where_the_sector_is_extended_is_refused_naming_the_law(center, module):
+    """x_b = -(x - 0.5 sin x - x^3 / 30) has ratio 1 - 0.5 cos x - 0.1 x^2, positive over the working range
+    (-3, 3) but negative beyond about 3.8 rad. The sector's pitch curves are extended by
+    1.3 * margin / r_min, margin = (1.25 + 1 spare + 2.5) pi m + 5 m and r_min = a * 0.5 / 1.5 the smallest
+    pitch radius (ratio 0.5 at x = 0): 3.88 rad = 222.6 deg, into the negative ratio: refused naming
+    ``gears.<name>.law`` with the extension in degrees (the same at 20 mm / module 1 and at 2 mm / module 0.1,
+    where r_min is 0.67 mm)."""
+    margin = (1.25 + 1 + 2.5) * math.pi * module + 5 * module
+    grow = 1.3 * margin / (center * 0.5 / 1.5)
+    assert f"{math.degrees(grow):.1f}" == "222.6"
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw("x - 0.5*sin(x) - x**3/30"), center, (-3.0, 3.0),
+                       GearSpec(module_mm=module, compare_methods=False), closed=False, name="mesh_q",
+                       run_mesh_check=False)
+    assert info.value.path == "gears.mesh_q.law"
+    message = info.value.message
+    assert message.startswith("transmission ratio -") and " <= 0 at x_a = " in message
+    assert message.endswith("(the law is extended 222.6 deg beyond the working range for the spare teeth; "
+                            "widen the law's range or use fewer spare_teeth)")
+
+
+@pytest.mark.parametrize(("hi", "teeth", "ends"), [(0.5, (8, 7), (-3.0, 6.0)), (0.175 * math.pi, (8, 8), (-3.0, 6.5))])
+def test_sector_pitch_curves_run_a_pitch_beyond_the_outermost_teeth(hi, teeth, ends):
+    """A sector's pitch curves (as drawn and as used by the strength check) run from one circular pitch
+    before the first tooth of either gear to one pitch after the last. Ratio 1 at 20 mm, module 0.5: the
+    range ends at 10 hi / p pitches (p = pi / 2 mm); gear a's teeth sit at whole pitches from -2 (1.25 + 1
+    spare before 0) to floor(10 hi / p + 2.25), gear b's half a pitch off. For hi = 0.5 (3.18 pitches) a's
+    last tooth, at 5, is the outermost: the curves span -3..6 pitches; for hi = 0.175 pi (3.5 pitches) b's,
+    at 5.5: -3..6.5. On the 10 mm circles that is x_a = s / 10: gear a's pitch point at polar angle -x_a
+    (listed CCW, from the far end), gear b's at pi + x_a (1e-9 mm)."""
+    pair = make_gear_pair(FormulaLaw("x"), 20.0, (0.0, hi), GearSpec(compare_methods=False), closed=False,
+                          run_mesh_check=False, chord_tolerance_mm=0.05)
+    assert pair.teeth == teeth
+    x0, x1 = (k * math.pi / 2 / 10 for k in ends)
+
+    def on_circle(angle):
+        return [10 * math.cos(angle), 10 * math.sin(angle)]
+
+    np.testing.assert_allclose(pair.pitch_a[[0, -1]], [on_circle(-x1), on_circle(-x0)], atol=1e-9)
+    np.testing.assert_allclose(pair.pitch_b[[0, -1]], [on_circle(math.pi + x0), on_circle(math.pi + x1)], atol=1e-9)
+
+
+def test_sector_whose_gear_b_turns_a_full_turn_is_refused():
+    """Ratio 2 at 30 mm (pitch circles 20 and 10 mm), module 1, range (0, 3): with its spare teeth gear a's
+    pitch curve runs from 3 pitches before 0 to 22 pitches (60 mm of range is 19.1 pitches; a's last tooth is
+    at floor(19.1 + 2.25) = 21), x_a from -3 pi / 20 = -0.47 to 22 pi / 20 = 3.46: 3.93 rad of gear a, less
+    than a turn, but 7.85 rad of gear b: refused naming ``gears.<name>.closed`` (exact message)."""
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw("2*x"), 30.0, (0.0, 3.0), GearSpec(module_mm=1.0, compare_methods=False),
+                       closed=False, name="mesh_q", run_mesh_check=False)
+    assert info.value.path == "gears.mesh_q.closed"
+    assert info.value.message == "the sector with its spare teeth spans a full turn; use closed = true"
+
+
+def test_ratio_sign_change_is_located_at_its_most_negative_sample():
+    """x_b = -sin(x_a) over (0, 5): ratio cos x_a, most negative at pi. The ratio is sampled at 1025 points
+    (every 5 / 1024 rad) before anything is built; the message names the sample nearest pi, 643 * 5 / 1024 rad
+    = 179.889 deg, its ratio (-1 to 4 digits) and ``gears.<name>.law``."""
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw("sin(x)"), 20.0, (0.0, 5.0), GearSpec(module_mm=0.5, compare_methods=False),
+                       closed=False, name="mesh_q", run_mesh_check=False)
+    assert info.value.path == "gears.mesh_q.law"
+    assert f"{math.degrees(643 * 5 / 1024):.3f}" == "179.889"
+    assert info.value.message == ("transmission ratio -1 <= 0 at x_a = 179.889 deg: an external gear pair needs "
+                                  "the driven angle to change monotonically with the driving angle; use a "
+                                  "monotonic law (ratio > 0 everywhere)")
+
+
+@pytest.mark.parametrize(("hi", "teeth"), [(95.5 * 0.5 * math.pi / 30, (100, 100))])
+def test_sector_of_exactly_100_teeth_is_cut(hi, teeth):
+    """Ratio 1 at 60 mm (30 mm circles), module 0.5 (pitch pi / 2), a range of 95.5 pitches: gear a's teeth
+    at -2..floor(95.5 + 2.25) = 97, 100 teeth; gear b's at -1.5..96.5, 100: at the 100-teeth bound, cut."""
+    pair = make_gear_pair(FormulaLaw("x"), 60.0, (0.0, hi), GearSpec(module_mm=0.5, compare_methods=False),
+                          closed=False, run_mesh_check=False, chord_tolerance_mm=0.05)
+    assert pair.teeth == teeth
+
+
+def test_sector_over_100_teeth_is_refused_before_it_is_cut():
+    """Ratio 1 at 80 mm (40 mm circles), module 0.5, range 1.5 pi: 60 pi mm = 120 pitches of range plus
+    1.25 + 1 spare each side: 124 teeth a gear by the sector's estimate (120 + 4.5, whole teeth), over the
+    bound: refused naming ``gears.module_mm`` with the module that fits, 0.5 * 124 / 100 = 0.62 mm."""
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw("x"), 80.0, (0.0, 1.5 * math.pi), GearSpec(module_mm=0.5, compare_methods=False),
+                       closed=False, run_mesh_check=False)
+    assert info.value.path == "gears.module_mm"
+    assert info.value.message == ("the pitch curves need 124 and 124 teeth at module 0.5 mm, over the bound of 100 "
+                                  "teeth per gear; use a module of at least 0.62 mm")
+
+
+@pytest.mark.parametrize("formula", ["2*exp(x/2)", "-2*exp(-x/2)"])
+def test_sector_pitch_curves_are_extended_by_the_margin_on_both_sides(formula):
+    """Spare teeth need the pitch curves beyond the range: they are built at least
+    margin = (1.25 + spare + 2.5) p + 5 m of arc beyond each end (p = pi m). Ratio e^(x/2) (or e^(-x/2)) at
+    20 mm, module 1, range (0, 1): the pitch radius shrinks towards one end, so the first extension
+    (1.3 margin / smallest radius) falls short there and is grown until both ends are covered."""
+    pair = make_gear_pair(FormulaLaw(formula), 20.0, (0.0, 1.0), GearSpec(module_mm=1.0, compare_methods=False),
+                          closed=False, run_mesh_check=False, chord_tolerance_mm=0.05)
+    margin = (1.25 + 1 + 2.5) * math.pi + 5
+    pitch = pair.pitch_model
+    s_hi = float(pitch.s_of_x(np.array([1.0]))[0])
+    assert pitch.s_nodes[0] < -margin and pitch.s_nodes[-1] > s_hi + margin
+
+
+def test_closed_pair_reports_the_smallest_radius_of_curvature_over_the_whole_turn():
+    """Two equal ellipses (e = 0.2, semi-major axis A = 20 mm, on foci 40 mm apart) turned from x_a = -pi/2:
+    the pitch curves' smallest radius of curvature is A (1 - e^2) = 19.2 mm, at the ends of the major axis
+    (x_a = 0 and pi), which the closed pair's 2049 samples of the turn from -pi/2 include. 1e-6 relative:
+    the curvature takes a finite-difference second derivative of the law (about 1e-7 relative)."""
+    from fabricate.gears.law import elliptic_law
+
+    lo = -math.pi / 2
+    pair = make_gear_pair(elliptic_law(0.2), 40.0, (lo, lo + TWO_PI), GearSpec(teeth=(20, 20), compare_methods=False),
+                          closed=True, run_mesh_check=False, chord_tolerance_mm=0.05)
+    assert pair.checks["min_pitch_radius_of_curvature_mm"] == pytest.approx(20.0 * (1 - 0.2**2), rel=1e-6)
+
+
+def test_report_ranges_are_the_laws_extremes_over_the_working_range():
+    """x_b = -(x_a - 0.5 cos x_a) over (0, pi): ratio 1 + 0.5 sin x_a, 1 at both ends and 1.5 at pi / 2, the
+    middle of the working range (sampled at 721 points including it). At 20 mm the pitch radii a i / (1 + i)
+    run from 10 to 12 mm on gear a and from 8 to 10 mm on gear b (1e-9 relative)."""
+    pair = make_gear_pair(FormulaLaw("x - 0.5*cos(x)"), 20.0, (0.0, math.pi),
+                          GearSpec(module_mm=0.5, compare_methods=False), closed=False, run_mesh_check=False,
+                          chord_tolerance_mm=0.05)
+    report = pair.report()
+    assert report["transmission_ratio"] == pytest.approx([1.0, 1.5], rel=1e-9)
+    assert report["pitch_radius_a_mm"] == pytest.approx([10.0, 12.0], rel=1e-9)
+    assert report["pitch_radius_b_mm"] == pytest.approx([8.0, 10.0], rel=1e-9)
+
+
+def test_a_law_whose_ratio_does_not_repeat_after_a_turn_of_gear_a_is_refused():
+    """Regression (found by helper-31): x_b = 1.5 x + (0.2 / 3) sin(1.5 x) advances gear b by exactly 1.5 turns
+    per turn of a (teeth 30:20 agree), but its ratio 1.5 + 0.1 cos(1.5 x) is 1.6 at 0 and 1.4 at 2 pi, so gear a's
+    pitch curve jumps at the seam (r 15.385 -> 14.583 mm). Only gear b's closure was checked; now gear a's
+    is too, naming gears.closed (the law or the closedness must change)."""
+    with pytest.raises(SpecError) as info:
+        make_gear_pair(FormulaLaw("1.5*x + (0.2/3)*sin(1.5*x)"), 25.0, (0.0, TWO_PI),
+                       GearSpec(teeth=(30, 20), compare_methods=False), closed=True, name="mesh_q",
+                       run_mesh_check=False)
+    assert info.value.path == "gears.closed"
+    assert info.value.message.startswith("the law does not close gear a: its ratio does not repeat")
+
+
+@pytest.mark.parametrize("centre, teeth", [(16.0, (8, 8)), (20.0, (10, 10))])
+def test_a_closed_pair_of_exactly_min_teeth_is_built(centre, teeth):
+    """Regression (found by helper-31): equal circles of radius centre / 2 with z = min_teeth = 8 (or 10 with
+    min_teeth 10) have module 2 rho / z exactly, the largest the feasibility check allows; the sampled curvature
+    made the bound 2e-16 smaller and the pair was refused with 'needs module <= 2 mm'. Built, with the module
+    centre / z (1e-12)."""
+    spec = GearSpec(teeth=teeth, min_teeth=teeth[0], compare_methods=False)
+    pair = make_gear_pair(FormulaLaw("x"), centre, (0.0, TWO_PI), spec, closed=True, run_mesh_check=False,
+                          chord_tolerance_mm=0.05)
+    assert pair.teeth == teeth
+    assert pair.module == pytest.approx(centre / teeth[0], abs=1e-12)

@@ -46,7 +46,9 @@ def check_feasible(curv: dict[str, float], module: float, spec: Any, path: str =
     """Raise :class:`SpecError` naming the quantity and the fix when the module cannot be cut."""
     rho = min(curv["min_radius_of_curvature_a_mm"], curv["min_radius_of_curvature_b_mm"])
     needed = 2.0 * rho / spec.min_teeth
-    if module > needed:
+    # a closed pair of exactly min_teeth teeth has module == needed up to the rounding of the sampled
+    # curvature (2e-16 relative): it is allowed, as the message's own bound says
+    if module > needed * (1.0 + 1e-9):
         raise SpecError(path, f"module {module:g} mm too large: min pitch radius of curvature {rho:.3g} mm "
                               f"holds {2 * rho / module:.1f} teeth (min_teeth = {spec.min_teeth}); "
                               f"needs module <= {needed:.3g} mm (or a gentler ratio law)")

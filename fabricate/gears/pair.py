@@ -209,6 +209,13 @@ def _closed_teeth(law: Callable, x0: float, spec: GearSpec, center_distance: flo
     if not np.isfinite(turns) or turns <= 0:
         raise SpecError("gears.closed", f"the law turns gear b {turns:.4g} times per turn of gear a; "
                                         "a closed external pair needs a positive number")
+    # gear a's pitch curve closes only if the ratio repeats after a's own turn: whole turns of b per turn
+    # of a are not enough (its ratio may still differ at the seam)
+    grid = np.linspace(x0, x0 + TWO_PI, 721)
+    ratio = law(grid, 1)
+    if np.max(np.abs(ratio - law(grid + TWO_PI, 1))) > 1e-7 * np.max(np.abs(ratio)):
+        raise SpecError("gears.closed", "the law does not close gear a: its ratio does not repeat after a full "
+                                        "turn of a; use a law periodic over 360 deg of a (or closed = false)")
     if spec.teeth is not None:
         z_a, z_b = spec.teeth
         if abs(z_a / z_b - turns) > 1e-6 * turns:
