@@ -781,5 +781,20 @@ def test_a_washer_whose_outside_is_not_outside_its_bore_is_refused():
 
     parts, motion, pins, spacers = two_plates_on_a_pin(2.0, washer=True)
     bad = [SimpleNamespace(**(vars(spacers[0]) | {"outer_diameter_mm": 2.5}))]
-    with pytest.raises(SpecError, match=r"spacers\[0\]\.outer_diameter_mm"):
+    with pytest.raises(SpecError, match=r"^spacers\[0\]\.outer_diameter_mm: must exceed inner_diameter_mm \(2\.5\), "
+                                        r"got 2\.5$"):
         sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.1, pins=pins, spacers=bad)
+
+
+def test_a_triangle_and_a_zero_clearance_are_valid_sweep_inputs():
+    """Three vertices are a solid (the degenerate-outline check needs fewer than 3 or no area), and a required
+    clearance of 0 is allowed (only negative ones are refused): a 6 x 4 right triangle 1 mm beside a box sweeps
+    without error and its clearance is the 1 mm gap (boxes and triangles are exact polygons: 1e-9)."""
+    tri = Part("T", "b", BulgePath.polyline(np.array([[11.0, -2.0], [17.0, -2.0], [11.0, 2.0]])), (), 3.0, 0.0, 0,
+               "sla")
+    parts = [box_part("A", "a", (20.0, 4.0), 0.0, 3.0), tri]
+    motion = motion_of(np.zeros((3, 3)))
+    result = sweep_interference(parts, motion, chord_tolerance_mm=TOL, min_clearance_mm=0.0, pins=[])
+    (pair,) = result.pairs
+    assert pair.min_clearance_mm == pytest.approx(1.0, abs=1e-9)
+    assert result.failures() == []

@@ -375,7 +375,7 @@ def _is_spacer(item: SweepItem) -> bool:
 
 def _outline(item: SweepItem) -> Outline:
     # the same words as the boolean reference's extrusion (parts/solids.py), not shapely's ring error
-    outer = np.asarray(item.rings[0], dtype=np.float64) if item.rings else np.zeros((0, 2))
+    outer = item.rings[0]  # every item has its outer ring (float64, from the parts layer's polygons)
     if len(outer) < 3 or not polygon_area(outer) > 0.0:
         raise GeometryError(f"{item.name}: empty cross-section")
     return Outline(list(item.rings))
