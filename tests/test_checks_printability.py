@@ -225,6 +225,9 @@ def test_plate_thinner_than_the_feature_size_reaches_from_its_vertex_mean():
     (-5, -0.1): hypot(5.2, 0.12). 1e-12."""
     strip = [(-5, -0.1), (5, -0.1), (5, 0.1), (1, 0.1), (-5, 0.1)]
     assert thin_feature(poly_part("strip", strip), 0.3, TOL) == pytest.approx(math.hypot(5.2, 0.12), abs=1e-12)
+    # the same strip 30 mm off the origin: a distance from the mean, not from the origin (1e-12)
+    far = [(x + 30.0, y - 7.0) for x, y in strip]
+    assert thin_feature(poly_part("strip", far), 0.3, TOL) == pytest.approx(math.hypot(5.2, 0.12), abs=1e-12)
 
 
 def test_thin_ring_reaches_from_the_mean_of_all_its_vertices():
