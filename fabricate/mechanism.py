@@ -514,8 +514,12 @@ class _System:
         direction = 1.0 if s1 >= s0 else -1.0
         h_mag = abs(s1 - s0)
         min_h = abs(s1 - s0) * 1e-6 + 1e-12
+        # near a Grashof change point a step of ~15 deg lands the corrector on the other branch (a false
+        # "branch change", or a silent jump where the orientation is not checked); steps of 1/360 of the
+        # input range (1 deg of a full turn, the default sweep's own spacing) stayed on the branch
+        max_h = abs(self.mech.input_range[1] - self.mech.input_range[0]) / 360.0 or abs(s1 - s0)
         while direction * (s1 - s) > 1e-15:
-            h = direction * min(h_mag, abs(s1 - s))
+            h = direction * min(h_mag, max_h, abs(s1 - s))
             # first-order (tangent) predictor keeps the corrector on this branch
             tangent = _solve_square(jac, -ds) if jac.shape[0] == jac.shape[1] \
                 else np.linalg.lstsq(jac, -ds, rcond=None)[0]
