@@ -79,6 +79,13 @@ def _line_pieces(geometry: shapely.Geometry) -> list[np.ndarray]:
     return []  # a Point: the line only touches a vertex, no material width
 
 
+def _flush_subnormal(xy: np.ndarray) -> np.ndarray:
+    # GEOS mis-intersects when a coordinate is subnormal (|x| < 2.2e-308: a cut across a 0.5 x 1 plate
+    # offset by 1e-310 mm came back 6 % wide); such a coordinate is 0 for any plate
+    xy = np.asarray(xy, dtype=np.float64)
+    return np.where(np.abs(xy) < np.finfo(np.float64).tiny, 0.0, xy)
+
+
 def plate_polygon(rings: list[np.ndarray]) -> shapely.Polygon:
     """The valid shapely polygon of a plate's rings (outline, then holes): made once per part and handed to
     :func:`cut_section` for its many cuts.
@@ -93,8 +100,7 @@ def plate_polygon(rings: list[np.ndarray]) -> shapely.Polygon:
     if not len(rings):
         raise ValueError("cut_section needs at least the outline ring")
     try:
-        polygon = shapely.Polygon(np.asarray(rings[0], dtype=np.float64),
-                                  [np.asarray(r, dtype=np.float64) for r in rings[1:]])
+        polygon = shapely.Polygon(_flush_subnormal(rings[0]), [_flush_subnormal(r) for r in rings[1:]])
     except (ValueError, shapely.errors.ShapelyError) as exc:
         raise GeometryError(f"cut_section: rings do not form a polygon: {exc}") from exc
     if polygon.is_empty or not polygon.is_valid:
@@ -139,6 +145,7 @@ def cut_section(rings: list[np.ndarray] | shapely.Polygon, point: np.ndarray, di
     p0 = np.asarray(point, dtype=np.float64).reshape(2)
     if not np.all(np.isfinite(p0)):
         raise ValueError(f"cut point must be finite, got {p0.tolist()}")
+    p0 = _flush_subnormal(p0)
     polygon = rings if isinstance(rings, shapely.Polygon) else plate_polygon(rings)
 
     # A segment long enough to cross the whole part from wherever the reference point lies.
