@@ -78,11 +78,7 @@ class BulgePath:
                 t = min(1.0, max(0.0, float((p - p0) @ chord_vec) / chord2))
                 best = min(best, float(np.hypot(*(p - p0 - t * chord_vec))))
                 continue
-            theta = 4.0 * math.atan(b)
-            chord = math.sqrt(chord2)
-            radius = chord / (2.0 * abs(math.sin(theta / 2.0)))
-            normal = np.array([-chord_vec[1], chord_vec[0]]) / chord
-            centre = 0.5 * (p0 + p1) + math.copysign(1.0, theta) * normal * (radius * math.cos(theta / 2.0))
+            centre, radius, theta = arc_circle(p0, p1, b)
             rel = p - centre
             a0 = math.atan2(p0[1] - centre[1], p0[0] - centre[0])
             # how far round the arc (in its own sense) the point's direction lies
@@ -108,18 +104,22 @@ class BulgePath:
         return area
 
 
-def arc_points(p0: np.ndarray, p1: np.ndarray, bulge: float, chord_tolerance_mm: float) -> np.ndarray:
-    """Points on the arc from ``p0`` to ``p1`` with ``bulge`` (ends included), sagitta ≤ tolerance; (k, 2)."""
+def arc_circle(p0: np.ndarray, p1: np.ndarray, bulge: float) -> tuple[np.ndarray, float, float]:
+    """Centre (2,), radius (mm) and signed included angle (rad) of the arc from ``p0`` to ``p1`` with ``bulge``."""
     theta = 4.0 * math.atan(bulge)
     chord_vec = p1 - p0
     chord = float(np.hypot(*chord_vec))
     radius = chord / (2.0 * abs(math.sin(theta / 2.0)))
-    segments = circle_segments(radius, chord_tolerance_mm, abs(theta))
     # centre lies left of the chord for a positive (counter-clockwise) bulge
-    mid = 0.5 * (p0 + p1)
     normal = np.array([-chord_vec[1], chord_vec[0]]) / chord
-    offset = radius * math.cos(theta / 2.0)
-    centre = mid + math.copysign(1.0, theta) * normal * offset
+    centre = 0.5 * (p0 + p1) + math.copysign(1.0, theta) * normal * (radius * math.cos(theta / 2.0))
+    return centre, radius, theta
+
+
+def arc_points(p0: np.ndarray, p1: np.ndarray, bulge: float, chord_tolerance_mm: float) -> np.ndarray:
+    """Points on the arc from ``p0`` to ``p1`` with ``bulge`` (ends included), sagitta ≤ tolerance; (k, 2)."""
+    centre, radius, theta = arc_circle(p0, p1, bulge)
+    segments = circle_segments(radius, chord_tolerance_mm, abs(theta))
     a0 = math.atan2(p0[1] - centre[1], p0[0] - centre[0])
     angles = a0 + np.linspace(0.0, theta, segments + 1)
     pts = centre + radius * np.column_stack([np.cos(angles), np.sin(angles)])

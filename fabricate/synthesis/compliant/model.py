@@ -279,7 +279,7 @@ def solve_grasp(path: ContactPath, springs: Springs, load: Load) -> Grasp | None
     SpecError
         ``load.mu`` is not the friction the path was sampled with: the path's validity (the hover
         determinant > 0) depends on it, and off the path the root search can land on that determinant's
-        pole (a hover force of 1e11 N was returned).
+        pole (a hover force of 2.2e11 N was returned).
     """
     if load.mu != path.mu:
         raise SpecError("load.mu", f"the contact path was sampled with mu = {path.mu:g}, the load has "
