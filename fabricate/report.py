@@ -53,6 +53,56 @@ def _table(header: Sequence[str], rows: Sequence[Sequence[Any]]) -> list[str]:
     return lines
 
 
+#: ``checks.not_checked`` reason of a synthesis-only run (``fabricate synth``): no check ran.
+SYNTH_ONLY = "synth only"
+
+
+def not_checked(report: Mapping[str, Any]) -> list[tuple[str, str]]:
+    """``(check, reason)`` of every check a report says did not run (``checks.not_checked``).
+
+    Entries of the wrong shape (a hand-edited report) are skipped: this only words a summary, the schema
+    check of ``fabricate check`` judges the file.
+    """
+    checks = report.get("checks")
+    entries = checks.get("not_checked") if isinstance(checks, Mapping) else None
+    if not isinstance(entries, list):
+        return []
+    return [(str(e.get("check")), str(e.get("reason"))) for e in entries
+            if isinstance(e, Mapping) and e.get("check") and e.get("reason")]
+
+
+def not_checked_notes(report: Mapping[str, Any]) -> list[str]:
+    """``"<check> not checked: <reason>"`` per check that did not run, one reason given once for all
+    the checks that share it (``"interference, gear mesh not checked: no poses in the motion"``)."""
+    by_reason: dict[str, list[str]] = {}
+    for check, reason in not_checked(report):
+        by_reason.setdefault(reason, []).append(check)
+    return [f"{', '.join(checks)} not checked: {reason}" for reason, checks in by_reason.items()]
+
+
+def verdict(report: Mapping[str, Any], failures: Sequence[str] | None = None) -> str:
+    """The one-line verdict people read: ``checks passed``, ``checks FAILED``, with what was not checked
+    in brackets (``checks passed (strength not checked: no materials in the profile)``); a synthesis-only
+    run says ``synthesis done (no checks run: synth only)``, never that checks passed.
+
+    ``failures`` (default: the report's) decides passed or FAILED: ``check DIR`` adds its own findings.
+    """
+    checks = report.get("checks")
+    checks = checks if isinstance(checks, Mapping) else {}
+    if failures is None:
+        failed = bool(checks.get("failures")) or checks.get("passed") is False
+    else:
+        failed = bool(failures)
+    skipped = not_checked(report)
+    design = report.get("design")
+    stage = design.get("stage") if isinstance(design, Mapping) else None
+    if stage == "synth" or any(reason == SYNTH_ONLY for _, reason in skipped):
+        return "synthesis FAILED" if failed else f"synthesis done (no checks run: {SYNTH_ONLY})"
+    text = "checks FAILED" if failed else "checks passed"
+    notes = not_checked_notes(report)
+    return f"{text} ({'; '.join(notes)})" if notes else text
+
+
 def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> str:
     """A human-readable summary of a report (report.md), linking the given image paths."""
     design = report.get("design", {})
@@ -61,11 +111,16 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
     if design.get("description"):
         out += [design["description"], ""]
     out += [f"Template: `{design.get('template', '')}` · fabricate {design.get('fabricate_version', '')}", ""]
-    verdict = "PASSED" if checks.get("passed") else "FAILED"
-    out += [f"## Checks: {verdict}", ""]
+    if design.get("stage") == "synth":
+        heading = "## Checks: none run (synth only; `fabricate build` runs them)"
+    else:
+        heading = f"## Checks: {'PASSED' if checks.get('passed') else 'FAILED'}"
+    out += [heading, ""]
     for failure in checks.get("failures", []):
         out.append(f"- {failure}")
-    if checks.get("failures"):
+    if design.get("stage") != "synth":
+        out += [f"- {note}" for note in not_checked_notes(report)]
+    if checks.get("failures") or (design.get("stage") != "synth" and not_checked(report)):
         out.append("")
     for note in report.get("notes", []):
         out += [f"Note: {note}", ""]
@@ -142,6 +197,9 @@ CONTACT_KINDS = {
 def interference_markdown(inter: Mapping[str, Any]) -> list[str]:
     """report.md's interference section: one line per kind of contact (what it is held to and why it
     passes), then every pair, worst first (least margin over its requirement)."""
+    if "passed" in inter and inter["passed"] is None:  # the sweep could not run: no table of nothing
+        return ["## Interference", "", f"Interference: not checked: {inter.get('reason') or 'no reason given'} "
+                f"(poses: {inter.get('poses')}, pairs checked: {inter.get('pairs_checked')}).", ""]
     pairs = [p for p in inter.get("pairs", []) if isinstance(p, Mapping)]
     collisions = inter.get("collisions", [])
     out = ["## Interference", "",
@@ -187,16 +245,28 @@ def interference_markdown(inter: Mapping[str, Any]) -> list[str]:
 
 
 def strength_markdown(strength: Mapping[str, Any]) -> list[str]:
-    """report.md's strength section: the loads, then one row per part and pin, weakest first."""
+    """report.md's strength section: the loads, then one row per part and pin, weakest first; a check that
+    could not run says "not checked: <reason>" and has no table."""
+    if strength.get("passed") is None:
+        out = ["## Strength", "", f"Strength: not checked: {strength.get('reason') or 'no reason given'}. No part "
+               "has a safety factor: none was computed.", ""]
+        out += [f"- {note}" for note in strength.get("notes", [])]
+        return out + ([""] if strength.get("notes") else [])
     verdict = "passed" if strength.get("passed") else "FAILED"
     out = ["## Strength", "",
            f"Every part and pin at the design load over the whole motion: {verdict} (safety factor = allowable / "
            f"stress, required {_fmt(strength.get('required_safety_factor'))}).", ""]
     loads = strength.get("loads") or ["no load stated ([load] in the template)"]
     out += ["Loads: " + "; ".join(loads) + ".", ""]
-    rows = sorted(strength.get("parts", []), key=lambda p: p.get("min_safety_factor", 0.0))
+
+    def weakest(p: Mapping[str, Any]) -> tuple[bool, float]:
+        sf = p.get("min_safety_factor")
+        return (not isinstance(sf, (int, float)), sf if isinstance(sf, (int, float)) else 0.0)
+
+    # a null safety factor: the load does not reach the part (zero stress), listed last
     out += _table(["part", "safety factor", "governing feature", "load", "at input", "stress MPa", "allowable MPa"],
-                  [[p.get("name"), p.get("min_safety_factor"), p.get("feature"), p.get("input"), p.get("pose_input"),
-                    p.get("stress_MPa"), p.get("allowable_MPa")] for p in rows]) + [""]
+                  [[p.get("name"), "unloaded" if p.get("min_safety_factor") is None else p.get("min_safety_factor"),
+                    p.get("feature"), p.get("input"), p.get("pose_input"), p.get("stress_MPa"), p.get("allowable_MPa")]
+                   for p in sorted(strength.get("parts", []), key=weakest)]) + [""]
     out += [f"- {note}" for note in strength.get("notes", [])]
     return out + ([""] if strength.get("notes") else [])

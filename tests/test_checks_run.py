@@ -107,9 +107,11 @@ def test_boxes_closer_than_the_required_clearance_fail_with_a_row_and_message(sl
     msg = "clearance: A and B come within 0.400 mm at input 12.5 deg; the process needs 0.500 mm"
     assert report.failures == [msg]
     assert report.passed is False
-    assert report.report() == {"interference": report.interference, "checks": {"passed": False, "failures": [msg]}}
+    assert report.report() == {"interference": report.interference,
+                               "checks": {"passed": False, "failures": [msg], "not_checked": []}}
     inter = report.interference
     assert inter["poses"] == 3 and inter["pairs_checked"] == 1 and inter["collisions"] == []
+    assert inter["passed"] is False and "reason" not in inter
     assert inter["min_clearance_mm"] == pytest.approx(0.4, abs=1e-9)
     assert inter["required_clearance_mm"] == 0.5
     assert inter["tolerance_mm"] == sla_process.chord_tolerance_mm
@@ -131,7 +133,8 @@ def test_boxes_farther_than_the_required_clearance_pass(sla_process):
     motion = slide_x([10.6, 11.0])
     report = run_checks(design(sla_process, 2, 0.5), two_boxes(), Mech(never_swept), motion, [])
     assert report.failures == [] and report.passed is True
-    assert report.report()["checks"] == {"passed": True, "failures": []}
+    assert report.report()["checks"] == {"passed": True, "failures": [], "not_checked": []}
+    assert report.interference["passed"] is True and report.not_checked == ()
     assert report.pair_table_markdown() == HEADER + "\n| A | B | moving | 0.600 | 0.00 | 0.5 | yes |"
 
 
@@ -388,12 +391,17 @@ def test_collides_overrides_lower_bound_prefix():
 
 
 def test_report_is_the_interference_and_the_verdict():
-    """report(): ``{"interference": <section>, "checks": {"passed", "failures"}}``, failures as a new list."""
+    """report(): ``{"interference": <section>, "checks": {"passed", "failures", "not_checked"}}``, failures
+    and the not-checked entries as new lists."""
     report = fake_report([], failures=["x", "y"], passed=False)
     out = report.report()
-    assert out == {"interference": {"k": 1}, "checks": {"passed": False, "failures": ["x", "y"]}}
+    assert out == {"interference": {"k": 1}, "checks": {"passed": False, "failures": ["x", "y"], "not_checked": []}}
     assert out["checks"]["failures"] is not report.failures
-    assert fake_report([]).report() == {"interference": {"k": 1}, "checks": {"passed": True, "failures": []}}
+    assert fake_report([]).report() == {"interference": {"k": 1},
+                                        "checks": {"passed": True, "failures": [], "not_checked": []}}
+    entry = {"check": "interference", "reason": "r"}
+    skipped = dataclasses.replace(fake_report([]), not_checked=(entry,)).report()["checks"]
+    assert skipped["not_checked"] == [entry] and skipped["not_checked"][0] is not entry
 
 
 def test_report_is_frozen_and_defaults():
@@ -411,3 +419,34 @@ def test_figures_is_the_clearance_png(sla_process):
     figs = report.figures()
     assert set(figs) == {"clearance.png"}
     assert figs["clearance.png"].startswith(PNG) and figs["clearance.png"] == report.figures()["clearance.png"]
+
+
+# -- checks that cannot run are "not checked", never passed ----------------------------------------
+def test_one_part_alone_has_no_pair_and_the_sweep_is_not_checked(sla_process):
+    """A single box: nothing moves against it, so no pair is swept; the interference verdict is null with
+    the reason, listed in not_checked, and no failure (the build is not failed for it)."""
+    partset = SimpleNamespace(parts=(box("A", "a"),), pins=(), spacers=())
+    report = run_checks(design(sla_process, 2, 0.25), partset, Mech(never_swept), slide_x([10.0, 11.0]), [])
+    assert report.interference["pairs_checked"] == 0
+    assert report.interference["passed"] is None and report.interference["reason"] == checks.NO_PAIRS
+    assert report.not_checked == ({"check": "interference", "reason": checks.NO_PAIRS},)
+    assert report.failures == [] and report.passed is True  # over the checks that ran (printability)
+    assert report.report()["checks"]["not_checked"] == [{"check": "interference", "reason": checks.NO_PAIRS}]
+
+
+def test_a_motion_of_no_poses_is_not_swept_and_not_checked(sla_process, monkeypatch):
+    """No pose to sweep (``sweep_poses`` 0, which only the API can ask for): neither the interference sweep
+    nor the gear mesh runs; both are listed as not checked with the reason, and the section says null."""
+    monkeypatch.setattr(checks, "sweep_interference", Recorder(None))
+    meshes = Recorder([])
+    monkeypatch.setattr(checks, "check_gear_meshes", meshes)
+    pair = SimpleNamespace(name="g")
+    monkeypatch.setattr(checks, "check_printability", Recorder(outcome([], {"passed": True})))
+    report = run_checks(design(sla_process, 0, 0.25), two_boxes(), Mech(never_swept), slide_x([]), [pair])
+    assert checks.sweep_interference.args == [] and meshes.args == []
+    assert report.not_checked == ({"check": "interference", "reason": checks.NO_POSES},
+                                  {"check": "gear mesh", "reason": checks.NO_POSES})
+    inter = report.interference
+    assert inter["poses"] == 0 and inter["pairs_checked"] == 0 and inter["passed"] is None
+    assert inter["reason"] == checks.NO_POSES and inter["gear_mesh"] == []
+    assert report.passed is True and report.failures == []

@@ -103,3 +103,50 @@ def test_kinematic_drawing_text_is_at_least_2_5_mm_in_its_dimension_style(five_b
     assert doc.header["$DIMTXT"] == style.dxf.dimtxt and doc.header["$DIMASZ"] == style.dxf.dimasz
     texts = list(doc.modelspace().query("TEXT"))
     assert texts and min(t.dxf.height for t in texts) >= MIN_DRAWING_TEXT_MM
+
+
+# -- "not checked" in report.md (issue 23) ------------------------------------------------------------
+
+def _md(**sections) -> str:
+    from fabricate.report import report_markdown
+
+    report = {"design": {"name": "d", "kind": "linkage", "stage": "build"},
+              "checks": {"passed": True, "failures": [], "not_checked": []}}
+    report.update(sections)
+    return report_markdown(report)
+
+
+def test_strength_not_checked_says_why_and_rates_no_part():
+    md = _md(strength={"passed": None, "reason": "no materials in the profile", "required_safety_factor": 2.0,
+                       "loads": [], "parts": [], "notes": []},
+             checks={"passed": True, "failures": [],
+                     "not_checked": [{"check": "strength", "reason": "no materials in the profile"}]})
+    section = md[md.index("## Strength"):]
+    assert "Strength: not checked: no materials in the profile." in section
+    assert "passed" not in section and "| part |" not in section
+    checks = md[md.index("## Checks"):md.index("## Strength")]
+    assert checks.startswith("## Checks: PASSED") and "- strength not checked: no materials in the profile" in checks
+
+
+def test_interference_not_checked_says_why():
+    md = _md(interference={"poses": 0, "pairs_checked": 0, "collisions": [], "passed": None,
+                           "reason": "no poses in the motion", "pairs": []})
+    section = md[md.index("## Interference"):]
+    assert section.startswith("## Interference\n\nInterference: not checked: no poses in the motion")
+    assert "| contact |" not in section
+
+
+def test_unloaded_parts_read_unloaded_and_come_after_the_weakest():
+    md = _md(strength={"passed": True, "required_safety_factor": 2.0, "loads": ["torque 50 N·mm on rocker"],
+                       "parts": [{"name": "idle", "min_safety_factor": None},
+                                 {"name": "weak", "min_safety_factor": 2.5},
+                                 {"name": "strong", "min_safety_factor": 9.0}], "notes": []})
+    rows = _rows(md, "| part | safety factor")
+    assert [(r[0], r[1]) for r in rows] == [("weak", "2.5"), ("strong", "9"), ("idle", "unloaded")]
+    assert not re.search(r"\binf\b", md)
+
+
+def test_synth_report_says_no_check_ran():
+    md = _md(design={"name": "d", "kind": "linkage", "stage": "synth"},
+             checks={"passed": True, "failures": [], "not_checked": [{"check": "strength", "reason": "synth only"}]})
+    assert "## Checks: none run (synth only" in md and "PASSED" not in md

@@ -322,3 +322,46 @@ def test_gear_contact_point_lies_on_both_pitch_curves_over_the_motion():
     for curve, points in ((pair.pitch_a, on_a), (pair.pitch_b, on_b)):
         gap = np.min(np.hypot(*(curve[None, :, :] - points[:, None, :]).transpose(2, 0, 1)), axis=1)
         assert gap.max() < spacing
+
+
+# -- a check that cannot run is "not checked" (issue 23) ---------------------------------------------
+
+def test_zero_load_and_no_materials_are_not_checked_never_passed():
+    """The four-bar with no load at all (no [load], no springs): every stress would be 0 and every safety
+    factor infinite, so the check does not run: passed None, the reason, no finding, no failure, no part
+    rated. The same with the profile's materials removed. The loaded control is checked (True or False)."""
+    from fabricate.parts.build import build_parts
+    from fabricate.strength.check import NO_LOAD, NO_MATERIALS, run_strength
+
+    mech = make_four_bar()
+    motion = mech.sweep(25)
+    hints = {"tip_point": "B", "pads": {"rocker": {"point": "B"}}}
+    loaded = _four_bar_design(None, 25.0)
+    partset = build_parts(loaded, mech, motion, [], hints)
+    control = run_strength(loaded, partset, mech, motion, [], hints)
+    assert control.reason is None and isinstance(control.passed, bool) and control.findings
+    assert "reason" not in control.report()
+
+    assert _four_bar_design(None, 0.0).load == LoadSpec()  # what a template without [load] gets
+    result = run_strength(_four_bar_design(None, 0.0), partset, mech, motion, [], hints)
+    assert result.passed is None and result.reason == NO_LOAD
+    assert result.findings == [] and result.failures() == [] and result.statics is None
+    section = result.report()
+    assert section["passed"] is None and section["reason"] == NO_LOAD and section["parts"] == []
+
+    bare = SimpleNamespace(**vars(loaded))
+    bare.process = dataclasses.replace(loaded.process, materials={})
+    result = run_strength(bare, partset, mech, motion, [], hints)
+    assert result.passed is None and result.reason == NO_MATERIALS and result.report()["parts"] == []
+
+
+def test_an_unloaded_part_has_a_null_safety_factor_not_inf():
+    """Within a checked run a part the load does not reach (zero stress) is written as null, never inf."""
+    from fabricate.strength.check import Finding, StrengthResult
+
+    result = StrengthResult([Finding("idle", "pin shear", "pin", 0.0, 50.0, 0, "no load", "none"),
+                             Finding("busy", "pin shear", "pin", 10.0, 50.0, 1, "5 N", "thicker")],
+                            None, 2.0, np.array([0.0, 1.0]))
+    rows = {p["name"]: p for p in result.report()["parts"]}
+    assert rows["idle"]["min_safety_factor"] is None and rows["busy"]["min_safety_factor"] == 5.0
+    assert result.passed is True and result.report()["passed"] is True

@@ -1,7 +1,9 @@
 """The checks that gate a build: interference over the motion, gear mesh in the assembly, printability.
 
 Findings are data: :func:`run_checks` returns a :class:`CheckReport` whose ``failures`` say in words
-what is wrong; the pipeline writes the files anyway and exits 1 when the list is not empty.
+what is wrong; the pipeline writes the files anyway and exits 1 when the list is not empty. A check that
+could not run (a motion of no poses, no pair of parts that move against each other) is "not checked":
+its ``passed`` is None and ``not_checked`` names it with the reason, never a pass.
 
 Public API
 ----------
@@ -18,12 +20,18 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from fabricate.checks.gear_mesh import GearMeshResult, check_gear_mesh, check_gear_meshes
-from fabricate.checks.interference import InterferenceResult, sweep_interference
+from fabricate.checks.interference import DEFAULT_SEARCH_MM, InterferenceResult, sweep_interference
 from fabricate.checks.printability import PrintabilityResult, check_printability
 from fabricate.mechanism import Mechanism, Motion
 
 __all__ = ["CheckReport", "run_checks", "sweep_interference", "check_gear_mesh", "check_printability"]
+
+#: Why the interference (and gear mesh) check did not run, in the words the CLI prints.
+NO_POSES = "no poses in the motion"
+NO_PAIRS = "no two parts move against each other"
 
 
 @dataclass(frozen=True)
@@ -35,12 +43,16 @@ class CheckReport:
     interference : dict
         report.json's ``interference`` section: DESIGN.md keys ``poses``, ``pairs_checked``,
         ``collisions`` [{a, b, input_deg, volume_mm3}], ``min_clearance_mm`` plus ``input_unit``, the
-        per-pair table ``pairs``, and the ``gear_mesh`` and ``printability`` results.
+        per-pair table ``pairs``, ``passed`` (the sweep's verdict; None when it could not run, with a
+        ``reason``), and the ``gear_mesh`` and ``printability`` results.
     failures : list of str
         Human-readable reasons the build fails (empty: it passes).
     passed : bool
+        No failure among the checks that ran.
     sweep, gear_mesh, printability
         The full results.
+    not_checked : tuple of dict
+        ``{"check": name, "reason": why}`` for each check that could not run.
     """
 
     interference: dict[str, Any]
@@ -49,11 +61,13 @@ class CheckReport:
     sweep: InterferenceResult = field(repr=False)
     gear_mesh: tuple[GearMeshResult, ...] = ()
     printability: PrintabilityResult | None = None
+    not_checked: tuple[dict[str, str], ...] = ()
 
     def report(self) -> dict[str, Any]:
-        """``{"interference": ..., "checks": {"passed", "failures"}}`` for report.json."""
+        """``{"interference": ..., "checks": {"passed", "failures", "not_checked"}}`` for report.json."""
         return {"interference": self.interference,
-                "checks": {"passed": self.passed, "failures": list(self.failures)}}
+                "checks": {"passed": self.passed, "failures": list(self.failures),
+                           "not_checked": [dict(entry) for entry in self.not_checked]}}
 
     def figures(self) -> dict[str, bytes]:
         """PNG plots: ``clearance.png`` (clearance against input for the closest pairs)."""
@@ -101,6 +115,9 @@ def run_checks(design: Any, partset: Any, mechanism: Mechanism, motion: Motion,
     Returns
     -------
     CheckReport
+        With no poses to sweep (only a motion of none and ``sweep_poses`` 0, which a template cannot ask
+        for) the interference and gear mesh checks are not run; with no pair of parts that move against
+        each other the sweep has nothing to check. Either is listed in ``not_checked``, never passed.
     """
     process = design.process
     poses = int(design.checks.sweep_poses)
@@ -111,17 +128,34 @@ def run_checks(design: Any, partset: Any, mechanism: Mechanism, motion: Motion,
         required = process.running_clearance_mm
     parts = tuple(partset.parts)
     pins = tuple(getattr(partset, "pins", ()) or ())
-    sweep = sweep_interference(parts, motion, chord_tolerance_mm=process.chord_tolerance_mm,
-                               min_clearance_mm=float(required), pins=pins or None,
-                               spacers=tuple(getattr(partset, "spacers", ()) or ()))
-    meshes = tuple(check_gear_meshes(gear_pairs, motion))
+    not_checked: list[dict[str, str]] = []
+    if len(motion.inputs) == 0:
+        # nothing to sweep: an empty result (the sweep itself needs at least one pose)
+        sweep = InterferenceResult(np.empty(0), motion.mechanism.input_unit, (), 0, float(required),
+                                   float(process.chord_tolerance_mm),
+                                   max(DEFAULT_SEARCH_MM, 4.0 * float(required)))
+        meshes: tuple[GearMeshResult, ...] = ()
+        not_checked.append({"check": "interference", "reason": NO_POSES})
+        if gear_pairs:
+            not_checked.append({"check": "gear mesh", "reason": NO_POSES})
+    else:
+        sweep = sweep_interference(parts, motion, chord_tolerance_mm=process.chord_tolerance_mm,
+                                   min_clearance_mm=float(required), pins=pins or None,
+                                   spacers=tuple(getattr(partset, "spacers", ()) or ()))
+        meshes = tuple(check_gear_meshes(gear_pairs, motion))
+        if not sweep.pairs:
+            not_checked.append({"check": "interference", "reason": NO_PAIRS})
     printable = check_printability(parts, process, gear_pairs, pins)
     failures = sweep.failures()
     for mesh in meshes:
         failures += list(mesh.failures)
     failures += list(printable.failures)
     interference = sweep.report()
+    skipped = next((e["reason"] for e in not_checked if e["check"] == "interference"), None)
+    interference["passed"] = None if skipped is not None else sweep.passed
+    if skipped is not None:
+        interference["reason"] = skipped
     interference["gear_mesh"] = [m.report() for m in meshes]
     interference["printability"] = printable.report()
     return CheckReport(interference=interference, failures=failures, passed=not failures, sweep=sweep,
-                       gear_mesh=meshes, printability=printable)
+                       gear_mesh=meshes, printability=printable, not_checked=tuple(not_checked))

@@ -16,6 +16,11 @@ pose:
 
 Safety factor = allowable / stress; a part below ``[checks] min_safety_factor`` fails the build with the
 part, the feature, the load that governs and what would fix it.
+
+A check that cannot run is "not checked", never "passed": with no materials in the process profile, or
+no load at all (no ``[load]`` and no springs), :attr:`StrengthResult.passed` is None and
+:attr:`StrengthResult.reason` says why; no part gets a safety factor (at zero load every one would be
+an infinite, meaningless "pass").
 """
 
 from __future__ import annotations
@@ -86,6 +91,7 @@ class StrengthResult:
     curves: dict[str, np.ndarray] = field(default_factory=dict)
     loads: tuple[str, ...] = ()
     notes: list[str] = field(default_factory=list)
+    reason: str | None = None  # why the check could not run (then nothing passed or failed)
 
     def per_part(self) -> dict[str, Finding]:
         worst: dict[str, Finding] = {}
@@ -95,10 +101,15 @@ class StrengthResult:
         return worst
 
     @property
-    def passed(self) -> bool:
+    def passed(self) -> bool | None:
+        """Whether every part keeps the safety factor; None when the check could not run (:attr:`reason`)."""
+        if self.reason is not None:
+            return None
         return all(f.safety_factor >= self.min_safety_factor for f in self.findings)
 
     def failures(self) -> list[str]:
+        if self.reason is not None:
+            return []
         out = []
         for name, f in sorted(self.per_part().items(), key=lambda kv: kv[1].safety_factor):
             if f.safety_factor >= self.min_safety_factor:
@@ -109,18 +120,31 @@ class StrengthResult:
         return out
 
     def report(self) -> dict[str, Any]:
+        """report.json's ``strength`` section: ``passed`` (None: not checked, then ``reason`` says why),
+        the loads and one row per part and pin (a part no load reaches has a null safety factor: JSON has
+        no infinity)."""
         parts = []
         for name, f in sorted(self.per_part().items()):
             parts.append({"name": name, "min_safety_factor": _round(f.safety_factor), "feature": f.feature,
                           "input": f.load, "pose_input": _round(float(self.inputs[f.pose])),
                           "stress_MPa": _round(f.stress_MPa), "allowable_MPa": _round(f.allowable_MPa),
                           "fix": f.fix})
-        return {"passed": self.passed, "required_safety_factor": self.min_safety_factor,
-                "loads": list(self.loads), "parts": parts, "notes": list(self.notes)}
+        out: dict[str, Any] = {"passed": self.passed}
+        if self.reason is not None:
+            out["reason"] = self.reason
+        out.update({"required_safety_factor": self.min_safety_factor, "loads": list(self.loads), "parts": parts,
+                    "notes": list(self.notes)})
+        return out
 
 
-def _round(x: float) -> float:
-    return float(f"{x:.6g}") if math.isfinite(x) else x
+def _round(x: float) -> float | None:
+    """``x`` to 6 significant digits; None for a non-finite value (what report.json writes for it)."""
+    return float(f"{x:.6g}") if math.isfinite(x) else None
+
+
+#: Why the strength check did not run (``StrengthResult.reason``), in the words the CLI prints.
+NO_MATERIALS = "no materials in the profile"
+NO_LOAD = "no [load] in the template"
 
 
 # -- loads -----------------------------------------------------------------------------------------
@@ -359,17 +383,20 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
     pin_material = design.process.pin_material_spec()
     result = StrengthResult([], None, required, np.asarray(motion.inputs))
     if material is None or pin_material is None:
-        result.notes.append("no material data in the process profile: strength not checked")
+        result.reason = NO_MATERIALS
         return result
     loads = design_loads(design, mechanism, motion, hints)
     result.loads = loads.described
+    if not loads.described:
+        # nothing loads the parts: every stress would be 0 and every safety factor infinite
+        # (every force, torque and effort of [load] is 0 then, and no spring of the synthesis acts)
+        result.reason = NO_LOAD
+        return result
     if any(float(sp.get("rate_Nmm_per_deg") or 0.0) > 0.0 for sp in hints.get("springs", ()) or ()):
         # the springs are bought parts (BOM rows with rate, preload, legs): their wire stress is the maker's
         # rating; what the check covers is the torque they put on the printed parts
         result.notes.append("springs are bought torsion springs (bom.csv): choose one rated for the torque "
                             "above; their torque loads the parts here")
-    if not loads.described:
-        result.notes.append("the template states no [load]: strength checked at zero load")
     statics = solve_statics(mechanism, motion, loads.forces, loads.torques, loads.efforts, loads.reaction)
     result.statics = statics
     if loads.reaction is not None:
