@@ -58,9 +58,15 @@ def evaluate(text: str, stage: str) -> tuple[int, str, dict[str, Any] | None, An
         return EXIT_INTERNAL, "out of memory", None, None
     except Exception as exc:  # noqa: BLE001 - a bug in one point must not end the sweep
         return EXIT_INTERNAL, f"internal error: {type(exc).__name__}: {_reason(exc)}", None, None
+    from fabricate.report import SYNTH_ONLY, not_checked, not_checked_notes
+
     report = outcome.report
     failures = list(report.get("checks", {}).get("failures", []))
-    return outcome.exit_code, "; ".join(failures)[:2000], report, outcome
+    # a passing point whose strength (say) was never checked says so in its reason, so a sweep's "best"
+    # is never a point that passed only because nothing was checked; synth points all skip every check
+    skipped = [n for n in not_checked_notes(report)
+               if not any(r == SYNTH_ONLY for _, r in not_checked(report))]
+    return outcome.exit_code, "; ".join(failures + skipped)[:2000], report, outcome
 
 
 def run_point(index: int, values: Mapping[str, Any], pid: str, base: Mapping[str, Any],
