@@ -2,16 +2,24 @@
 
 An output folder (``-o``) may be new, empty, or a previous fabricate output; anything else is refused
 before any work is done unless the user passes ``--force``. A previous output is recognised by its
-``report.json`` and must hold nothing but the files that report lists, so a note the user dropped into
-a build folder is never deleted silently. A file or symbolic link given as the folder, the current
-folder (or one holding it) and a folder holding the template being built are refused even with
-``--force``.
+``report.json`` (a regular file: a link, FIFO or device of that name is not read) and must hold nothing but
+the files that report lists, so a note the user dropped into a build folder is never deleted silently. A
+file or symbolic link given as the folder, the current folder (or one holding it) and a folder holding an
+input of the command (the template, the process profile) are refused even with ``--force``.
 
-Writing goes into a temporary sibling (``.NAME.XXXXXXXX.tmp``) which is swapped with the old folder in one
-atomic step (``renameat2(RENAME_EXCHANGE)`` on Linux; elsewhere two renames with Ctrl-C held off), so a
-reader sees the old output or the new one, never half of either. Writers of one folder are serialised
-by an exclusive lock on ``.NAME.lock`` beside it; whoever holds the lock first removes what killed runs
-left behind (their ``.NAME.*.tmp`` / ``.NAME.*.old`` siblings), since only a lock holder ever makes them.
+Writing goes into a temporary sibling ``.NAME.fabricate-XXXXXXXXXXXXXXXX.tmp`` (16 random hex digits) which
+is swapped with the old folder in one atomic step (``renameat2(RENAME_EXCHANGE)`` on Linux; elsewhere two
+renames with Ctrl-C held off), so a reader sees the old output or the new one, never half of either. The
+swap is checked (by inode) to have put the folder fabricate wrote in place of the folder it checked; if
+anything else moved in meanwhile, the swap is undone and nothing is deleted.
+
+Writers of one folder are serialised by an exclusive lock on ``.NAME.lock`` beside it. Before the lock
+holder makes a sibling it records the sibling's random part (and the inode of the folder that will sit
+there) in the lock file, and a run that ends removes its lock file; so records in a lock file are the trace
+of a killed run, and the next holder removes exactly the siblings recorded there that are still real
+folders of this user with the recorded inode. Any other ``.NAME.*.tmp`` / ``.NAME.*.old`` is left alone
+and named in a warning. The random part has a fixed length and alphabet, so a sibling's name fixes the
+output's name: those of ``a`` never match those of ``a.b``.
 """
 
 from __future__ import annotations
@@ -19,13 +27,17 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import errno
-import glob
 import json
 import os
+import re
+import secrets
 import shutil
 import signal
+import stat
 import tempfile
-from collections.abc import Callable, Iterator, Mapping, Sequence
+import warnings
+from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -37,19 +49,103 @@ except ImportError:  # pragma: no cover - Windows
     fcntl = None  # type: ignore[assignment]
 
 REPORT = "report.json"
-#: Room the temporary sibling's name needs beyond the folder's own name (".", ".", 8 random, ".tmp").
-_SIBLING_EXTRA = 14
+#: Largest report.json read from an existing folder to decide whether it is a fabricate output (a linkage at
+#: every documented bound writes a few MB); a larger one is not taken for a fabricate output.
+MAX_REPORT_BYTES = 64 * 2**20
+#: Random hex digits in a temporary sibling's name (fixed, so the name before them is unambiguous).
+_TOKEN_HEX = 16
+#: Room a sibling's name needs beyond the folder's own name: ".", ".fabricate-", the digits, ".tmp".
+_SIBLING_EXTRA = 1 + len(".fabricate-") + _TOKEN_HEX + len(".tmp")
+_SIBLING = re.compile(rf"\.(?P<name>.+)\.fabricate-(?P<token>[0-9a-f]{{{_TOKEN_HEX}}})\.(?P<kind>tmp|old)", re.S)
+_RECORD = re.compile(rf"(?P<token>[0-9a-f]{{{_TOKEN_HEX}}})(?: (?P<dev>[0-9]+) (?P<ino>[0-9]+))?")
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+_NONBLOCK = getattr(os, "O_NONBLOCK", 0)
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
+
+Identity = tuple[int, int]
+
+
+class LeftAloneWarning(UserWarning):
+    """A sibling of an output folder is named like fabricate's temporary folders, but fabricate cannot
+    prove it made it, so it was not removed."""
 
 
 def _refuse(out: Path, why: str) -> SpecError:
     return SpecError(f"output folder {out}", why)
 
 
-def previous_output(directory: Path) -> dict[str, Any] | None:
-    """The report of a fabricate output folder, or None when ``directory`` is not one."""
+def sibling_name(name: str, token: str, kind: str) -> str:
+    """The name of a temporary (``kind="tmp"``) or backup (``"old"``) sibling of output folder ``name``."""
+    return f".{name}.fabricate-{token}.{kind}"
+
+
+def parse_sibling(entry: str) -> tuple[str, str, str] | None:
+    """``(output folder name, token, kind)`` of a name made by :func:`sibling_name`, else None."""
+    match = _SIBLING.fullmatch(entry)
+    return (match["name"], match["token"], match["kind"]) if match else None
+
+
+def _identity(path: Path) -> Identity | None:
+    """``(device, inode)`` of ``path`` itself (a link is not followed), None when nothing is there."""
     try:
-        report = json.loads((directory / REPORT).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        st = os.lstat(path)
+    except FileNotFoundError:
+        return None
+    return st.st_dev, st.st_ino
+
+
+def read_regular(path: Path, limit: int) -> bytes | None:
+    """The bytes of ``path`` if it is a regular file of at most ``limit`` bytes, else None.
+
+    A symbolic link, FIFO, device or socket is never opened for reading, so this never blocks: the path is
+    checked with ``lstat``, then opened non-blocking without following a link and checked again on the
+    open descriptor (it may have been swapped in between).
+    """
+    try:
+        before = os.lstat(path)
+        if not stat.S_ISREG(before.st_mode) or before.st_size > limit:
+            return None
+        fd = os.open(path, os.O_RDONLY | _NOFOLLOW | _NONBLOCK | _CLOEXEC)
+    except OSError:
+        return None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or (st.st_dev, st.st_ino) != (before.st_dev, before.st_ino):
+            return None
+        chunks, total = [], 0
+        while total <= limit:  # bounded even if the file grows while it is read
+            chunk = os.read(fd, min(1 << 20, limit + 1 - total))
+            if not chunk:
+                return b"".join(chunks)
+            chunks.append(chunk)
+            total += len(chunk)
+        return None
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+
+
+def _not_regular(path: Path) -> str:
+    """What ``path`` is if it exists but is not a regular file ("a FIFO"), else ""."""
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return ""
+    kinds = ((stat.S_ISLNK, "a symbolic link"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISSOCK, "a socket"),
+             (stat.S_ISCHR, "a device"), (stat.S_ISBLK, "a device"), (stat.S_ISDIR, "a folder"))
+    return next((what for test, what in kinds if test(mode)), "")
+
+
+def previous_output(directory: Path) -> dict[str, Any] | None:
+    """The report of a fabricate output folder, or None when ``directory`` is not one (its report.json is
+    missing, not a regular file, larger than :data:`MAX_REPORT_BYTES` or not a fabricate report)."""
+    data = read_regular(Path(directory) / REPORT, MAX_REPORT_BYTES)
+    if data is None:
+        return None
+    try:
+        report = json.loads(data.decode("utf-8"))
+    except (ValueError, RecursionError):
         return None
     if not isinstance(report, dict) or not isinstance(report.get("design"), dict) \
             or "fabricate_version" not in report["design"] or not isinstance(report.get("files"), list):
@@ -94,7 +190,7 @@ def _nearest_existing(path: Path) -> Path:
 
 
 def check_output_dir(out: str | Path, *, force: bool = False, stage: str = "build",
-                     protect: Sequence[Path] = ()) -> Path:
+                     protect: Sequence[Path] | Mapping[Path, str] = ()) -> Path:
     """Decide before any work whether ``out`` may receive a fabricate output.
 
     Parameters
@@ -106,8 +202,9 @@ def check_output_dir(out: str | Path, *, force: bool = False, stage: str = "buil
         a ``protect`` path).
     stage : str
         ``"build"`` or ``"synth"``; a synth output never replaces a build unless forced.
-    protect : sequence of Path
-        Paths that must survive (the template being built).
+    protect : sequence of Path, or mapping of Path to str
+        Inputs of the command, which must survive even with ``force`` (the template being built, the
+        process profile); a mapping says what each is ("the template being built").
 
     Returns
     -------
@@ -138,10 +235,13 @@ def check_output_dir(out: str | Path, *, force: bool = False, stage: str = "buil
     cwd = Path.cwd().resolve()
     if real == cwd or real in cwd.parents:
         raise _refuse(out, "is the current folder or holds it; name a new folder for the output")
-    for path in protect:
-        path = Path(path).resolve()
-        if path == real or real in path.parents:
-            raise _refuse(out, f"holds {path.name}, the template being built")
+    what = protect if isinstance(protect, Mapping) else dict.fromkeys(protect, "an input of this command")
+    for given, role in what.items():
+        given = Path(given)
+        # the file itself and, if it is a link, the link: neither may be inside the folder replaced
+        for path in {given.resolve(), given.parent.resolve() / given.name}:
+            if path == real or real in path.parents:
+                raise _refuse(out, f"holds {given.name}, {role}")
     if out.is_dir():
         _check_replaceable(out, force, stage)
     _probe_writable(existing, out)
@@ -157,6 +257,10 @@ def _check_replaceable(out: Path, force: bool, stage: str) -> None:
         return
     report = previous_output(out)
     if report is None:
+        odd = _not_regular(out / REPORT)
+        if odd:
+            raise _refuse(out, f"holds a report.json that is {odd}, not one fabricate wrote (it is never opened); "
+                               "choose a new or empty folder, or pass --force to replace it")
         raise _refuse(out, f"holds files fabricate did not write ({', '.join(entries[:3])}"
                            f"{', ...' if len(entries) > 3 else ''}); choose a new or empty folder, or pass "
                            "--force to replace it")
@@ -180,60 +284,192 @@ def _probe_writable(existing: Path, out: Path) -> None:
         raise _refuse(out, f"cannot be written: {existing}: {exc.strerror}") from exc
 
 
+class _Lock:
+    """The held lock of one output folder; its file records the siblings the holder makes (see the module
+    docstring). Without POSIX locks (``fd`` None) nothing is recorded, so no leftover is ever removed."""
+
+    def __init__(self, fd: int | None, path: Path) -> None:
+        self.fd = fd
+        self.path = path
+        #: Record lines to leave for the next holder: siblings of fabricate that could not be removed.
+        self.keep: list[str] = []
+
+    def records(self) -> dict[str, set[Identity | None]]:
+        """What earlier (killed) holders recorded: for each token, the identities its sibling may have
+        (None: recorded before the folder was made, so it can only be an empty folder)."""
+        if self.fd is None:
+            return {}
+        data = os.pread(self.fd, 1 << 20, 0)
+        found: dict[str, set[Identity | None]] = {}
+        for line in data.decode("ascii", "replace").splitlines():
+            match = _RECORD.fullmatch(line)
+            if match:
+                found.setdefault(match["token"], set()).add(
+                    (int(match["dev"]), int(match["ino"])) if match["dev"] else None)
+        return found
+
+    def rewrite(self, lines: Sequence[str]) -> None:
+        """Replace the records with ``lines``."""
+        if self.fd is not None:
+            os.ftruncate(self.fd, 0)
+            if lines:
+                os.write(self.fd, "".join(f"{line}\n" for line in lines).encode("ascii"))
+
+    def record(self, token: str, ident: Identity | None = None) -> None:
+        """Record a sibling before it exists (synced: a killed run's records must survive it)."""
+        if self.fd is not None:
+            os.write(self.fd, f"{token}{'' if ident is None else f' {ident[0]} {ident[1]}'}\n".encode("ascii"))
+            os.fsync(self.fd)
+
+
 @contextlib.contextmanager
-def _locked(parent: Path, name: str) -> Iterator[None]:
-    """Hold the exclusive lock of output ``parent/name`` (a no-op where there are no POSIX locks)."""
-    if fcntl is None:  # pragma: no cover
-        yield
-        return
+def _locked(parent: Path, name: str) -> Iterator[_Lock]:
+    """Hold the exclusive lock of output ``parent/name`` (nothing is locked where there are no POSIX locks)."""
     path = parent / f".{name}.lock"
+    if fcntl is None:  # pragma: no cover
+        yield _Lock(None, path)
+        return
     while True:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:  # never through a link, never blocking on a FIFO someone named like the lock
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_APPEND | _NOFOLLOW | _NONBLOCK | _CLOEXEC, 0o644)
+        except OSError as exc:
+            if exc.errno not in (errno.ELOOP, errno.EISDIR, errno.ENXIO):
+                raise
+            fd = None
+        st = os.fstat(fd) if fd is not None else None
+        if st is None or not stat.S_ISREG(st.st_mode):
+            if fd is not None:
+                os.close(fd)
+            raise _refuse(parent / name, f"its lock file {path} is not a plain file; fabricate makes it and "
+                                         "removes it after writing: remove what is there")
         fcntl.flock(fd, fcntl.LOCK_EX)
-        try:
-            current = os.stat(path).st_ino
-        except FileNotFoundError:
-            current = None
-        if current == os.fstat(fd).st_ino:
+        if _identity(path) == (st.st_dev, st.st_ino):
             break
         os.close(fd)  # the holder before us removed this lock file: lock the new one
+    lock = _Lock(fd, path)
     try:
-        yield
+        yield lock
     finally:
-        # remove the file before unlocking: a waiter then sees it gone and locks a fresh one
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(path)
-        os.close(fd)
-
-
-def remove_leftovers(parent: Path, name: str) -> list[Path]:
-    """Remove temporary siblings that killed runs left for output ``parent/name``; call under its lock."""
-    removed = []
-    for pattern in (f".{glob.escape(name)}.*.tmp", f".{glob.escape(name)}.*.old"):
-        for path in sorted(parent.glob(pattern)):
-            if path.is_dir() and not path.is_symlink():
-                shutil.rmtree(path, ignore_errors=True)
+        try:
+            if lock.keep:  # siblings fabricate made but could not remove: the next holder tries again
+                lock.rewrite(lock.keep)
             else:
-                with contextlib.suppress(OSError):
-                    path.unlink()
-            removed.append(path)
-    return removed
+                # remove the file before unlocking: a waiter then sees it gone and locks a fresh one
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(path)
+        finally:
+            os.close(fd)
 
 
-def _exchange(a: Path, b: Path) -> bool:
-    """Swap two paths atomically (Linux ``renameat2``); False where the system cannot."""
+@dataclass
+class Leftovers:
+    """What :func:`remove_leftovers` found beside an output folder.
+
+    Attributes
+    ----------
+    removed : list of Path
+        Siblings fabricate made (recorded in the lock by a killed run), removed.
+    left_alone : list of Path
+        Siblings named like fabricate's (``.NAME.*.tmp``, ``.NAME.*.old``) that fabricate cannot prove it
+        made: not touched.
+    stuck : list of str
+        Records of siblings fabricate made but could not remove (kept in the lock for the next run).
+    """
+
+    removed: list[Path] = field(default_factory=list)
+    left_alone: list[Path] = field(default_factory=list)
+    stuck: list[str] = field(default_factory=list)
+
+
+def _looks_like_ours(entry: str, name: str) -> bool:
+    """Whether ``entry`` matches ``.NAME.*.tmp`` / ``.NAME.*.old`` (what fabricate once removed unasked)."""
+    prefix = f".{name}."
+    return entry.startswith(prefix) and entry.endswith((".tmp", ".old")) and len(entry) >= len(prefix) + 4
+
+
+def remove_leftovers(parent: Path, name: str, made: Mapping[str, Collection[Identity | None]] | None = None
+                     ) -> Leftovers:
+    """Remove the siblings of output ``parent/name`` that killed runs of fabricate left; call under its lock.
+
+    Parameters
+    ----------
+    parent, name : Path, str
+        The output folder ``parent/name``.
+    made : mapping of str to identities, optional
+        The lock's records (:meth:`_Lock.records`): a sibling is removed only if its name carries a
+        recorded token and it is a real folder (not a link) owned by this user whose ``(device, inode)``
+        was recorded, or an empty folder recorded before it was made. Without records nothing is removed.
+
+    Returns
+    -------
+    Leftovers
+        What was removed, and what was left alone (to be named in a warning).
+    """
+    found = Leftovers()
+    try:
+        entries = sorted(os.listdir(parent))
+    except OSError:
+        return found
+    uid = os.geteuid() if hasattr(os, "geteuid") else None
+    for entry in entries:
+        if not _looks_like_ours(entry, name):
+            continue
+        parsed = parse_sibling(entry)
+        if parsed is not None and parsed[0] != name:
+            continue  # another output's sibling (".a.b.fabricate-....tmp" for output "a"): not ours to judge
+        path = parent / entry
+        idents = set((made or {}).get(parsed[1], ())) if parsed else set()
+        try:
+            st = os.lstat(path)
+        except FileNotFoundError:
+            continue
+        ident = (st.st_dev, st.st_ino)
+        mine = parsed is not None and stat.S_ISDIR(st.st_mode) and (uid is None or st.st_uid == uid)
+        if mine and ident in idents:
+            shutil.rmtree(path, ignore_errors=True)
+            if _identity(path) == ident:
+                found.stuck.append(f"{parsed[1]} {ident[0]} {ident[1]}")
+            else:
+                found.removed.append(path)
+        elif mine and None in idents:  # made by a run killed before it recorded the inode: still empty
+            try:
+                os.rmdir(path)
+                found.removed.append(path)
+            except OSError:
+                found.left_alone.append(path)
+        else:
+            found.left_alone.append(path)
+    return found
+
+
+def _renameat2(a: Path, b: Path, flags: int) -> bool:
+    """Linux ``renameat2(a, b, flags)``; False where the system cannot (then nothing was done)."""
     try:
         renameat2 = ctypes.CDLL(None, use_errno=True).renameat2
     except (OSError, AttributeError):
         return False
     renameat2.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
-    at_fdcwd, rename_exchange = -100, 2
-    if renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0:
+    at_fdcwd = -100
+    if renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), flags) == 0:
         return True
     err = ctypes.get_errno()
     if err in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP, errno.EPERM):
         return False
     raise OSError(err, os.strerror(err), str(b))
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths atomically (``RENAME_EXCHANGE``); False where the system cannot."""
+    return _renameat2(a, b, 2)
+
+
+def _rename_new(a: Path, b: Path) -> None:
+    """Rename ``a`` to ``b`` only if nothing is at ``b`` (``RENAME_NOREPLACE`` where there is one)."""
+    if _renameat2(a, b, 1):
+        return
+    if os.path.lexists(b):  # a plain rename would replace an empty folder or fail confusingly
+        raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), str(b))
+    os.rename(a, b)
 
 
 @contextlib.contextmanager
@@ -263,51 +499,130 @@ def _write_tree(files: Mapping[str, bytes], root: Path) -> None:
     os.chmod(root, 0o755)
 
 
+def _warn_default(message: str) -> None:
+    warnings.warn(message, LeftAloneWarning, stacklevel=4)
+
+
 def write_atomically(files: Mapping[str, bytes], out_dir: str | Path,
-                     before: Callable[[Path], Any] | None = None) -> Path:
+                     before: Callable[[Path], Any] | None = None, *,
+                     warn: Callable[[str], Any] | None = None) -> Path:
     """Write ``{relative path: bytes}`` into a temporary sibling of ``out_dir`` and swap it into place.
 
-    Under the folder's lock: leftovers of killed runs are removed, ``before(out_dir)`` runs (the caller's
-    last word on whether the folder may be replaced), then the files are written and swapped in. An
-    existing ``out_dir`` is replaced only once the new one is complete; on any failure (Ctrl-C included)
-    the temporary folder is removed and the old output is left as it was.
+    Under the folder's lock: leftovers of killed runs are removed (only those the lock's records prove
+    fabricate made; every other ``.NAME.*.tmp`` / ``.NAME.*.old`` is named by ``warn``, by default a
+    :class:`LeftAloneWarning`), ``before(out_dir)`` runs (the caller's last word on whether the folder may
+    be replaced), then the files are written and swapped in. An existing ``out_dir`` is replaced only once
+    the new one is complete, and only if it is still the folder ``before`` saw; on any failure (Ctrl-C
+    included) the temporary folder is removed and the old output is left as it was.
+
+    Raises
+    ------
+    SpecError
+        The folder or the temporary one changed while fabricate wrote (nothing replaced, nothing deleted).
     """
     out_dir = Path(os.path.abspath(out_dir))
     out_dir.parent.mkdir(parents=True, exist_ok=True)
-    with _locked(out_dir.parent, out_dir.name):
-        remove_leftovers(out_dir.parent, out_dir.name)
+    say = warn or _warn_default
+    with _locked(out_dir.parent, out_dir.name) as lock:
+        found = remove_leftovers(out_dir.parent, out_dir.name, lock.records())
+        lock.keep = list(found.stuck)
+        lock.rewrite(lock.keep)  # the killed runs' records are done with; this run records its own
+        for path in found.left_alone:
+            say(f"left {path.name} alone: fabricate did not make it")
         if before is not None:
             before(out_dir)
-        _swap_in(files, out_dir)
+        _swap_in(files, out_dir, lock, _identity(out_dir))
     return out_dir
 
 
-def _swap_in(files: Mapping[str, bytes], out_dir: Path) -> None:
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".tmp", dir=out_dir.parent))
+def _changed(out: Path, what: str) -> SpecError:
+    return _refuse(out, f"{what} while fabricate wrote the new output; nothing was replaced or deleted "
+                        "(run the command again)")
+
+
+def _remove_ours(path: Path, ident: Identity | None, lock: _Lock) -> None:
+    """Remove folder ``path`` if it is still the one fabricate made (``ident``); else leave it."""
+    if ident is None or _identity(path) != ident:
+        return
+    shutil.rmtree(path, ignore_errors=True)
+    if _identity(path) == ident:  # e.g. a file in it cannot be removed: the next run tries again
+        parsed = parse_sibling(path.name)
+        if parsed is not None:
+            lock.keep.append(f"{parsed[1]} {ident[0]} {ident[1]}")
+
+
+def _swap_in(files: Mapping[str, bytes], out_dir: Path, lock: _Lock, checked: Identity | None) -> None:
+    """Write ``files`` into a new sibling and put it at ``out_dir``, which must still be ``checked``."""
+    parent, name = out_dir.parent, out_dir.name
+    token = secrets.token_hex(_TOKEN_HEX // 2)
+    tmp = parent / sibling_name(name, token, "tmp")
+    lock.record(token)  # before the folder exists: a run killed right after mkdir leaves a recorded folder
+    os.mkdir(tmp, 0o700)
+    st = os.lstat(tmp)
+    ours = (st.st_dev, st.st_ino)
+    lock.record(token, ours)
     try:
         _write_tree(files, tmp)
         with _no_interrupt():
-            if not os.path.lexists(out_dir):
-                os.replace(tmp, out_dir)
-                return
-            if not _exchange(tmp, out_dir):
-                old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".old", dir=out_dir.parent))
-                os.rmdir(old)
-                os.replace(out_dir, old)
-                os.replace(tmp, out_dir)
-                tmp = old
-        shutil.rmtree(tmp, ignore_errors=True)  # now the previous output
+            previous = _swap(tmp, ours, out_dir, checked, lock)
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+        _remove_ours(tmp, ours, lock)  # only if the folder there is still the one made here
         raise
+    if previous is not None:
+        _remove_ours(previous, checked, lock)  # the previous output, verified to be the one checked
+
+
+def _swap(tmp: Path, ours: Identity, out_dir: Path, checked: Identity | None, lock: _Lock) -> Path | None:
+    """Put folder ``tmp`` (identity ``ours``) at ``out_dir`` in place of ``checked`` (None: nothing).
+
+    Returns where the previous output now is (to be removed), None when there was none.
+    """
+    if _identity(tmp) != ours:
+        raise _changed(out_dir, f"its temporary folder {tmp.name} was replaced")
+    if _identity(out_dir) != checked:
+        raise _changed(out_dir, "it was created, replaced or removed" if checked is None or
+                       _identity(out_dir) is None else "it was replaced by another folder")
+    if checked is None:
+        try:
+            _rename_new(tmp, out_dir)
+        except FileExistsError:
+            raise _changed(out_dir, "it was created") from None
+        if _identity(out_dir) != ours:
+            raise _changed(out_dir, "it was replaced right after the swap")
+        return None
+    token = parse_sibling(tmp.name)[1]  # type: ignore[index]
+    lock.record(token, checked)  # the previous output will be at tmp's name
+    if _exchange(tmp, out_dir):
+        if _identity(out_dir) == ours and _identity(tmp) == checked:
+            return tmp
+        # someone swapped a folder in between the checks and the exchange: put both back, delete nothing
+        _exchange(tmp, out_dir)
+        raise _changed(out_dir, "it or its temporary folder was replaced")
+    old = tmp.parent / sibling_name(out_dir.name, secrets.token_hex(_TOKEN_HEX // 2), "old")
+    lock.record(parse_sibling(old.name)[1], checked)  # type: ignore[index]
+    os.rename(out_dir, old)
+    if _identity(old) != checked:
+        os.rename(old, out_dir)
+        raise _changed(out_dir, "it was replaced by another folder")
+    try:
+        _rename_new(tmp, out_dir)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            _rename_new(old, out_dir)  # the previous output back in place
+        raise
+    if _identity(out_dir) != ours:
+        raise _changed(out_dir, "it was replaced right after the swap")
+    return old
 
 
 def write_output(files: Mapping[str, bytes], out: str | Path, *, force: bool = False, stage: str = "build",
-                 protect: Sequence[Path] = ()) -> Path:
+                 protect: Sequence[Path] | Mapping[Path, str] = (),
+                 warn: Callable[[str], Any] | None = None) -> Path:
     """Write a whole output folder safely: check it (again, under the lock), then :func:`write_atomically`.
 
     The folder is checked again under the lock because another writer may have filled it since the
-    first check (its result, a fabricate output, may then be replaced).
+    first check (its result, a fabricate output, may then be replaced). ``warn`` receives one line per
+    sibling left alone (default: a :class:`LeftAloneWarning`).
 
     Raises
     ------
@@ -317,7 +632,7 @@ def write_output(files: Mapping[str, bytes], out: str | Path, *, force: bool = F
     out = Path(os.path.abspath(out))
     try:
         return write_atomically(files, out, before=lambda o: check_output_dir(o, force=force, stage=stage,
-                                                                             protect=protect))
+                                                                             protect=protect), warn=warn)
     except OSError as exc:
         where = exc.filename or out
         raise _refuse(out, f"cannot be written: {where}: {exc.strerror or exc}") from exc

@@ -405,3 +405,79 @@ def test_cli_sweep_never_writes_into_a_foreign_folder(tmp_path, capsys):
     assert main(["sweep", "gear_pair_elliptic", "--vary", "gears.module_mm=1,2", "-o", str(out)]) == 2
     assert "did not write" in capsys.readouterr().err
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+# -- a sweep folder is never written through a link ---------------------------------------------------------------
+
+def _earlier_sweep(tmp_path: Path) -> tuple[Path, Path, object]:
+    """A spec file and the folder of an earlier run of it (its sweep.json, no rows yet)."""
+    from fabricate.sweep.runner import SWEEP_JSON, _json, _marker
+    from fabricate.tomlwrite import dumps
+
+    tables = gear_tables(eccentricities=(0.1, 0.2), modules=(1.0,))
+    spec_file = tmp_path / "gears.toml"
+    spec_file.write_text(dumps(tables))
+    spec = sweep_from_tables(tables, tmp_path)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / SWEEP_JSON).write_bytes(_json(_marker(spec, {"points": 2, "done": 0, "complete": False})))
+    return spec_file, out, spec
+
+
+def test_a_symlinked_journal_is_refused_and_never_written_through(tmp_path, capsys):
+    from fabricate.cli import main
+    from fabricate.sweep.runner import Journal, read_journal
+
+    spec_file, out, spec = _earlier_sweep(tmp_path)
+    target = tmp_path / "thesis.txt"
+    target.write_text("line one\nno newline at the end")  # what a torn journal line looks like
+    (out / "rows.jsonl").symlink_to(target)
+    assert main(["sweep", str(spec_file), "-o", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "rows.jsonl: is a symbolic link" in err and "Traceback" not in err
+    # and below the folder check, the journal itself is never opened through the link
+    with pytest.raises(SpecError, match="symbolic link"):
+        read_journal(out, spec)
+    with pytest.raises(SpecError, match="symbolic link"):
+        Journal(out / "rows.jsonl")
+    assert target.read_text() == "line one\nno newline at the end"
+    assert (out / "rows.jsonl").is_symlink()
+
+
+@pytest.mark.parametrize("name, make", [("rows.jsonl", "fifo"), ("rows.jsonl", "folder"), ("plots", "link"),
+                                        ("best", "link"), ("sweep.json", "link")])
+def test_a_sweep_folder_entry_of_the_wrong_kind_is_refused(tmp_path, name, make):
+    spec_file, out, _ = _earlier_sweep(tmp_path)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    path = out / name
+    if name == "sweep.json":
+        os.replace(path, elsewhere / "sweep.json")
+        path.symlink_to(elsewhere / "sweep.json")
+    elif make == "fifo":
+        os.mkfifo(path)
+    elif make == "folder":
+        path.mkdir()
+    else:
+        path.symlink_to(elsewhere)
+    before = sorted(p.name for p in out.iterdir())
+    # a child, so that a FIFO opened by mistake fails the test instead of hanging it
+    child = _cli("sweep", str(spec_file), "-o", str(out), "-q")
+    stdout, stderr = child.communicate(timeout=120)
+    assert child.returncode == 2, (stdout, stderr)
+    assert f"{path}: is " in stderr and "Traceback" not in stderr
+    assert sorted(p.name for p in out.iterdir()) == before and list(elsewhere.iterdir()) == (
+        [elsewhere / "sweep.json"] if name == "sweep.json" else [])
+
+
+def test_a_sweep_never_writes_into_a_folder_holding_its_spec(tmp_path, capsys):
+    from fabricate.cli import main
+    from fabricate.tomlwrite import dumps
+
+    folder = tmp_path / "work"
+    folder.mkdir()
+    spec_file = folder / "gears.toml"
+    spec_file.write_text(dumps(gear_tables(eccentricities=(0.1, 0.2), modules=(1.0,))))
+    assert main(["sweep", str(spec_file), "-o", str(folder), "-q"]) == 2
+    assert "holds gears.toml, an input of this sweep" in capsys.readouterr().err
+    assert sorted(p.name for p in folder.iterdir()) == ["gears.toml"]

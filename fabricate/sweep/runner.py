@@ -21,11 +21,12 @@ import json
 import logging
 import math
 import os
+import stat
 import sys
 import tempfile
 import time
 from collections import deque
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -101,30 +102,77 @@ def _marker(spec: SweepSpec, extra: Mapping[str, Any] | None = None) -> dict[str
             "template_text": spec.template_text, **(extra or {})}
 
 
-def prepare_folder(out: Path, spec: SweepSpec) -> bool:
+#: Largest sweep.json read from an earlier run (it holds the spec, counts and best points: kilobytes).
+MAX_RECORD_BYTES = 16 * 2**20
+#: What fabricate writes at the top of a sweep folder, and what each must be (a link is never either).
+_FOLDER_ENTRIES = {SWEEP_JSON: "file", JOURNAL: "file", "sweep.csv": "file", "sweep.parquet": "file",
+                   "plots": "folder", "best": "folder"}
+
+
+def _kind(path: Path) -> str:
+    """``"file"``, ``"folder"`` or what else ``path`` itself is (a link is not followed); "" if absent."""
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return ""
+    if stat.S_ISREG(mode):
+        return "file"
+    if stat.S_ISDIR(mode):
+        return "folder"
+    return next((what for test, what in ((stat.S_ISLNK, "a symbolic link"), (stat.S_ISFIFO, "a FIFO"),
+                                         (stat.S_ISSOCK, "a socket")) if test(mode)), "a device")
+
+
+def prepare_folder(out: Path, spec: SweepSpec, protect: Sequence[Path] = ()) -> bool:
     """Check the output folder before any work. Returns whether it holds an earlier run of this spec.
+
+    Parameters
+    ----------
+    out : Path
+    spec : SweepSpec
+    protect : sequence of Path
+        The inputs of the sweep (its spec file, its template): the folder may not be or hold one.
 
     Raises
     ------
     SpecError
-        The folder is a file, holds files fabricate did not write, or a sweep of another spec.
+        The folder is a file or a link, is or holds an input, holds files fabricate did not write, a sweep
+        of another spec, or one of the names a sweep writes as something else (``rows.jsonl`` a link, a FIFO
+        or a folder, say: it is never opened).
     """
     if os.path.lexists(out) and (out.is_symlink() or not out.is_dir()):
         raise SpecError(str(out), "is not a folder; a sweep writes into a new, empty or earlier sweep folder")
+    real = out.resolve()
+    for given in protect:
+        given = Path(given)
+        for path in {given.resolve(), given.parent.resolve() / given.name}:
+            if path == real or real in path.parents:
+                raise SpecError(str(out), f"holds {given.name}, an input of this sweep; choose another folder")
     if not out.exists():
         return False
     entries = sorted(p.name for p in out.iterdir())
     if not entries:
         return False
+    for name, want in _FOLDER_ENTRIES.items():
+        kind = _kind(out / name)
+        if kind and kind != want:
+            raise SpecError(str(out / name), f"is {kind}, not the {want} a sweep writes there (it is never "
+                                             "opened or written through); remove it or choose another folder")
     marker = out / SWEEP_JSON
     if not marker.is_file():
         raise SpecError(str(out), f"holds files fabricate did not write ({', '.join(entries[:3])}"
                                   f"{', ...' if len(entries) > 3 else ''}); choose a new or empty folder")
+    from fabricate.output import read_regular
+
+    data = read_regular(marker, MAX_RECORD_BYTES)
+    if data is None:
+        raise SpecError(str(marker), f"cannot be read as a sweep's record (larger than {MAX_RECORD_BYTES} bytes, "
+                                     "or unreadable)")
     try:
-        previous = json.loads(marker.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
+        previous = json.loads(data.decode("utf-8"))
+    except (ValueError, RecursionError) as exc:
         raise SpecError(str(marker), f"cannot be read as a sweep's record: {exc}") from None
-    if previous.get("kind") != "sweep":
+    if not isinstance(previous, dict) or previous.get("kind") != "sweep":
         raise SpecError(str(out), "holds a sweep.json fabricate did not write; choose a new or empty folder")
     if previous.get("spec_digest") != spec.digest or previous.get("spec") != spec.describe():
         raise SpecError(str(out), "holds a sweep of another spec (template, values, stage or metrics differ); "
@@ -132,19 +180,50 @@ def prepare_folder(out: Path, spec: SweepSpec) -> bool:
     return True
 
 
+def _open_journal(path: Path, flags: int) -> int:
+    """Open the journal without following a link or blocking on a FIFO; refuse anything but a plain file.
+
+    Raises
+    ------
+    SpecError
+        Naming the journal: it is a symbolic link, a FIFO, a device or a folder (nothing was written).
+    """
+    try:
+        fd = os.open(path, flags | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
+                     | getattr(os, "O_CLOEXEC", 0), 0o644)
+    except OSError as exc:
+        kind = _kind(path)
+        if kind and kind != "file":
+            raise SpecError(str(path), f"is {kind}, not the plain file a sweep's journal is; it is never "
+                                       "written through: remove it or choose another folder") from None
+        raise SpecError(str(path), f"cannot be opened: {exc.strerror}") from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise SpecError(str(path), f"is {_kind(path) or 'not a plain file'}, not the plain file a sweep's "
+                                   "journal is; it is never written through: remove it or choose another folder")
+    return fd
+
+
 def read_journal(out: Path, spec: SweepSpec) -> dict[str, dict[str, Any]]:
-    """Rows of an earlier run by point id (a torn last line is cut off so appending can go on)."""
+    """Rows of an earlier run by point id (a torn last line is cut off so appending can go on).
+
+    Raises
+    ------
+    SpecError
+        The journal is not a plain file (a link is never truncated through).
+    """
     path = out / JOURNAL
-    if not path.is_file():
+    if not os.path.lexists(path):
         return {}
-    data = path.read_bytes()
-    if data and not data.endswith(b"\n"):
-        cut = data.rfind(b"\n") + 1
-        with open(path, "r+b") as fh:
+    fd = _open_journal(path, os.O_RDWR)
+    with os.fdopen(fd, "r+b") as fh:
+        data = fh.read()
+        if data and not data.endswith(b"\n"):
+            cut = data.rfind(b"\n") + 1
             fh.truncate(cut)
-        data = data[:cut]
+            data = data[:cut]
     rows: dict[str, dict[str, Any]] = {}
-    for line in data.decode("utf-8").splitlines():
+    for line in data.decode("utf-8", "replace").splitlines():  # a garbled line is not a row: it is run again
         try:
             row = row_from_json(line, spec.metrics)
         except ValueError:
@@ -158,7 +237,8 @@ class Journal:
 
     def __init__(self, path: Path) -> None:
         self.path = path
-        self._fh = open(path, "a", encoding="utf-8")  # noqa: SIM115 - closed by close()
+        fd = _open_journal(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT)  # never appended through a link
+        self._fh = os.fdopen(fd, "a", encoding="utf-8")
 
     def append(self, rows: list[dict[str, Any]]) -> None:
         self._fh.write("".join(row_json(r) + "\n" for r in rows))
@@ -229,7 +309,8 @@ def _counts(rows: Mapping[str, Mapping[str, Any]]) -> dict[str, int]:
 
 
 def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, scheduler: str | None = None,
-              quiet: bool = False, progress_bar: bool | None = None, log: Progress | None = None) -> SweepOutcome:
+              quiet: bool = False, progress_bar: bool | None = None, log: Progress | None = None,
+              protect: Sequence[Path] = ()) -> SweepOutcome:
     """Run every point of ``spec`` not done yet in ``out``, then write the tables, plots and best builds.
 
     Parameters
@@ -245,9 +326,11 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
         No progress output.
     progress_bar : bool, optional
         Draw the progress bar on stderr (default: when stderr is a terminal).
+    protect : sequence of Path
+        The sweep's input files (spec, template): ``out`` may not be or hold one.
     """
     out = Path(os.path.abspath(out))
-    resuming = prepare_folder(out, spec)
+    resuming = prepare_folder(out, spec, protect)
     points = spec.points()
     ids = [spec.point_id(values) for values in points]
     by_id = dict(zip(ids, range(len(points)), strict=True))
@@ -297,7 +380,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
             if best:
                 if client is None:
                     client, cluster = connect(workers, scheduler)
-                _build_best(client, spec, best, out, say)
+                _build_best(client, spec, best, out, say, protect)
         counts = _counts(done)
         complete = len(rows) == len(points)
         notes = _notes(spec, rows)
@@ -490,9 +573,10 @@ def _best(spec: SweepSpec, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
              "values": {f.path: r[f.path] for f in spec.fields}} for k, r in enumerate(ok[:spec.best])]
 
 
-def _build_best(client: Any, spec: SweepSpec, best: list[dict[str, Any]], out: Path, say: Progress) -> None:
+def _build_best(client: Any, spec: SweepSpec, best: list[dict[str, Any]], out: Path, say: Progress,
+                protect: Sequence[Path] = ()) -> None:
     """Build the best points in full on the cluster and write each as a normal build output folder."""
-    from fabricate.output import write_output
+    from fabricate.output import MAX_REPORT_BYTES, read_regular, write_output
     from fabricate.sweep.task import point_text
 
     parts = spec.field_parts()
@@ -500,13 +584,14 @@ def _build_best(client: Any, spec: SweepSpec, best: list[dict[str, Any]], out: P
     for entry in best:
         folder = out / "best" / f"{entry['rank']:02d}-point{entry['point']}"
         entry["folder"] = folder.relative_to(out).as_posix()
-        report = folder / "report.json"
-        if report.is_file():  # an earlier run built it: the same template gives the same files
+        data = read_regular(folder / "report.json", MAX_REPORT_BYTES)  # never a link, a FIFO or a device
+        if data is not None:  # an earlier run built it: the same template gives the same files
             try:
-                previous = json.loads(report.read_text(encoding="utf-8")).get("template_text")
-            except (OSError, ValueError):
+                previous = json.loads(data.decode("utf-8"))
+            except (ValueError, RecursionError):
                 previous = None
-            if previous == point_text(spec.base, parts, entry["values"]):
+            if isinstance(previous, dict) and previous.get("template_text") == point_text(spec.base, parts,
+                                                                                        entry["values"]):
                 continue
         wanted.append((entry, folder))
     if not wanted:
@@ -520,4 +605,5 @@ def _build_best(client: Any, spec: SweepSpec, best: list[dict[str, Any]], out: P
         if not files:
             entry["build_reason"] = reason
             continue
-        write_output(files, folder, stage="build")
+        write_output(files, folder, stage="build", protect=protect,
+                     warn=lambda msg: print(f"fabricate: warning: {msg}", file=sys.stderr, flush=True))
