@@ -316,10 +316,10 @@ class _Lock:
                 os.write(self.fd, "".join(f"{line}\n" for line in lines).encode("ascii"))
 
     def record(self, token: str, ident: Identity | None = None) -> None:
-        """Record a sibling before it exists (synced: a killed run's records must survive it)."""
+        """Record a sibling before it exists. Not synced: a killed process's writes survive it, and a record
+        lost with the machine only leaves a leftover alone (named in a warning), never removes a wrong one."""
         if self.fd is not None:
             os.write(self.fd, f"{token}{'' if ident is None else f' {ident[0]} {ident[1]}'}\n".encode("ascii"))
-            os.fsync(self.fd)
 
 
 @contextlib.contextmanager

@@ -351,7 +351,7 @@ def test_the_cli_leaves_a_foreign_backup_folder_and_warns(tmp_path, capsys):
     backup = tmp_path / ".results.backup.old"
     backup.mkdir()
     (backup / "thesis.txt").write_text("x\n")
-    assert main(["build", FAST, "-o", str(tmp_path / "results"), "-q"]) == 0
+    assert main(["synth", FAST, "-o", str(tmp_path / "results"), "-q"]) == 0  # writes as a build does, faster
     assert (backup / "thesis.txt").read_text() == "x\n"
     assert "fabricate: warning: left .results.backup.old alone: fabricate did not make it" in capsys.readouterr().err
     assert _siblings(tmp_path) == [".results.backup.old", "results"]
