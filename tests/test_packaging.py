@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 import os
+import re
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -92,3 +94,82 @@ def test_init_writes_an_editable_copy_and_never_overwrites(tmp_path, monkeypatch
     assert main(["init", "../escape"]) == 2
     assert main(["init", "x", "--from", "no_such_template"]) == 2
     assert sorted(p.name for p in tmp_path.iterdir()) == ["my_finger.toml", "pair.toml"]
+
+
+@pytest.fixture(scope="module")
+def built_linkage(tmp_path_factory) -> Path:
+    """A small build (the shipped Stephenson linkage, whose mechanism.toml is exact) to copy from."""
+    out = tmp_path_factory.mktemp("built") / "linkage_stephenson"
+    assert main(["build", "linkage_stephenson", "-o", str(out), "-q"]) == 0
+    return out
+
+
+def _project(built: Path, root: Path) -> Path:
+    """``root/outputs/<name>/``: a copy of ``built`` where a user's ``fabricate build`` would have put it."""
+    folder = root / "outputs" / built.name
+    shutil.copytree(built, folder)
+    return folder
+
+
+def _fabricate(cwd: Path, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "fabricate", *args], cwd=cwd, capture_output=True, text=True,
+                          timeout=300)
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_the_outputs_readme_rebuild_recipe_works_as_written(built_linkage, tmp_path):
+    """Issue 23: outputs/README.md's recipe, run as written from the folder holding outputs/, exits 0 and
+    writes where the README says; the build it came from is left as it was (nothing nested in it), a plain
+    re-run replaces the rebuild, and run from inside the build folder it lands in the same place."""
+    text = (ROOT / "outputs" / "README.md").read_text(encoding="utf-8")
+    recipe = re.search(r"^fabricate build (outputs/NAME/mechanism\.toml)\s+# writes (outputs/NAME-rebuild)/$", text,
+                       re.MULTILINE)
+    assert recipe, "outputs/README.md no longer states the rebuild recipe this test runs"
+    source = _project(built_linkage, tmp_path)
+    before = _files(source)
+    name = source.name
+    template, target = (recipe.group(k).replace("NAME", name) for k in (1, 2))
+    done = _fabricate(tmp_path, "build", template, "-q")
+    assert done.returncode == 0, done.stderr
+    rebuilt = tmp_path / target
+    assert f"building into {rebuilt}" in done.stderr  # said, with -q too
+    assert (rebuilt / "report.json").is_file()
+    assert _files(source) == before  # the source build: not replaced, nothing written into it
+    parts = {k: v for k, v in before.items() if k.startswith("parts/") and k.endswith(".stl")}
+    assert parts and all(_files(rebuilt)[k] == v for k, v in parts.items())  # the same parts, byte for byte
+    assert sorted(p.name for p in (tmp_path / "outputs").iterdir()) == [name, f"{name}-rebuild"]
+    again = _fabricate(tmp_path, "build", template, "-q")  # a plain re-run replaces the rebuild
+    assert again.returncode == 0, again.stderr
+    inside = _fabricate(source, "build", "mechanism.toml", "-q")  # the other reading: from inside the folder
+    assert inside.returncode == 0, inside.stderr
+    assert _files(source) == before
+    assert sorted(p.name for p in (tmp_path / "outputs").iterdir()) == [name, f"{name}-rebuild"]
+    assert not (source / "outputs").exists()
+
+
+def test_a_default_output_is_never_written_into_a_fabricate_output_folder(built_linkage, tmp_path, monkeypatch,
+                                                                           capsys):
+    """Issue 23: run from inside a build folder (or a folder in it), the default output (outputs/<name>/
+    under the current folder) would nest a build inside a build: refused with exit 2, naming the folder and
+    -o, before any work; nothing is written into the build. An explicit -o elsewhere still works."""
+    source = _project(built_linkage, tmp_path)
+    before = _files(source)
+    for cwd in (source, source / "parts"):
+        monkeypatch.chdir(cwd)
+        for command in (["build", "linkage_stephenson"], ["synth", "linkage_stephenson"], ["build"]):
+            assert main([*command, "-q"]) == 2, (cwd, command)
+            err = capsys.readouterr().err
+            assert f"inside {source}, a fabricate output folder" in err and "-o" in err, err
+            assert "Traceback" not in err
+    assert _files(source) == before and not (source / "outputs").exists()
+    # a template copied out of the build builds by default as any template does, beside nothing
+    elsewhere = tmp_path / "work"
+    elsewhere.mkdir()
+    shutil.copy(source / "mechanism.toml", elsewhere / "edited.toml")
+    monkeypatch.chdir(elsewhere)
+    assert main(["synth", "edited.toml", "-q"]) in (0, 1)
+    assert (elsewhere / "outputs" / f"{source.name}-synth" / "report.json").is_file()
+    assert _files(source) == before
