@@ -17,6 +17,7 @@ the bytes ``fabricate build`` writes (the same template gives the same bytes).
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -63,59 +64,100 @@ class Build:
         current folder). Returns the folder written."""
         from fabricate.output import check_output_dir, write_output
 
+        out = _as_path(out, "out", "an output folder")
+        if not isinstance(force, bool):
+            raise SpecError("force", f"expected True or False, got {_type_name(force)}")
         protect = [Path(self.design.template)]
         check_output_dir(out, force=force, stage="build", protect=protect)
         return write_output(self.files, out, force=force, stage="build", protect=protect)
 
 
-def load(template: str | Path | Mapping[str, Any], process: str | None = None) -> DesignSpec:
+def load(template: str | Path | Mapping[str, Any], process: str | Path | None = None) -> DesignSpec:
     """A validated design from a shipped template's name, a template path, or a dict of its tables.
 
     Parameters
     ----------
     template : str, Path or Mapping
         ``"finger_five_bar_ncg"``, ``"my_design.toml"``, or ``{"design": {...}, "process": {...}, ...}``
-        (the TOML tables as Python values; it is written out as TOML text so the build's report embeds a
-        template that ``fabricate check`` can rebuild).
-    process : str, optional
+        (the TOML tables as Python values: strings, numbers, booleans, lists, tuples, numpy arrays and
+        nested dicts; it is written out as TOML text so the build's report embeds a template that
+        ``fabricate check`` can rebuild).
+    process : str or Path, optional
         ``"sla"``, ``"laser"`` or a profile file: replaces the template's process (``--process``).
 
     Raises
     ------
     SpecError
-        On the first invalid field, naming it.
+        On the first invalid field, naming it; an argument of the wrong type names the argument
+        (``template``, ``process``) or, inside a dict, the value's path.
     """
     from fabricate.spec import design_from_text, load_design, process_override
 
+    if process is not None:
+        process = str(_as_path(process, "process", '"sla", "laser" or a process profile file'))
     if isinstance(template, Mapping):
         from fabricate.tomlwrite import dumps
 
-        name = str(template.get("design", {}).get("name", "design"))
+        tables = _toml_value(template, "")
+        design = tables.get("design")
+        name = design.get("name") if isinstance(design, dict) else None
+        # the file name only labels the report; the name itself is validated as design.name
+        label = f"{name}.toml" if isinstance(name, str) and name and "\0" not in name else "design.toml"
         override = process_override(process) if process is not None else None
-        return design_from_text(dumps(template), f"{name}.toml", override)
-    return load_design(template, process)
+        return design_from_text(dumps(tables), Path(label).name or "design.toml", override)
+    if not isinstance(template, (str, os.PathLike)):
+        raise SpecError("template", "expected a shipped template's name, a template path or a dict of its tables, "
+                                    f"got {_type_name(template)}")
+    return load_design(_as_path(template, "template", "a template name or path"), process)
 
 
 def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | None = None,
                    pads: Mapping[str, Mapping[str, Any]] | None = None,
                    tables: Mapping[str, Any] | None = None) -> DesignSpec:
-    """A design from a :class:`~fabricate.mechanism.Mechanism` built in code: it is written as the exact
-    form of a ``kind = "linkage"`` template (bodies in their own frames, every law by its coefficients;
-    see :mod:`fabricate.synthesis.linkage.exact`) and validated like one, so the build is of this very
-    mechanism and its report embeds a template ``fabricate check`` can rebuild.
+    """A design from a :class:`~fabricate.mechanism.Mechanism` built in code.
+
+    The mechanism is written as the exact form of a ``kind = "linkage"`` template (bodies in their own
+    frames, every law by its coefficients; see :mod:`fabricate.synthesis.linkage.exact`) and validated like
+    one, so the build is of this very mechanism and its report embeds a template ``fabricate check`` can
+    rebuild.
 
     Parameters
     ----------
     mechanism : Mechanism
+        It must carry ``assembly``: for every body but the ground, its frame's world pose
+        ``(x_mm, y_mm, angle_rad)`` at ``input_range[0]``, e.g.
+        ``Mechanism(..., assembly={"crank": (0.0, 0.0, 1.05), "coupler": (7.5, 13.0, 0.2), ...})``.
+        The pose solver starts from it, so it picks the assembly branch (elbow up or down); it need only be
+        near the true pose. A body drawn in world coordinates at the first pose has ``(0.0, 0.0, 0.0)``.
     process : str
         Process profile, ``"sla"`` or ``"laser"``.
-    tip_point, pads
-        The output point and fingertip pads (``{body: {"point": name, "radius_mm": r}}``).
+    tip_point : str, optional
+        The output point (a point name of a body).
+    pads : Mapping, optional
+        Fingertip pads, ``{body: {"point": name, "radius_mm": r}}``.
     tables : Mapping, optional
         More template tables: ``{"load": {...}, "parts": {...}, "checks": {...}}``.
+
+    Raises
+    ------
+    SpecError
+        ``mechanism`` is not a Mechanism, or its ``assembly`` lacks a body (``mechanism.assembly``), or an
+        argument has the wrong type (naming it), or the written template is invalid (naming the field).
     """
+    from fabricate.mechanism import Mechanism
     from fabricate.synthesis.linkage.exact import exact_linkage
 
+    if not isinstance(mechanism, Mechanism):
+        raise SpecError("mechanism", f"expected a fabricate.mechanism.Mechanism, got {_type_name(mechanism)}")
+    _check_assembly(mechanism)
+    if not isinstance(process, str):
+        raise SpecError("process", f'expected "sla" or "laser", got {_type_name(process)}')
+    if tip_point is not None and not isinstance(tip_point, str):
+        raise SpecError("tip_point", f"expected a point name (str), got {_type_name(tip_point)}")
+    for arg, value in (("pads", pads), ("tables", tables)):
+        if value is not None and not (isinstance(value, Mapping)
+                                      and all(isinstance(v, Mapping) for v in value.values())):
+            raise SpecError(arg, f"expected a dict of tables ({{name: {{...}}}}), got {_type_name(value)}")
     template: dict[str, Any] = {"design": {"name": mechanism.name, "kind": "linkage"},
                                 "process": {"profile": process}}
     for key, value in (tables or {}).items():
@@ -125,7 +167,12 @@ def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | Non
         hints["tip_point"] = tip_point
     if pads:
         hints["pads"] = {body: dict(pad) for body, pad in pads.items()}
-    linkage, exact = exact_linkage(mechanism, hints)
+    try:
+        linkage, exact = exact_linkage(mechanism, hints)
+    except SpecError:
+        raise
+    except (TypeError, ValueError) as exc:  # a point, range or law that holds no numbers
+        raise SpecError("mechanism", f"cannot be written as a template: {exc}") from None
     if not exact:
         raise SpecError("mechanism", "a law of this mechanism is neither linear nor a piecewise polynomial "
                                      "(scipy PPoly: CubicSpline, PchipInterpolator, ...): it cannot be written "
@@ -134,14 +181,51 @@ def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | Non
     return load(template)
 
 
-def build(design: DesignSpec | str | Path | Mapping[str, Any]) -> Build:
-    """Run the whole pipeline in memory (see :func:`load` for what ``design`` may be; a
-    :class:`~fabricate.mechanism.Mechanism` goes through :func:`from_mechanism` with its defaults).
+def _check_assembly(mechanism: Any) -> None:
+    """Every moving body has a first-pose guess of three finite numbers, else a :class:`SpecError` saying
+    what to pass (the pose solver has no other way to know which assembly branch is meant)."""
+    import math
+
+    assembly = mechanism.assembly
+    moving = [b.name for b in mechanism.bodies if b.name != mechanism.ground]
+    example = f'Mechanism(..., assembly={{"{moving[0] if moving else "body"}": (x_mm, y_mm, angle_rad), ...}})'
+    if not isinstance(assembly, Mapping):
+        raise SpecError("mechanism.assembly", f"expected a dict of body name -> (x_mm, y_mm, angle_rad), got "
+                                              f"{_type_name(assembly)}; pass {example}")
+    missing = [name for name in moving if name not in assembly]
+    if missing:
+        more = f" (nor for {', '.join(map(repr, missing[1:]))})" if len(missing) > 1 else ""
+        example = example.replace(f'"{moving[0]}"', f'"{missing[0]}"')
+        raise SpecError("mechanism.assembly", f"no first pose for body {missing[0]!r}{more}: pass {example}, every "
+                                              "moving body's frame position and angle in the world at "
+                                              "input_range[0]; it picks the assembly branch and need only be "
+                                              "near the true pose ((0.0, 0.0, 0.0) for a body drawn in world "
+                                              "coordinates there)")
+    for name, pose in assembly.items():
+        try:
+            values = [float(v) for v in pose]
+        except (TypeError, ValueError, OverflowError):
+            values = []
+        if len(values) != 3 or not all(math.isfinite(v) for v in values):
+            raise SpecError(f"mechanism.assembly.{name}", f"expected (x_mm, y_mm, angle_rad): three finite "
+                                                          f"numbers, got {pose!r:.80}")
+
+
+def build(design: DesignSpec | str | Path | Mapping[str, Any], process: str | Path | None = None) -> Build:
+    """Run the whole pipeline in memory.
+
+    Parameters
+    ----------
+    design : DesignSpec, str, Path, Mapping or Mechanism
+        What :func:`load` takes, a design it returned, or a :class:`~fabricate.mechanism.Mechanism`
+        (through :func:`from_mechanism` with its defaults).
+    process : str or Path, optional
+        ``"sla"``, ``"laser"`` or a profile file: replaces the design's process (``--process``).
 
     Raises
     ------
     SpecError, SynthesisError
-        Bad input or nothing feasible (the CLI's exit code 2).
+        Bad input or nothing feasible (the CLI's exit code 2); an argument of the wrong type names it.
     """
     from fabricate.mechanism import Mechanism
     from fabricate.pipeline import run_build
@@ -149,7 +233,77 @@ def build(design: DesignSpec | str | Path | Mapping[str, Any]) -> Build:
     if isinstance(design, Mechanism):
         design = from_mechanism(design)
     elif not isinstance(design, DesignSpec):
-        design = load(design)
+        if not isinstance(design, (str, os.PathLike, Mapping)):
+            raise SpecError("design", "expected what fabricate.load takes (a template name, path or dict of tables), "
+                                      f"a design it returned, or a Mechanism; got {_type_name(design)}")
+        design, process = load(design, process), None
+    if process is not None:
+        from fabricate.spec import design_from_text, process_override
+
+        override = process_override(str(_as_path(process, "process", '"sla", "laser" or a process profile file')))
+        design = design_from_text(design.template_text, design.template, override)
     outcome = run_build(design)
     return Build(exit_code=outcome.exit_code, report=outcome.report, files=dict(outcome.files), design=design,
                  outcome=outcome)
+
+
+def _type_name(value: Any) -> str:
+    text = repr(value)
+    return f"{type(value).__name__} {text[:60]}{'...' if len(text) > 60 else ''}"
+
+
+def _as_path(value: Any, argument: str, what: str) -> Path:
+    """``value`` as a Path, or a :class:`SpecError` naming ``argument`` (bytes, numbers, None, a NUL...)."""
+    if isinstance(value, (str, os.PathLike)):
+        try:
+            path = Path(value)
+        except TypeError:  # a PathLike that returns bytes
+            path = None
+        if path is not None and "\0" in str(path):
+            raise SpecError(argument, f"a path cannot hold a NUL character, got {str(path)!r:.80}")
+        if path is not None and str(value):
+            return path
+    raise SpecError(argument, f"expected {what} (str or pathlib.Path), got {_type_name(value)}")
+
+
+#: Deepest nesting of a dict of tables (a template's deepest is a few levels; a cycle would recurse forever).
+MAX_TABLE_DEPTH = 32
+
+
+def _toml_value(value: Any, path: str, depth: int = 0) -> Any:
+    """``value`` as plain TOML values (tuples and numpy arrays as lists, numpy scalars as numbers), or a
+    :class:`SpecError` at ``path`` for anything TOML cannot hold."""
+    if depth > MAX_TABLE_DEPTH:
+        raise SpecError(path, f"nested more than {MAX_TABLE_DEPTH} levels deep (a table that holds itself?)")
+    import numpy as np
+
+    if isinstance(value, Mapping):
+        out = {}
+        for key, item in value.items():
+            if not isinstance(key, str):
+                raise SpecError(path or "template", f"expected text keys, got {_type_name(key)}")
+            where = f"{path}.{key}" if path else key
+            out[_text(key, where)] = _toml_value(item, where, depth + 1)
+        return out
+    if isinstance(value, str):
+        return _text(value, path)
+    if isinstance(value, bool) or isinstance(value, float):
+        return value
+    if isinstance(value, int):
+        if not -2**63 <= value < 2**63:
+            raise SpecError(path, f"expected a number, got an integer beyond 64 bits ({value.bit_length()} bits)")
+        return value
+    if isinstance(value, (np.ndarray, np.generic)):
+        return _toml_value(value.tolist(), path, depth)
+    if isinstance(value, (list, tuple)):
+        return [_toml_value(item, f"{path}[{i}]", depth + 1) for i, item in enumerate(value)]
+    raise SpecError(path or "template", "expected a TOML value (string, number, boolean, list or table), got "
+                                        f"{_type_name(value)}")
+
+
+def _text(value: str, path: str) -> str:
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError:
+        raise SpecError(path, f"expected UTF-8 text, got {value!r:.60} (a lone surrogate)") from None
+    return value

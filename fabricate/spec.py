@@ -46,16 +46,37 @@ MAX_TEMPLATE_BYTES = 1_000_000
 from fabricate.table import _MISSING, Table, _describe, check_array, check_number  # noqa: E402,F401 (re-exported)
 
 
+def path_kind(path: str | Path, what: str = "") -> str:
+    """``"file"`` (a regular file, after links), ``"other"`` (a folder, FIFO, device...) or ``"missing"``.
+
+    A path the system refuses to look at (a name too long, a NUL, no permission) is a :class:`SpecError`
+    naming ``what`` (the argument) rather than an ``OSError``: it is the user's input, not fabricate's fault.
+    """
+    try:
+        path = Path(path)
+        if path.is_file():
+            return "file"
+        return "other" if path.exists() else "missing"
+    except (TypeError, ValueError) as exc:  # a NUL in the name; a value that is no path at all
+        raise SpecError(what, f"not a usable path: {exc}") from None
+    except OSError as exc:
+        raise SpecError(what, f"cannot look at {str(path)[:80]!r}: {exc.strerror}") from None
+
+
 def find_template(name_or_path: str | Path) -> Path:
     """Resolve a template argument: an existing path, or a shipped template's name (with or without .toml)."""
+    if not isinstance(name_or_path, (str, Path)):
+        raise SpecError("template", "expected a template name or path (str or pathlib.Path), got "
+                                    f"{type(name_or_path).__name__}")
     candidate = Path(name_or_path)
-    if candidate.is_file():
+    kind = path_kind(candidate, "template")
+    if kind == "file":
         return candidate
-    if candidate.exists():
+    if kind == "other":
         raise SpecError("", f"template {name_or_path} is not a file")
     stem = candidate.name[:-5] if candidate.name.endswith(".toml") else candidate.name
     shipped = TEMPLATE_DIR / f"{stem}.toml"
-    if shipped.is_file() and candidate.parent == Path(".") and not stem.startswith("process_"):
+    if candidate.parent == Path(".") and not stem.startswith("process_") and path_kind(shipped) == "file":
         return shipped
     raise SpecError("", f"template not found: {name_or_path} (see 'fabricate list')")
 
@@ -72,6 +93,8 @@ def read_text(path: Path) -> str:
             data = fh.read(MAX_TEMPLATE_BYTES + 1)
     except OSError as exc:
         raise SpecError(str(path), f"cannot read: {exc.strerror}") from exc
+    except ValueError as exc:  # a NUL in the path
+        raise SpecError(repr(str(path)), f"cannot read: {exc}") from exc
     if len(data) > MAX_TEMPLATE_BYTES:
         raise SpecError(str(path), f"larger than {MAX_TEMPLATE_BYTES} bytes: not a design template")
     try:
@@ -87,6 +110,8 @@ def parse_toml(text: str, source: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(source, f"invalid TOML: {exc}") from exc
+    except ValueError as exc:  # int() refuses an integer literal of more than sys.get_int_max_str_digits()
+        raise SpecError(source, f"invalid TOML: a number too long to read ({str(exc).split(';')[0]})") from exc
     except RecursionError as exc:  # tomllib recurses per nesting level of arrays and inline tables
         raise SpecError(source, "invalid TOML: nested too deeply") from exc
 
@@ -179,12 +204,15 @@ class ProcessOverride:
     text: str
 
 
-def process_override(name_or_path: str) -> ProcessOverride:
+def process_override(name_or_path: str | Path) -> ProcessOverride:
     """Resolve ``--process``: a shipped profile name or a profile file."""
+    if not isinstance(name_or_path, (str, Path)):
+        raise SpecError("process", "expected \"sla\", \"laser\" or a process profile file (str or pathlib.Path), "
+                                   f"got {type(name_or_path).__name__}")
     if name_or_path in ("sla", "laser"):
         return ProcessOverride(name_or_path, read_text(TEMPLATE_DIR / f"process_{name_or_path}.toml"))
     path = Path(name_or_path)
-    if not path.is_file():
+    if path_kind(path, "--process") != "file":
         raise SpecError("--process", f"expected sla, laser or a process profile file, got \"{name_or_path}\"")
     return ProcessOverride(path.name, read_text(path))
 
@@ -288,6 +316,48 @@ def parse_checks(table: Table) -> ChecksSpec:
     return spec
 
 
+#: Longest design name: it names the output folder (plus "-synth" or "-sweep" and fabricate's temporary
+#: siblings' suffix), which must stay within a file system's 255 bytes per name.
+MAX_NAME_CHARS = 100
+MAX_NAME_BYTES = 200
+#: Characters no design name may hold: path separators, and those Windows refuses in a folder name.
+_NAME_FORBIDDEN = '/\\:*?"<>|'
+
+
+def check_design_name(name: str, path: str = "design.name") -> str:
+    """A design name that is safe as a folder name on every platform, else a :class:`SpecError` at ``path``.
+
+    Refused: an empty name, ``.``/``..`` or any name starting with ``.`` (a hidden folder), leading or trailing
+    spaces and a trailing ``.`` (Windows drops them), control characters (NUL included), line separators, lone
+    surrogates, the characters ``/ \\ : * ? " < > |``, and more than :data:`MAX_NAME_CHARS` characters or
+    :data:`MAX_NAME_BYTES` bytes of UTF-8.
+    """
+    import unicodedata
+
+    # as the user would type it in TOML, without writing a NUL or a control character to the terminal
+    shown = '"' + "".join(c if c.isprintable() else f"\\u{ord(c):04X}" for c in name[:60]) \
+        + ('..."' if len(name) > 60 else '"')
+    if not name:
+        raise SpecError(path, "expected a plain file name (it names the output folder), got an empty name")
+    kinds = {"Cc": "control character", "Cs": "lone surrogate", "Zl": "line separator", "Zp": "paragraph separator"}
+    bad = next((c for c in name if c in _NAME_FORBIDDEN or unicodedata.category(c) in kinds), None)
+    why = ""
+    if bad is not None:
+        why = f'it holds "{bad}"' if bad in _NAME_FORBIDDEN else \
+            f"it holds the {kinds[unicodedata.category(bad)]} U+{ord(bad):04X}"
+    elif name.startswith("."):
+        why = 'it starts with "." (a hidden folder, or the folder itself or its parent)'
+    elif name.endswith(".") or name != name.strip():
+        why = 'it ends with "." or has spaces at an end (Windows drops them from folder names)'
+    if why:
+        raise SpecError(path, f"expected a plain file name (it names the output folder), got {shown}: {why}")
+    size = len(name.encode("utf-8"))
+    if len(name) > MAX_NAME_CHARS or size > MAX_NAME_BYTES:
+        raise SpecError(path, f"expected at most {MAX_NAME_CHARS} characters ({MAX_NAME_BYTES} bytes of UTF-8): it "
+                              f"names the output folder; got {len(name)} characters ({size} bytes)")
+    return name
+
+
 @dataclass(frozen=True)
 class DesignSpec:
     """A whole validated template.
@@ -357,9 +427,7 @@ def design_from_text(text: str, path: str | Path, process: ProcessOverride | Non
         text = text[1:]
     root = Table(parse_toml(text, str(path)))
     design = root.table("design")
-    name = design.string("name")
-    if not name or any(c in name for c in "/\\:") or name.startswith("."):
-        raise SpecError("design.name", f"expected a plain file name, got \"{name}\"")
+    name = check_design_name(design.string("name"), design.field("name"))
     kind = design.string("kind", choices=tuple(sorted(KINDS)))
     description = design.string("description", "")
     design.finish()

@@ -7,6 +7,7 @@ and of each synthesis method read templates without importing :mod:`fabricate.sp
 
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -16,6 +17,31 @@ import numpy as np
 from fabricate.errors import SpecError
 
 _MISSING = object()
+
+#: Least :class:`difflib.SequenceMatcher` ratio of a misspelt key to the missing one it is offered for (one
+#: slip in a 10-letter name scores about 0.9). No required field of a shipped template scores this against a
+#: valid field beside it that :func:`_different_field` lets through (tests/test_spec.py checks it).
+MISSPELLING_CUTOFF = 0.8
+_NO_DIGITS = str.maketrans("", "", "0123456789")
+
+
+def _different_field(key: str, other: str) -> bool:
+    """Whether ``other`` reads as another field of a family rather than a slip of ``key``.
+
+    Exactly one ``_`` word differs and those words are not a slip of each other: both short (``x``/``y``,
+    ``deg``/``mm``), equal but for digits (``k1``/``k2``, ``theta1``/``theta3``) or unlike (``input``/
+    ``output``); or one name's words are a run of the other's (``teeth`` in ``min_teeth``).
+    """
+    a, b = key.lower().split("_"), other.lower().split("_")
+    if len(a) == len(b):
+        diff = [(x, y) for x, y in zip(a, b, strict=True) if x != y]
+        if len(diff) != 1:
+            return False
+        x, y = diff[0]
+        return (len(x) <= 3 and len(y) <= 3) or x.translate(_NO_DIGITS) == y.translate(_NO_DIGITS) \
+            or difflib.SequenceMatcher(None, x, y).ratio() < MISSPELLING_CUTOFF
+    short, long_ = (a, b) if len(a) < len(b) else (b, a)
+    return any(long_[i:i + len(short)] == short for i in range(len(long_) - len(short) + 1))
 
 
 def _describe(value: Any) -> str:
@@ -68,8 +94,23 @@ class Table:
         if key in self.data:
             return self.data[key]
         if default is _MISSING:
-            raise SpecError(self.field(key), "missing required field")
+            raise SpecError(self.field(key), "missing required field" + self._misspelt(key))
         return default
+
+    def _misspelt(self, key: str) -> str:
+        """`` (found unknown "lenghts_mm": did you mean "lengths_mm"?)`` when a key of this table that no
+        getter has read looks like a misspelling of the missing ``key``; else ``""``.
+
+        Keys read later are not known yet, so a close key may be a valid field still to come: siblings of a
+        series (``theta1_deg`` / ``theta2_deg``, ``a_x_mm`` / ``a_y_mm``, ``input_arm_deg`` / ``input_arm_mm``)
+        and qualified names (``teeth`` / ``min_teeth``) are never offered, and the likeness must be high.
+        """
+        unread = [k for k in self.data if isinstance(k, str) and k not in self._used and k != key]
+        same_case = [k for k in unread if k.lower() == key.lower()]
+        plausible = same_case or [k for k in unread if not _different_field(key, k)]
+        lowered = {k.lower(): k for k in plausible}
+        match = difflib.get_close_matches(key.lower(), list(lowered), n=1, cutoff=MISSPELLING_CUTOFF)
+        return f' (found unknown "{lowered[match[0]]}": did you mean "{key}"?)' if match else ""
 
     # -- getters -----------------------------------------------------------------------------
     def number(
@@ -169,7 +210,11 @@ def check_number(value: Any, path: str, *, min: float | None = None, max: float 
     """Validate one number; see :meth:`Table.number`."""
     if not _is_number(value):
         raise SpecError(path, f"expected a number, got {_describe(value)}")
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # an integer past float's range (TOML integers have no size limit in tomllib)
+        digits = int(value.bit_length() * math.log10(2)) + 1  # str() of a huge int is itself refused past 4300
+        raise SpecError(path, f"expected a finite number, got an integer of about {digits} digits") from None
     if not math.isfinite(value):
         raise SpecError(path, f"expected a finite number, got {value}")
     if integer and value != round(value):

@@ -23,14 +23,16 @@ same spec gives the same points on every machine with the same scipy.
 
 from __future__ import annotations
 
+import contextlib
 import copy
+import difflib
 import functools
 import hashlib
 import itertools
 import json
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -214,6 +216,18 @@ class Field:
         return int(round(x)) if self.integer else float(x)
 
 
+def check_finite(value: Any, where: str, depth: int = 0) -> None:
+    """Refuse NaN and infinities anywhere in a sweep value (a list, a nested list or table): they cannot be
+    a valid template value, and a point's values are written to JSON, which has no NaN."""
+    if depth > 32:
+        raise SpecError(where, "nested too deeply")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise SpecError(where, f"expected finite values, got {value}")
+    items = value.values() if isinstance(value, Mapping) else value if isinstance(value, (list, tuple)) else ()
+    for item in items:
+        check_finite(item, where, depth + 1)
+
+
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+)(?::([^:]+))?\s*$")
 
 
@@ -227,6 +241,7 @@ def parse_values(raw: Any, where: str, sampling: str, integer: bool) -> tuple[tu
             raise SpecError(where, "expected at least one value, got an empty list")
         if len(raw) > MAX_VALUES_PER_FIELD:
             raise SpecError(where, f"at most {MAX_VALUES_PER_FIELD} values, got {len(raw)}")
+        check_finite(raw, where)
         return tuple(raw), math.nan, math.nan
     if isinstance(raw, str):
         m = _RANGE.match(raw)
@@ -247,11 +262,16 @@ def parse_values(raw: Any, where: str, sampling: str, integer: bool) -> tuple[tu
                     raise SpecError(where, f'count must be a whole number, got "{count_text}"') from None
                 if not 1 <= count <= MAX_VALUES_PER_FIELD:
                     raise SpecError(where, f"count must be in 1 .. {MAX_VALUES_PER_FIELD}, got {count}")
-                grid = np.linspace(start, stop, count) if count > 1 else np.array([start])
+                with np.errstate(over="ignore", invalid="ignore"):
+                    grid = np.linspace(start, stop, count) if count > 1 else np.array([start])
+                if not np.all(np.isfinite(grid)):  # stop - start overflows past 1.8e308
+                    raise SpecError(where, f'"{raw}" spans more than a float can hold')
                 values = tuple(int(round(v)) for v in grid) if integer else tuple(float(v) for v in grid)
                 return values, math.nan, math.nan
             if stop < start:
                 raise SpecError(where, f'expected start <= stop in "{raw}"')
+            if not math.isfinite(stop - start):
+                raise SpecError(where, f'"{raw}" spans more than a float can hold')
             return None, start, stop
     raise SpecError(where, f'expected a list of values or "start:stop:count", got {raw!r}')
 
@@ -392,27 +412,35 @@ def default_metrics(stage: str) -> list[str]:
     return []
 
 
-def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None) -> SweepSpec:
+def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None, *,
+                      origins: Mapping[str, str] | None = None) -> SweepSpec:
     """Validate a sweep spec's tables (``[sweep]``, ``[vary]``, ``[set]``); :class:`SpecError` names the field.
 
-    ``base_dir`` is where a relative ``sweep.template`` path is looked for first.
+    ``base_dir`` is where a relative ``sweep.template`` path is looked for first. ``origins`` says how the
+    user gave the entries that did not come from the file: with ``{"vary.gears.module_mm": "--vary
+    gears.module_mm"}`` an error in that entry ends "(given as --vary gears.module_mm)".
     """
-    from fabricate.spec import design_from_text, find_template, parse_toml, read_text
+    from fabricate.spec import design_from_text, find_template, parse_toml, path_kind, read_text
 
-    unknown = sorted(set(tables) - {"sweep", "vary", "set"})
+    origins = origins or {}
+    if not isinstance(tables, Mapping):
+        raise SpecError("", f"expected the tables of a sweep spec, got {type(tables).__name__}")
+    unknown = sorted(str(k) for k in set(tables) - {"sweep", "vary", "set"})
     if unknown:
         raise SpecError(unknown[0], "unknown table (a sweep spec has [sweep], [vary] and [set])")
     sweep = tables.get("sweep")
     if not isinstance(sweep, Mapping):
         raise SpecError("sweep", "missing table [sweep]")
-    bad = sorted(set(sweep) - _SWEEP_KEYS)
+    bad = sorted(str(k) for k in set(sweep) - _SWEEP_KEYS)
     if bad:
-        raise SpecError(f"sweep.{bad[0]}", "unknown field")
+        close = difflib.get_close_matches(bad[0], sorted(_SWEEP_KEYS), n=1)
+        raise SpecError(f"sweep.{bad[0]}", "unknown field" + (f' (did you mean "{close[0]}"?)' if close else ""))
     template_arg = sweep.get("template")
     if not isinstance(template_arg, str) or not template_arg:
         raise SpecError("sweep.template", "expected the base template's name or path")
     candidate = (base_dir / template_arg) if base_dir is not None else None
-    path = candidate if candidate is not None and candidate.is_file() else find_template(template_arg)
+    path = candidate if candidate is not None and path_kind(candidate, "sweep.template") == "file" \
+        else find_template(template_arg)
     text = read_text(path)
     design_from_text(text, path)  # the base template must be valid by itself
     base = parse_toml(text, str(path))
@@ -436,11 +464,14 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None) -
         raise SpecError("set", "expected a table of field path = value")
     sets: dict[str, Any] = {}
     for key, value in sets_raw.items():
-        try:
-            parts = parse_path(key)
-            set_path(base, parts, copy.deepcopy(value))
-        except (ValueError, KeyError) as exc:
-            raise SpecError(f"set.{key}", f"not a field of the template ({exc})") from None
+        where = f"set.{key}"
+        with _given_as(origins.get(where), where):
+            check_finite(value, where)
+            try:
+                parts = parse_path(key)
+                set_path(base, parts, copy.deepcopy(value))
+            except (ValueError, KeyError) as exc:
+                raise SpecError(where, f"not a field of the template ({exc})") from None
         sets[key] = value
 
     vary = tables.get("vary")
@@ -451,27 +482,28 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None) -
     fields: list[Field] = []
     for key, raw in vary.items():
         where = f"vary.{key}"
-        try:
-            parts = parse_path(key)
-        except ValueError as exc:
-            raise SpecError(where, str(exc)) from None
-        if key in sets:
-            raise SpecError(where, "is also in [set]: a field is either varied or set")
-        try:
-            current = get_path(base, parts)
-        except KeyError:
-            current = None
-            try:  # a field the template leaves at its default: the table (or list) above it must exist
-                get_path(base, parts[:-1]) if len(parts) > 1 else None
+        with _given_as(origins.get(where), where):
+            try:
+                parts = parse_path(key)
+            except ValueError as exc:
+                raise SpecError(where, str(exc)) from None
+            if key in sets:
+                raise SpecError(where, "is also in [set]: a field is either varied or set")
+            try:
+                current = get_path(base, parts)
             except KeyError:
-                raise SpecError(where, "not a field of the template (its table or list is not there)") from None
-            if isinstance(parts[-1], int):
-                raise SpecError(where, "the list has no such element (a sweep never grows a list)") from None
-        integer = isinstance(current, int) and not isinstance(current, bool)
-        values, low, high = parse_values(raw, where, sampling, integer)
-        fields.append(Field(path=key, parts=parts, values=values, low=low, high=high, integer=integer))
-        if current is None:
-            _check_known(base, fields[-1], where, str(path))
+                current = None
+                try:  # a field the template leaves at its default: the table (or list) above it must exist
+                    get_path(base, parts[:-1]) if len(parts) > 1 else None
+                except KeyError:
+                    raise SpecError(where, "not a field of the template (its table or list is not there)") from None
+                if isinstance(parts[-1], int):
+                    raise SpecError(where, "the list has no such element (a sweep never grows a list)") from None
+            integer = isinstance(current, int) and not isinstance(current, bool)
+            values, low, high = parse_values(raw, where, sampling, integer)
+            fields.append(Field(path=key, parts=parts, values=values, low=low, high=high, integer=integer))
+            if current is None:
+                _check_known(base, fields[-1], where, str(path))
 
     count = math.prod(len(f.values or ()) for f in fields) if sampling == "grid" else samples
     if count > MAX_POINTS:
@@ -527,6 +559,18 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None) -
                      batch_seconds=float(batch), sets=sets)
 
 
+@contextlib.contextmanager
+def _given_as(origin: str | None, where: str) -> Iterator[None]:
+    """An error in entry ``where`` also says how the user gave it (``--vary gears.module_mm``) when that was
+    not in the spec file."""
+    try:
+        yield
+    except SpecError as exc:
+        if origin is None or exc.path != where:
+            raise
+        raise SpecError(where, f"{exc.message} (given as {origin})") from None
+
+
 def _check_known(base: dict[str, Any], f: Field, where: str, source: str) -> None:
     """A field the base template leaves at its default must be one the template's kind knows: set its first
     value and validate (a misspelt path would otherwise make every point an "unknown field" row)."""
@@ -551,13 +595,16 @@ def _is_numeric(f: Field) -> bool:
 def find_sweep(path: str | Path) -> Path | None:
     """The sweep spec file ``path`` names (a path, or a shipped spec's name from ``templates/sweeps/``), or
     None when ``path`` is not a sweep spec (a design template, say)."""
-    from fabricate.spec import TEMPLATE_DIR, parse_toml, read_text
+    from fabricate.spec import TEMPLATE_DIR, parse_toml, path_kind, read_text
 
+    if not isinstance(path, (str, Path)):
+        raise SpecError("spec", "expected a sweep spec's name or path (str or pathlib.Path), got "
+                                f"{type(path).__name__}")
     candidate = Path(path)
-    if not candidate.is_file():
+    if path_kind(candidate, "spec") != "file":
         stem = candidate.name[:-5] if candidate.name.endswith(".toml") else candidate.name
         shipped = TEMPLATE_DIR / "sweeps" / f"{stem}.toml"
-        return shipped if candidate.parent == Path(".") and shipped.is_file() else None
+        return shipped if candidate.parent == Path(".") and path_kind(shipped) == "file" else None
     try:
         return candidate if "sweep" in parse_toml(read_text(candidate), str(candidate)) else None
     except SpecError:
