@@ -474,15 +474,35 @@ def _rename_new(a: Path, b: Path) -> None:
 
 @contextlib.contextmanager
 def _no_interrupt() -> Iterator[None]:
-    """Hold Ctrl-C (SIGINT) off for a few system calls; it is delivered right after."""
-    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover
-        yield
+    """Hold the stop signals (Ctrl-C's SIGINT, SIGTERM, SIGHUP) off for a few system calls; they are
+    delivered right after, so a stop between the two renames of the fallback swap never leaves the
+    output folder missing.
+
+    The signals are deferred at Python's level (a handler that only records them, then the old handlers
+    back and the recorded signals raised again), not by ``pthread_sigmask``: a mask holds only for the
+    calling thread, and a process-directed signal is delivered to any other thread (BLAS's workers) whose
+    mask lets it through, whose C handler then runs the Python handler in the main thread at once.
+    """
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield  # Python runs signal handlers in the main thread only: this thread is never interrupted
         return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    stops = [signal.SIGINT] + [getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    held: list[int] = []
+    old = {}
+    for signum in stops:
+        current = signal.getsignal(signum)
+        if current in (signal.SIG_IGN, None):  # ignored by the caller (nohup), or set outside Python
+            continue
+        old[signum] = signal.signal(signum, lambda s, _f: held.append(s))
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for signum, handler in old.items():
+            signal.signal(signum, handler)
+        for signum in dict.fromkeys(held):
+            signal.raise_signal(signum)
 
 
 def _write_tree(files: Mapping[str, bytes], root: Path) -> None:

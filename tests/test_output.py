@@ -552,3 +552,19 @@ def test_the_cli_refuses_a_fifo_report_with_exit_2(tmp_path):
     assert run.returncode == 2, run.stderr
     assert "report.json that is a FIFO" in run.stderr and "Traceback" not in run.stderr
     assert _siblings(out) == ["report.json"]
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_stop_signals_wait_until_the_swap_is_done(signum: int) -> None:
+    """A stop signal sent between the swap's renames is delivered only after them (issue 23 item 2)."""
+    from fabricate.output import _no_interrupt
+
+    seen: list[int] = []
+    old = signal.signal(signum, lambda s, _f: seen.append(s))
+    try:
+        with _no_interrupt():
+            os.kill(os.getpid(), signum)
+            assert seen == []  # held off while the folder is being swapped
+        assert seen == [signum]  # and delivered right after
+    finally:
+        signal.signal(signum, old)
