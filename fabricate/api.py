@@ -158,6 +158,8 @@ def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | Non
         if value is not None and not (isinstance(value, Mapping)
                                       and all(isinstance(v, Mapping) for v in value.values())):
             raise SpecError(arg, f"expected a dict of tables ({{name: {{...}}}}), got {_type_name(value)}")
+    pads, tables = (_toml_value(value, arg) if value is not None else None
+                    for arg, value in (("pads", pads), ("tables", tables)))
     template: dict[str, Any] = {"design": {"name": mechanism.name, "kind": "linkage"},
                                 "process": {"profile": process}}
     for key, value in (tables or {}).items():
@@ -261,6 +263,10 @@ def _as_path(value: Any, argument: str, what: str) -> Path:
             path = None
         if path is not None and "\0" in str(path):
             raise SpecError(argument, f"a path cannot hold a NUL character, got {str(path)!r:.80}")
+        try:
+            os.fsencode(path) if path is not None else None
+        except UnicodeError:  # a lone surrogate the file system's encoding cannot write
+            raise SpecError(argument, f"not a name the file system can hold: {str(path)!r:.80}") from None
         if path is not None and str(value):
             return path
     raise SpecError(argument, f"expected {what} (str or pathlib.Path), got {_type_name(value)}")

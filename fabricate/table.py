@@ -213,8 +213,11 @@ def check_number(value: Any, path: str, *, min: float | None = None, max: float 
     try:
         value = float(value)
     except OverflowError:  # an integer past float's range (TOML integers have no size limit in tomllib)
-        digits = int(value.bit_length() * math.log10(2)) + 1  # str() of a huge int is itself refused past 4300
-        raise SpecError(path, f"expected a finite number, got an integer of about {digits} digits") from None
+        try:
+            digits = f"{len(str(abs(value)))}"
+        except ValueError:  # str() of an int refuses past sys.get_int_max_str_digits() (4300 by default)
+            digits = "thousands of"
+        raise SpecError(path, f"expected a finite number, got an integer of {digits} digits") from None
     if not math.isfinite(value):
         raise SpecError(path, f"expected a finite number, got {value}")
     if integer and value != round(value):

@@ -481,3 +481,45 @@ def test_a_sweep_never_writes_into_a_folder_holding_its_spec(tmp_path, capsys):
     assert main(["sweep", str(spec_file), "-o", str(folder), "-q"]) == 2
     assert "holds gears.toml, an input of this sweep" in capsys.readouterr().err
     assert sorted(p.name for p in folder.iterdir()) == ["gears.toml"]
+
+
+# -- issue 23: every sweep value is finite, checked where the spec is validated ---------------------------------
+
+@pytest.mark.parametrize(("change", "field", "needle"), [
+    (lambda t: t["vary"].update({"gears.module_mm": [0.8, math.nan]}), "vary.gears.module_mm", "got nan"),
+    (lambda t: t["vary"].update({"gears.module_mm": [math.inf]}), "vary.gears.module_mm", "got inf"),
+    (lambda t: t["vary"].update({"gears.teeth": [[30, 30], [30, -math.inf]]}), "vary.gears.teeth", "got -inf"),
+    (lambda t: t["vary"].update({"gears.module_mm": "-1e308:1e308:3"}), "vary.gears.module_mm",
+     "spans more than a float can hold"),
+    (lambda t: t.update({"sweep": {**t["sweep"], "sampling": "lhs", "samples": 4},
+                         "vary": {"gears.module_mm": "-1e308:1e308"}}), "vary.gears.module_mm",
+     "spans more than a float can hold"),
+    (lambda t: t["set"].update({"gears.backlash_mm": math.nan}), "set.gears.backlash_mm", "got nan"),
+    (lambda t: t["sweep"].update({"metrcs": []}), "sweep.metrcs", 'did you mean "metrics"?'),
+])
+def test_non_finite_sweep_values_are_refused_naming_the_entry(change, field, needle):
+    tables = gear_tables()
+    change(tables)
+    with pytest.raises(SpecError) as info:
+        sweep_from_tables(tables)
+    assert info.value.path == field and needle in info.value.message, str(info.value)
+
+
+def test_an_entry_given_on_the_command_line_says_so():
+    tables = gear_tables(modules=[math.nan])
+    with pytest.raises(SpecError) as info:
+        sweep_from_tables(tables, origins={"vary.gears.module_mm": "--vary gears.module_mm"})
+    assert str(info.value) == "vary.gears.module_mm: expected finite values, got nan (given as --vary gears.module_mm)"
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf", "0.8,nan", "[nan]", "1e400"])
+def test_cli_vary_nan_exits_2_naming_the_flag(tmp_path, capsys, value):
+    """The issue's case: `--vary field=nan` was an internal error (exit 3) when the row went to JSON."""
+    from fabricate.cli import main
+
+    out = tmp_path / "out"
+    assert main(["sweep", "gear_pair_elliptic", "--vary", f"gears.module_mm={value}", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "expected finite values" in err and "--vary gears.module_mm" in err, err
+    assert "Traceback" not in err and "internal error" not in err
+    assert not out.exists()
