@@ -43,7 +43,7 @@ TEMPLATE_DIR = _template_dir()
 #: Largest template file read (a design template is a few kB; this keeps a stray binary out of memory).
 MAX_TEMPLATE_BYTES = 1_000_000
 
-from fabricate.table import _MISSING, Table, _describe, check_array, check_number  # noqa: E402,F401 (re-exported)
+from fabricate.table import _MISSING, Table, _describe, _quote, check_array, check_number  # noqa: E402,F401 (re-exported)
 
 
 def path_kind(path: str | Path, what: str = "") -> str:
@@ -213,7 +213,7 @@ def process_override(name_or_path: str | Path) -> ProcessOverride:
         return ProcessOverride(name_or_path, read_text(TEMPLATE_DIR / f"process_{name_or_path}.toml"))
     path = Path(name_or_path)
     if path_kind(path, "--process") != "file":
-        raise SpecError("--process", f"expected sla, laser or a process profile file, got \"{name_or_path}\"")
+        raise SpecError("--process", f"expected sla, laser or a process profile file, got {_quote(str(name_or_path))}")
     return ProcessOverride(path.name, read_text(path))
 
 
@@ -290,7 +290,7 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
 def _colour(t: Table, key: str, default: str) -> str:
     value = t.string(key, default)
     if not (len(value) == 7 and value[0] == "#" and all(c in "0123456789abcdefABCDEF" for c in value[1:])):
-        raise SpecError(t.field(key), f'expected a colour "#rrggbb", got "{value}"')
+        raise SpecError(t.field(key), f'expected a colour "#rrggbb", got {_quote(value)}')
     return value.lower()
 
 

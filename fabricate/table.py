@@ -44,9 +44,16 @@ def _different_field(key: str, other: str) -> bool:
     return any(long_[i:i + len(short)] == short for i in range(len(long_) - len(short) + 1))
 
 
+def _quote(text: str, limit: int = 80) -> str:
+    """``text`` in double quotes for a message: control characters, separators and the like as ``\\uXXXX``
+    (a NUL or an escape sequence in a template never reaches the terminal raw), cut after ``limit``."""
+    shown = "".join(c if c.isprintable() else f"\\u{ord(c):04X}" for c in text[:limit])
+    return f'"{shown}{"..." if len(text) > limit else ""}"'
+
+
 def _describe(value: Any) -> str:
     if isinstance(value, str):
-        return f'"{value}"'
+        return _quote(value)
     if isinstance(value, Mapping):
         return "a table"
     if isinstance(value, (list, tuple)):
@@ -142,7 +149,7 @@ class Table:
         if not isinstance(value, str):
             raise SpecError(self.field(key), f"expected a string, got {_describe(value)}")
         if choices is not None and value not in choices:
-            raise SpecError(self.field(key), f"expected one of {', '.join(map(repr, choices))}, got \"{value}\"")
+            raise SpecError(self.field(key), f"expected one of {', '.join(map(repr, choices))}, got {_quote(value)}")
         return value
 
     def boolean(self, key: str, default: Any = _MISSING) -> bool:

@@ -31,7 +31,8 @@ def value(v: Any) -> str:
     if hasattr(v, "item") and not isinstance(v, (list, tuple, Mapping)):  # numpy scalars
         return value(v.item())
     if isinstance(v, str):
-        return json.dumps(v, ensure_ascii=False)
+        # JSON escapes the C0 controls; TOML also forbids a raw DEL in a basic string
+        return json.dumps(v, ensure_ascii=False).replace("\x7f", "\\u007f")
     if isinstance(v, (list, tuple)) or hasattr(v, "tolist"):
         items = v.tolist() if hasattr(v, "tolist") else v
         return "[" + ", ".join(value(x) for x in items) + "]"

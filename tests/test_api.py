@@ -122,3 +122,27 @@ def test_a_geared_mechanism_built_in_code_is_the_mechanism_built():
     a, b = geared.sweep(inputs), again.sweep(inputs)
     for body in ("crank", "coupler", "rocker", "wheel"):
         assert np.array_equal(a.pose(body), b.pose(body)), body
+
+
+def test_build_takes_a_process_like_the_cli(monkeypatch):
+    """build(..., process=) replaces the design's process as `--process` does, for a name and for a design
+    already loaded (the pipeline is stubbed: this is about which design reaches it)."""
+    from types import SimpleNamespace
+
+    import fabricate.pipeline
+
+    seen = []
+    monkeypatch.setattr(fabricate.pipeline, "run_build", lambda design: seen.append(design) or SimpleNamespace(
+        exit_code=0, report={}, files={}))
+    design = fabricate.load("gear_pair_elliptic")
+    assert design.process.name == "sla"
+    for given in (design, "gear_pair_elliptic"):
+        result = fabricate.build(given, process="laser")
+        assert result.design is seen[-1]
+        assert seen[-1].process.name == "laser" and seen[-1].process.kerf_mm > 0
+        assert seen[-1].process_override.source == "laser"
+        assert seen[-1].template_text == design.template_text
+    fabricate.build(design)
+    assert seen[-1] is design
+    with pytest.raises(fabricate.SpecError, match="--process: expected sla, laser or a process profile file"):
+        fabricate.build(design, process="cnc")
