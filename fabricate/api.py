@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from fabricate.errors import SpecError
-from fabricate.spec import DesignSpec
+from fabricate.spec import DesignSpec, check_design_name
 
 
 @dataclass(frozen=True)
@@ -149,6 +149,9 @@ def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | Non
 
     if not isinstance(mechanism, Mechanism):
         raise SpecError("mechanism", f"expected a fabricate.mechanism.Mechanism, got {_type_name(mechanism)}")
+    if not isinstance(mechanism.name, str):
+        raise SpecError("mechanism.name", f"expected a name (str), got {_type_name(mechanism.name)}")
+    check_design_name(mechanism.name, "mechanism.name")  # it becomes design.name, the output folder's name
     _check_assembly(mechanism)
     if not isinstance(process, str):
         raise SpecError("process", f'expected "sla" or "laser", got {_type_name(process)}')

@@ -111,6 +111,8 @@ def test_from_mechanism_takes_any_value_for_each_argument(value):
     assert isinstance(pose, DesignSpec) or pose.path == "mechanism.assembly.crank", pose  # range(3) is a pose
     result = _outcome_or_fabricate_error(fabricate.build, dataclasses.replace(mech, assembly=value))
     assert isinstance(result, (SpecError, fabricate.Build)), result
+    result = _outcome_or_fabricate_error(fabricate.from_mechanism, dataclasses.replace(mech, name=value))
+    assert isinstance(result, SpecError) and result.path == "mechanism.name" or isinstance(value, str), result
 
 
 def test_a_mechanism_without_assembly_says_what_to_pass():
