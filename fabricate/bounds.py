@@ -17,6 +17,12 @@ length of 1e300 would overflow the kinematic mapping), forces and spring rates b
 
 from __future__ import annotations
 
+import ast
+import contextlib
+import ctypes
+import os
+import sys
+from collections.abc import Iterator
 from typing import Any
 
 from fabricate.errors import SpecError
@@ -80,6 +86,44 @@ MAX_LINKAGE_DRIVERS = 8
 MAX_LINKAGE_POINTS = 32
 #: Samples of one sampled law of a declared linkage (gear law or driver table).
 MAX_LINKAGE_TABLE = 10000
+#: Exact form (``[linkage] exact = true``, a build's ``mechanism.toml``): ``hints.copies``, identical copies of
+#: the mechanism made (every copy of every part is laid out on the plates; 2000 copies took 62 s). The compliant
+#: gripper, the only kind that writes copies, makes at most 12 fingers.
+MAX_COPIES = 12
+#: Exact form: breakpoints of a ``ppoly`` law or samples of a ``samples`` law (a build writes at most
+#: :data:`MAX_LINKAGE_TABLE` breakpoints of a template's table, 5001 of the compliant gripper's path and 2001
+#: samples of a law it cannot write exactly).
+MAX_EXACT_LAW_POINTS = 10001
+#: Exact form: coefficients of one ``ppoly`` piece (a cubic spline has 4).
+MAX_EXACT_LAW_ORDER = 8
+#: Characters of a gear law expression: ``linkage.gears[].expression`` and ``gear_pair.law``. A formula is
+#: evaluated node by node in Python at every solver step, twice (value and slope) per gear: a 49 kB
+#: ``gear_pair.law`` took 108 s, and 8 linkage gears of 1000 characters cost 4.2 ms per Jacobian against
+#: 0.55 ms with constant ratios (so their product with the poses is bounded too: :func:`preflight`).
+MAX_EXPRESSION_LENGTH = 1000
+#: Nesting depth of a gear law expression's syntax tree. Compiling and evaluating it takes one Python frame a
+#: level: 998 unary minus signs overflowed the interpreter's stack (1000 frames); a sum of n terms is n deep.
+MAX_EXPRESSION_DEPTH = 100
+#: Linkage solver (both forms of kind ``linkage``): CPU seconds of one Jacobian of the worst linkage (40
+#: bodies, one BLAS thread), and what each slider, gear pair, driver and character of a gear expression adds
+#: (Python rows; a formula is evaluated node by node, value and slope). Measured: 0.55 ms with 6 sliders and
+#: 8 constant-ratio gears, 1.4 ms with 18 sliders, 4.2 ms with 8 gear expressions of 1000 characters.
+SOLVER_JACOBIAN_S = 1.2e-4
+SOLVER_SLIDER_S = 7.0e-5
+SOLVER_GEAR_S = 2.0e-5
+SOLVER_DRIVER_S = 3.0e-5
+SOLVER_EXPRESSION_CHAR_S = 4.6e-7
+#: Jacobians per continuation step (the tangent, the corrector's one or two iterations and the check; a step
+#: per pose above 360 poses, 360 steps below).
+SOLVER_JACOBIANS_PER_STEP = 3.5
+#: CPU seconds the linkage's sweep may be estimated to take (the rest of the budget is parts and checks).
+MAX_SOLVER_S = 15.0
+#: Linkage kind: teeth of all its gear pairs together (z_a + z_b summed; a pair of the most teeth alone is 200:
+#: 8 pairs of 100 + 100 teeth spent 21 s cutting gears and 16 s laying out parts at 360 poses).
+MAX_LINKAGE_GEAR_TEETH = 2 * MAX_TEETH
+#: Linkage kind: ``checks.sweep_poses`` × the teeth of all its gear pairs (every pose moves every toothed
+#: outline through the layer and interference sweeps).
+MAX_LINKAGE_POSE_TEETH = 300_000
 #: ``push_rod.samples`` (underactuated): stroke samples of the closing motion.
 MAX_STROKE_SAMPLES = 2001
 #: ``optimisation.path_samples`` (compliant gripper).
@@ -99,7 +143,10 @@ def preflight(design: Any) -> None:
 
     - compliant gripper: the optimisation grid (points per axis and in all);
     - Watt six-bar: the solution region's d samples × d0 samples × statics samples;
-    - gear pair: sweep poses and GIF frames × teeth.
+    - gear pair: sweep poses and GIF frames × teeth;
+    - linkage (declared and exact form): the solver's steps × the cost of a step (bodies, sliders, gears,
+      drivers, characters of gear expressions), and the teeth of its gear pairs, alone and × poses and
+      GIF frames.
 
     (The gear mesh check's steps × teeth is refused where the tooth counts are known, in
     :mod:`fabricate.gears.pair`.)
@@ -137,6 +184,9 @@ def preflight(design: Any) -> None:
                             "with these axes, or larger steps on k1, k2, phi01")
     if design.kind == "gear_pair":
         _gear_pair_work(design)
+    if design.kind == "linkage":
+        _linkage_solver_work(design)
+        _linkage_gear_work(design)
     if design.kind == "watt_six_bar":
         counts = [int((box[1] - box[0]) / method.step_mm + 1e-9) + 1 for box in (method.box("d"), method.box("d0"))]
         work = float(counts[0] * counts[1] * method.statics_samples)
@@ -165,5 +215,257 @@ def _gear_pair_work(design: Any) -> None:
                                    f"{what} with {total} teeth")
 
 
+def _linkage_solver_work(design: Any) -> None:
+    """The sweep's estimated CPU time: continuation steps × Jacobians a step × the cost of one Jacobian."""
+    spec = design.method
+    mech = getattr(spec, "mechanism", None)
+    if mech is not None:  # the exact form: laws by coefficients (cheap), joints as the mechanism has them
+        sliders = sum(type(j).__name__ != "Revolute" for j in mech.joints)
+        gears, drivers, expressions = len(mech.gears), len(mech.drivers), []
+    else:
+        sliders = sum(j.type != "revolute" for j in spec.joints)
+        gears, drivers = len(spec.gears), len(spec.drivers)
+        expressions = [(k, len(g.expression)) for k, g in enumerate(spec.gears) if g.expression is not None]
+    chars = sum(n for _, n in expressions)
+    jacobian = (SOLVER_JACOBIAN_S + SOLVER_SLIDER_S * sliders + SOLVER_GEAR_S * gears + SOLVER_DRIVER_S * drivers
+                + SOLVER_EXPRESSION_CHAR_S * chars)
+    step = SOLVER_JACOBIANS_PER_STEP * jacobian
+    poses = int(design.checks.sweep_poses)
+    seconds = max(poses - 1, 360) * step
+    if seconds <= MAX_SOLVER_S:
+        return
+    what = (f"{sliders} slider{'s' if sliders != 1 else ''}, {gears} gear pair{'s' if gears != 1 else ''}"
+            + (f" ({chars} characters of gear expressions)" if chars else "")
+            + f", {drivers} driver{'s' if drivers != 1 else ''}")
+    most = int(MAX_SOLVER_S / step) + 1
+    if most > 361:
+        raise SpecError("checks.sweep_poses", f"{poses} poses of a linkage with {what}: about {seconds:.0f} s of "
+                                              f"solving estimated, over the budget of {MAX_SOLVER_S:.0f} s; at most "
+                                              f"{most} poses")
+    field = (f"linkage.gears[{max(expressions, key=lambda e: e[1])[0]}].expression" if chars
+             else "linkage.joints")
+    raise SpecError(field, f"a linkage with {what}: about {seconds:.0f} s of solving estimated even at 360 steps, "
+                           f"over the budget of {MAX_SOLVER_S:.0f} s; "
+                           + ("shorten the gear expressions" if chars else "use fewer sliders"))
+
+
+def _linkage_gear_work(design: Any) -> None:
+    """Teeth of a linkage's gear pairs (estimated before any is cut), alone and × poses and GIF frames."""
+    import math
+
+    spec = design.method
+    mech = getattr(spec, "mechanism", None)
+    gear = design.gears
+    pairs = []  # (centre distance, fraction of a turn, closed)
+    if mech is not None:
+        for g in mech.gears:
+            carrier = mech.body(g.carrier)
+            a = math.dist(carrier.points[g.axis_a], carrier.points[g.axis_b])
+            span = abs(g.working_range[1] - g.working_range[0]) / (2 * math.pi)
+            pairs.append((a, span, span >= 1.0 - 1e-9))
+    else:
+        points = {b.name: dict(b.points) for b in spec.bodies}
+        for g in spec.gears:
+            a = math.dist(points[g.carrier][g.axes[0]], points[g.carrier][g.axes[1]])
+            pairs.append((a, (g.working_range_deg[1] - g.working_range_deg[0]) / 360.0, g.closed))
+    if not pairs:
+        return
+    total = 0
+    for a, span, closed in pairs:
+        if closed and gear.teeth is not None:
+            total += sum(gear.teeth)
+        elif closed and gear.module_mm is None:
+            continue  # the gear layer asks for teeth or a module (exit 2) before cutting any
+        else:  # whole pitch curves of 2a / m teeth (r_a + r_b = a), a sector's share and its spare teeth
+            module = gear.module_or(0.5)
+            share = 1.0 if closed else min(1.0, span)
+            total += min(2 * MAX_TEETH, int(2 * a / module * share) + (0 if closed else 4 * gear.spare_teeth + 6))
+    field = "gears.teeth" if gear.teeth is not None else "gears.module_mm"
+    if total > MAX_LINKAGE_GEAR_TEETH:
+        raise SpecError(field, f"{len(pairs)} gear pair{'s' if len(pairs) != 1 else ''} with about {total} teeth in "
+                               f"all, over the bound of {MAX_LINKAGE_GEAR_TEETH}; fewer teeth (a larger module)")
+    for field, count, bound, what in (
+            ("checks.sweep_poses", design.checks.sweep_poses, MAX_LINKAGE_POSE_TEETH, "poses"),
+            ("parts.gif_frames", design.parts.gif_frames, MAX_FRAME_TEETH, "GIF frames")):
+        if count * total > bound:
+            raise SpecError(field, f"{count} {what} × about {total} teeth of the linkage's gears = {count * total}, "
+                                   f"over the bound of {bound} (every pose moves every toothed outline); at most "
+                                   f"{max(1, bound // total)} {what} with {total} teeth")
+
+
 _GRID_FIELDS = {"alpha": "alpha_deg", "c": "c_mm", "k1": "k1_Nmm_per_deg", "k2": "k2_Nmm_per_deg",
                 "phi01": "phi01_deg", "phi02": "phi02_deg"}
+
+
+def check_expression(text: str, path: str) -> None:
+    """Refuse a gear law expression longer or deeper than the bounds, before it is compiled.
+
+    Parameters
+    ----------
+    text : str
+        The formula as written.
+    path : str
+        The field (``gear_pair.law``, ``linkage.gears[2].expression``) named in the error.
+
+    Raises
+    ------
+    SpecError
+        Over :data:`MAX_EXPRESSION_LENGTH` characters or :data:`MAX_EXPRESSION_DEPTH` levels of nesting. A
+        syntax error is left to the formula compiler, which names it.
+    """
+    if len(text) > MAX_EXPRESSION_LENGTH:
+        raise SpecError(path, f"the expression has {len(text)} characters, over the bound of "
+                              f"{MAX_EXPRESSION_LENGTH} (it is evaluated at every step of the motion)")
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError:
+        return
+    except (RecursionError, MemoryError):  # the parser's own stack: deeper than any bound below
+        raise SpecError(path, f"the expression is nested too deeply (at most {MAX_EXPRESSION_DEPTH} levels)") from None
+    # the depth by an explicit stack: a recursive walk would overflow on the input it is meant to refuse
+    deepest, stack = 0, [(tree.body, 1)]
+    while stack:
+        node, depth = stack.pop()
+        deepest = max(deepest, depth)
+        if deepest > MAX_EXPRESSION_DEPTH:
+            raise SpecError(path, f"the expression is nested more than {MAX_EXPRESSION_DEPTH} levels deep "
+                                  "(each unary sign, operator and call is a level; a sum of n terms is n deep)")
+        stack.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
+
+
+# -- processes and threads -------------------------------------------------------------------------
+
+#: Measured peak resident memory (MB) of one local Dask worker process of ``fabricate sweep`` (its imports
+#: and the points it builds); ``--workers`` is bounded by the available memory divided by it.
+WORKER_MB = 450.0
+#: Environment variables that set the thread count of the BLAS libraries numpy and scipy may load.
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
+
+
+def available_cores() -> int:
+    """Cores this process may run on (its CPU affinity where the platform has one)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # macOS, Windows
+        return max(1, os.cpu_count() or 1)
+
+
+def available_memory_mb() -> float | None:
+    """``MemAvailable`` of ``/proc/meminfo`` in MB (memory that can be had without swapping), or None."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) / 1024.0
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def max_workers() -> int:
+    """Most local sweep worker processes: one per core, and no more than the available memory holds.
+
+    Each worker is a single-threaded process (a point is CPU-bound Python), so more workers than cores only
+    wait for each other; each costs :data:`WORKER_MB` of memory.
+    """
+    cores = available_cores()
+    memory = available_memory_mb()
+    if memory is None:
+        return cores
+    return max(1, min(cores, int(memory // WORKER_MB)))
+
+
+def check_workers(workers: int, field: str = "--workers") -> None:
+    """Refuse a local worker count outside ``1 .. max_workers()``, naming the limit that binds.
+
+    Raises
+    ------
+    SpecError
+        Naming ``field``, the cores and the memory available.
+    """
+    if isinstance(workers, bool) or not isinstance(workers, int):
+        raise SpecError(field, f"expected a whole number of processes, got {workers!r}")
+    limit = max_workers()
+    if 1 <= workers <= limit:
+        return
+    cores, memory = available_cores(), available_memory_mb()
+    held = "" if memory is None else f", {memory / 1024:.1f} GB available at {WORKER_MB:.0f} MB a worker holds " \
+                                      f"{max(1, int(memory // WORKER_MB))}"
+    raise SpecError(field, f"expected 1 .. {limit} processes, got {workers} (this machine: {cores} "
+                           f"core{'s' if cores != 1 else ''}{held})")
+
+
+def pin_blas_threads() -> None:
+    """One BLAS thread in numpy and scipy loaded after this call (unless the environment sets a count).
+
+    fabricate's matrices are small (the solver's are at most 117 × 117): a second BLAS thread saves nothing,
+    and on busy cores the threads wait for each other. The worst linkage's sweep of 360 poses took 42 s with
+    OpenBLAS's default threads and 2 s with one, on two cores shared with other work. Environment variables
+    only take effect before numpy is imported; :func:`blas_threads` limits a library already loaded.
+    """
+    for name in BLAS_THREAD_VARIABLES:
+        os.environ.setdefault(name, "1")
+
+
+@contextlib.contextmanager
+def blas_threads(count: int = 1) -> Iterator[None]:
+    """Run the block with at most ``count`` threads in every OpenBLAS loaded (numpy's, scipy's), then restore.
+
+    Does nothing where no OpenBLAS is loaded or the platform does not list the libraries (only Linux's
+    ``/proc/self/maps`` is read), and leaves a count the environment sets (see :func:`pin_blas_threads`).
+    """
+    if any(name in os.environ and os.environ[name] != "1" for name in BLAS_THREAD_VARIABLES[:1]):
+        yield
+        return
+    restore = []
+    for get, put in _openblas_controls():
+        try:
+            before = int(get())
+            if before > count:
+                put(count)
+                restore.append((put, before))
+        except (OSError, ValueError):  # a library that does not answer is left as it is
+            continue
+    try:
+        yield
+    finally:
+        for put, before in restore:
+            put(before)
+
+
+def _openblas_controls() -> list[tuple[Any, Any]]:
+    """``(get_num_threads, set_num_threads)`` of every OpenBLAS mapped into this process (Linux)."""
+    if "numpy" not in sys.modules or not sys.platform.startswith("linux"):
+        return []
+    cache = _OPENBLAS.get("controls")
+    if cache is not None:
+        return cache
+    paths: list[str] = []
+    try:
+        with open("/proc/self/maps", encoding="utf-8", errors="replace") as f:
+            for line in f:
+                fields = line.split(maxsplit=5)  # address, perms, offset, device, inode, path
+                path = fields[5].strip() if len(fields) == 6 else ""
+                if "openblas" in path.lower() and path.startswith("/") and path not in paths:
+                    paths.append(path)
+    except OSError:
+        return []
+    controls = []
+    for path in paths:
+        try:
+            lib = ctypes.CDLL(path)
+        except OSError:
+            continue
+        for prefix, suffix in (("scipy_openblas", "64_"), ("scipy_openblas", ""), ("openblas", "64_"),
+                               ("openblas", "")):
+            get = getattr(lib, f"{prefix}_get_num_threads{suffix}", None)
+            put = getattr(lib, f"{prefix}_set_num_threads{suffix}", None)
+            if get is not None and put is not None:
+                put.argtypes = [ctypes.c_int]
+                controls.append((get, put))
+                break
+    _OPENBLAS["controls"] = controls
+    return controls
+
+
+_OPENBLAS: dict[str, list[tuple[Any, Any]]] = {}

@@ -7,6 +7,7 @@ builds; a count exactly at its bound validates and one past it is refused naming
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -14,7 +15,9 @@ import pytest
 
 from fabricate import bounds
 from fabricate.cli import main
-from fabricate.spec import TEMPLATE_DIR, load_design
+from fabricate.errors import SpecError
+from fabricate.spec import TEMPLATE_DIR, design_from_text, load_design, parse_toml
+from tests.toml_writer import toml_text
 
 
 def _template(tmp_path: Path, name: str, edits: list[tuple[str, str]], extra: str = "") -> Path:
@@ -146,3 +149,201 @@ def test_gear_pair_poses_times_teeth_over_the_bound_names_sweep_poses(tmp_path: 
                      extra=f"\n[checks]\nsweep_poses = {bounds.MAX_SWEEP_POSES}\n")
     err = _assert_refused(path, "checks.sweep_poses", tmp_path, capsys)
     assert f"at most {bounds.MAX_POSE_TEETH // (2 * bounds.MAX_TEETH)}" in err
+
+
+# -- issue 23 item 4: gear law expressions, the exact form, the linkage's solver work, --workers -----------
+
+LINKAGE_GEARS = """
+[design]
+name = "geared"
+kind = "linkage"
+
+[gears]
+teeth = [30, 30]
+
+[linkage]
+ground = "frame"
+input_unit = "deg"
+input_range = [0.0, 360.0]
+
+[[linkage.bodies]]
+name = "frame"
+points = { OA = [0.0, 0.0], OB = [40.0, 0.0] }
+
+[[linkage.bodies]]
+name = "gear_a"
+points = { OA = [0.0, 0.0] }
+
+[[linkage.bodies]]
+name = "gear_b"
+points = { OB = [40.0, 0.0] }
+
+[[linkage.joints]]
+name = "OA"
+type = "revolute"
+bodies = ["frame", "gear_a"]
+
+[[linkage.joints]]
+name = "OB"
+type = "revolute"
+bodies = ["frame", "gear_b"]
+
+[[linkage.gears]]
+name = "g"
+carrier = "frame"
+bodies = ["gear_a", "gear_b"]
+axes = ["OA", "OB"]
+law = "expression"
+expression = "EXPRESSION"
+
+[[linkage.drivers]]
+joint = "OA"
+"""
+
+
+def _padded(length: int) -> str:
+    """A valid closed 1:1 law of exactly ``length`` characters (spaces pad it)."""
+    return "x + 0.01*sin(x)".ljust(length)
+
+
+def _linkage_refusal(expression: str) -> SpecError:
+    with pytest.raises(SpecError) as info:
+        design_from_text(LINKAGE_GEARS.replace("EXPRESSION", expression), "g.toml")
+    return info.value
+
+
+def test_linkage_gear_expression_at_its_length_bound_validates_and_past_it_is_refused() -> None:
+    design_from_text(LINKAGE_GEARS.replace("EXPRESSION", _padded(bounds.MAX_EXPRESSION_LENGTH)), "g.toml")
+    err = _linkage_refusal(_padded(bounds.MAX_EXPRESSION_LENGTH + 1))
+    assert err.path == "linkage.gears[0].expression"
+    assert f"{bounds.MAX_EXPRESSION_LENGTH + 1} characters, over the bound of {bounds.MAX_EXPRESSION_LENGTH}" \
+        in err.message
+
+
+def test_gear_pair_law_has_the_linkage_expressions_length_bound(tmp_path: Path, capsys) -> None:
+    line = 'law = "{value}"\nteeth = [30, 30]'
+    at = _template(tmp_path, GEARS, [(r'^family = "elliptic"\neccentricity = 0.2',
+                                      line.format(value=_padded(bounds.MAX_EXPRESSION_LENGTH)))])
+    load_design(at)
+    over = _template(tmp_path, GEARS, [(r'^family = "elliptic"\neccentricity = 0.2',
+                                        line.format(value=_padded(bounds.MAX_EXPRESSION_LENGTH + 1)))])
+    err = _assert_refused(over, "gear_pair.law", tmp_path, capsys)
+    assert f"over the bound of {bounds.MAX_EXPRESSION_LENGTH}" in err
+
+
+def test_998_unary_minus_signs_are_a_named_input_error_not_an_internal_one(tmp_path: Path, capsys) -> None:
+    # the expression of the issue: within the length bound, but 998 levels deep (it overflowed Python's stack)
+    expression = "-" * 998 + "x"
+    err = _linkage_refusal(expression)
+    assert err.path == "linkage.gears[0].expression" and "nested more than" in err.message
+    path = tmp_path / "deep.toml"
+    path.write_text(LINKAGE_GEARS.replace("EXPRESSION", expression), encoding="utf-8")
+    code, text = _build(path, tmp_path, capsys)
+    assert code == 2 and "fabricate: error: linkage.gears[0].expression:" in text, text
+
+
+def test_expression_nesting_at_its_depth_bound_validates_and_past_it_is_refused() -> None:
+    # an even number of minus signs is the identity law; the name x is one level more
+    at = "-" * (bounds.MAX_EXPRESSION_DEPTH - 2) + "x"
+    bounds.check_expression(at, "law")
+    design_from_text(LINKAGE_GEARS.replace("EXPRESSION", at), "g.toml")
+    with pytest.raises(SpecError) as info:
+        bounds.check_expression("-" * bounds.MAX_EXPRESSION_DEPTH + "x", "gear_pair.law")
+    assert info.value.path == "gear_pair.law"
+    # parentheses are no level: the syntax tree is what is compiled, one Python frame a level
+    bounds.check_expression("(" * 50 + "x" + ")" * 50, "law")
+
+
+def test_gear_pair_law_too_deep_exits_2_naming_the_field(tmp_path: Path, capsys) -> None:
+    path = _template(tmp_path, GEARS, [(r'^family = "elliptic"\neccentricity = 0.2',
+                                        'law = "' + "-" * 998 + 'x"\nteeth = [30, 30]')])
+    _assert_refused(path, "gear_pair.law", tmp_path, capsys)
+
+
+@pytest.fixture(scope="module")
+def exact_text() -> str:
+    """The exact form (mechanism.toml) of the shipped Stephenson six-bar, written without a build."""
+    from fabricate.synthesis.linkage.exact import mechanism_toml
+    from fabricate.synthesis.linkage.mechanism import build_mechanism
+
+    design = load_design(TEMPLATE_DIR / "linkage_stephenson.toml")
+    return mechanism_toml(design, build_mechanism(design.name, design.method), {"copies": 1}).decode("utf-8")
+
+
+def test_exact_form_copies_at_the_bound_validate_and_past_it_are_refused(exact_text: str) -> None:
+    assert "copies = 1\n" in exact_text
+    design = design_from_text(exact_text.replace("copies = 1\n", f"copies = {bounds.MAX_COPIES}\n"), "m.toml")
+    assert design.method.hints["copies"] == bounds.MAX_COPIES
+    for bad in (bounds.MAX_COPIES + 1, 2000, 0, 2.5, "true"):
+        with pytest.raises(SpecError) as info:
+            design_from_text(exact_text.replace("copies = 1\n", f"copies = {bad}\n"), "m.toml")
+        assert info.value.path == "linkage.hints.copies", info.value
+        assert f"from 1 to {bounds.MAX_COPIES}" in info.value.message
+
+
+def test_exact_form_points_per_body_at_the_bound_validate_and_past_it_are_refused(exact_text: str) -> None:
+    data = parse_toml(exact_text, "m.toml")
+    frame = data["linkage"]["bodies"][0]["points"]
+    for count, refused in ((bounds.MAX_LINKAGE_POINTS, False), (bounds.MAX_LINKAGE_POINTS + 1, True)):
+        points = dict(frame)
+        points.update({f"extra{k}": [float(k), 1.0] for k in range(count - len(frame))})
+        data["linkage"]["bodies"][0]["points"] = points
+        text = toml_text(data)
+        if refused:
+            with pytest.raises(SpecError) as info:
+                design_from_text(text, "m.toml")
+            assert info.value.path == "linkage.bodies[0].points"
+            assert f"{count} points, over the bound of {bounds.MAX_LINKAGE_POINTS}" in info.value.message
+        else:
+            design_from_text(text, "m.toml")
+
+
+def test_exact_form_law_points_past_the_bound_are_refused(exact_text: str) -> None:
+    data = parse_toml(exact_text, "m.toml")
+    driver = data["linkage"]["drivers"][0]
+    n = bounds.MAX_EXACT_LAW_POINTS + 1
+    driver["law"] = {"type": "samples", "x": [float(k) for k in range(n)], "y": [0.0] * n}
+    with pytest.raises(SpecError) as info:
+        design_from_text(toml_text(data), "m.toml")
+    assert info.value.path == "linkage.drivers[0].law.x"
+    assert f"{n} points, over the bound of {bounds.MAX_EXACT_LAW_POINTS}" in info.value.message
+
+
+def test_max_workers_is_bounded_by_the_cores_and_the_memory(monkeypatch: pytest.MonkeyPatch) -> None:
+    cores = bounds.available_cores()
+    assert 1 <= bounds.max_workers() <= cores
+    # memory for two workers and a half: two, however many cores
+    monkeypatch.setattr(bounds, "available_cores", lambda: 64)
+    monkeypatch.setattr(bounds, "available_memory_mb", lambda: 2.5 * bounds.WORKER_MB)
+    assert bounds.max_workers() == 2
+    bounds.check_workers(2)
+    with pytest.raises(SpecError) as info:
+        bounds.check_workers(3)
+    assert info.value.path == "--workers" and "expected 1 .. 2 processes, got 3" in info.value.message
+    assert "64 cores" in info.value.message and "holds 2" in info.value.message
+    monkeypatch.setattr(bounds, "available_memory_mb", lambda: None)  # no /proc/meminfo: the cores bound
+    assert bounds.max_workers() == 64
+    monkeypatch.setattr(bounds, "available_memory_mb", lambda: 1.0)  # too little for one: still one
+    assert bounds.max_workers() == 1
+
+
+@pytest.mark.parametrize("workers", ["0", "513", "{over}"])
+def test_sweep_workers_past_the_bound_exits_2_naming_the_limit(workers: str, tmp_path: Path, capsys) -> None:
+    value = workers.format(over=bounds.max_workers() + 1)
+    code = main(["sweep", "finger_hand_sizes", "-o", str(tmp_path / "s"), "--workers", value, "-q"])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert f"fabricate: error: --workers: expected 1 .. {bounds.max_workers()} processes, got {value}" in err
+    assert not (tmp_path / "s").exists()
+
+
+def test_blas_threads_pins_and_restores() -> None:
+    import numpy  # noqa: F401  (its OpenBLAS is the one pinned)
+
+    controls = bounds._openblas_controls()
+    before = [int(get()) for get, _ in controls]
+    with bounds.blas_threads(1):
+        inside = [int(get()) for get, _ in controls]
+    assert [int(get()) for get, _ in controls] == before
+    if os.environ.get("OPENBLAS_NUM_THREADS", "1") == "1":
+        assert all(n == 1 for n in inside)

@@ -6,7 +6,9 @@ Template tables
     One of
       ``family = "elliptic"`` with ``eccentricity`` (0 <= e < 1): two equal ellipses about their foci, 1:1;
       ``law = "x + 0.03*sin(x)"``: the driven gear's angle as a formula in the driving angle ``x``
-      (rad; the numpy functions of :data:`fabricate.gears.law.FUNCTIONS`, evaluated safely);
+      (rad; the numpy functions of :data:`fabricate.gears.law.FUNCTIONS`, evaluated safely; at most
+      :data:`~fabricate.bounds.MAX_EXPRESSION_LENGTH` characters and
+      :data:`~fabricate.bounds.MAX_EXPRESSION_DEPTH` levels of nesting);
       ``law_samples_deg = [[x_a, x_b], ...]``: driven against driving angle (deg), a cubic spline.
     The driven angle is counted positive in its own sense of turning (external gears turn opposite
     ways): the coupling law is its negative.
@@ -29,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from fabricate.bounds import MAX_TEETH
+from fabricate.bounds import MAX_TEETH, check_expression
 from fabricate.errors import SpecError
 from fabricate.gears.law import FormulaLaw, check_ratio, elliptic_formula, samples_law
 from fabricate.gears.pitch import PitchCurves
@@ -66,6 +68,8 @@ def parse_spec(root: Table) -> GearPairSpec:
     if family == "elliptic" and t.has("family"):
         ecc = t.number("eccentricity", min=0.0, max=0.95)
     formula = t.string("law", None)
+    if formula is not None:
+        check_expression(formula, t.field("law"))  # length and nesting depth, before anything compiles it
     samples = t.array("law_samples_deg", None, shape=(None, 2), min_rows=3, min=-3600.0, max=3600.0)
     if samples is not None and len(samples) > 10000:
         raise SpecError(t.field("law_samples_deg"), f"{len(samples)} samples, over the bound of 10000")

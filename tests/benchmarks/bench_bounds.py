@@ -1,18 +1,27 @@
 """Worst valid template of each kind against the resource budget of :mod:`fabricate.bounds`.
 
 Each shipped template is turned into its most expensive valid form (every bounded count at its
-maximum, products of counts at the preflight bound) and built by ``python -m fabricate build T -o DIR
--q`` in a subprocess of its own wrapper process, so the wrapper's ``RUSAGE_CHILDREN`` peak is that
-build's alone. Prints: kind, wall time, CPU time (user + sys of the build and its forked picture
-child: on a shared machine the wall time also counts waiting for a core), peak RSS, exit code and the
-ratios to the 60 s / 4 GB budget.
+maximum, products of counts at the preflight bound); the declared linkage and its exact form (the
+``mechanism.toml`` every build writes) are generated (:func:`worst_linkage`, :func:`worst_exact`). Each is
+built by ``python -m fabricate build T -o DIR -q`` in a subprocess of its own wrapper process, so the
+wrapper's ``RUSAGE_CHILDREN`` peak is that build's alone. Prints: kind, BLAS threads, wall time, CPU time
+(user + sys of the build and its forked picture child, from ``resource.getrusage``: on a shared machine the
+wall time also counts waiting for a core, so CPU time is the figure to hold against the budget there), peak
+RSS, exit code and the ratios to the 60 s / 4 GB budget.
 
-Run: ``python tests/benchmarks/bench_bounds.py [kind ...]`` (not part of the test suite; a few minutes).
+``--blas 1`` runs with one BLAS thread (``OPENBLAS_NUM_THREADS=1``), ``--blas 2`` with two (the environment
+then overrides fabricate's own pin to one), ``--blas both`` (default) each kind both ways.
+
+Run: ``python tests/benchmarks/bench_bounds.py [--blas 1|2|both] [kind ...]`` (not part of the test suite;
+about ten minutes on an idle machine).
 """
 
 from __future__ import annotations
 
+import argparse
 import json
+import math
+import os
 import subprocess
 import sys
 import tempfile
@@ -30,10 +39,11 @@ WRAPPER = """
 import json, resource, subprocess, sys, time
 start = time.perf_counter()
 rc = subprocess.run([sys.executable, "-m", "fabricate", "build", sys.argv[1], "-o", sys.argv[2], "-q"],
-                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE).returncode
+                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
 elapsed = time.perf_counter() - start
 usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-print(json.dumps({"rc": rc, "seconds": elapsed, "cpu_seconds": usage.ru_utime + usage.ru_stime,
+print(json.dumps({"rc": rc.returncode, "stderr": rc.stderr.decode(errors="replace"), "seconds": elapsed,
+                  "cpu_seconds": usage.ru_utime + usage.ru_stime,
                   "peak_mb": usage.ru_maxrss / 1024.0}))
 """
 
@@ -78,8 +88,186 @@ WORST: dict[str, tuple[str, dict[tuple[str, str], Any]]] = {
 }
 
 
+def _expression(length: int) -> str:
+    """A closed gear law of ``length`` characters: the 1:1 law plus tiny harmonics (ratio 1 ± 1e-4, so
+    the pitch curves stay round and the teeth cut), y(0) = 0 and repeating after a turn."""
+    text, k = "x", 1
+    while True:
+        term = f" + 1e-06*sin({k}*x)"
+        if len(text) + len(term) > length:
+            break
+        text, k = text + term, k + 1
+    return text + " " * (length - len(text))
+
+
+def worst_linkage(poses: int = bounds.MAX_SWEEP_POSES, points: int = bounds.MAX_LINKAGE_POINTS,
+                  gears: int = bounds.MAX_LINKAGE_GEARS, teeth: int = 12,
+                  expression: int = bounds.MAX_EXPRESSION_LENGTH, sliders: int = 6,
+                  table: int = bounds.MAX_LINKAGE_TABLE) -> dict[str, Any]:
+    """A worst-case declared linkage, as a parsed template (the two worst: :func:`linkage_poses`,
+    :func:`linkage_gears`).
+
+    A crank-rocker four-bar drives a chain of stages that all assemble and move without a dead point:
+    ``gears`` gear stages (the rotating body drives a gear on the frame through a closed pair of
+    ``teeth`` + ``teeth`` teeth whose law is an expression of ``expression`` characters), each followed by a
+    parallelogram stage (coupler and rocker: the rocker turns as the gear does), more parallelogram stages,
+    then ``sliders`` slider stages (a rod to a block on a slide, block to block), up to
+    :data:`~fabricate.bounds.MAX_LINKAGE_BODIES` bodies; one driver (a table law of ``table`` samples), a pad
+    on every moving body, every body with ``points`` points (the joints', the rest on a small circle: a hull
+    of that many circles), ``poses`` sweep poses and a torque load. Gruebler: 3 × 39 - 2 × joints - gears = 1.
+    """
+    bodies: list[dict[str, Any]] = []
+    joints: list[dict[str, Any]] = []
+    gear_pairs: list[dict[str, Any]] = []
+    frame: dict[str, list[float]] = {"O": [0.0, 0.0]}
+    bodies.append({"name": "frame", "points": frame})
+    h, arm, d, cd = 30.0, 5.0, 40.0, 30.0
+
+    def body(name: str, pts: dict[str, list[float]]) -> None:
+        bodies.append({"name": name, "points": pts})
+
+    def joint(name: str, a: str, b: str, axis: list[float] | None = None) -> None:
+        entry: dict[str, Any] = {"name": name, "type": "slider" if axis else "revolute", "bodies": [a, b]}
+        if axis:
+            entry["axis"] = axis
+        joints.append(entry)
+
+    def parallelogram(k: int, rot: tuple[str, str, float, str, list[float]]) -> tuple[str, str, float, str,
+                                                                                          list[float]]:
+        """A coupler and a rocker whose input arm equals the driving body's output arm (arms alternate
+        between two vectors), so the rocker turns as the driving body does."""
+        name, _, px, out, out_xy = rot
+        x = px + d
+        va = [out_xy[0] - px, out_xy[1]] if k > 1 else [0.0, h]
+        vb = [arm, h] if va[0] == 0.0 else [0.0, h]
+        inp = [x + va[0], va[1]]
+        coupler, rocker = f"coupler{k}", f"rocker{k}"
+        body(coupler, {out: out_xy, f"I{k}": inp})
+        joint(out, name, coupler)
+        frame[f"G{k}"] = [x, 0.0]
+        body(rocker, {f"G{k}": [x, 0.0], f"I{k}": inp, f"U{k}": [x + vb[0], vb[1]]})
+        joint(f"I{k}", coupler, rocker)
+        joint(f"G{k}", "frame", rocker)
+        return rocker, f"G{k}", x, f"U{k}", [x + vb[0], vb[1]]
+
+    body("crank", {"O": [0.0, 0.0], "A": [8.0, 0.0]})
+    joint("O", "frame", "crank")
+    rot = parallelogram(1, ("crank", "O", 0.0, "A", [8.0, 0.0]))  # with the crank: a crank-rocker
+    k = 1
+    for g in range(1, gears + 1):
+        name, pivot, px, _, _ = rot
+        x = px + cd
+        gear = f"gear{g}"
+        frame[f"Q{g}"] = [x, 0.0]
+        body(gear, {f"Q{g}": [x, 0.0], f"V{g}": [x + arm, h]})
+        joint(f"Q{g}", "frame", gear)
+        gear_pairs.append({"name": f"pair{g}", "carrier": "frame", "bodies": [name, gear], "axes": [pivot, f"Q{g}"],
+                           "law": "expression", "expression": _expression(expression)})
+        k += 1
+        rot = parallelogram(k, (gear, f"Q{g}", x, f"V{g}", [x + arm, h]))
+    while len(bodies) + 2 * (sliders + 1) <= bounds.MAX_LINKAGE_BODIES:
+        k += 1
+        rot = parallelogram(k, rot)
+    # slider stages: a rod from the last rocker to a block on the x axis, then block to block (the blocks'
+    # pin holes off the slide line, clear of the guide slot cut along it)
+    name, _, _, out, out_xy = rot
+    loaded = name
+    k, length = 1, 40.0
+    while len(bodies) + 2 <= bounds.MAX_LINKAGE_BODIES:
+        x = out_xy[0] + math.sqrt(length ** 2 - (out_xy[1] - 8.0) ** 2) + 2.0
+        rod, block = f"rod{k}", f"block{k}"
+        body(rod, {out: out_xy, f"B{k}": [x - 2.0, 8.0]})
+        joint(out, name, rod)
+        frame[f"S{k}"] = [x, 0.0]
+        body(block, {f"B{k}": [x - 2.0, 8.0], f"S{k}": [x, 0.0], f"C{k}": [x + 2.0, -8.0]})
+        joint(f"B{k}", rod, block)
+        joint(f"S{k}", "frame", block, axis=[1.0, 0.0])
+        name, out, out_xy = block, f"C{k}", [x + 2.0, -8.0]
+        k, length = k + 1, 30.0
+    for b in bodies:  # every body at the point bound: the rest on a circle about its first point
+        pts = b["points"]
+        cx, cy = next(iter(pts.values()))
+        n = points - len(pts)
+        for i in range(n):
+            t = 2 * math.pi * i / max(n, 1)
+            pts[f"m{i}"] = [round(cx + 4.0 * math.cos(t), 9), round(cy + 4.0 * math.sin(t), 9)]
+    inputs = [360.0 * i / (table - 1) for i in range(table)]
+    return {
+        "design": {"name": "worst_linkage", "kind": "linkage", "description": "a worst-case declared linkage"},
+        "process": {"profile": "sla", "pin_diameter_mm": 3.0, "chord_tolerance_mm": bounds.MIN_CHORD_TOLERANCE_MM},
+        "checks": {"sweep_poses": poses},
+        "gears": {"teeth": [teeth, teeth]},
+        # the most GIF frames the frames × teeth bound allows
+        "parts": {"gif_frames": min(_GENERIC[("parts", "gif_frames")],
+                                    bounds.MAX_FRAME_TEETH // max(1, 2 * teeth * gears)), "preview_poses": 24},
+        "load": {"torque_Nmm": 50.0, "torque_body": loaded, "source": "benchmark"},
+        "linkage": {"ground": "frame", "input_unit": "deg", "input_range": [0.0, 360.0], "tip_point": "A",
+                    "bodies": bodies, "joints": joints, "gears": gear_pairs,
+                    "drivers": [{"joint": "O", "law": "table", "input": inputs, "value": inputs}],
+                    "pads": [{"body": b["name"], "point": "m0", "radius_mm": 3.0} for b in bodies[1:]]},
+    }
+
+
+def _largest(make: Any, lo: int, hi: int) -> int:
+    """The largest ``n`` in ``lo .. hi`` whose template ``make(n)`` validates (the preflight included)."""
+    from fabricate.errors import SpecError
+    from fabricate.spec import design_from_text
+
+    def valid(n: int) -> bool:
+        try:
+            design_from_text(toml_text(make(n)), "worst.toml")
+        except SpecError:
+            return False
+        return True
+
+    if not valid(lo):
+        raise SystemExit(f"no valid template at {lo}")
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        lo, hi = (mid, hi) if valid(mid) else (lo, mid - 1)
+    return lo
+
+
+def linkage_poses() -> dict[str, Any]:
+    """The worst linkage for the poses: the most poses, two gear pairs with the most teeth that 5000 poses
+    allow (the poses × teeth bound), and the most sliders the solver's estimate then allows."""
+    kw = dict(gears=2, teeth=bounds.MAX_LINKAGE_POSE_TEETH // bounds.MAX_SWEEP_POSES // 4, expression=60)
+    sliders = _largest(lambda n: worst_linkage(sliders=n, **kw), 0, 18)
+    return worst_linkage(sliders=sliders, **kw)
+
+
+def linkage_gears() -> dict[str, Any]:
+    """The worst linkage for the gears: 8 pairs with the most teeth in all, gear expressions of the most
+    characters, and the most poses the solver's estimate and the poses × teeth bound then allow."""
+    teeth = bounds.MAX_LINKAGE_GEAR_TEETH // (2 * bounds.MAX_LINKAGE_GEARS)
+    kw = dict(gears=bounds.MAX_LINKAGE_GEARS, teeth=teeth, expression=bounds.MAX_EXPRESSION_LENGTH, sliders=6)
+    poses = _largest(lambda n: worst_linkage(poses=n, **kw), 2, bounds.MAX_SWEEP_POSES)
+    return worst_linkage(poses=poses, **kw)
+
+
+def worst_exact(copies: int = bounds.MAX_COPIES) -> str:
+    """The worst exact form: the poses-worst linkage's ``mechanism.toml`` (every body at the point bound, laws
+    by their coefficients or samples) with ``hints.copies`` at its bound, as the build writes it."""
+    from fabricate.spec import design_from_text
+    from fabricate.synthesis.linkage.exact import mechanism_toml
+    from fabricate.synthesis.linkage.mechanism import build_mechanism
+
+    design = design_from_text(toml_text(linkage_poses()), "worst_linkage.toml")
+    mechanism = build_mechanism(design.name, design.method)
+    hints = {"copies": copies, "tip_point": "A", "pads": {p.body: {"point": p.point, "radius_mm": p.radius_mm}
+                                                          for p in design.method.pads}}
+    return mechanism_toml(design, mechanism, hints).decode("utf-8")
+
+
+#: Generated kinds: the declared linkage and its exact form.
+GENERATED = {"linkage": lambda: toml_text(linkage_poses()), "linkage_gears": lambda: toml_text(linkage_gears()),
+             "linkage_exact": worst_exact}
+
+
 def worst_template(kind: str) -> str:
     """The worst valid template text of ``kind``."""
+    if kind in GENERATED:
+        return GENERATED[kind]()
     name, overrides = WORST[kind]
     data = parse_toml((TEMPLATE_DIR / name).read_text(encoding="utf-8"), name)
     data["design"]["name"] = f"worst_{kind}"
@@ -88,23 +276,39 @@ def worst_template(kind: str) -> str:
     return toml_text(data)
 
 
-def run(kind: str, work: Path) -> dict[str, Any]:
+def run(kind: str, work: Path, blas: int) -> dict[str, Any]:
+    """Build the worst template of ``kind`` with ``blas`` BLAS threads; its wall, CPU, peak and exit."""
     template = work / f"worst_{kind}.toml"
     template.write_text(worst_template(kind), encoding="utf-8")
-    out = subprocess.run([sys.executable, "-c", WRAPPER, str(template), str(work / f"out_{kind}")],
-                         capture_output=True, text=True, check=True)
+    env = {**os.environ, **{name: str(blas) for name in bounds.BLAS_THREAD_VARIABLES}}
+    out = subprocess.run([sys.executable, "-c", WRAPPER, str(template), str(work / f"out_{kind}_{blas}")],
+                         capture_output=True, text=True, check=True, env=env)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def main(kinds: list[str]) -> None:
-    print(f"{'kind':18s} {'time s':>8s} {'CPU s':>7s} {'peak MB':>9s} {'exit':>5s} {'time/60s':>9s} {'RSS/4GB':>8s}")
+def main(argv: list[str]) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--blas", choices=("1", "2", "both"), default="both")
+    parser.add_argument("kinds", nargs="*", metavar="kind", help=f"of {', '.join([*WORST, *GENERATED])}")
+    args = parser.parse_args(argv)
+    kinds = args.kinds or [*WORST, *GENERATED]
+    unknown = [k for k in kinds if k not in WORST and k not in GENERATED]
+    if unknown:
+        parser.error(f"unknown kind {', '.join(unknown)}")
+    threads = (1, 2) if args.blas == "both" else (int(args.blas),)
+    print(f"{'kind':18s} {'BLAS':>4s} {'wall s':>8s} {'CPU s':>7s} {'peak MB':>9s} {'exit':>5s} "
+          f"{'CPU/60s':>8s} {'wall/60s':>9s} {'RSS/4GB':>8s}")
     with tempfile.TemporaryDirectory(prefix="bench_bounds_") as tmp:
         for kind in kinds:
-            r = run(kind, Path(tmp))
-            print(f"{kind:18s} {r['seconds']:8.1f} {r['cpu_seconds']:7.1f} {r['peak_mb']:9.0f} {r['rc']:5d} "
-                  f"{r['seconds'] / bounds.TIME_BUDGET_S:9.2f} {r['peak_mb'] / bounds.MEMORY_BUDGET_MB:8.2f}",
-                  flush=True)
+            for blas in threads:
+                r = run(kind, Path(tmp), blas)
+                print(f"{kind:18s} {blas:4d} {r['seconds']:8.1f} {r['cpu_seconds']:7.1f} {r['peak_mb']:9.0f} "
+                      f"{r['rc']:5d} {r['cpu_seconds'] / bounds.TIME_BUDGET_S:8.2f} "
+                      f"{r['seconds'] / bounds.TIME_BUDGET_S:9.2f} {r['peak_mb'] / bounds.MEMORY_BUDGET_MB:8.2f}",
+                      flush=True)
+                if r["rc"] not in (0, 1):
+                    print(f"  exit {r['rc']}: {r['stderr'].strip()[-300:]}", flush=True)
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:] or list(WORST))
+    main(sys.argv[1:])

@@ -67,6 +67,7 @@ the joint nearest a dead point (exit 1).
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -81,6 +82,8 @@ from fabricate.bounds import (
     MAX_LINKAGE_JOINTS,
     MAX_LINKAGE_POINTS,
     MAX_LINKAGE_TABLE,
+    blas_threads,
+    check_expression,
 )
 from fabricate.errors import LockupError, SpecError
 from fabricate.gears.law import FormulaLaw
@@ -280,8 +283,7 @@ def _parse_gear(t: Table, bodies: dict[str, BodySpec], joints: dict[str, JointSp
         extra["eccentricity"] = t.number("eccentricity", min=0.0, max=0.95)
     elif law == "expression":
         extra["expression"] = t.string("expression")
-        if len(extra["expression"]) > 1000:
-            raise SpecError(t.field("expression"), "longer than 1000 characters")
+        check_expression(extra["expression"], t.field("expression"))  # length and depth before it is compiled
         FormulaLaw(extra["expression"], path=t.field("expression"))  # syntax now, with the path
     else:
         x = t.array("x_deg", shape=(None,), min_rows=3, min=-MAX_INPUT_DEG, max=MAX_INPUT_DEG)
@@ -519,17 +521,22 @@ def _check_gear_ranges(spec: LinkageSpec, mech: Mechanism, motion: Any) -> None:
 def synthesise(design: Any) -> SynthesisResult:
     """Build the declared linkage (no synthesis: the template is the design)."""
     spec: LinkageSpec = design.method
+    sweep_poses = max(int(getattr(getattr(design, "checks", None), "sweep_poses", 360)), 2)
     if isinstance(spec, ExactLinkageSpec):
         report = {"method": "declared linkage, exact form (a build's mechanism.toml)",
                   "degrees_of_freedom": spec.mechanism.degrees_of_freedom(), "tip_point": spec.tip_point}
+        with blas_threads(), contextlib.suppress(LockupError):
+            spec.mechanism.sweep(sweep_poses)  # solved here with one BLAS thread; the pipeline's sweep is cached
         return SynthesisResult(mechanism=spec.mechanism, report=report, parts=dict(spec.hints))
-    mech = build_mechanism(design.name, spec)
-    sweep_poses = int(getattr(getattr(design, "checks", None), "sweep_poses", 360))
-    motion = None
-    try:  # the pipeline sweeps the same inputs next (cached); a lock-up is its to report (exit 1)
-        motion = mech.sweep(max(sweep_poses, 2))
-    except LockupError:
-        pass
+    # one BLAS thread: the solver's systems (3 × bodies unknowns) are too small to share, and on busy cores
+    # OpenBLAS's threads wait for each other (the worst linkage's 360 poses: 42 s with them, 2 s without)
+    with blas_threads():
+        mech = build_mechanism(design.name, spec)
+        motion = None
+        try:  # the pipeline sweeps the same inputs next (cached); a lock-up is its to report (exit 1)
+            motion = mech.sweep(sweep_poses)
+        except LockupError:
+            pass
     if motion is not None:
         _check_gear_ranges(spec, mech, motion)
     laws = {g.name: gear_law(g, f"linkage.gears[{k}]")[1] for k, g in enumerate(spec.gears)}

@@ -21,6 +21,16 @@ from typing import Any
 
 import numpy as np
 
+from fabricate.bounds import (
+    MAX_COPIES,
+    MAX_EXACT_LAW_ORDER,
+    MAX_EXACT_LAW_POINTS,
+    MAX_LINKAGE_BODIES,
+    MAX_LINKAGE_DRIVERS,
+    MAX_LINKAGE_GEARS,
+    MAX_LINKAGE_JOINTS,
+    MAX_LINKAGE_POINTS,
+)
 from fabricate.errors import SpecError
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
 
@@ -135,8 +145,10 @@ def _law(table: Any, field: str) -> Any:
         table.finish()
         return law
     if kind == "ppoly":
-        x = table.array("x", shape=(None,), min_rows=2, min=-1e6, max=1e6)
+        x = _law_points(table, "x")
         c = table.array("c", shape=(None, len(x) - 1), min_rows=1, min=-1e12, max=1e12)
+        if len(c) > MAX_EXACT_LAW_ORDER:
+            raise SpecError(table.field("c"), f"{len(c)} coefficients a piece, over the bound of {MAX_EXACT_LAW_ORDER}")
         extrapolate = table.raw("extrapolate", True)
         if extrapolate not in (True, False, "periodic"):
             raise SpecError(table.field("extrapolate"), "expected true, false or \"periodic\"")
@@ -144,7 +156,7 @@ def _law(table: Any, field: str) -> Any:
         if np.any(np.diff(x) <= 0):
             raise SpecError(table.field("x"), "breakpoints must increase strictly")
         return PPoly(c, x, extrapolate=extrapolate)
-    x = table.array("x", shape=(None,), min_rows=2, min=-1e6, max=1e6)
+    x = _law_points(table, "x")
     y = table.array("y", shape=(len(x),), min=-1e6, max=1e6)
     table.finish()
     if np.any(np.diff(x) <= 0):
@@ -152,9 +164,29 @@ def _law(table: Any, field: str) -> Any:
     return PchipInterpolator(x, y)
 
 
+def _law_points(table: Any, key: str) -> np.ndarray:
+    """A law's breakpoints or sample abscissae, at most :data:`~fabricate.bounds.MAX_EXACT_LAW_POINTS`."""
+    raw = table.raw(key, None)
+    if isinstance(raw, list) and len(raw) > MAX_EXACT_LAW_POINTS:  # before converting a long list
+        raise SpecError(table.field(key), f"{len(raw)} points, over the bound of {MAX_EXACT_LAW_POINTS}")
+    return table.array(key, shape=(None,), min_rows=2, min=-1e6, max=1e6)
+
+
+def _hints(t: Any) -> dict[str, Any]:
+    """The parts hints, with the counts that drive the parts' cost checked (``copies``)."""
+    raw = t.raw("hints", {})
+    if not isinstance(raw, Mapping):
+        raise SpecError(t.field("hints"), "expected a table")
+    hints = dict(raw)
+    copies = hints.get("copies", 1)
+    if isinstance(copies, bool) or not isinstance(copies, int) or not 1 <= copies <= MAX_COPIES:
+        raise SpecError(f"{t.field('hints')}.copies", f"expected a whole number of copies from 1 to {MAX_COPIES} "
+                                                      f"(every copy of every part is laid out), got {copies!r}")
+    return hints
+
+
 def parse_exact(t: Any, name: str) -> tuple[Mechanism, dict[str, Any], str | None]:
     """The mechanism and the parts hints of an exact ``[linkage]`` table (``t`` after ``exact``)."""
-    from fabricate.bounds import MAX_LINKAGE_BODIES, MAX_LINKAGE_DRIVERS, MAX_LINKAGE_GEARS, MAX_LINKAGE_JOINTS
 
     unit = t.string("input_unit", choices=("deg", "mm"))
     rng = t.array("input_range", shape=(2,), min=-1e5, max=1e5)
@@ -165,6 +197,8 @@ def parse_exact(t: Any, name: str) -> tuple[Mechanism, dict[str, Any], str | Non
     bodies = []
     for b in tables:
         points = b.table("points")
+        if len(points.data) > MAX_LINKAGE_POINTS:
+            raise SpecError(b.field("points"), f"{len(points.data)} points, over the bound of {MAX_LINKAGE_POINTS}")
         pts = {k: tuple(points.array(k, shape=(2,), min=-1e4, max=1e4).tolist()) for k in list(points.data)}
         points.finish()
         bodies.append(Body(b.string("name"), pts))
@@ -211,9 +245,7 @@ def parse_exact(t: Any, name: str) -> tuple[Mechanism, dict[str, Any], str | Non
     assembly_t = t.table("assembly", {})
     assembly = {k: tuple(assembly_t.array(k, shape=(3,), min=-1e5, max=1e5).tolist()) for k in list(assembly_t.data)}
     assembly_t.finish()
-    hints = dict(t.raw("hints", {}))
-    if not isinstance(t.raw("hints", {}), Mapping):
-        raise SpecError(t.field("hints"), "expected a table")
+    hints = _hints(t)
     t.finish()
     mech = Mechanism(name=name, bodies=tuple(bodies), ground=ground, joints=tuple(joints), gears=tuple(gears),
                      drivers=tuple(drivers), input_range=(float(rng[0]), float(rng[1])), input_unit=unit,
