@@ -6,5 +6,5 @@ from setuptools import find_packages, setup
 setup(
     packages=[*find_packages(include=["fabricate", "fabricate.*"]), "fabricate.templates"],
     package_dir={"fabricate.templates": "templates"},
-    package_data={"fabricate": ["py.typed"], "fabricate.templates": ["*.toml", "sweeps/*.toml"]},
+    package_data={"fabricate": ["py.typed", "report_schema.json"], "fabricate.templates": ["*.toml", "sweeps/*.toml"]},
 )

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import io
 import json
+import os
 import shutil
+import subprocess
+import sys
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
@@ -100,14 +103,22 @@ def test_an_untouched_output_passes(copy, capsys):
     assert "checks passed" in out
 
 
+def _edit_first_cut_radius(path: Path, change: Callable[[float], float]) -> None:
+    """Change the first CUT circle's radius (group code 40) in place, the file no larger than before: a file
+    within its manifest size is read and parsed (a larger one is named by its size alone, never read)."""
+    lines = path.read_text().split("\n")
+    start = next(k for k in range(len(lines) - 8) if lines[k] == "CIRCLE" and "CUT" in lines[k:k + 10])
+    at = next(k for k in range(start, len(lines)) if lines[k].strip() == "40") + 1
+    radius = float(lines[at])
+    lines[at] = next(text for digits in range(8, 0, -1)
+                     if len(text := f"{change(radius):.{digits}g}") <= len(lines[at]))
+    path.write_text("\n".join(lines))
+    edited = ezdxf.read(io.StringIO(path.read_text())).modelspace().query('CIRCLE[layer=="CUT"]').first
+    assert edited.dxf.radius == pytest.approx(change(radius), abs=0.01)
+
+
 def _dxf_hole_radius_x3(d: Path) -> str:
-    path = d / "drawings" / "carrier.dxf"
-    doc = ezdxf.read(io.StringIO(path.read_text()))
-    circle = doc.modelspace().query('CIRCLE[layer=="CUT"]').first
-    circle.dxf.radius *= 3.0
-    stream = io.StringIO()
-    doc.write(stream)
-    path.write_text(stream.getvalue())
+    _edit_first_cut_radius(d / "drawings" / "carrier.dxf", lambda r: 3.0 * r)
     return "drawings/carrier.dxf: cut holes"
 
 
@@ -147,7 +158,9 @@ def _3mf_object_dropped(d: Path) -> str:
     start = model.index('<object id="3"')
     model = model[:start] + model[model.index("</object>", start) + len("</object>"):]
     entries["3D/3dmodel.model"] = model.replace('<item objectid="3"/>', "").encode()
-    with zipfile.ZipFile(path, "w") as archive:
+    # compressed like fabricate's own: smaller than the manifest says, so check reads and parses it (a file
+    # larger on disk than its manifest entry is named by its size, never read)
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
         for name, data in entries.items():
             archive.writestr(name, data)
     return "assembly.3mf: objects"
@@ -281,12 +294,7 @@ def test_a_laser_output_passes_and_its_cut_files_are_verified(laser_built, tmp_p
     code, out = _check(copy, capsys)
     assert "cut/" not in out, out  # whatever the design's own verdict, no cut file is flagged
     (copy / "cut" / "sheet_1.svg").write_text("<svg")
-    path = copy / "cut" / "gear_a.dxf"
-    doc = ezdxf.read(io.StringIO(path.read_text()))
-    doc.modelspace().query('CIRCLE[layer=="CUT"]').first.dxf.radius += 0.1  # a kerf applied twice
-    stream = io.StringIO()
-    doc.write(stream)
-    path.write_text(stream.getvalue())
+    _edit_first_cut_radius(copy / "cut" / "gear_a.dxf", lambda r: r + 0.1)  # a kerf applied twice
     code, out = _check(copy, capsys)
     assert code == 1
     assert "cut/sheet_1.svg: not readable SVG" in out and "cut/gear_a.dxf: cut holes" in out
@@ -296,15 +304,17 @@ def test_a_tampered_step_solid_is_named(copy, capsys):
     pytest.importorskip("OCP")
     path = copy / "parts" / "gear_a.step"
     text = path.read_text()
-    # move one Cartesian point of the solid: still a STEP file, no longer the reported solid
+    # move one Cartesian point of the solid by 50 mm in x (its leading digit, so the size stays): still a
+    # STEP file, no longer the reported solid
     marker = "CARTESIAN_POINT('',("
     start = text.index(marker, len(text) // 2) + len(marker)
-    end = text.index(",", start)
-    path.write_text(text[:start] + str(float(text[start:end]) + 5.0) + text[end:])
+    start += text[start] == "-"
+    path.write_text(text[:start] + str((int(text[start]) + 5) % 10) + text[start + 1:])
     code, out = _check(copy, capsys)
     assert code == 1
     assert "parts/gear_a.step: contents differ from the manifest" in out
-    assert "parts/gear_a.step: differs from a rebuild" in out
+    assert "parts/gear_a.step: solid" in out  # read back: the solid is not the reported one
+    assert "not compared with a rebuild" in out and "differs from a rebuild" not in out
 
 
 def test_without_ocp_a_build_says_step_was_skipped(tmp_path, monkeypatch, capsys):
@@ -318,3 +328,373 @@ def test_without_ocp_a_build_says_step_was_skipped(tmp_path, monkeypatch, capsys
     assert not any(f.endswith(".step") for f in report["files"])
     assert all(p["step"] is None for p in report["parts"])
     assert "STEP skipped" in (tmp_path / "out" / "report.md").read_text()
+
+
+# --- check is bounded by the manifest (issue 23, item 3) ---------------------------------------------------
+
+#: Peak resident memory (MB) a `check` that rejects a wrong file may reach: the interpreter, numpy, trimesh,
+#: ezdxf and Pillow imported and the small files parsed measure 65-125 MB; reading the 2 GB file or inflating
+#: the bomb would take 2 GB or more (a plain `check` of the intact folder peaks at ~560 MB: it rebuilds).
+REJECT_PEAK_MB = 200
+
+
+def _fabricate_peak_mb(*args: str) -> tuple[int, str, float]:
+    """Run ``fabricate ARGS`` in a fresh interpreter that reports the peak resident memory of that child
+    alone (RUSAGE_CHILDREN of this process would include every earlier child): (exit code, output, MB)."""
+    probe = ("import resource, subprocess, sys\n"
+             "done = subprocess.run([sys.executable, '-m', 'fabricate', *sys.argv[1:]], capture_output=True,\n"
+             "                      text=True)\n"
+             "peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss\n"
+             "print(done.returncode, peak / (2**20 if sys.platform == 'darwin' else 2**10))\n"
+             "print(done.stdout + done.stderr)\n")
+    env = {**os.environ, "FABRICATE_SERIAL": "1"}
+    run = subprocess.run([sys.executable, "-c", probe, *args], capture_output=True, text=True, timeout=600, env=env)
+    assert run.returncode == 0, run.stderr
+    head, _, output = run.stdout.partition("\n")
+    code, peak = head.split()
+    return int(code), output, float(peak)
+
+
+def test_a_2gb_sparse_file_is_named_by_its_size_and_never_read(copy):
+    listed = {m["path"]: m["bytes"] for m in _report(copy)["manifest"]}
+    with open(copy / "motion.csv", "r+b") as fh:
+        fh.truncate(2**31)  # sparse: no disk space, 2 GB to whoever reads it
+    code, out, peak = _fabricate_peak_mb("check", str(copy), "-q")
+    assert code == 1, out
+    assert f"motion.csv: 2147483648 bytes on disk, {listed['motion.csv']} bytes in the manifest" in out
+    assert "Traceback" not in out
+    assert peak < REJECT_PEAK_MB, f"{peak:.0f} MB"
+
+
+def _zip_bomb(inflated_mb: int) -> bytes:
+    """A zip named like a 3MF whose model member is ``inflated_mb`` MB of zeros (~1000-fold deflate)."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED, compresslevel=9) as archive:
+        archive.writestr("[Content_Types].xml", "<Types/>")
+        with archive.open("3D/3dmodel.model", "w", force_zip64=True) as member:
+            for _ in range(inflated_mb):
+                member.write(b"\0" * 2**20)
+    return buffer.getvalue()
+
+
+def _forge_manifest(folder: Path, rel: str, data: bytes, drop_step: bool = False) -> None:
+    """Write ``data`` to ``rel`` and make report.json's manifest agree with it (a forged folder)."""
+    import hashlib
+
+    (folder / rel).write_bytes(data)
+    report = _report(folder)
+    for item in report["manifest"]:
+        if item["path"] == rel:
+            item["bytes"], item["sha256"] = len(data), hashlib.sha256(data).hexdigest()
+    if drop_step:  # so the child's peak is the bomb's, not OCP reading the STEP files back
+        steps = {m["path"] for m in report["manifest"] if m["path"].endswith(".step")}
+        report["manifest"] = [m for m in report["manifest"] if m["path"] not in steps]
+        report["files"] = [f for f in report["files"] if f not in steps]
+        for rel_step in steps:
+            (folder / rel_step).unlink()
+    (folder / "report.json").write_text(json.dumps(report, indent=2))
+
+
+def test_a_zip_bomb_3mf_is_rejected_without_inflating(copy, tmp_path):
+    bomb = _zip_bomb(256)
+    assert len(bomb) < 300_000  # the issue's 262 kB bomb: 256 MB of model
+    # as found: larger than the manifest's 3MF, so it is named by its size and never opened
+    (copy / "assembly.3mf").write_bytes(bomb)
+    code, out, peak = _fabricate_peak_mb("check", str(copy), "-q")
+    assert code == 1 and f"assembly.3mf: {len(bomb)} bytes on disk" in out, out
+    assert peak < REJECT_PEAK_MB, f"{peak:.0f} MB"
+    # with a manifest forged to match it, it is opened as a zip and judged by its members' declared sizes
+    _forge_manifest(copy, "assembly.3mf", bomb, drop_step=True)
+    code, out, peak = _fabricate_peak_mb("check", str(copy), "-q")
+    assert code == 1, out
+    assert "assembly.3mf: member '3D/3dmodel.model' declares 268435456 bytes" in out and "not inflated" in out
+    assert "Traceback" not in out
+    assert peak < REJECT_PEAK_MB, f"{peak:.0f} MB"
+
+
+def test_a_zip_bomb_within_the_manifest_size_is_never_inflated(copy, capsys, monkeypatch):
+    import fabricate.export.stl as stl
+
+    manifest_bytes = {m["path"]: m["bytes"] for m in _report(copy)["manifest"]}["assembly.3mf"]
+    bomb = _zip_bomb(64)
+    assert len(bomb) <= manifest_bytes  # so it is read (its hash differs) and parsed to say how it differs
+    (copy / "assembly.3mf").write_bytes(bomb)
+    inflated = []
+    real = stl.read_3mf
+    monkeypatch.setattr(stl, "read_3mf", lambda data: inflated.append(data == bomb) or real(data))
+    code, out = _check(copy, capsys)
+    assert code == 1
+    assert f"assembly.3mf: {len(bomb)} bytes on disk, {manifest_bytes} bytes in the manifest" in out
+    assert "assembly.3mf: member '3D/3dmodel.model' declares 67108864 bytes" in out
+    assert True not in inflated
+
+
+def test_a_3mf_with_another_compression_method_is_not_inflated(copy, capsys):
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_BZIP2) as archive:  # bzip2 chunks inflate whole
+        archive.writestr("3D/3dmodel.model", "<model/>")
+    _forge_manifest(copy, "plates/plate_1.3mf", buffer.getvalue())
+    code, out = _check(copy, capsys)
+    assert code == 1 and "plates/plate_1.3mf: member '3D/3dmodel.model' is compressed with method 12" in out
+
+
+def test_an_image_declaring_too_many_pixels_is_not_decoded(copy, capsys):
+    from PIL import Image
+
+    from fabricate.verify import IMAGE_MAX_PIXELS
+
+    side = int(IMAGE_MAX_PIXELS**0.5) + 1
+    buffer = io.BytesIO()
+    Image.new("1", (side, side)).save(buffer, format="PNG")  # a few kB on disk, 2 GB as RGBA
+    _forge_manifest(copy, "previews/assembly.png", buffer.getvalue())
+    code, out = _check(copy, capsys)
+    assert code == 1 and f"previews/assembly.png: an image of {side} x {side} pixels" in out
+
+
+def _outside_copy(copy: Path, rel: str) -> Path:
+    outside = copy.parent / "elsewhere"
+    outside.mkdir(exist_ok=True)
+    target = outside / Path(rel).name
+    shutil.copyfile(copy / rel, target)
+    return target
+
+
+def test_a_symlink_is_never_followed_even_to_identical_bytes(copy, capsys):
+    target = _outside_copy(copy, "bom.csv")
+    (copy / "bom.csv").unlink()
+    (copy / "bom.csv").symlink_to(target)  # the same bytes: only the link betrays it
+    code, out = _check(copy, capsys)
+    assert code == 1
+    assert f"bom.csv: is a symbolic link to '{target}', not a regular file (check follows no links)" in out
+
+
+def test_a_symlinked_folder_on_the_path_is_never_followed(copy, capsys):
+    outside = copy.parent / "elsewhere_parts"
+    shutil.copytree(copy / "parts", outside)
+    shutil.rmtree(copy / "parts")
+    (copy / "parts").symlink_to(outside, target_is_directory=True)
+    code, out = _check(copy, capsys)
+    assert code == 1
+    assert "parts/gear_a.stl: its folder parts is a symbolic link" in out
+    assert "parts: not written by fabricate" in out
+
+
+def test_a_folder_in_place_of_a_file_is_named(copy, capsys):
+    (copy / "assembly.csv").unlink()
+    (copy / "assembly.csv").mkdir()
+    code, out = _check(copy, capsys)
+    assert code == 1 and "assembly.csv: is a folder, not a regular file" in out
+
+
+def test_a_socket_in_place_of_a_file_is_never_opened(copy, capsys, monkeypatch):
+    import socket
+
+    if not hasattr(socket, "AF_UNIX"):
+        pytest.skip("no Unix sockets here")
+    (copy / "assembly.csv").unlink()
+    monkeypatch.chdir(copy)  # a relative name: socket paths are limited to ~100 bytes
+    with socket.socket(socket.AF_UNIX) as server:
+        server.bind("assembly.csv")
+        code, out = _check(copy, capsys)
+    assert code == 1 and "assembly.csv: is a socket, not a regular file" in out
+
+
+@pytest.mark.parametrize("rel", ["motion.csv", "report.json"])
+def test_a_fifo_is_never_opened(copy, rel):
+    if not hasattr(os, "mkfifo"):
+        pytest.skip("no FIFOs here")
+    (copy / rel).unlink()
+    os.mkfifo(copy / rel)  # opening it for reading would block until a writer came: forever
+    done = subprocess.run([sys.executable, "-m", "fabricate", "check", str(copy), "-q"], capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert f"{rel}: is a FIFO (named pipe), not a regular file" in done.stdout
+    assert "Traceback" not in done.stdout + done.stderr
+
+
+def test_a_symlinked_report_is_never_followed(copy, capsys):
+    target = _outside_copy(copy, "report.json")
+    (copy / "report.json").unlink()
+    (copy / "report.json").symlink_to(target)
+    code, out = _check(copy, capsys)
+    assert code == 1 and "report.json: is a symbolic link to" in out
+
+
+# --- report.json: bounded, then validated against its schema (issue 23, items 3 and 6) ---------------------
+
+
+def test_a_huge_report_is_not_read(copy, capsys):
+    from fabricate.verify import REPORT_MAX_BYTES
+
+    with open(copy / "report.json", "r+b") as fh:
+        fh.truncate(REPORT_MAX_BYTES + 1)
+    code, out = _check(copy, capsys)
+    assert code == 1 and f"report.json: {REPORT_MAX_BYTES + 1} bytes, more than any report fabricate writes" in out
+
+
+def _edit_report(folder: Path, edit: Callable[[dict], None]) -> None:
+    report = _report(folder)
+    edit(report)
+    (folder / "report.json").write_text(json.dumps(report, indent=2))
+
+
+@pytest.mark.parametrize(("edit", "message"), [
+    (lambda r: r["parts"][1].update(holes="4 holes"), "report.json: parts[1].holes is not a list (it is a string)"),
+    (lambda r: r["parts"][0]["holes"][0].update(diameter_mm=None), "parts[0].holes[0].diameter_mm is not a number"),
+    (lambda r: r["manifest"][2].update(bytes="512"), "report.json: manifest[2].bytes is not an integer"),
+    (lambda r: r["manifest"][0].update(sha256="0" * 63), "manifest[0].sha256 '000"),
+    (lambda r: r["manifest"][0].update(path="../../etc/passwd"), "manifest[0].path '../../etc/passwd' is not a"),
+    (lambda r: r["files"].append("/etc/passwd"), "is not a relative path inside the output folder"),
+    (lambda r: r["design"].update(name=["x"]), "report.json: design.name is not a string (it is a list)"),
+    (lambda r: r["checks"].pop("failures"), "report.json: checks.failures is missing"),
+    (lambda r: r["checks"].update(not_checked=[{"check": "strength"}]), "checks.not_checked[0].reason is missing"),
+    (lambda r: r["parts"][0].update(plate={"index": "1"}), "parts[0].plate.index is not a list"),
+    (lambda r: r["parts"][0].update(copies=0), "parts[0].copies is 0, less than 1"),
+    (lambda r: r["mechanism"].update(input_range_deg=[0]), "mechanism.input_range_deg has 1 item, not 2"),
+    (lambda r: r.update(template_text=7), "template_text is not a string"),
+    (lambda r: r["design"].update(process_override={"source": "x"}), "design.process_override.text is missing"),
+])
+def test_a_report_of_the_wrong_shape_is_named_before_it_is_read(copy, capsys, edit, message):
+    _edit_report(copy, edit)
+    code, out = _check(copy, capsys)
+    assert code == 1
+    assert message in out, out
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ('{"design": {"name": NaN}}', "not valid JSON (NaN is not JSON)"),
+    ("[" * 100_000 + "]" * 100_000, "not valid JSON (nested too deeply)"),
+    ('{"design": {}, "manifest": [], "n": ' + "9" * 5000 + "}", "not valid JSON"),
+    ("[]", "not a fabricate report (no design section)"),
+])
+def test_a_report_that_is_not_json_is_named(copy, capsys, text, message):
+    (copy / "report.json").write_text(text)
+    code, out = _check(copy, capsys)
+    assert code == 1 and f"report.json: {message}" in out
+
+
+def test_the_schema_uses_only_what_its_validator_implements():
+    import re
+
+    from fabricate.report_schema import report_schema, unsupported_keywords
+
+    schema = report_schema()
+    assert unsupported_keywords(schema) == set()
+    assert unsupported_keywords({"properties": {"a": {"oneOf": []}}, "items": {"format": "x"}}) == {"oneOf", "format"}
+
+    def patterns(node):
+        if isinstance(node, dict):
+            yield from ([node["pattern"]] if isinstance(node.get("pattern"), str) else [])
+            for value in node.values():
+                yield from patterns(value)
+
+    found = list(patterns(schema))
+    assert len(found) >= 3
+    for pattern in found:
+        re.compile(pattern)
+
+
+def test_the_path_pattern_admits_only_relative_paths_inside_the_folder():
+    import re
+
+    from fabricate.report_schema import report_schema
+
+    pattern = report_schema()["$defs"]["path"]["pattern"]
+    good = ["report.md", "parts/gear_a.stl", "gears/pair_mesh.png", ".hidden/x", "a..b/c", "..."]
+    bad = ["", "/etc/passwd", "../x", "a/../b", "..", ".", "a/.", "./a", "a//b", "a/", "a\0b", "a\n", "x/..\n"]
+    assert all(re.search(pattern, p) for p in good)
+    assert not any(re.search(pattern, p) for p in bad)
+
+
+def _quick_design(path: Path):
+    """A shipped template with fewer poses: the same report sections, a fraction of the build time."""
+    import dataclasses
+
+    design = load_design(path)
+    return dataclasses.replace(design, checks=dataclasses.replace(
+        design.checks, sweep_poses=min(design.checks.sweep_poses, 24)))
+
+
+def test_every_shipped_template_writes_a_report_that_matches_its_schema(monkeypatch):
+    import fabricate.pipeline as pipeline
+    from fabricate.report_schema import schema_errors
+    from fabricate.spec import shipped_templates
+
+    class NoPictures:  # pictures and STEP files add files, not report keys: skip their time
+        def __init__(self, _jobs):
+            pass
+
+        def result(self):
+            return {}
+
+        def cancel(self):
+            pass
+
+    monkeypatch.setattr(pipeline, "Background", NoPictures)
+    templates = shipped_templates()
+    assert len(templates) >= 8
+    for path in templates:
+        outcome = run_build(_quick_design(path))  # the module's own: not the cached rebuild of the fixture
+        report = json.loads(outcome.files["report.json"])
+        assert report["parts"] and report["strength"] and report["outputs"]["step"]
+        assert schema_errors(report) == [], path.stem
+    synth = pipeline.run_synth(load_design("linkage_stephenson"))
+    assert schema_errors(json.loads(synth.files["report.json"])) == []
+
+
+def test_the_full_builds_match_the_schema_too(built, laser_built):
+    from fabricate.report_schema import schema_errors
+
+    for folder in (built, laser_built):
+        assert schema_errors(_report(folder)) == []
+
+
+# --- the same verdict on any install (issue 23, item 7) ---------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def built_without_cad(tmp_path_factory) -> Path:
+    """The same pair built as on an install without the `cad` extra (no OCP: STEP skipped)."""
+    import fabricate.export.step as step
+
+    out = tmp_path_factory.mktemp("no_cad") / FAST
+    real = step.step_available
+    step.step_available = lambda: False
+    try:
+        outcome = run_build(load_design(FAST))
+    finally:
+        step.step_available = real
+    write_output(outcome.files, out)
+    return out
+
+
+@pytest.mark.parametrize("built_with", ["cad", "no_cad"], ids=["built_with_cad", "built_without"])
+@pytest.mark.parametrize("checked_with", ["cad", "no_cad"], ids=["checked_with_cad", "checked_without"])
+def test_check_gives_the_same_verdict_on_any_install(built, built_without_cad, tmp_path, monkeypatch, capsys,
+                                                     built_with, checked_with):
+    import fabricate.export.step as step
+
+    if "cad" in (built_with, checked_with) and not step.step_available():
+        pytest.skip("OCP (the cad extra) is not installed here")
+    source = built if built_with == "cad" else built_without_cad
+    folder = tmp_path / FAST
+    shutil.copytree(source, folder)
+    report = _report(folder)
+    has_step = any(f.endswith(".step") for f in report["files"])
+    assert has_step == (built_with == "cad")
+    assert report["outputs"]["step"] == "written" if has_step else report["outputs"]["step"].startswith("skipped")
+    if checked_with == "no_cad":  # as without OCP: asked, it is not there; STEP export would fail
+        monkeypatch.setattr(step, "step_available", lambda: False)
+
+        def no_ocp(*_args, **_kwargs):
+            raise ImportError("No module named 'OCP'")
+
+        monkeypatch.setattr(step, "step_files", no_ocp)
+        if built_with == "cad":  # the real rebuild, not one cached with OCP: STEP bytes must come from the folder
+            import fabricate.pipeline as pipeline
+
+            monkeypatch.setattr(pipeline, "run_build", run_build)
+    code, out = _check(folder, capsys)
+    assert code == 0, out
+    assert ("not comparable here" in out) == (built_with == "cad" and checked_with == "no_cad")
+    assert step.step_available() == (checked_with == "cad")  # the rebuild's answer was the folder's, then restored
