@@ -117,7 +117,11 @@ SOLVER_EXPRESSION_CHAR_S = 4.6e-7
 #: per pose above 360 poses, 360 steps below).
 SOLVER_JACOBIANS_PER_STEP = 3.5
 #: CPU seconds the linkage's sweep may be estimated to take (the rest of the budget is parts and checks).
-MAX_SOLVER_S = 15.0
+MAX_SOLVER_S = 10.0
+#: Linkage kind: ``checks.sweep_poses`` × bodies. The interference sweep and the statics go through every pose
+#: of every part: 40 bodies at 5000 poses took 99 s of CPU (one BLAS thread): checks 54 s (the interference
+#: sweep's clearance tests), the sweep 20 s, strength 16 s, exports 5 s, parts 6 s.
+MAX_LINKAGE_POSE_BODIES = 80_000
 #: Linkage kind: teeth of all its gear pairs together (z_a + z_b summed; a pair of the most teeth alone is 200:
 #: 8 pairs of 100 + 100 teeth spent 21 s cutting gears and 16 s laying out parts at 360 poses).
 MAX_LINKAGE_GEAR_TEETH = 2 * MAX_TEETH
@@ -144,9 +148,9 @@ def preflight(design: Any) -> None:
     - compliant gripper: the optimisation grid (points per axis and in all);
     - Watt six-bar: the solution region's d samples × d0 samples × statics samples;
     - gear pair: sweep poses and GIF frames × teeth;
-    - linkage (declared and exact form): the solver's steps × the cost of a step (bodies, sliders, gears,
-      drivers, characters of gear expressions), and the teeth of its gear pairs, alone and × poses and
-      GIF frames.
+    - linkage (declared and exact form): poses × bodies, the solver's steps × the cost of a step (sliders,
+      gears, drivers, characters of gear expressions), and the teeth of its gear pairs, alone and × poses
+      and GIF frames.
 
     (The gear mesh check's steps × teeth is refused where the tooth counts are known, in
     :mod:`fabricate.gears.pair`.)
@@ -185,6 +189,7 @@ def preflight(design: Any) -> None:
     if design.kind == "gear_pair":
         _gear_pair_work(design)
     if design.kind == "linkage":
+        _linkage_pose_work(design)
         _linkage_solver_work(design)
         _linkage_gear_work(design)
     if design.kind == "watt_six_bar":
@@ -213,6 +218,18 @@ def _gear_pair_work(design: Any) -> None:
             raise SpecError(field, f"{count} {what} × {total} teeth = {count * total}, over the bound of {bound} "
                                    f"(every pose moves both toothed outlines); at most {max(1, bound // total)} "
                                    f"{what} with {total} teeth")
+
+
+def _linkage_pose_work(design: Any) -> None:
+    """Poses × bodies of a linkage (the interference sweep and the statics visit every pose of every part)."""
+    spec = design.method
+    bodies = len(spec.mechanism.bodies) if hasattr(spec, "mechanism") else len(spec.bodies)
+    poses = int(design.checks.sweep_poses)
+    if poses * bodies > MAX_LINKAGE_POSE_BODIES:
+        raise SpecError("checks.sweep_poses", f"{poses} poses × {bodies} bodies = {poses * bodies}, over the bound of "
+                                              f"{MAX_LINKAGE_POSE_BODIES} (the checks go through every pose of every "
+                                              f"part); at most {MAX_LINKAGE_POSE_BODIES // bodies} poses with "
+                                              f"{bodies} bodies")
 
 
 def _linkage_solver_work(design: Any) -> None:
@@ -335,9 +352,10 @@ def check_expression(text: str, path: str) -> None:
 
 # -- processes and threads -------------------------------------------------------------------------
 
-#: Measured peak resident memory (MB) of one local Dask worker process of ``fabricate sweep`` (its imports
-#: and the points it builds); ``--workers`` is bounded by the available memory divided by it.
-WORKER_MB = 450.0
+#: Peak resident memory (MB) of one local Dask worker process of ``fabricate sweep``: its imports and the builds
+#: it runs (idle, a worker holds about 75 MB; building the shipped Stephenson six-bar at 90 to 720 poses each of
+#: two workers peaked at 474 MB). ``--workers`` is bounded by the available memory divided by it.
+WORKER_MB = 500.0
 #: Environment variables that set the thread count of the BLAS libraries numpy and scipy may load.
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
 

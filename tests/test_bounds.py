@@ -347,3 +347,61 @@ def test_blas_threads_pins_and_restores() -> None:
     assert [int(get()) for get, _ in controls] == before
     if os.environ.get("OPENBLAS_NUM_THREADS", "1") == "1":
         assert all(n == 1 for n in inside)
+
+
+def test_linkage_poses_times_bodies_at_the_bound_validate_and_past_it_are_refused() -> None:
+    poses = bounds.MAX_LINKAGE_POSE_BODIES // bounds.MAX_LINKAGE_BODIES
+    kw = dict(gears=0, sliders=0)  # revolutes only: the solver's estimate is not what binds
+    design_from_text(_worst_linkage(poses=poses, **kw), "w.toml")
+    with pytest.raises(SpecError) as info:
+        design_from_text(_worst_linkage(poses=poses + 1, **kw), "w.toml")
+    assert info.value.path == "checks.sweep_poses"
+    assert f"over the bound of {bounds.MAX_LINKAGE_POSE_BODIES}" in info.value.message
+    assert f"at most {poses} poses with {bounds.MAX_LINKAGE_BODIES} bodies" in info.value.message
+
+
+def _worst_linkage(**kw: object) -> str:
+    from tests.benchmarks.bench_bounds import worst_linkage
+
+    return toml_text(worst_linkage(**kw))
+
+
+def test_linkage_solver_estimate_refuses_poses_past_its_bound_and_names_the_most() -> None:
+    # 8 gear expressions of the most characters: each field is within its bound, the solver's work is not
+    kw = dict(gears=bounds.MAX_LINKAGE_GEARS, teeth=12, expression=bounds.MAX_EXPRESSION_LENGTH, sliders=6)
+    poses = bounds.MAX_LINKAGE_POSE_BODIES // bounds.MAX_LINKAGE_BODIES  # the most poses × bodies allow
+    with pytest.raises(SpecError) as info:
+        design_from_text(_worst_linkage(poses=poses, **kw), "w.toml")
+    assert info.value.path == "checks.sweep_poses", info.value
+    assert "s of solving estimated" in info.value.message
+    most = int(re.search(r"at most (\d+) poses", info.value.message).group(1))
+    assert 361 < most < poses
+    design_from_text(_worst_linkage(poses=most, **kw), "w.toml")  # the bound itself validates
+    with pytest.raises(SpecError) as info:
+        design_from_text(_worst_linkage(poses=most + 1, **kw), "w.toml")
+    assert info.value.path == "checks.sweep_poses"
+
+
+def test_linkage_gear_teeth_in_all_at_the_bound_validate_and_past_it_are_refused() -> None:
+    per_gear = bounds.MAX_LINKAGE_GEAR_TEETH // 4  # two pairs
+    poses = bounds.MAX_LINKAGE_POSE_TEETH // bounds.MAX_LINKAGE_GEAR_TEETH
+    kw = dict(gears=2, expression=60, sliders=0, poses=poses)
+    design_from_text(_worst_linkage(teeth=per_gear, **kw), "w.toml")
+    with pytest.raises(SpecError) as info:
+        design_from_text(_worst_linkage(teeth=per_gear + 1, **kw), "w.toml")
+    assert info.value.path == "gears.teeth"
+    assert f"{4 * (per_gear + 1)} teeth in all, over the bound of {bounds.MAX_LINKAGE_GEAR_TEETH}" \
+        in info.value.message
+    # the poses × teeth product: the most poses with these teeth, and one more
+    with pytest.raises(SpecError) as info:
+        design_from_text(_worst_linkage(teeth=per_gear, **{**kw, "poses": poses + 1}), "w.toml")
+    assert info.value.path == "checks.sweep_poses" and f"at most {poses} poses" in info.value.message
+
+
+def test_pin_blas_threads_sets_one_thread_unless_the_environment_chose(monkeypatch: pytest.MonkeyPatch) -> None:
+    for name in bounds.BLAS_THREAD_VARIABLES:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "2")
+    bounds.pin_blas_threads()
+    assert os.environ["OPENBLAS_NUM_THREADS"] == "2"  # the user's choice stands
+    assert all(os.environ[name] == "1" for name in bounds.BLAS_THREAD_VARIABLES[1:])

@@ -9,6 +9,7 @@ are the parametrised tests of test_cli.py and test_export.py.
 from __future__ import annotations
 
 import math
+import os
 import re
 import sys
 from pathlib import Path
@@ -498,3 +499,38 @@ def test_table_driver_maps_the_input_to_the_joint_and_is_zero_at_the_reference()
     with pytest.raises(SpecError) as info:
         design_from_text(text.replace("value = [0.0, 45.0, 90.0]", "value = [10.0, 45.0, 90.0]"), "t.toml")
     assert info.value.path == "linkage.drivers[0].value" and "0 there" in info.value.message
+
+
+def test_synthesis_solves_with_one_blas_thread_and_restores_the_count(monkeypatch: pytest.MonkeyPatch) -> None:
+    # OpenBLAS's threads on a 117-unknown solve wait for each other on busy cores (42 s against 2 s)
+    from fabricate import bounds
+    from fabricate.mechanism import Mechanism
+
+    def counts() -> list[int]:
+        return [int(get()) for get, _ in bounds._openblas_controls()]
+
+    design = load_design(TEMPLATE_DIR / "linkage_stephenson.toml")
+    before, seen = counts(), []
+    original = Mechanism.sweep
+
+    def spy(self: Mechanism, inputs: object = None) -> object:
+        seen.append(counts())
+        return original(self, inputs)
+
+    monkeypatch.setattr(Mechanism, "sweep", spy)
+    synthesise(design)
+    assert seen and counts() == before
+    if "OPENBLAS_NUM_THREADS" not in os.environ:  # else the environment's count stands
+        assert all(n == 1 for during in seen for n in during)
+
+
+def test_exact_form_synthesis_solves_the_sweep_the_pipeline_asks_for() -> None:
+    from fabricate.synthesis.linkage.exact import mechanism_toml
+    from fabricate.synthesis.linkage.mechanism import build_mechanism
+
+    design = load_design(TEMPLATE_DIR / "linkage_stephenson.toml")
+    text = mechanism_toml(design, build_mechanism(design.name, design.method), {}).decode("utf-8")
+    exact = design_from_text(text, "mechanism.toml")
+    mech = synthesise(exact).mechanism
+    inputs = np.linspace(*mech.input_range, exact.checks.sweep_poses)
+    assert inputs.tobytes() in mech.__dict__.get("_sweep_cache", {})  # the pipeline's sweep is this one

@@ -229,9 +229,12 @@ def _largest(make: Any, lo: int, hi: int) -> int:
 
 
 def linkage_poses() -> dict[str, Any]:
-    """The worst linkage for the poses: the most poses, two gear pairs with the most teeth that 5000 poses
-    allow (the poses × teeth bound), and the most sliders the solver's estimate then allows."""
-    kw = dict(gears=2, teeth=bounds.MAX_LINKAGE_POSE_TEETH // bounds.MAX_SWEEP_POSES // 4, expression=60)
+    """The worst linkage for the poses: the most bodies and the most poses they allow (the poses × bodies
+    bound), two gear pairs with the most teeth those poses allow (poses × teeth), and the most sliders the
+    solver's estimate then allows."""
+    poses = min(bounds.MAX_SWEEP_POSES, bounds.MAX_LINKAGE_POSE_BODIES // bounds.MAX_LINKAGE_BODIES)
+    teeth = min(bounds.MAX_LINKAGE_POSE_TEETH // poses, bounds.MAX_LINKAGE_GEAR_TEETH) // 4
+    kw = dict(poses=poses, gears=2, teeth=teeth, expression=60)
     sliders = _largest(lambda n: worst_linkage(sliders=n, **kw), 0, 18)
     return worst_linkage(sliders=sliders, **kw)
 
