@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -183,3 +184,22 @@ def test_every_text_field_takes_hostile_text_without_a_bug(tmp_path, capsys):
             ran.append(_dotted(path))
     # load.torque_body names a body: a build checks it against the mechanism's (synth has no load)
     assert ran == ["design.description", "load.torque_body", "load.source"]
+
+
+@pytest.mark.parametrize(("template", "path", "value", "needle"), [
+    # a spring grid of k2 = 0 only holds nothing: the optimiser's "no point" was a bare ValueError (exit 3)
+    ("gripper_compliant.toml", ("optimisation", "k2_Nmm_per_deg"), [0.0, 0.0, 1.0],
+     "no point of the [optimisation] grid holds the object"),
+    # a 0.14 mm crank locks at once: a zero-length stroke made the driver law's spline raise (exit 3)
+    ("finger_underactuated.toml", ("push_rod", "crank_mm"), 0.14, "the finger does not close"),
+])
+def test_valid_but_hopeless_values_are_synthesis_errors(template, path, value, needle, tmp_path, capsys):
+    """Found by scaling every numeric field of each kind's template by 0, -1, 1e6 and 1e-6 (synth stage):
+    values inside every bound that leave synthesis nothing to find exit 2 saying what to change."""
+    data = parse_toml(TEMPLATES[template], "t")
+    _set(data, path, value)
+    source, out = tmp_path / "t.toml", tmp_path / "out"
+    source.write_text(toml_text(data), encoding="utf-8")
+    code, err = _run(["synth", str(source), "-o", str(out), "-q"], capsys)
+    assert code == 2 and needle in err, err
+    assert not out.exists()

@@ -52,6 +52,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fabricate.errors import SynthesisError
 from fabricate.synthesis.compliant.model import (
     DEG_PER_RAD,
     ContactPath,
@@ -357,8 +358,10 @@ def optimise(geom: GripperGeometry, grid: ParameterGrid, load: Load, samples: in
         ia, ic, tab = tables[t]
         searched[t] = _search_path(tab, bounds[t], grid, load, hinge_margin, (ia, ic), state)
         paths_searched += 1
-    if state.where is None:
-        raise ValueError("no grid point gives a valid grasp")
+    if state.where is None:  # the template's grid, not fabricate, has no answer: exit 2 naming what to change
+        raise SynthesisError("compliant_gripper: no point of the [optimisation] grid holds the object with both "
+                             "hinges min_hinge_deg off their stops; widen the grid's ranges (k1, k2, phi01, "
+                             "phi02, alpha, c) or lower min_hinge_deg")
     pruned = min((float(b[~s].min()) for b, s in zip(bounds, searched, strict=True) if (~s).any()),
                  default=np.inf)
     # the certificate: an interval is left unsearched only when its bound is not below the incumbent,

@@ -600,6 +600,10 @@ def synthesise(design) -> SynthesisResult:
     spec: UnderactuatedSpec = design.method
     d = spec.design
     motion = closing_motion(spec, with_object=True)
+    if motion.strokes[-1] < 1e-3:  # the driver law needs a stroke to span (a 0.14 mm crank stopped at 0)
+        raise SynthesisError(f"underactuated: the finger does not close: the push rod stops at stroke "
+                             f"{motion.strokes[-1]:.3g} mm (the linkage locks or meets the object at once); "
+                             "check the [push_rod] and [transmission] dimensions")
     free = closing_motion(spec, with_object=False, stroke=float(motion.strokes[-1]))
     final = final_contact_forces(spec, motion)
     mech = build_mechanism(spec, motion, design.name)
