@@ -242,7 +242,9 @@ def _linkage_solver_work(design: Any) -> None:
     else:
         sliders = sum(j.type != "revolute" for j in spec.joints)
         gears, drivers = len(spec.gears), len(spec.drivers)
-        expressions = [(k, len(g.expression)) for k, g in enumerate(spec.gears) if g.expression is not None]
+        # an elliptic law is a formula too (at most 60 characters: fabricate.gears.law.elliptic_formula)
+        expressions = [(k, len(g.expression) if g.expression is not None else 60) for k, g in enumerate(spec.gears)
+                       if g.law in ("expression", "elliptic")]
     chars = sum(n for _, n in expressions)
     jacobian = (SOLVER_JACOBIAN_S + SOLVER_SLIDER_S * sliders + SOLVER_GEAR_S * gears + SOLVER_DRIVER_S * drivers
                 + SOLVER_EXPRESSION_CHAR_S * chars)

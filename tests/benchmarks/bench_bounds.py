@@ -89,11 +89,11 @@ WORST: dict[str, tuple[str, dict[tuple[str, str], Any]]] = {
 
 
 def _expression(length: int) -> str:
-    """A closed gear law of ``length`` characters: the 1:1 law plus tiny harmonics (ratio 1 ± 1e-4, so
-    the pitch curves stay round and the teeth cut), y(0) = 0 and repeating after a turn."""
+    """A closed gear law of ``length`` characters: the 1:1 law plus tiny harmonics (so the pitch curves stay
+    round and the teeth cut), y(0) = 0 and repeating after a turn."""
     text, k = "x", 1
     while True:
-        term = f" + 1e-06*sin({k}*x)"
+        term = f" + 1e-09*sin({k}*x)"
         if len(text) + len(term) > length:
             break
         text, k = text + term, k + 1
@@ -228,13 +228,13 @@ def _largest(make: Any, lo: int, hi: int) -> int:
     return lo
 
 
-def linkage_poses() -> dict[str, Any]:
+def linkage_poses(table: int = bounds.MAX_LINKAGE_TABLE) -> dict[str, Any]:
     """The worst linkage for the poses: the most bodies and the most poses they allow (the poses × bodies
     bound), two gear pairs with the most teeth those poses allow (poses × teeth), and the most sliders the
     solver's estimate then allows."""
     poses = min(bounds.MAX_SWEEP_POSES, bounds.MAX_LINKAGE_POSE_BODIES // bounds.MAX_LINKAGE_BODIES)
     teeth = min(bounds.MAX_LINKAGE_POSE_TEETH // poses, bounds.MAX_LINKAGE_GEAR_TEETH) // 4
-    kw = dict(poses=poses, gears=2, teeth=teeth, expression=60)
+    kw = dict(poses=poses, gears=2, teeth=teeth, expression=60, table=table)
     sliders = _largest(lambda n: worst_linkage(sliders=n, **kw), 0, 18)
     return worst_linkage(sliders=sliders, **kw)
 
@@ -250,16 +250,25 @@ def linkage_gears() -> dict[str, Any]:
 
 def worst_exact(copies: int = bounds.MAX_COPIES) -> str:
     """The worst exact form: the poses-worst linkage's ``mechanism.toml`` (every body at the point bound, laws
-    by their coefficients or samples) with ``hints.copies`` at its bound, as the build writes it."""
-    from fabricate.spec import design_from_text
+    by their coefficients or samples) with ``hints.copies`` at its bound, as the build writes it.
+
+    The driver's table is halved until the file fits :data:`fabricate.spec.MAX_TEMPLATE_BYTES` (its 10000
+    samples alone write 1.2 MB of PCHIP coefficients: the exact form of such a linkage is refused).
+    """
+    from fabricate.spec import MAX_TEMPLATE_BYTES, design_from_text
     from fabricate.synthesis.linkage.exact import mechanism_toml
     from fabricate.synthesis.linkage.mechanism import build_mechanism
 
-    design = design_from_text(toml_text(linkage_poses()), "worst_linkage.toml")
-    mechanism = build_mechanism(design.name, design.method)
-    hints = {"copies": copies, "tip_point": "A", "pads": {p.body: {"point": p.point, "radius_mm": p.radius_mm}
-                                                          for p in design.method.pads}}
-    return mechanism_toml(design, mechanism, hints).decode("utf-8")
+    table = bounds.MAX_LINKAGE_TABLE
+    while True:
+        design = design_from_text(toml_text(linkage_poses(table)), "worst_linkage.toml")
+        mechanism = build_mechanism(design.name, design.method)
+        hints = {"copies": copies, "tip_point": "A",
+                 "pads": {p.body: {"point": p.point, "radius_mm": p.radius_mm} for p in design.method.pads}}
+        text = mechanism_toml(design, mechanism, hints)
+        if len(text) <= MAX_TEMPLATE_BYTES:
+            return text.decode("utf-8")
+        table //= 2
 
 
 #: Generated kinds: the declared linkage and its exact form.
