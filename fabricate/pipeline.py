@@ -8,11 +8,12 @@ and the template text itself, so ``fabricate check DIR`` can verify the files an
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import hashlib
 import multiprocessing
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,7 +21,7 @@ from typing import Any
 from fabricate import __version__
 from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
 from fabricate.mechanism import Mechanism, Motion
-from fabricate.report import report_json, report_markdown
+from fabricate.report import SYNTH_ONLY, report_json, report_markdown
 from fabricate.spec import DesignSpec
 from fabricate.synthesis import KINDS
 from fabricate.synthesis.base import SynthesisResult
@@ -107,12 +108,35 @@ def _synthesis_stage(design: DesignSpec, progress: Progress, stage: str
     return result, report, motion, []
 
 
+@dataclass(frozen=True)
+class OptionalOutputs:
+    """Which optional outputs a build makes, when not what this install can make.
+
+    ``fabricate check`` rebuilds a folder with the outputs its build recorded (``report.outputs``), so its
+    verdict does not depend on the checker's install.
+
+    Attributes
+    ----------
+    step : bool
+        Write the STEP files (``parts/*.step``, ``assembly.step``) and report them as written.
+    step_files : mapping of str to bytes, optional
+        Files to hand over in place of a STEP export (the folder's own, verified against its manifest,
+        where the checker has no OCP); None exports them.
+    """
+
+    step: bool
+    step_files: Mapping[str, bytes] | None = None
+
+
 def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     """Synthesis only: report.json with design, mechanism and synthesis, plus the method's plots."""
     result, report, motion, failures = _synthesis_stage(design, progress, "synth")
     progress("plots")
     files = synthesis_plots(result)
-    report["checks"] = {"passed": not failures, "failures": failures}
+    # no check runs here: the report says so, so nothing reads as "checks passed"
+    report["checks"] = {"passed": not failures, "failures": failures,
+                        "not_checked": [{"check": name, "reason": SYNTH_ONLY}
+                                        for name in ("interference", "gear mesh", "printability", "strength")]}
     return _finish(design, report, files, exit_code=1 if failures else 0, synthesis=result, motion=motion)
 
 
@@ -127,8 +151,11 @@ def _kernel_failures() -> tuple[type[BaseException], ...]:
             FloatingPointError, OverflowError, ZeroDivisionError, ValueError)
 
 
-def run_build(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
+def run_build(design: DesignSpec, progress: Progress = _quiet, *,
+              optional: OptionalOutputs | None = None) -> BuildOutcome:
     """The whole pipeline in memory.
+
+    ``optional`` fixes the optional outputs (STEP) instead of making what this install can make.
 
     A geometry or numeric kernel failing after synthesis (GEOS, manifold, a singular matrix) is a design
     failure named in the report with the stage it happened in (exit code 1), never a bare exception.
@@ -144,7 +171,7 @@ def run_build(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
         return _finish(design, report, {}, exit_code=1, synthesis=result)
     stage = ["gears"]
     try:
-        return _build_stages(design, result, report, motion, progress, stage)
+        return _build_stages(design, result, report, motion, progress, stage, optional)
     except (SpecError, SynthesisError):
         raise
     except _kernel_failures() as exc:
@@ -158,7 +185,7 @@ def run_build(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
 
 
 def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str, Any], motion: Motion,
-                  progress: Progress, stage: list[str]) -> BuildOutcome:
+                  progress: Progress, stage: list[str], optional: OptionalOutputs | None = None) -> BuildOutcome:
     """Gears, parts, exports, checks and pictures; ``stage[0]`` names the stage running (for failures)."""
     from fabricate.checks import run_checks
     from fabricate.export import STEP_SKIPPED, assembly_csv, export_all, export_previews, export_step, motion_csv
@@ -191,14 +218,27 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
                                                     for w, sf in tried]}
     enter("parts")
     partset = build_parts(design, mechanism, motion, gear_pairs, result.parts)
+    def step_job() -> dict[str, bytes]:
+        if optional is None:
+            return export_step(design, partset, motion)
+        if not optional.step:
+            return {}
+        return dict(optional.step_files) if optional.step_files is not None else export_step(design, partset,
+                                                                                             motion)
+
     # pictures take as long as everything else: draw them in a forked child on the second core
     pictures = Background([lambda: synthesis_plots(result), lambda: gear_pictures(gear_pairs),
-                           lambda: export_previews(design, partset, motion),
-                           lambda: export_step(design, partset, motion)])
-    report["notes"] = [] if step_available() else [STEP_SKIPPED]
+                           lambda: export_previews(design, partset, motion), step_job])
     try:
+        # inside the try: this may import OCP (slow), and a stop signal landing here must cancel the child
+        with_step = step_available() if optional is None else optional.step
+        report["notes"] = [] if with_step else [STEP_SKIPPED]
+        # optional outputs as written or skipped: `check` rebuilds with the same set, so its verdict does not
+        # depend on the checker's install (fabricate/verify.py)
+        report["outputs"] = {"step": "written" if with_step else "skipped: OCP is not installed (extra 'cad')"}
         enter("exports")
-        exported, parts_report = export_all(design, partset, mechanism, motion, previews=False, step=False)
+        exported, parts_report = export_all(design, partset, mechanism, motion, previews=False, step=False,
+                                             with_step=with_step)
         files.update(exported)
         report["parts"] = parts_report
         report["bom"] = list(getattr(partset, "bom", []))
@@ -219,7 +259,11 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
         if sizing is not None:
             report["strength"]["sizing"] = sizing
         failures += strength.failures()
-        report["checks"] = {"passed": not failures, "failures": failures}
+        # passed is over the checks that ran; those that could not run are listed, never passed
+        not_checked = [dict(entry) for entry in checks.not_checked]
+        if strength.reason is not None:
+            not_checked.append({"check": "strength", "reason": strength.reason})
+        report["checks"] = {"passed": not failures, "failures": failures, "not_checked": not_checked}
         enter("plots")
         if strength.findings:
             files["plots/strength.png"] = strength_plot(strength, mechanism.input_unit)
@@ -258,11 +302,64 @@ def _run_jobs(jobs: list[Callable[[], dict[str, bytes]]]) -> dict[str, bytes]:
     return files
 
 
-def _child(jobs: list[Callable[[], dict[str, bytes]]], conn: Any) -> None:
+def _die_with_parent(parent: int) -> None:
+    """Make this forked child die with ``parent``, even when the parent is killed by SIGKILL.
+
+    On Linux the kernel sends SIGKILL when the parent goes (``PR_SET_PDEATHSIG``); the parent may have died
+    between the fork and this call, so the parent is looked at again after the signal is armed. The death
+    signal fires when the forking *thread* ends: :class:`Background` is collected or cancelled by the thread
+    that made it, which therefore outlives the child.
+    """
+    import signal
+    import sys
+
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        pr_set_pdeathsig = 1
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):  # no prctl in this libc: the getppid check below still holds
+            pass
+    if os.getppid() != parent:  # orphaned already: nobody will read the result
+        os._exit(1)
+
+
+def _detach_from_caller() -> None:
+    """Let the caller's signals kill the child at once, and give its stdout/stderr back.
+
+    The CLI's handlers (SIGTERM or SIGHUP raised as an exception) are copied by the fork; in the child the
+    default action is right, since it holds no file to clean up. A signal the caller ignores stays ignored.
+    The child's fds 1 and 2 go to /dev/null, so a caller reading this process's output to the end never
+    waits for the child, and the parent's unflushed buffers copied by the fork are not printed twice.
+    """
+    import signal
+
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        number = getattr(signal, name, None)
+        if number is not None and callable(signal.getsignal(number)):
+            signal.signal(number, signal.SIG_DFL)
+    devnull = os.open(os.devnull, os.O_WRONLY)
     try:
+        for fd in (1, 2):
+            os.dup2(devnull, fd)
+    finally:
+        os.close(devnull)
+
+
+def _child(jobs: list[Callable[[], dict[str, bytes]]], conn: Any, parent: int = 0, receiver: Any = None) -> None:
+    try:
+        if parent:
+            _die_with_parent(parent)
+        _detach_from_caller()
+        if receiver is not None:
+            # the fork copied the parent's end of the pipe: holding it, this child would block forever on a
+            # full pipe once the parent is gone, instead of failing with EPIPE
+            receiver.close()
         conn.send((True, _run_jobs(jobs)))
     except BaseException as exc:  # the parent redoes the work serially and raises there
-        conn.send((False, repr(exc)))
+        with contextlib.suppress(BaseException):  # the parent may be gone: nothing is left to tell
+            conn.send((False, repr(exc)))
     finally:
         conn.close()
 
@@ -272,7 +369,9 @@ class Background:
 
     Where ``fork`` is unavailable, or ``FABRICATE_SERIAL`` is set, or this process is a daemon (a Dask
     worker), or the child fails, the jobs run in the calling process when :meth:`result` is asked for, so
-    the outcome never depends on it.
+    the outcome never depends on it. Call :meth:`cancel` in a ``finally``: the child is killed and reaped
+    however the caller ends; on Linux it also dies with its parent (a SIGKILL of the parent included) and
+    never holds the parent's stdout or stderr.
     """
 
     def __init__(self, jobs: list[Callable[[], dict[str, bytes]]]) -> None:
@@ -284,15 +383,20 @@ class Background:
             return
         ctx = multiprocessing.get_context("fork")
         self._conn, sender = ctx.Pipe(duplex=False)
-        self._process = ctx.Process(target=_child, args=(jobs, sender), daemon=True)
-        self._process.start()
-        sender.close()
+        self._process = ctx.Process(target=_child, args=(jobs, sender, os.getpid(), self._conn), daemon=True)
+        try:
+            self._process.start()
+        except OSError:  # no fork now (EAGAIN, ENOMEM): the jobs run here when asked for
+            self._process = None
+            self._conn.close()
+        finally:
+            sender.close()
 
     def result(self) -> dict[str, bytes]:
         if self._process is not None:
             try:
                 ok, payload = self._conn.recv()
-            except (EOFError, OSError):
+            except Exception:  # noqa: BLE001 - EOF (the child died), a broken or unreadable pickle: redo it here
                 ok, payload = False, None
             self._conn.close()
             self._process.join()
@@ -302,9 +406,13 @@ class Background:
         return _run_jobs(self.jobs)
 
     def cancel(self) -> None:
-        """Stop the child if its result was never asked for (the build failed or was interrupted)."""
+        """Kill the child if its result was never collected (the build failed or was interrupted).
+
+        SIGKILL, not SIGTERM: the child writes no file, so nothing is lost, and no handler it may have
+        inherited can delay it.
+        """
         if self._process is not None:
-            self._process.terminate()
+            self._process.kill()
             self._process.join()
             self._conn.close()
             self._process = None

@@ -41,16 +41,14 @@ Nothing here writes files.
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import hashlib
 import io
 import json
 import os
 import stat
-import threading
 import zipfile
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path, PurePosixPath
 from typing import Any
 
@@ -573,35 +571,6 @@ def _recorded_step(report: Mapping[str, Any]) -> bool | None:
     return any(str(m.get("path")).endswith(".step") for m in report.get("manifest", []) if isinstance(m, dict))
 
 
-_REBUILD_LOCK = threading.Lock()
-
-
-@contextlib.contextmanager
-def _optional_outputs_as(step_written: bool | None, step_bytes: Mapping[str, bytes] | None) -> Iterator[None]:
-    """Let the rebuild make the optional outputs the folder's build made, whatever this install can make.
-
-    The pipeline asks :func:`fabricate.export.step.step_available` whether to write STEP (and records the
-    answer in the report, report.md and the manifest); for the rebuild it answers as the folder's build
-    did. Where STEP was written but OCP is not installed here, the files STEP export would return are
-    the folder's own (verified against the manifest), so every other file, report.json and report.md
-    included, is compared byte for byte. Serialised by a lock: the answer is the module's for the while.
-    """
-    import fabricate.export.step as step
-
-    if step_written is None or (step_written == step.step_available() and step_bytes is None):
-        yield
-        return
-    with _REBUILD_LOCK:
-        saved = step.step_available, step.step_files
-        step.step_available = lambda: step_written
-        if step_bytes is not None:
-            step.step_files = lambda *_args, **_kwargs: dict(step_bytes)
-        try:
-            yield
-        finally:
-            step.step_available, step.step_files = saved
-
-
 def _folder_step_files(folder: OutputFolder, report: Mapping[str, Any]) -> dict[str, bytes]:
     """The folder's STEP files that match their manifest entries (stand-ins for a rebuild without OCP)."""
     entries, _problems = _manifest(report)
@@ -621,7 +590,7 @@ def _folder_step_files(folder: OutputFolder, report: Mapping[str, Any]) -> dict[
 def _rebuild(folder: OutputFolder, report: Mapping[str, Any], raw: bytes, progress: Callable[[str], None],
              notes: list[str]) -> tuple[list[str], dict[str, Any] | None]:
     from fabricate.export.step import step_available
-    from fabricate.pipeline import run_build, run_synth
+    from fabricate.pipeline import OptionalOutputs, run_build, run_synth
     from fabricate.spec import ProcessOverride, design_from_text
 
     text = report.get("template_text")
@@ -645,7 +614,10 @@ def _rebuild(folder: OutputFolder, report: Mapping[str, Any], raw: bytes, progre
         not_comparable = {str(m["path"]) for m in report.get("manifest", []) if str(m["path"]).endswith(".step")}
         notes.append(_STEP_NOT_COMPARABLE.format(n=len(not_comparable)))
     try:
-        with _optional_outputs_as(step_written, stand_ins):
+        if runner is run_build and step_written is not None:
+            # the optional outputs the folder's build made, whatever this install can make
+            outcome = run_build(design, progress, optional=OptionalOutputs(step_written, stand_ins))
+        else:
             outcome = runner(design, progress)
     except FabricateError as exc:  # the embedded template no longer builds (nothing feasible, a bound)
         return [f"{REPORT}: the embedded template cannot be built again: {exc}"], None

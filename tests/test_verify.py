@@ -45,12 +45,15 @@ def _one_rebuild_per_template(monkeypatch):
 
     real = pipeline.run_build
 
-    def cached(design, progress=lambda _m: None):
+    def cached(design, progress=lambda _m: None, *, optional=None):
         from fabricate.export.step import step_available
 
-        key = (Path(design.template).name, design.template_text, step_available())
+        if optional is not None and optional.step_files is not None:  # stand-ins: never cached
+            return real(design, progress, optional=optional)
+        step = step_available() if optional is None else optional.step
+        key = (Path(design.template).name, design.template_text, step)
         if key not in _REBUILDS:
-            _REBUILDS[key] = real(design, progress)
+            _REBUILDS[key] = real(design, progress, optional=optional)
         return _REBUILDS[key]
 
     monkeypatch.setattr(pipeline, "run_build", cached)

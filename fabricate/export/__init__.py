@@ -75,7 +75,7 @@ def motion_csv(mechanism: Any, motion: Any) -> bytes:
 
 
 def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews: bool = True,
-               step: bool = True) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
+               step: bool = True, with_step: bool | None = None) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
     """Every export of a part set.
 
     Parameters
@@ -92,6 +92,9 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     step : bool
         Include the STEP files when OCP is installed (the pipeline makes them separately, see
         :func:`export_step`); the report names their paths either way.
+    with_step : bool, optional
+        Whether STEP files are part of this build (default: whether OCP is installed); ``fabricate check``
+        rebuilds with the answer the folder's build recorded.
 
     Returns
     -------
@@ -150,7 +153,8 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     where: dict[str, list[Any]] = {}
     for part, placement in zip(made, placements, strict=True):
         where.setdefault(part.name, []).append(placement)
-    with_step = step_available()  # optional extra `cad` (OCP); without it no STEP files, "step": None
+    if with_step is None:  # optional extra `cad` (OCP); without it no STEP files, "step": None
+        with_step = step_available()
     for part in parts:
         stl_path, dxf_path = f"parts/{part.name}.stl", f"drawings/{part.name}.dxf"
         stl = part_stl(part, cache)
