@@ -50,8 +50,17 @@ class Build:
 
     @property
     def passed(self) -> bool:
-        """Whether every check (interference, gears, printability, strength) passed."""
+        """Whether no check that ran failed (the CLI's exit code 0). A check that could not run (strength
+        without materials or a load) is not a failure: :attr:`not_checked` names it."""
         return self.exit_code == 0
+
+    @property
+    def not_checked(self) -> list[str]:
+        """The checks that could not run, each with why (``"strength not checked: no [load] in the
+        template"``); empty when everything was checked."""
+        from fabricate.report import not_checked_notes
+
+        return not_checked_notes(self.report)
 
     @property
     def failures(self) -> list[str]:

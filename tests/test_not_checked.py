@@ -201,3 +201,11 @@ def test_report_json_writes_null_for_infinite_values():
     text = report_json({"strength": {"parts": [{"min_safety_factor": math.inf}], "x": -math.inf, "y": math.nan}})
     data = json.loads(text, parse_constant=lambda token: pytest.fail(f"non-JSON {token}"))
     assert data == {"strength": {"parts": [{"min_safety_factor": None}], "x": None, "y": None}}
+
+
+def test_the_api_names_what_was_not_checked() -> None:
+    """``Build.not_checked`` says what ``passed`` does not cover (issue 23 item 5)."""
+    unloaded = fabricate.build(fabricate.load(_tables(load=False)))
+    assert unloaded.passed and unloaded.not_checked == ["strength not checked: " + NO_LOAD]
+    loaded = fabricate.build(fabricate.load(_tables(load=True)))
+    assert loaded.passed and loaded.not_checked == []
