@@ -107,12 +107,13 @@ MAX_EXPRESSION_DEPTH = 100
 #: Linkage solver (both forms of kind ``linkage``): CPU seconds of one Jacobian of the worst linkage (40
 #: bodies, one BLAS thread), and what each slider, gear pair, driver and character of a gear expression adds
 #: (Python rows; a formula is evaluated node by node, value and slope). Measured: 0.55 ms with 6 sliders and
-#: 8 constant-ratio gears, 1.4 ms with 18 sliders, 4.2 ms with 8 gear expressions of 1000 characters.
+#: 8 constant-ratio gears, 1.4 ms with 18 sliders, 4.2 ms with 8 gear expressions of 1000 characters (whose
+#: sweep of 648 poses then took 13.4 s: the character cost is set from that sweep).
 SOLVER_JACOBIAN_S = 1.2e-4
 SOLVER_SLIDER_S = 7.0e-5
 SOLVER_GEAR_S = 2.0e-5
 SOLVER_DRIVER_S = 3.0e-5
-SOLVER_EXPRESSION_CHAR_S = 4.6e-7
+SOLVER_EXPRESSION_CHAR_S = 6.5e-7
 #: Jacobians per continuation step (the tangent, the corrector's one or two iterations and the check; a step
 #: per pose above 360 poses, 360 steps below).
 SOLVER_JACOBIANS_PER_STEP = 3.5
@@ -120,14 +121,20 @@ SOLVER_JACOBIANS_PER_STEP = 3.5
 MAX_SOLVER_S = 10.0
 #: Linkage kind: ``checks.sweep_poses`` × bodies. The interference sweep and the statics go through every pose
 #: of every part: 40 bodies at 5000 poses took 99 s of CPU (one BLAS thread): checks 54 s (the interference
-#: sweep's clearance tests), the sweep 20 s, strength 16 s, exports 5 s, parts 6 s.
-MAX_LINKAGE_POSE_BODIES = 80_000
+#: sweep's clearance tests), the sweep 20 s, strength 16 s, exports 5 s, parts 6 s; at 2000 poses (15 sliders,
+#: 2 gear pairs of 37 + 37 teeth) 59 s of CPU, 49 s wall.
+MAX_LINKAGE_POSE_BODIES = 60_000
+#: Linkage kind: characters of all its gear expressions together. Each is evaluated at every solver step and
+#: throughout gear cutting: 8 expressions of 1000 characters took 13 s of solving (648 poses) and 10 s of
+#: cutting 8 pairs of 12 + 12 teeth.
+MAX_LINKAGE_EXPRESSION_CHARS = 2 * MAX_EXPRESSION_LENGTH
 #: Linkage kind: teeth of all its gear pairs together (z_a + z_b summed; a pair of the most teeth alone is 200:
 #: 8 pairs of 100 + 100 teeth spent 21 s cutting gears and 16 s laying out parts at 360 poses).
 MAX_LINKAGE_GEAR_TEETH = 2 * MAX_TEETH
 #: Linkage kind: ``checks.sweep_poses`` × the teeth of all its gear pairs (every pose moves every toothed
-#: outline through the layer and interference sweeps).
-MAX_LINKAGE_POSE_TEETH = 300_000
+#: outline through the layer and interference sweeps), as for the gear pair kind: 1408 poses × 192 teeth (8
+#: pairs, 40 bodies) took 62 s, 19 s of it in the checks.
+MAX_LINKAGE_POSE_TEETH = MAX_POSE_TEETH
 #: ``push_rod.samples`` (underactuated): stroke samples of the closing motion.
 MAX_STROKE_SAMPLES = 2001
 #: ``optimisation.path_samples`` (compliant gripper).
@@ -246,6 +253,11 @@ def _linkage_solver_work(design: Any) -> None:
         expressions = [(k, len(g.expression) if g.expression is not None else 60) for k, g in enumerate(spec.gears)
                        if g.law in ("expression", "elliptic")]
     chars = sum(n for _, n in expressions)
+    if chars > MAX_LINKAGE_EXPRESSION_CHARS:
+        raise SpecError(f"linkage.gears[{max(expressions, key=lambda e: e[1])[0]}].expression",
+                        f"the gear expressions have {chars} characters in all, over the bound of "
+                        f"{MAX_LINKAGE_EXPRESSION_CHARS} (each is evaluated at every step of the motion and "
+                        "throughout gear cutting); shorten them")
     jacobian = (SOLVER_JACOBIAN_S + SOLVER_SLIDER_S * sliders + SOLVER_GEAR_S * gears + SOLVER_DRIVER_S * drivers
                 + SOLVER_EXPRESSION_CHAR_S * chars)
     step = SOLVER_JACOBIANS_PER_STEP * jacobian

@@ -349,6 +349,17 @@ def test_blas_threads_pins_and_restores() -> None:
         assert all(n == 1 for n in inside)
 
 
+def test_linkage_gear_expressions_in_all_past_their_bound_are_refused() -> None:
+    each = bounds.MAX_LINKAGE_EXPRESSION_CHARS // bounds.MAX_LINKAGE_GEARS
+    kw = dict(gears=bounds.MAX_LINKAGE_GEARS, teeth=8, sliders=0, poses=100)
+    design_from_text(_worst_linkage(expression=each, **kw), "w.toml")
+    with pytest.raises(SpecError) as info:
+        design_from_text(_worst_linkage(expression=each + 1, **kw), "w.toml")
+    assert info.value.path == "linkage.gears[0].expression"
+    assert f"{bounds.MAX_LINKAGE_GEARS * (each + 1)} characters in all, over the bound of " \
+           f"{bounds.MAX_LINKAGE_EXPRESSION_CHARS}" in info.value.message
+
+
 def test_linkage_poses_times_bodies_at_the_bound_validate_and_past_it_are_refused() -> None:
     poses = bounds.MAX_LINKAGE_POSE_BODIES // bounds.MAX_LINKAGE_BODIES
     kw = dict(gears=0, sliders=0)  # revolutes only: the solver's estimate is not what binds
@@ -367,8 +378,9 @@ def _worst_linkage(**kw: object) -> str:
 
 
 def test_linkage_solver_estimate_refuses_poses_past_its_bound_and_names_the_most() -> None:
-    # 8 gear expressions of the most characters: each field is within its bound, the solver's work is not
-    kw = dict(gears=bounds.MAX_LINKAGE_GEARS, teeth=12, expression=bounds.MAX_EXPRESSION_LENGTH, sliders=6)
+    # gear expressions of the most characters and the most sliders: each field is within its bound, and so are
+    # the poses × bodies, but not the solver's work
+    kw = dict(gears=2, teeth=12, expression=bounds.MAX_LINKAGE_EXPRESSION_CHARS // 2, sliders=18)
     poses = bounds.MAX_LINKAGE_POSE_BODIES // bounds.MAX_LINKAGE_BODIES  # the most poses × bodies allow
     with pytest.raises(SpecError) as info:
         design_from_text(_worst_linkage(poses=poses, **kw), "w.toml")

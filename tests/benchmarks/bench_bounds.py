@@ -241,9 +241,10 @@ def linkage_poses(table: int = bounds.MAX_LINKAGE_TABLE) -> dict[str, Any]:
 
 def linkage_gears() -> dict[str, Any]:
     """The worst linkage for the gears: 8 pairs with the most teeth in all, gear expressions of the most
-    characters, and the most poses the solver's estimate and the poses × teeth bound then allow."""
+    characters in all, and the most poses the solver's estimate and the poses × teeth bound then allow."""
     teeth = bounds.MAX_LINKAGE_GEAR_TEETH // (2 * bounds.MAX_LINKAGE_GEARS)
-    kw = dict(gears=bounds.MAX_LINKAGE_GEARS, teeth=teeth, expression=bounds.MAX_EXPRESSION_LENGTH, sliders=6)
+    expression = min(bounds.MAX_EXPRESSION_LENGTH, bounds.MAX_LINKAGE_EXPRESSION_CHARS // bounds.MAX_LINKAGE_GEARS)
+    kw = dict(gears=bounds.MAX_LINKAGE_GEARS, teeth=teeth, expression=expression, sliders=6)
     poses = _largest(lambda n: worst_linkage(poses=n, **kw), 2, bounds.MAX_SWEEP_POSES)
     return worst_linkage(poses=poses, **kw)
 
