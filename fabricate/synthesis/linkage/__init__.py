@@ -33,7 +33,10 @@ Template tables
       ``"periodic"``; a closed pair needs ``"periodic"``: the law then repeats after 360° of x with
       ``y(x + 360) = y(x) + y_end - y_start``);
     - ``"expression"``: ``expression``, a formula in ``x`` (radians) giving ``y`` (radians), e.g.
-      ``"x + 0.2*sin(x)"`` (the functions of :data:`fabricate.gears.law.FUNCTIONS`).
+      ``"x + 0.2*sin(x)"`` (the functions of :data:`fabricate.gears.law.FUNCTIONS`; at most
+      :data:`~fabricate.bounds.MAX_EXPRESSION_LENGTH` characters and
+      :data:`~fabricate.bounds.MAX_EXPRESSION_DEPTH` levels of nesting, all of a linkage's together at most
+      :data:`~fabricate.bounds.MAX_LINKAGE_EXPRESSION_CHARS` characters).
 ``[[linkage.drivers]]`` (one per degree of freedom)
     ``joint`` (a revolute: the angle of ``bodies[1]`` against ``bodies[0]``; a slider: the displacement of
     its point along the axis), ``law`` (``"linear"``: value = input - reference; degrees become radians
@@ -58,7 +61,8 @@ pose is on the branch the template draws); a lock-up on that way is reported by 
 Validation
 ----------
 Every error is a :class:`~fabricate.errors.SpecError` naming the field (``linkage.joints[3].bodies``) and,
-for joints, the joint: unknown bodies or points, duplicate names, counts beyond :mod:`fabricate.bounds`,
+for joints, the joint: unknown bodies or points, duplicate names, counts beyond :mod:`fabricate.bounds`
+(and, by its preflight estimate, poses × bodies, the solver's work and the gears' teeth × poses),
 a linkage that does not assemble at the reference pose, degrees of freedom (Gruebler, gears one
 constraint each) that differ from the number of drivers. A lock-up inside the range is found by the
 pipeline's sweep: a :class:`~fabricate.errors.LockupError` naming the input value, the driven joint and

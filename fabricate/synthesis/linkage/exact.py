@@ -10,7 +10,11 @@ springs, purchased items, copies) come along, so the same parts come out byte fo
 kind (a method's own piecewise class) is written as dense samples under a PCHIP and the file says that
 its rebuild is close, not identical.
 
-Edit it by hand (move a point, change a law) and ``fabricate build mechanism.toml`` builds the edit.
+Edit it by hand (move a point, change a law) and ``fabricate build mechanism.toml`` builds the edit. The
+reader holds it to the declared linkage's bounds (bodies, joints, gears, drivers, points per body) and to
+its own: ``hints.copies`` at most :data:`~fabricate.bounds.MAX_COPIES`, a law's points at most
+:data:`~fabricate.bounds.MAX_EXACT_LAW_POINTS` and pieces of at most
+:data:`~fabricate.bounds.MAX_EXACT_LAW_ORDER` coefficients.
 """
 
 from __future__ import annotations
