@@ -128,13 +128,14 @@ MAX_LINKAGE_POSE_BODIES = 60_000
 #: throughout gear cutting: 8 expressions of 1000 characters took 13 s of solving (648 poses) and 10 s of
 #: cutting 8 pairs of 12 + 12 teeth.
 MAX_LINKAGE_EXPRESSION_CHARS = 2 * MAX_EXPRESSION_LENGTH
-#: Linkage kind: teeth of all its gear pairs together (z_a + z_b summed; a pair of the most teeth alone is 200:
-#: 8 pairs of 100 + 100 teeth spent 21 s cutting gears and 16 s laying out parts at 360 poses).
-MAX_LINKAGE_GEAR_TEETH = 2 * MAX_TEETH
+#: Linkage kind: teeth of all its gear pairs together (z_a + z_b summed). 8 pairs of 100 + 100 teeth spent 21 s
+#: cutting gears and 16 s laying out parts at 360 poses; 8 pairs of 12 + 12 at 781 poses took 69 s of CPU in
+#: all, 16 s of it the STEP export of the toothed parts at the finest chord tolerance.
+MAX_LINKAGE_GEAR_TEETH = 100
 #: Linkage kind: ``checks.sweep_poses`` × the teeth of all its gear pairs (every pose moves every toothed
-#: outline through the layer and interference sweeps), as for the gear pair kind: 1408 poses × 192 teeth (8
-#: pairs, 40 bodies) took 62 s, 19 s of it in the checks.
-MAX_LINKAGE_POSE_TEETH = MAX_POSE_TEETH
+#: outline through the layer and interference sweeps, among up to 40 bodies): 1408 poses × 192 teeth (8 pairs,
+#: 40 bodies) took 62 s wall, 19 s of it in the checks.
+MAX_LINKAGE_POSE_TEETH = 80_000
 #: ``push_rod.samples`` (underactuated): stroke samples of the closing motion.
 MAX_STROKE_SAMPLES = 2001
 #: ``optimisation.path_samples`` (compliant gripper).
@@ -370,10 +371,6 @@ def check_expression(text: str, path: str) -> None:
 #: it runs (idle, a worker holds about 75 MB; building the shipped Stephenson six-bar at 90 to 720 poses each of
 #: two workers peaked at 474 MB). ``--workers`` is bounded by the available memory divided by it.
 WORKER_MB = 500.0
-#: Environment variables that set the thread count of the BLAS libraries numpy and scipy may load.
-BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
-
-
 def available_cores() -> int:
     """Cores this process may run on (its CPU affinity where the platform has one)."""
     try:
@@ -427,28 +424,20 @@ def check_workers(workers: int, field: str = "--workers") -> None:
                            f"core{'s' if cores != 1 else ''}{held})")
 
 
-def pin_blas_threads() -> None:
-    """One BLAS thread in numpy and scipy loaded after this call (unless the environment sets a count).
-
-    fabricate's matrices are small (the solver's are at most 117 × 117): a second BLAS thread saves nothing,
-    and on busy cores the threads wait for each other. The worst linkage's sweep of 360 poses took 42 s with
-    OpenBLAS's default threads and 2 s with one, on two cores shared with other work. Environment variables
-    only take effect before numpy is imported; :func:`blas_threads` limits a library already loaded.
-    """
-    for name in BLAS_THREAD_VARIABLES:
-        os.environ.setdefault(name, "1")
-
-
 @contextlib.contextmanager
 def blas_threads(count: int = 1) -> Iterator[None]:
-    """Run the block with at most ``count`` threads in every OpenBLAS loaded (numpy's, scipy's), then restore.
+    """Run the block (or, as a decorator, the function) with at most ``count`` threads in every OpenBLAS
+    loaded (numpy's, scipy's), then restore the counts.
+
+    fabricate's matrices are small (the solver's are at most 117 × 117, the statics' as large): a second
+    BLAS thread saves nothing, and on busy cores OpenBLAS's threads wait for each other. A 117 × 117 solve
+    took 8.5 ms instead of 0.1 ms, so the worst linkage's sweep of 360 poses took 42 s instead of 2 s, and a
+    whole build with two threads 159 s of CPU instead of 54. The pin holds whatever the environment asks
+    (``OPENBLAS_NUM_THREADS``): nothing fabricate runs is faster with more.
 
     Does nothing where no OpenBLAS is loaded or the platform does not list the libraries (only Linux's
-    ``/proc/self/maps`` is read), and leaves a count the environment sets (see :func:`pin_blas_threads`).
+    ``/proc/self/maps`` is read). A process forked inside the block inherits the pin.
     """
-    if any(name in os.environ and os.environ[name] != "1" for name in BLAS_THREAD_VARIABLES[:1]):
-        yield
-        return
     restore = []
     for get, put in _openblas_controls():
         try:

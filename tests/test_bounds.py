@@ -7,7 +7,6 @@ builds; a count exactly at its bound validates and one past it is refused naming
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
@@ -337,26 +336,34 @@ def test_sweep_workers_past_the_bound_exits_2_naming_the_limit(workers: str, tmp
     assert not (tmp_path / "s").exists()
 
 
-def test_blas_threads_pins_and_restores() -> None:
+def test_blas_threads_pins_and_restores(monkeypatch: pytest.MonkeyPatch) -> None:
     import numpy  # noqa: F401  (its OpenBLAS is the one pinned)
 
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "2")  # the pin holds whatever the environment asks
     controls = bounds._openblas_controls()
     before = [int(get()) for get, _ in controls]
     with bounds.blas_threads(1):
         inside = [int(get()) for get, _ in controls]
     assert [int(get()) for get, _ in controls] == before
-    if os.environ.get("OPENBLAS_NUM_THREADS", "1") == "1":
-        assert all(n == 1 for n in inside)
+    assert all(n == 1 for n in inside)
+
+    @bounds.blas_threads()
+    def solve() -> list[int]:
+        return [int(get()) for get, _ in controls]
+
+    assert all(n == 1 for n in solve()) and all(n == 1 for n in solve())  # a decorator, every call
+    assert [int(get()) for get, _ in controls] == before
 
 
 def test_linkage_gear_expressions_in_all_past_their_bound_are_refused() -> None:
-    each = bounds.MAX_LINKAGE_EXPRESSION_CHARS // bounds.MAX_LINKAGE_GEARS
-    kw = dict(gears=bounds.MAX_LINKAGE_GEARS, teeth=8, sliders=0, poses=100)
+    gears = 4
+    each = bounds.MAX_LINKAGE_EXPRESSION_CHARS // gears
+    kw = dict(gears=gears, teeth=8, sliders=0, poses=100)
     design_from_text(_worst_linkage(expression=each, **kw), "w.toml")
     with pytest.raises(SpecError) as info:
         design_from_text(_worst_linkage(expression=each + 1, **kw), "w.toml")
     assert info.value.path == "linkage.gears[0].expression"
-    assert f"{bounds.MAX_LINKAGE_GEARS * (each + 1)} characters in all, over the bound of " \
+    assert f"{gears * (each + 1)} characters in all, over the bound of " \
            f"{bounds.MAX_LINKAGE_EXPRESSION_CHARS}" in info.value.message
 
 
@@ -408,12 +415,3 @@ def test_linkage_gear_teeth_in_all_at_the_bound_validate_and_past_it_are_refused
     with pytest.raises(SpecError) as info:
         design_from_text(_worst_linkage(teeth=per_gear, **{**kw, "poses": poses + 1}), "w.toml")
     assert info.value.path == "checks.sweep_poses" and f"at most {poses} poses" in info.value.message
-
-
-def test_pin_blas_threads_sets_one_thread_unless_the_environment_chose(monkeypatch: pytest.MonkeyPatch) -> None:
-    for name in bounds.BLAS_THREAD_VARIABLES:
-        monkeypatch.delenv(name, raising=False)
-    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "2")
-    bounds.pin_blas_threads()
-    assert os.environ["OPENBLAS_NUM_THREADS"] == "2"  # the user's choice stands
-    assert all(os.environ[name] == "1" for name in bounds.BLAS_THREAD_VARIABLES[1:])

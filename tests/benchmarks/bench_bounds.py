@@ -9,8 +9,9 @@ wrapper's ``RUSAGE_CHILDREN`` peak is that build's alone. Prints: kind, BLAS thr
 wall time also counts waiting for a core, so CPU time is the figure to hold against the budget there), peak
 RSS, exit code and the ratios to the 60 s / 4 GB budget.
 
-``--blas 1`` runs with one BLAS thread (``OPENBLAS_NUM_THREADS=1``), ``--blas 2`` with two (the environment
-then overrides fabricate's own pin to one), ``--blas both`` (default) each kind both ways.
+``--blas 1`` runs with the BLAS libraries' environment set to one thread (``OPENBLAS_NUM_THREADS=1``), ``--blas 2``
+with two (fabricate pins OpenBLAS to one thread where it solves, :func:`fabricate.bounds.blas_threads`, so this
+shows what is left unpinned), ``--blas both`` (default) each kind both ways.
 
 Run: ``python tests/benchmarks/bench_bounds.py [--blas 1|2|both] [kind ...]`` (not part of the test suite;
 about ten minutes on an idle machine).
@@ -33,6 +34,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository: 
 from fabricate import bounds  # noqa: E402
 from fabricate.spec import TEMPLATE_DIR, parse_toml  # noqa: E402
 from tests.toml_writer import toml_text  # noqa: E402
+
+#: Environment variables that set the thread count of the BLAS libraries numpy and scipy may load.
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS",
+                         "OMP_NUM_THREADS")
 
 #: Wrapper run in its own process: times one build and reads its peak RSS (kB on Linux).
 WRAPPER = """
@@ -240,11 +245,13 @@ def linkage_poses(table: int = bounds.MAX_LINKAGE_TABLE) -> dict[str, Any]:
 
 
 def linkage_gears() -> dict[str, Any]:
-    """The worst linkage for the gears: 8 pairs with the most teeth in all, gear expressions of the most
-    characters in all, and the most poses the solver's estimate and the poses × teeth bound then allow."""
-    teeth = bounds.MAX_LINKAGE_GEAR_TEETH // (2 * bounds.MAX_LINKAGE_GEARS)
-    expression = min(bounds.MAX_EXPRESSION_LENGTH, bounds.MAX_LINKAGE_EXPRESSION_CHARS // bounds.MAX_LINKAGE_GEARS)
-    kw = dict(gears=bounds.MAX_LINKAGE_GEARS, teeth=teeth, expression=expression, sliders=6)
+    """The worst linkage for the gears: the most pairs of at least 8 + 8 teeth that the teeth in all allow
+    (and the most teeth), gear expressions of the most characters in all, and the most poses the solver's
+    estimate and the poses × teeth bound then allow."""
+    gears = min(bounds.MAX_LINKAGE_GEARS, bounds.MAX_LINKAGE_GEAR_TEETH // 16)  # 8 + 8 teeth: min_teeth's default
+    teeth = bounds.MAX_LINKAGE_GEAR_TEETH // (2 * gears)
+    expression = min(bounds.MAX_EXPRESSION_LENGTH, bounds.MAX_LINKAGE_EXPRESSION_CHARS // gears)
+    kw = dict(gears=gears, teeth=teeth, expression=expression, sliders=6)
     poses = _largest(lambda n: worst_linkage(poses=n, **kw), 2, bounds.MAX_SWEEP_POSES)
     return worst_linkage(poses=poses, **kw)
 
@@ -293,7 +300,7 @@ def run(kind: str, work: Path, blas: int) -> dict[str, Any]:
     """Build the worst template of ``kind`` with ``blas`` BLAS threads; its wall, CPU, peak and exit."""
     template = work / f"worst_{kind}.toml"
     template.write_text(worst_template(kind), encoding="utf-8")
-    env = {**os.environ, **{name: str(blas) for name in bounds.BLAS_THREAD_VARIABLES}}
+    env = {**os.environ, **{name: str(blas) for name in BLAS_THREAD_VARIABLES}}
     out = subprocess.run([sys.executable, "-c", WRAPPER, str(template), str(work / f"out_{kind}_{blas}")],
                          capture_output=True, text=True, check=True, env=env)
     return json.loads(out.stdout.strip().splitlines()[-1])
