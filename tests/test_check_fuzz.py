@@ -67,11 +67,12 @@ def _fast_and_bounded(monkeypatch):
 
     monkeypatch.setattr(step, "step_available", lambda: False)
 
-    def cached_build(design, progress=lambda _m: None):
+    def cached_build(design, progress=lambda _m: None, *, optional=None):
         override = design.process_override
-        key = (design.template_text, None if override is None else (override.source, override.text))
+        key = (design.template_text, None if override is None else (override.source, override.text),
+               optional)
         if key not in _REBUILDS:
-            _REBUILDS[key] = run_build(design, progress)
+            _REBUILDS[key] = run_build(design, progress, optional=optional)
         return _REBUILDS[key]
 
     monkeypatch.setattr(pipeline, "run_build", cached_build)

@@ -38,7 +38,7 @@ def test_four_bar_build_passes_and_reports(sla_process):
     assert inter["poses"] == 360 and inter["collisions"] == []
     # the smallest clearance is a pin in its hole: 0.25 mm radial, less at most the chord tolerance
     assert 0.25 - sla_process.chord_tolerance_mm <= inter["min_clearance_mm"] <= 0.25
-    assert report.report()["checks"] == {"passed": True, "failures": []}
+    assert report.report()["checks"] == {"passed": True, "failures": [], "not_checked": []}
     png = report.figures()["clearance.png"]
     assert png.startswith(PNG) and png == report.figures()["clearance.png"]
     assert "| crank | coupler | joined | 0.300 |" in report.pair_table_markdown()
