@@ -245,10 +245,12 @@ def linkage_poses(table: int = bounds.MAX_LINKAGE_TABLE) -> dict[str, Any]:
 
 
 def linkage_gears() -> dict[str, Any]:
-    """The worst linkage for the gears: the most pairs of at least 8 + 8 teeth that the teeth in all allow
+    """The worst linkage for the gears: the most pairs of at least 9 + 9 teeth that the teeth in all allow
     (and the most teeth), gear expressions of the most characters in all, and the most poses the solver's
     estimate and the poses × teeth bound then allow."""
-    gears = min(bounds.MAX_LINKAGE_GEARS, bounds.MAX_LINKAGE_GEAR_TEETH // 16)  # 8 + 8 teeth: min_teeth's default
+    # 9 + 9 teeth at least: 8 + 8 round gears of 30 mm centre distance hold exactly min_teeth = 8 and are refused
+    gears = min(bounds.MAX_LINKAGE_GEARS, bounds.MAX_LINKAGE_GEAR_TEETH // 18)
+    gears -= gears % 2  # a gear stage adds three bodies, the others two: an even count reaches 40 bodies
     teeth = bounds.MAX_LINKAGE_GEAR_TEETH // (2 * gears)
     expression = min(bounds.MAX_EXPRESSION_LENGTH, bounds.MAX_LINKAGE_EXPRESSION_CHARS // gears)
     kw = dict(gears=gears, teeth=teeth, expression=expression, sliders=6)
