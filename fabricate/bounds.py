@@ -122,7 +122,9 @@ MAX_SOLVER_S = 10.0
 #: Linkage kind: ``checks.sweep_poses`` × bodies. The interference sweep and the statics go through every pose
 #: of every part: 40 bodies at 5000 poses took 99 s of CPU (one BLAS thread): checks 54 s (the interference
 #: sweep's clearance tests), the sweep 20 s, strength 16 s, exports 5 s, parts 6 s; at 2000 poses (15 sliders,
-#: 2 gear pairs of 37 + 37 teeth) 59 s of CPU, 49 s wall.
+#: 2 gear pairs of 37 + 37 teeth) 59 s of CPU, 49 s wall; at the bound (1500 poses, 15 sliders, 2 pairs of
+#: 13 + 13 teeth) 52 s of CPU with the picture child, 56 s wall on cores shared with other work; its exact form
+#: with 12 copies 59 s of CPU, 53 s wall.
 MAX_LINKAGE_POSE_BODIES = 60_000
 #: Linkage kind: characters of all its gear expressions together. Each is evaluated at every solver step and
 #: throughout gear cutting: 8 expressions of 1000 characters took 13 s of solving (648 poses) and 10 s of
