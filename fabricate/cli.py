@@ -2,23 +2,182 @@
 
 Exit codes: 0 all checks pass; 1 the design fails a check (files are written, the report says why);
 2 invalid input or usage (nothing is written); 3 an internal error (a bug: please report it with the
-template); 130 interrupted (Ctrl-C; the previous output is left as it was).
+template); 128 + N stopped by signal N: 130 Ctrl-C (SIGINT), 143 SIGTERM, 129 SIGHUP (the previous output
+is left as it was, no temporary folder and no child process is left).
+
+However a run ends, it ends here with one line on stderr and an exit code, never a traceback: SIGTERM and
+SIGHUP are raised as an exception like Ctrl-C's, so every ``finally`` runs (the picture child is killed,
+a half-written folder removed); a reader that closed stdout (``fabricate list | head -1``) or a terminal
+that went away is not an error, and the exit code stays the command's own.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import errno
+import os
 import re
+import signal
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 from fabricate import __version__
 from fabricate.errors import FabricateError, SpecError
 
 DEFAULT_TEMPLATE = "finger_five_bar_ncg"
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+#: Signals that stop a run cleanly (exit 128 + the signal's number), and how the last line names them.
+STOP_SIGNALS = {"SIGINT": "interrupted", "SIGTERM": "terminated (SIGTERM)", "SIGHUP": "hung up (SIGHUP)"}
+HELP_EPILOG = ("exit codes: 0 every check passed; 1 the design fails a check (files are written, the report says "
+               "why) or 'check' found a problem; 2 invalid input or usage (nothing is written); 3 a bug in "
+               "fabricate (please report it); 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP (128 + the signal: a previous "
+               "output is left as it was, nothing half-written). -q hides progress only: the result line and "
+               "any failures are always printed.")
+
+
+class Stopped(KeyboardInterrupt):
+    """A stopping signal (SIGINT, SIGTERM, SIGHUP) raised like Ctrl-C's KeyboardInterrupt.
+
+    Being a KeyboardInterrupt, it runs every ``finally`` (the picture child is killed, a temporary folder
+    removed) and stops cleanly whatever already stops cleanly on Ctrl-C (a sweep records its points).
+
+    Parameters
+    ----------
+    signum : int
+        The signal's number; the exit code is 128 + ``signum``.
+    """
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def _stop_on_signals() -> Iterator[list[int]]:
+    """Raise :class:`Stopped` on the first SIGINT, SIGTERM or SIGHUP while the command runs.
+
+    Yields the list the received signal's number is put in. Later signals are ignored so the cleanup the
+    first one started can finish (SIGKILL still ends the process, and its children die with it). A signal
+    the caller ignores stays ignored (``nohup``, a background job) and a handler the caller installed (a
+    program calling :func:`main`) stays in place. Only the main thread can have handlers.
+    """
+    received: list[int] = []
+    closing = [False]
+
+    def stop(signum: int, _frame: Any) -> None:
+        if received or closing[0]:
+            return
+        received.append(signum)
+        raise Stopped(signum)
+
+    previous: dict[int, Any] = {}
+    for name in STOP_SIGNALS:
+        number = getattr(signal, name, None)
+        if number is None or signal.getsignal(number) not in (signal.SIG_DFL, signal.default_int_handler):
+            continue
+        try:
+            previous[number] = signal.signal(number, stop)
+        except ValueError:  # not the main thread
+            break
+    try:
+        yield received
+    finally:
+        closing[0] = True  # a signal now is too late to stop anything: the handlers go back as they were
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+class _Stream:
+    """A text stream that goes quiet once it cannot be written (its reader closed the pipe, its terminal
+    went away): delivering the result line is not worth failing a run that did its work for.
+
+    Attributes
+    ----------
+    error : OSError or None
+        The first write error that was not a reader going away (EPIPE) or a terminal hanging up (EIO).
+    """
+
+    def __init__(self, stream: TextIO) -> None:
+        self._stream = stream
+        self.gone = False
+        self.error: OSError | None = None
+
+    def _lost(self, exc: Exception) -> None:
+        self.gone = True
+        if isinstance(exc, OSError) and exc.errno not in (errno.EPIPE, errno.EIO, None):
+            self.error = exc
+        # Python flushes the stream once more at exit, and native code may write to the fd: both now land
+        # in /dev/null instead of failing again (the recipe of Python's signal module documentation)
+        with contextlib.suppress(Exception):
+            fd = self._stream.fileno()
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, fd)
+            os.close(devnull)
+
+    def write(self, text: str) -> int:
+        if not self.gone:
+            try:
+                try:
+                    return self._stream.write(text)
+                except UnicodeEncodeError:  # a file name that is not text (b"\xff"): shown escaped, no crash
+                    encoding = getattr(self._stream, "encoding", None) or "utf-8"
+                    return self._stream.write(text.encode(encoding, "backslashreplace").decode(encoding, "replace"))
+            except OSError as exc:
+                self._lost(exc)
+            except ValueError as exc:
+                if not getattr(self._stream, "closed", False):
+                    raise
+                self._lost(exc)  # the stream was closed
+        return len(text)
+
+    def flush(self) -> None:
+        if not self.gone:
+            try:
+                self._stream.flush()
+            except OSError as exc:
+                self._lost(exc)
+            except ValueError as exc:
+                if not getattr(self._stream, "closed", False):
+                    raise
+                self._lost(exc)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
+@contextlib.contextmanager
+def _guarded_streams() -> Iterator[tuple[_Stream | None, _Stream | None]]:
+    """sys.stdout and sys.stderr as :class:`_Stream` while the command runs; flushed before they go back."""
+    saved = sys.stdout, sys.stderr
+    out = _Stream(saved[0]) if saved[0] is not None else None
+    err = _Stream(saved[1]) if saved[1] is not None else None
+    if out is not None:
+        sys.stdout = out  # type: ignore[assignment]
+    if err is not None:
+        sys.stderr = err  # type: ignore[assignment]
+    try:
+        yield out, err
+    finally:
+        for stream in (out, err):
+            if stream is not None:
+                stream.flush()
+        sys.stdout, sys.stderr = saved
+
+
+def _say(line: str) -> None:
+    """One line on stderr: control characters of user text (a newline in a path) would make it several."""
+    line = line.replace("\r", "\\r").replace("\n", "\\n")
+    if sys.stderr is None:  # started with fd 2 closed (print would fall back to stdout)
+        return
+    with contextlib.suppress(Exception):  # stderr may be gone: the exit code still tells
+        print(line, file=sys.stderr, flush=True)
+
+
+QUIET_HELP = "no progress output (the result line and any failures are still printed)"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -29,17 +188,19 @@ class _Parser(argparse.ArgumentParser):
 
 def _progress(quiet: bool):
     start = time.perf_counter()
-    if quiet or not sys.stderr.isatty():
+    if quiet or sys.stderr is None or not sys.stderr.isatty():
         return lambda _msg: None
 
     def report(msg: str) -> None:
-        print(f"[{time.perf_counter() - start:6.2f} s] {msg}", file=sys.stderr, flush=True)
+        with contextlib.suppress(OSError, ValueError):  # a terminal that went away ends the progress, not the run
+            print(f"[{time.perf_counter() - start:6.2f} s] {msg}", file=sys.stderr, flush=True)
 
     return report
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="fabricate", description=__doc__.splitlines()[0])
+    p = _Parser(prog="fabricate", description="Turn a template into a prototype to make: fabricate "
+                                              "build|synth|check|sweep|list|init.", epilog=HELP_EPILOG)
     p.add_argument("--version", action="version", version=f"fabricate {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     b = sub.add_parser("build", help="the whole pipeline into an output folder")
@@ -52,10 +213,10 @@ def _parser() -> argparse.ArgumentParser:
                          help=f"output folder (default {default}): new, empty, or a previous fabricate output")
         cmd.add_argument("--force", action="store_true",
                          help="replace an output folder that holds files fabricate did not write")
-        cmd.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+        cmd.add_argument("-q", "--quiet", action="store_true", help=QUIET_HELP)
     c = sub.add_parser("check", help="verify an output folder (files, contents, rebuild) or check a template")
     c.add_argument("target", help="template, or a folder written by 'fabricate build'")
-    c.add_argument("-q", "--quiet", action="store_true")
+    c.add_argument("-q", "--quiet", action="store_true", help=QUIET_HELP)
     for cmd in (b, s, c):
         cmd.add_argument("--process", metavar="sla|laser|PATH",
                          help="make it with this process profile instead of the template's (the template's "
@@ -82,7 +243,7 @@ def _parser() -> argparse.ArgumentParser:
     where.add_argument("--scheduler", metavar="ADDR", help="an existing Dask scheduler, e.g. tcp://host:8786")
     w.add_argument("-o", "--output", type=Path, help="output folder (default outputs/<name>-sweep/): new, empty, "
                                                      "or an earlier run of the same sweep, which is resumed")
-    w.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+    w.add_argument("-q", "--quiet", action="store_true", help=QUIET_HELP)
     sub.add_parser("list", help="templates shipped")
     i = sub.add_parser("init", help="write an editable copy of a shipped template into the current folder")
     i.add_argument("name", help="name of the new design (writes NAME.toml)")
@@ -92,14 +253,60 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _summary(report: dict, out: Path | None, failures: list[str] | None = None) -> None:
+    """The result line (``NAME: checks passed -> DIR``, with what was not checked in brackets), the
+    failures and notes; each check that could not run is also a note on stderr."""
+    from fabricate.report import not_checked_notes, verdict
+
     checks = report.get("checks", {})
     failures = list(checks.get("failures", [])) if failures is None else failures
     where = f" -> {out}" if out is not None else ""
-    print(f"{report['design']['name']}: checks {'passed' if not failures else 'FAILED'}{where}")
+    print(f"{report['design']['name']}: {verdict(report, failures)}{where}")
     for failure in failures:
         print(f"  - {failure}")
     for note in report.get("notes", []):
         print(f"  note: {note}")
+    if report.get("design", {}).get("stage") != "synth":  # synth: its line says no check ran
+        for note in not_checked_notes(report):
+            print(f"fabricate: note: {note}", file=sys.stderr)
+
+
+def _output_holding(path: Path) -> Path | None:
+    """The nearest of ``path`` and its parents that is a fabricate output folder (it has our report.json)."""
+    from fabricate.output import previous_output
+
+    for folder in (path, *path.parents):
+        if previous_output(folder) is not None:
+            return folder
+    return None
+
+
+def _default_output(name: str, template: Path, stage: str) -> Path:
+    """The output folder when no ``-o`` is given: ``outputs/<name>/`` (``-synth`` for synth) under the current
+    folder, or, for a template inside a fabricate output (a build's ``mechanism.toml``), ``<that folder>-rebuild``
+    beside it (said on stderr, even with ``-q``: it is where the result goes): the default must neither hold
+    the template (refused) nor nest a build inside a build.
+
+    Raises
+    ------
+    SpecError
+        The default would land inside a fabricate output folder (the current folder is in one).
+    """
+    suffix = "" if stage == "build" else "-synth"
+    home = _output_holding(template.resolve().parent)
+    if home is not None:
+        default = home.parent / f"{home.name}-rebuild{suffix}"
+        _say(f"fabricate: {template.name} is inside the output folder {home}: building into {default} "
+             "beside it (-o chooses another folder)")
+    else:
+        default = Path("outputs") / f"{name}{suffix}"
+    inside = _output_holding(Path(os.path.abspath(default)).parent)
+    if inside is not None:
+        beside = inside.parent / f"{name}{suffix}"
+        beside = beside if beside != inside else inside.parent / f"{name}-2{suffix}"
+        raise SpecError(f"the default output folder {default}", f"would be written inside {inside}, a fabricate "
+                                                                "output folder, and become part of it; choose a "
+                                                                f"folder outside it with -o (e.g. -o {beside})")
+    return default
 
 
 def _build(args: argparse.Namespace) -> int:
@@ -109,23 +316,35 @@ def _build(args: argparse.Namespace) -> int:
 
     design = load_design(args.template, args.process)
     stage = args.command
-    default = Path("outputs") / (design.name if stage == "build" else f"{design.name}-synth")
-    protect = [design.template]
+    default = None if args.output else _default_output(design.name, Path(design.template), stage)
+    # inputs the build reads: never inside the folder replaced, even with --force
+    protect = {Path(design.template): "the template being built"}
+    if args.process and args.process not in ("sla", "laser"):
+        protect[Path(args.process)] = "the process profile in use"
     # refuse a bad output folder before the work, and again under the lock when writing
     out = check_output_dir(args.output or default, force=args.force, stage=stage, protect=protect)
     outcome = (run_build if stage == "build" else run_synth)(design, _progress(args.quiet))
-    write_output(outcome.files, out, force=args.force, stage=stage, protect=protect)
-    if not args.quiet:
-        _summary(outcome.report, out)
+    write_output(outcome.files, out, force=args.force, stage=stage, protect=protect,
+                 warn=lambda msg: _say(f"fabricate: warning: {msg}"))
+    args.written = out  # an interruption from here on comes after a complete write
+    _summary(outcome.report, out)  # -q hides progress, never the result
     return outcome.exit_code
 
 
 def _check(args: argparse.Namespace) -> int:
     from fabricate.pipeline import run_build
-    from fabricate.spec import load_design
+    from fabricate.spec import find_template, load_design, path_kind
 
     target = Path(args.target)
+    path_kind(target, "TARGET")  # a name the system refuses to look at (too long) is exit 2, not an OSError
     if not target.is_dir():
+        if not os.path.lexists(target):
+            try:
+                find_template(args.target)  # a shipped template's name
+            except SpecError:
+                raise SpecError(args.target, "no such folder or template: 'check' takes a folder written by "
+                                             "'fabricate build' or a template (a file, or a name from "
+                                             "'fabricate list'), and neither exists") from None
         outcome = run_build(load_design(args.target, args.process), _progress(args.quiet))
         _summary(outcome.report, None)
         return outcome.exit_code
@@ -184,38 +403,55 @@ def _sweep(args: argparse.Namespace) -> int:
         base_dir = None
     tables = {k: dict(v) if isinstance(v, dict) else v for k, v in tables.items()}
     sweep = tables.setdefault("sweep", {})
-    tables.setdefault("vary", {}).update(_assignments(args.vary, "--vary", True))
-    if args.set:
-        tables.setdefault("set", {}).update(_assignments(args.set, "--set", False))
+    given = {"vary": _assignments(args.vary, "--vary", True), "set": _assignments(args.set or [], "--set", False)}
+    for table, entries in given.items():
+        if entries:
+            if not isinstance(tables.setdefault(table, {}), dict):
+                raise SpecError(table, "expected a table of field path = value")
+            tables[table].update(entries)
+    if not isinstance(sweep, dict):
+        raise SpecError("sweep", "missing table [sweep]")
+    # an error in an entry given on the command line ends "(given as --vary FIELD)"
+    origins = {f"{table}.{key}": f"--{table} {key}" for table, entries in given.items() for key in entries}
     for key in ("sampling", "samples", "seed", "stage", "best"):
         if getattr(args, key) is not None:
             sweep[key] = getattr(args, key)
     if args.metric:
         sweep["metrics"] = list(args.metric)
-    if args.workers is not None and not 1 <= args.workers <= 512:
-        raise SpecError("--workers", f"expected 1 .. 512 processes, got {args.workers}")
-    spec = sweep_from_tables(tables, base_dir)
+    if args.workers is not None:  # local processes: the cores and the memory bound them
+        from fabricate.bounds import check_workers
+
+        check_workers(args.workers)
+    spec = sweep_from_tables(tables, base_dir, origins=origins)
     from fabricate.sweep.runner import run_sweep
 
     out = args.output or Path("outputs") / f"{spec.name}-sweep"
-    outcome = run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler, quiet=args.quiet)
+    # the inputs (spec file, base template) are never inside the sweep's folder (as sweep_from_tables finds them)
+    from fabricate.spec import find_template
+
+    near = base_dir / spec.template if base_dir is not None else None
+    template = near if near is not None and near.is_file() else find_template(spec.template)
+    protect = [template] if source is None else [source, template]
+    outcome = run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler, quiet=args.quiet,
+                        protect=protect)
     if outcome.exit_code == EXIT_INTERRUPTED:
-        print(f"fabricate: interrupted; {outcome.done} of {outcome.total} points are recorded in {outcome.out} "
-              "(run the same command again to resume)", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    if not args.quiet:
-        c = outcome.counts
-        errors = f", {c['3']} internal errors" if c.get("3") else ""
-        print(f"sweep {spec.name}: {outcome.total} points ({outcome.resumed} done earlier): {c.get('0', 0)} pass, "
-              f"{c.get('1', 0)} fail a check, {c.get('2', 0)} invalid or infeasible{errors} -> {outcome.out}")
-        for note in outcome.notes:
-            print(f"  note: {note}")
-        for entry in outcome.best:
-            metric = spec.best_metric.name if spec.best_metric else ""
-            verdict = {0: "", 1: " (its full build fails a check: see its report)"}.get(
-                entry.get("build_exit_code", 0), f" (not built: {entry.get('build_reason', '')})")
-            print(f"  best {entry['rank']}: point {entry['point']} {metric} = {entry.get(metric)!r} "
-                  f"-> {entry.get('folder', '')}{verdict}")
+        signum = args.received[0] if getattr(args, "received", None) else signal.SIGINT
+        _say(f"fabricate: {STOP_SIGNALS[signal.Signals(signum).name]}; {outcome.done} of {outcome.total} points are "
+             f"recorded in {outcome.out} (run the same command again to resume)")
+        return 128 + signum
+    # -q hides progress, never the result
+    c = outcome.counts
+    errors = f", {c['3']} internal errors" if c.get("3") else ""
+    print(f"sweep {spec.name}: {outcome.total} points ({outcome.resumed} done earlier): {c.get('0', 0)} pass, "
+          f"{c.get('1', 0)} fail a check, {c.get('2', 0)} invalid or infeasible{errors} -> {outcome.out}")
+    for note in outcome.notes:
+        print(f"  note: {note}")
+    for entry in outcome.best:
+        metric = spec.best_metric.name if spec.best_metric else ""
+        verdict = {0: "", 1: " (its full build fails a check: see its report)"}.get(
+            entry.get("build_exit_code", 0), f" (not built: {entry.get('build_reason', '')})")
+        print(f"  best {entry['rank']}: point {entry['point']} {metric} = {entry.get(metric)!r} "
+              f"-> {entry.get('folder', '')}{verdict}")
     return outcome.exit_code
 
 
@@ -260,9 +496,39 @@ def _init(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+def _text(exc: BaseException) -> str:
     try:
+        return str(exc)
+    except Exception:  # noqa: BLE001 - an exception that cannot describe itself is still reported
+        return repr(type(exc))
+
+
+def _stopped(args: argparse.Namespace | None, signum: int) -> str:
+    """The last line of a run stopped by a signal: which signal, and what was written."""
+    what = STOP_SIGNALS.get(signal.Signals(signum).name, signal.Signals(signum).name)
+    written = getattr(args, "written", None)
+    if written is not None:
+        return f"fabricate: {what} after {written} was written (it is complete)"
+    return f"fabricate: {what}; nothing was written (a previous output is unchanged)"
+
+
+def _out_of_memory(args: argparse.Namespace | None) -> tuple[str, int]:
+    command = getattr(args, "command", None)
+    if command == "check" and Path(args.target).is_dir():  # the folder's files, not a template, took it
+        return f"fabricate: error: out of memory while checking {args.target} (the folder was not verified)", \
+            EXIT_FAILED
+    if command == "sweep":
+        return ("fabricate: error: out of memory; the sweep asks for more than this machine has (fewer --workers, "
+                "or see the bounds in README.md)"), EXIT_USAGE
+    return ("fabricate: error: out of memory; a count or tolerance in the template asks for more than this "
+            "machine has (see the bounds in README.md)"), EXIT_USAGE
+
+
+def _run(argv: list[str] | None, received: list[int]) -> int:
+    args = None
+    try:
+        args = _parser().parse_args(argv)
+        args.received = received
         if args.command == "list":
             return _list()
         if args.command == "init":
@@ -273,19 +539,39 @@ def main(argv: list[str] | None = None) -> int:
             return _sweep(args)
         return _build(args)
     except FabricateError as exc:  # invalid input, nothing feasible, a refused folder: nothing written
-        print(f"fabricate: error: {exc}", file=sys.stderr)
+        _say(f"fabricate: error: {_text(exc)}")
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print("fabricate: interrupted; nothing was written (a previous output is unchanged)", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM / SIGHUP raised as Stopped
+        signum = getattr(exc, "signum", signal.SIGINT)
+        _say(_stopped(args, signum))
+        return 128 + signum
     except MemoryError:
-        print("fabricate: error: out of memory; a count or tolerance in the template asks for more than this "
-              "machine has (see the bounds in README.md)", file=sys.stderr)
-        return EXIT_USAGE
+        line, code = _out_of_memory(args)
+        _say(line)
+        return code
     except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, never a traceback
-        print(f"fabricate: internal error: {type(exc).__name__}: {exc} (a bug in fabricate {__version__}; "
-              "please report it with the template)", file=sys.stderr)
+        _say(f"fabricate: internal error: {type(exc).__name__}: {_text(exc)} (a bug in fabricate {__version__}; "
+             "please report it with the template)")
         return EXIT_INTERNAL
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run one command; its exit code is returned (see the module docstring), one line on stderr at most
+    for an error, never a traceback. Only argparse's SystemExit (``--help``, ``--version``, a usage error)
+    leaves by an exception."""
+    with _guarded_streams() as (out, _err), _stop_on_signals() as received:
+        code = _run(argv, received)
+        if received and code != 128 + received[0]:
+            # the signal's exception was swallowed on its way (it hit a destructor): the run ended anyway
+            _say(f"fabricate: {STOP_SIGNALS[signal.Signals(received[0]).name]} as the run ended (its result "
+                 "is complete)")
+            return 128 + received[0]
+        if out is not None:
+            out.flush()
+            if out.error is not None:  # a full disk under '> file'; a closed pipe or terminal is not an error
+                _say(f"fabricate: error: cannot write to standard output: {out.error.strerror or out.error}")
+                return max(code, EXIT_USAGE)
+    return code
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from fabricate import __version__
+from fabricate.bounds import blas_threads
 from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
 from fabricate.mechanism import Mechanism, Motion
 from fabricate.report import SYNTH_ONLY, report_json, report_markdown
@@ -128,6 +129,7 @@ class OptionalOutputs:
     step_files: Mapping[str, bytes] | None = None
 
 
+@blas_threads()  # one BLAS thread: fabricate's systems are small, and threads only wait on busy cores
 def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     """Synthesis only: report.json with design, mechanism and synthesis, plus the method's plots."""
     result, report, motion, failures = _synthesis_stage(design, progress, "synth")
@@ -151,6 +153,7 @@ def _kernel_failures() -> tuple[type[BaseException], ...]:
             FloatingPointError, OverflowError, ZeroDivisionError, ValueError)
 
 
+@blas_threads()  # one BLAS thread (fabricate.bounds.blas_threads: a whole build with two took 3x the CPU)
 def run_build(design: DesignSpec, progress: Progress = _quiet, *,
               optional: OptionalOutputs | None = None) -> BuildOutcome:
     """The whole pipeline in memory.

@@ -319,7 +319,8 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     out : str or Path
         Output folder (new, empty, or an earlier run of this spec, which is resumed).
     workers : int, optional
-        Processes of the local cluster (default: the cores this process may use).
+        Processes of the local cluster (default: the cores this process may use); at most
+        :func:`fabricate.bounds.max_workers` (a SpecError naming ``--workers`` past it).
     scheduler : str, optional
         Address of a running Dask scheduler (``tcp://host:8786``); its workers need fabricate installed.
     quiet : bool
@@ -329,6 +330,10 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     protect : sequence of Path
         The sweep's input files (spec, template): ``out`` may not be or hold one.
     """
+    if workers is not None:  # before anything is written: the cores and the memory bound the local processes
+        from fabricate.bounds import check_workers
+
+        check_workers(workers)
     out = Path(os.path.abspath(out))
     resuming = prepare_folder(out, spec, protect)
     points = spec.points()
