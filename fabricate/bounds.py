@@ -84,8 +84,12 @@ MAX_LINKAGE_JOINTS = 80
 MAX_LINKAGE_GEARS = 8
 MAX_LINKAGE_DRIVERS = 8
 MAX_LINKAGE_POINTS = 32
-#: Samples of one sampled law of a declared linkage (gear law or driver table).
-MAX_LINKAGE_TABLE = 10000
+#: Samples of one sampled law of a declared linkage (gear law or driver table), and of all of them together: a
+#: build writes each as piecewise-polynomial coefficients into its ``mechanism.toml`` (~120 bytes a sample:
+#: 10000 samples wrote 1.2 MB, over ``fabricate.spec.MAX_TEMPLATE_BYTES``, so the rebuild of a valid build
+#: was refused); 4000 in all keeps the exact form of any valid linkage within that size (measured by
+#: ``tests/test_bounds.py::test_the_exact_form_of_the_largest_tables_is_a_valid_template``).
+MAX_LINKAGE_TABLE = 4000
 #: Exact form (``[linkage] exact = true``, a build's ``mechanism.toml``): ``hints.copies``, identical copies of
 #: the mechanism made (every copy of every part is laid out on the plates; 2000 copies took 62 s). The compliant
 #: gripper, the only kind that writes copies, makes at most 12 fingers.

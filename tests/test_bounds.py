@@ -415,3 +415,36 @@ def test_linkage_gear_teeth_in_all_at_the_bound_validate_and_past_it_are_refused
     with pytest.raises(SpecError) as info:
         design_from_text(_worst_linkage(teeth=per_gear, **{**kw, "poses": poses + 1}), "w.toml")
     assert info.value.path == "checks.sweep_poses" and f"at most {poses} poses" in info.value.message
+
+
+def test_the_exact_form_of_the_largest_tables_is_a_valid_template() -> None:
+    """A linkage whose driver table holds every sample the bound allows writes a mechanism.toml that is itself
+    a valid template (within MAX_TEMPLATE_BYTES): the rebuild of a valid build is never refused; one sample
+    more is refused up front, naming the field."""
+    import copy
+
+    import numpy as np
+
+    from fabricate.bounds import MAX_LINKAGE_TABLE
+    from fabricate.errors import SpecError
+    from fabricate.spec import MAX_TEMPLATE_BYTES, design_from_text
+    from fabricate.synthesis.linkage.exact import mechanism_toml
+    from fabricate.synthesis.linkage.mechanism import build_mechanism
+    from fabricate.tomlwrite import dumps
+    from tests.test_not_checked import FOUR_BAR
+
+    def tables(n: int) -> dict:
+        t = copy.deepcopy(FOUR_BAR)
+        s = np.linspace(0.0, 360.0, n)
+        # a non-linear table, so no two spline pieces share their coefficients
+        t["linkage"]["drivers"] = [{"joint": "O", "law": "table", "input": s.tolist(),
+                                    "value": (s + 10.0 * np.sin(np.radians(s))).tolist()}]
+        return t
+
+    design = design_from_text(dumps(tables(MAX_LINKAGE_TABLE)), "largest_table.toml")
+    text = mechanism_toml(design, build_mechanism(design.name, design.method), {"tip_point": "B"})
+    assert len(text) <= MAX_TEMPLATE_BYTES
+    rebuilt = design_from_text(text.decode("utf-8"), "mechanism.toml")
+    assert rebuilt.kind == "linkage"
+    with pytest.raises(SpecError, match=r"linkage\.drivers.*4001 samples in all|linkage\.drivers\[0\]\.input"):
+        design_from_text(dumps(tables(MAX_LINKAGE_TABLE + 1)), "too_large.toml")

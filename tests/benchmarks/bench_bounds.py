@@ -262,8 +262,8 @@ def worst_exact(copies: int = bounds.MAX_COPIES) -> str:
     """The worst exact form: the poses-worst linkage's ``mechanism.toml`` (every body at the point bound, laws
     by their coefficients or samples) with ``hints.copies`` at its bound, as the build writes it.
 
-    The driver's table is halved until the file fits :data:`fabricate.spec.MAX_TEMPLATE_BYTES` (its 10000
-    samples alone write 1.2 MB of PCHIP coefficients: the exact form of such a linkage is refused).
+    The driver's table is halved until the file fits :data:`fabricate.spec.MAX_TEMPLATE_BYTES` (a guard: at
+    the bound of 4000 samples in all the table writes 0.44 MB of PCHIP coefficients and fits as it is).
     """
     from fabricate.spec import MAX_TEMPLATE_BYTES, design_from_text
     from fabricate.synthesis.linkage.exact import mechanism_toml

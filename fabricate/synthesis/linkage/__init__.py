@@ -420,6 +420,11 @@ def parse_spec(root: Table) -> LinkageSpec | ExactLinkageSpec:
     if not driver_tables:
         raise SpecError(t.field("drivers"), "a linkage needs at least one driver")
     drivers = [_parse_driver(d, joints, unit, float(rng[0])) for d in driver_tables]
+    samples = sum(len(g.x_deg or ()) for g in gears) + sum(len(d.input or ()) for d in drivers)
+    if samples > MAX_LINKAGE_TABLE:  # in all: the build's mechanism.toml writes every one of them
+        raise SpecError(t.field("drivers" if not any(g.x_deg for g in gears) else "gears"),
+                        f"the gear and driver tables have {samples} samples in all, over the bound of "
+                        f"{MAX_LINKAGE_TABLE} (each is written into the build's mechanism.toml)")
     seen: set[str] = set()
     for d, dt in zip(drivers, driver_tables, strict=True):
         if d.joint in seen:
