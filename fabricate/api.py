@@ -19,66 +19,17 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from fabricate.errors import SpecError
+from fabricate.pipeline import BuildOutcome, path_argument, type_name
 from fabricate.spec import DesignSpec, check_design_name
 
-
-@dataclass(frozen=True)
-class Build:
-    """A finished build, in memory.
-
-    Attributes
-    ----------
-    exit_code : int
-        0 when every check passes, 1 when the design fails one (the files are still made): the CLI's code.
-    report : dict
-        report.json's content.
-    files : Mapping[str, bytes]
-        Every output file by its path relative to the output folder.
-    design : DesignSpec
-    """
-
-    exit_code: int
-    report: dict[str, Any]
-    files: Mapping[str, bytes]
-    design: DesignSpec
-    outcome: Any = None
-
-    @property
-    def passed(self) -> bool:
-        """Whether no check that ran failed (the CLI's exit code 0). A check that could not run (strength
-        without materials or a load) is not a failure: :attr:`not_checked` names it."""
-        return self.exit_code == 0
-
-    @property
-    def not_checked(self) -> list[str]:
-        """The checks that could not run, each with why (``"strength not checked: no [load] in the
-        template"``); empty when everything was checked."""
-        from fabricate.report import not_checked_notes
-
-        return not_checked_notes(self.report)
-
-    @property
-    def failures(self) -> list[str]:
-        """Why the design fails, one line per failure (empty when it passes)."""
-        return list(self.report.get("checks", {}).get("failures", []))
-
-    def write(self, out: str | Path, *, force: bool = False) -> Path:
-        """Write the files to folder ``out`` atomically, with the CLI's rules: ``out`` must be new, empty or
-        a previous fabricate output; ``force`` replaces another folder (never a file, a link or the
-        current folder). Returns the folder written."""
-        from fabricate.output import check_output_dir, write_output
-
-        out = _as_path(out, "out", "an output folder")
-        if not isinstance(force, bool):
-            raise SpecError("force", f"expected True or False, got {_type_name(force)}")
-        protect = [Path(self.design.template)]
-        check_output_dir(out, force=force, stage="build", protect=protect)
-        return write_output(self.files, out, force=force, stage="build", protect=protect)
+#: What :func:`build` returns: the pipeline's own result type (:class:`fabricate.pipeline.BuildOutcome`),
+#: under the API's name. ``.passed``, ``.failures``, ``.not_checked``, ``.report``, ``.files``, ``.design`` and
+#: ``.write(folder)``, the same object ``fabricate build`` writes from.
+Build = BuildOutcome
 
 
 def load(template: str | Path | Mapping[str, Any], process: str | Path | None = None) -> DesignSpec:
@@ -103,7 +54,7 @@ def load(template: str | Path | Mapping[str, Any], process: str | Path | None = 
     from fabricate.spec import design_from_text, load_design, process_override
 
     if process is not None:
-        process = str(_as_path(process, "process", '"sla", "laser" or a process profile file'))
+        process = str(path_argument(process, "process", '"sla", "laser" or a process profile file'))
     if isinstance(template, Mapping):
         from fabricate.tomlwrite import dumps
 
@@ -116,8 +67,8 @@ def load(template: str | Path | Mapping[str, Any], process: str | Path | None = 
         return design_from_text(dumps(tables), Path(label).name or "design.toml", override)
     if not isinstance(template, (str, os.PathLike)):
         raise SpecError("template", "expected a shipped template's name, a template path or a dict of its tables, "
-                                    f"got {_type_name(template)}")
-    return load_design(_as_path(template, "template", "a template name or path"), process)
+                                    f"got {type_name(template)}")
+    return load_design(path_argument(template, "template", "a template name or path"), process)
 
 
 def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | None = None,
@@ -157,19 +108,19 @@ def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | Non
     from fabricate.synthesis.linkage.exact import exact_linkage
 
     if not isinstance(mechanism, Mechanism):
-        raise SpecError("mechanism", f"expected a fabricate.mechanism.Mechanism, got {_type_name(mechanism)}")
+        raise SpecError("mechanism", f"expected a fabricate.mechanism.Mechanism, got {type_name(mechanism)}")
     if not isinstance(mechanism.name, str):
-        raise SpecError("mechanism.name", f"expected a name (str), got {_type_name(mechanism.name)}")
+        raise SpecError("mechanism.name", f"expected a name (str), got {type_name(mechanism.name)}")
     check_design_name(mechanism.name, "mechanism.name")  # it becomes design.name, the output folder's name
     _check_assembly(mechanism)
     if not isinstance(process, str):
-        raise SpecError("process", f'expected "sla" or "laser", got {_type_name(process)}')
+        raise SpecError("process", f'expected "sla" or "laser", got {type_name(process)}')
     if tip_point is not None and not isinstance(tip_point, str):
-        raise SpecError("tip_point", f"expected a point name (str), got {_type_name(tip_point)}")
+        raise SpecError("tip_point", f"expected a point name (str), got {type_name(tip_point)}")
     for arg, value in (("pads", pads), ("tables", tables)):
         if value is not None and not (isinstance(value, Mapping)
                                       and all(isinstance(v, Mapping) for v in value.values())):
-            raise SpecError(arg, f"expected a dict of tables ({{name: {{...}}}}), got {_type_name(value)}")
+            raise SpecError(arg, f"expected a dict of tables ({{name: {{...}}}}), got {type_name(value)}")
     pads, tables = (_toml_value(value, arg) if value is not None else None
                     for arg, value in (("pads", pads), ("tables", tables)))
     template: dict[str, Any] = {"design": {"name": mechanism.name, "kind": "linkage"},
@@ -205,7 +156,7 @@ def _check_assembly(mechanism: Any) -> None:
     example = f'Mechanism(..., assembly={{"{moving[0] if moving else "body"}": (x_mm, y_mm, angle_rad), ...}})'
     if not isinstance(assembly, Mapping):
         raise SpecError("mechanism.assembly", f"expected a dict of body name -> (x_mm, y_mm, angle_rad), got "
-                                              f"{_type_name(assembly)}; pass {example}")
+                                              f"{type_name(assembly)}; pass {example}")
     missing = [name for name in moving if name not in assembly]
     if missing:
         more = f" (nor for {', '.join(map(repr, missing[1:]))})" if len(missing) > 1 else ""
@@ -249,39 +200,14 @@ def build(design: DesignSpec | str | Path | Mapping[str, Any], process: str | Pa
     elif not isinstance(design, DesignSpec):
         if not isinstance(design, (str, os.PathLike, Mapping)):
             raise SpecError("design", "expected what fabricate.load takes (a template name, path or dict of tables), "
-                                      f"a design it returned, or a Mechanism; got {_type_name(design)}")
+                                      f"a design it returned, or a Mechanism; got {type_name(design)}")
         design, process = load(design, process), None
     if process is not None:
         from fabricate.spec import design_from_text, process_override
 
-        override = process_override(str(_as_path(process, "process", '"sla", "laser" or a process profile file')))
+        override = process_override(str(path_argument(process, "process", '"sla", "laser" or a process profile file')))
         design = design_from_text(design.template_text, design.template, override)
-    outcome = run_build(design)
-    return Build(exit_code=outcome.exit_code, report=outcome.report, files=dict(outcome.files), design=design,
-                 outcome=outcome)
-
-
-def _type_name(value: Any) -> str:
-    text = repr(value)
-    return f"{type(value).__name__} {text[:60]}{'...' if len(text) > 60 else ''}"
-
-
-def _as_path(value: Any, argument: str, what: str) -> Path:
-    """``value`` as a Path, or a :class:`SpecError` naming ``argument`` (bytes, numbers, None, a NUL...)."""
-    if isinstance(value, (str, os.PathLike)):
-        try:
-            path = Path(value)
-        except TypeError:  # a PathLike that returns bytes
-            path = None
-        if path is not None and "\0" in str(path):
-            raise SpecError(argument, f"a path cannot hold a NUL character, got {str(path)!r:.80}")
-        try:
-            os.fsencode(path) if path is not None else None
-        except UnicodeError:  # a lone surrogate the file system's encoding cannot write
-            raise SpecError(argument, f"not a name the file system can hold: {str(path)!r:.80}") from None
-        if path is not None and str(value):
-            return path
-    raise SpecError(argument, f"expected {what} (str or pathlib.Path), got {_type_name(value)}")
+    return run_build(design)
 
 
 #: Deepest nesting of a dict of tables (a template's deepest is a few levels; a cycle would recurse forever).
@@ -299,7 +225,7 @@ def _toml_value(value: Any, path: str, depth: int = 0) -> Any:
         out = {}
         for key, item in value.items():
             if not isinstance(key, str):
-                raise SpecError(path or "template", f"expected text keys, got {_type_name(key)}")
+                raise SpecError(path or "template", f"expected text keys, got {type_name(key)}")
             where = f"{path}.{key}" if path else key
             out[_text(key, where)] = _toml_value(item, where, depth + 1)
         return out
@@ -316,7 +242,7 @@ def _toml_value(value: Any, path: str, depth: int = 0) -> Any:
     if isinstance(value, (list, tuple)):
         return [_toml_value(item, f"{path}[{i}]", depth + 1) for i, item in enumerate(value)]
     raise SpecError(path or "template", "expected a TOML value (string, number, boolean, list or table), got "
-                                        f"{_type_name(value)}")
+                                        f"{type_name(value)}")
 
 
 def _text(value: str, path: str) -> str:

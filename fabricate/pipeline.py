@@ -16,42 +16,90 @@ import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fabricate import __version__
 from fabricate.bounds import blas_threads
 from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
 from fabricate.mechanism import Mechanism, Motion
-from fabricate.report import SYNTH_ONLY, report_json, report_markdown
+from fabricate.report import SYNTH_ONLY, not_checked_notes, report_json, report_markdown
+from fabricate.report_schema import SCHEMA_VERSION
 from fabricate.spec import DesignSpec
 from fabricate.synthesis import KINDS
 from fabricate.synthesis.base import SynthesisResult
 
+if TYPE_CHECKING:
+    from fabricate.checks import CheckReport
+    from fabricate.gears.pair import GearPair
+    from fabricate.parts.build import PartSet
+    from fabricate.strength.check import StrengthResult
+
 Progress = Callable[[str], None]
 
 
-@dataclass
+@dataclass(frozen=True)
 class BuildOutcome:
-    """What a pipeline run produced.
+    """A finished run of the pipeline, in memory: the one result type of a build.
+
+    :func:`run_build` and :func:`run_synth` return it, and so does the API's ``fabricate.build``, which
+    calls it :class:`fabricate.Build`.
 
     Attributes
     ----------
     exit_code : int
-        0 all checks pass, 1 the design fails a check (files are still produced).
+        0 when every check that ran passes, 1 when the design fails one (the files are still made): the
+        CLI's exit code.
     report : dict
-        The report.json content.
+        report.json's content (its keys: ``fabricate/report_schema.json``, described in ``docs/report.md``).
     files : dict
-        ``{relative path: bytes}`` including report.json and report.md.
+        Every output file, ``{path relative to the output folder: bytes}``, report.json and report.md included.
+    design : DesignSpec or None
+        The design the run was given (None only in a result made by hand, such as a test's stand-in).
+    synthesis, motion, partset, gear_pairs, checks
+        What the stages made, for callers that look past the files (None or empty where the run stopped
+        before that stage).
     """
 
     exit_code: int
     report: dict[str, Any]
     files: dict[str, bytes] = field(default_factory=dict)
+    design: DesignSpec | None = None
     synthesis: SynthesisResult | None = None
     motion: Motion | None = None
-    partset: Any = None
-    gear_pairs: list[Any] = field(default_factory=list)
-    checks: Any = None
+    partset: PartSet | None = None
+    gear_pairs: list[GearPair] = field(default_factory=list)
+    checks: CheckReport | None = None
+
+    @property
+    def passed(self) -> bool:
+        """Whether no check that ran failed (the CLI's exit code 0). A check that could not run (strength
+        without materials or a load) is not a failure: :attr:`not_checked` names it."""
+        return self.exit_code == 0
+
+    @property
+    def not_checked(self) -> list[str]:
+        """The checks that could not run, each with why (``"strength not checked: no [load] in the
+        template"``); empty when everything was checked."""
+        return not_checked_notes(self.report)
+
+    @property
+    def failures(self) -> list[str]:
+        """Why the design fails, one line per failure (empty when it passes)."""
+        return list(self.report.get("checks", {}).get("failures", []))
+
+    def write(self, out: str | Path, *, force: bool = False) -> Path:
+        """Write the files to folder ``out`` atomically, with the CLI's rules: ``out`` must be new, empty or
+        a previous fabricate output; ``force`` replaces another folder (never a file, a link or the
+        current folder). Returns the folder written."""
+        from fabricate.output import check_output_dir, write_output
+
+        out = path_argument(out, "out", "an output folder")
+        if not isinstance(force, bool):
+            raise SpecError("force", f"expected True or False, got {type_name(force)}")
+        stage = "synth" if self.report.get("design", {}).get("stage") == "synth" else "build"
+        protect = [Path(self.design.template)] if self.design is not None else []
+        check_output_dir(out, force=force, stage=stage, protect=protect)
+        return write_output(self.files, out, force=force, stage=stage, protect=protect)
 
 
 def _quiet(_: str) -> None:
@@ -71,7 +119,8 @@ def design_section(design: DesignSpec, stage: str) -> dict[str, Any]:
 
 
 def mechanism_section(mechanism: Mechanism, motion: Motion) -> dict[str, Any]:
-    """DESIGN.md ``mechanism`` keys: every named point at the first pose, bodies with their points."""
+    """report.json's ``mechanism`` section (fabricate/report_schema.json): every named point at the first
+    pose, bodies with their points."""
     joints = {}
     for body in mechanism.bodies:
         for name in body.points:
@@ -97,7 +146,8 @@ def _synthesis_stage(design: DesignSpec, progress: Progress, stage: str
                      ) -> tuple[SynthesisResult, dict[str, Any], Motion | None, list[str]]:
     """Synthesis and the swept motion; a lock-up inside the range is a design failure, not an error."""
     result = synthesise(design, progress)
-    report: dict[str, Any] = {"design": design_section(design, stage)}
+    # the schema version first: a reader learns which contract the rest follows before reading it
+    report: dict[str, Any] = {"schema_version": SCHEMA_VERSION, "design": design_section(design, stage)}
     progress("sweep")
     try:
         motion = result.mechanism.sweep(design.checks.sweep_poses)
@@ -142,6 +192,44 @@ def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     return _finish(design, report, files, exit_code=1 if failures else 0, synthesis=result, motion=motion)
 
 
+@dataclass
+class BuildRun:
+    """One build in progress after synthesis: the stage running, and what the stages before it made.
+
+    Each step of :func:`_build_stages` reads what earlier steps left here and adds its own part (report
+    sections, files); :attr:`stage` names the step running, so a kernel failure inside it is reported with it.
+    """
+
+    design: DesignSpec  # the design being built: link sizing replaces it with the width it chose
+    synthesis: SynthesisResult
+    motion: Motion
+    report: dict[str, Any]
+    progress: Progress = _quiet
+    optional: OptionalOutputs | None = None
+    given: DesignSpec | None = None  # the design the caller gave (the outcome's); None: ``design``
+    stage: str = "gears"
+    files: dict[str, bytes] = field(default_factory=dict)
+    gear_pairs: list[GearPair] = field(default_factory=list)
+    sizing: dict[str, Any] | None = None
+    partset: PartSet | None = None
+    checks: CheckReport | None = None
+    strength: StrengthResult | None = None
+    failures: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if self.given is None:
+            self.given = self.design
+
+    @property
+    def mechanism(self) -> Mechanism:
+        return self.synthesis.mechanism
+
+    def enter(self, stage: str) -> None:
+        """Start ``stage``: it names any failure from here on, and the progress line shows it."""
+        self.stage = stage
+        self.progress(stage)
+
+
 def _kernel_failures() -> tuple[type[BaseException], ...]:
     """Exceptions of the numeric and geometry kernels that a design can provoke (not bugs of ours)."""
     import numpy as np
@@ -172,9 +260,9 @@ def run_build(design: DesignSpec, progress: Progress = _quiet, *,
     if motion is None:
         report["checks"] = {"passed": False, "failures": failures}
         return _finish(design, report, {}, exit_code=1, synthesis=result)
-    stage = ["gears"]
+    run = BuildRun(design, result, motion, report, progress, optional)
     try:
-        return _build_stages(design, result, report, motion, progress, stage, optional)
+        return _build_stages(run)
     except (SpecError, SynthesisError):
         raise
     except _kernel_failures() as exc:
@@ -182,45 +270,73 @@ def run_build(design: DesignSpec, progress: Progress = _quiet, *,
             text = str(exc)
         else:
             text = f"{type(exc).__name__}: {exc}".strip().rstrip(":")
-        failure = f"{stage[0]}: this design cannot be made ({text})"
+        failure = f"{run.stage}: this design cannot be made ({text})"
         report["checks"] = {"passed": False, "failures": [failure]}
         return _finish(design, report, {}, exit_code=1, synthesis=result, motion=motion)
 
 
-def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str, Any], motion: Motion,
-                  progress: Progress, stage: list[str], optional: OptionalOutputs | None = None) -> BuildOutcome:
-    """Gears, parts, exports, checks and pictures; ``stage[0]`` names the stage running (for failures)."""
-    from fabricate.checks import run_checks
-    from fabricate.export import STEP_SKIPPED, assembly_csv, export_all, export_previews, export_step, motion_csv
-    from fabricate.export.step import step_available
+def _build_stages(run: BuildRun) -> BuildOutcome:
+    """Gears, parts, then exports and checks while a forked child draws the pictures (and exports STEP)."""
+    _make_gears(run)
+    if run.design.parts.link_width_mm == "auto":
+        _size_links(run)
+    _make_parts(run)
+    # pictures take as long as everything else: draw them in a forked child on the second core
+    pictures = Background(_picture_jobs(run))
+    try:
+        # inside the try: this may import OCP (slow), and a stop signal landing here must cancel the child
+        with_step = _record_optional_outputs(run)
+        _export(run, with_step)
+        _check(run)
+        _check_strength(run)
+        _verdict(run)
+        _plots(run, pictures)
+    finally:
+        pictures.cancel()
+    return _finish(run.given, run.report, run.files, exit_code=0 if not run.failures else 1,
+                   synthesis=run.synthesis, motion=run.motion, partset=run.partset, gear_pairs=run.gear_pairs,
+                   checks=run.checks)
+
+
+def _make_gears(run: BuildRun) -> None:
+    """One cut, checked gear pair per gear coupling: report.json's ``gears``."""
     from fabricate.gears import build_gear_pairs
-    from fabricate.parts.assembly import assembly_steps, pin_stacks, stacks_report
+
+    run.enter("gears")
+    run.gear_pairs = build_gear_pairs(run.mechanism, run.design.gears, run.design.process.chord_tolerance_mm)
+    run.report["gears"] = [pair.report() for pair in run.gear_pairs]
+
+
+def _size_links(run: BuildRun) -> None:
+    """``parts.link_width_mm = "auto"``: the width the strength check asks for replaces it in the design."""
     from fabricate.parts.build import build_parts
-    from fabricate.strength.check import run_strength
-    from fabricate.strength.plots import strength_plot
-    from fabricate.synthesis.linkage.exact import mechanism_toml
+    from fabricate.strength.sizing import size_link_width
 
-    def enter(name: str) -> None:
-        stage[0] = name
-        progress(name)
-
-    files: dict[str, bytes] = {}
-    mechanism = result.mechanism
-    enter("gears")
-    gear_pairs = build_gear_pairs(mechanism, design.gears, design.process.chord_tolerance_mm)
-    report["gears"] = [pair.report() for pair in gear_pairs]
-    sizing = None
-    if design.parts.link_width_mm == "auto":
-        enter("sizing")
-        from fabricate.strength.sizing import size_link_width
-
-        width, tried = size_link_width(design, mechanism, motion, gear_pairs, result.parts,
-                                       lambda d: build_parts(d, mechanism, motion, gear_pairs, result.parts))
-        design = dataclasses.replace(design, parts=dataclasses.replace(design.parts, link_width_mm=width))
-        sizing = {"link_width_mm": width, "tried": [{"link_width_mm": w, "least_safety_factor": sf}
+    run.enter("sizing")
+    design, mechanism, motion, gear_pairs, hints = run.design, run.mechanism, run.motion, run.gear_pairs, \
+        run.synthesis.parts
+    width, tried = size_link_width(design, mechanism, motion, gear_pairs, hints,
+                                   lambda d: build_parts(d, mechanism, motion, gear_pairs, hints))
+    run.design = dataclasses.replace(design, parts=dataclasses.replace(design.parts, link_width_mm=width))
+    run.sizing = {"link_width_mm": width, "tried": [{"link_width_mm": w, "least_safety_factor": sf}
                                                     for w, sf in tried]}
-    enter("parts")
-    partset = build_parts(design, mechanism, motion, gear_pairs, result.parts)
+
+
+def _make_parts(run: BuildRun) -> None:
+    """Every body as parts (plates, gears fused on), pins, spacers and the bill of materials."""
+    from fabricate.parts.build import build_parts
+
+    run.enter("parts")
+    run.partset = build_parts(run.design, run.mechanism, run.motion, run.gear_pairs, run.synthesis.parts)
+
+
+def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
+    """The slow outputs, for the forked child: the method's plots, gear pictures, previews, STEP files."""
+    from fabricate.export import export_previews, export_step
+
+    result, gear_pairs, design, partset, motion = run.synthesis, run.gear_pairs, run.design, run.partset, run.motion
+    optional = run.optional
+
     def step_job() -> dict[str, bytes]:
         if optional is None:
             return export_step(design, partset, motion)
@@ -229,54 +345,86 @@ def _build_stages(design: DesignSpec, result: SynthesisResult, report: dict[str,
         return dict(optional.step_files) if optional.step_files is not None else export_step(design, partset,
                                                                                              motion)
 
-    # pictures take as long as everything else: draw them in a forked child on the second core
-    pictures = Background([lambda: synthesis_plots(result), lambda: gear_pictures(gear_pairs),
-                           lambda: export_previews(design, partset, motion), step_job])
-    try:
-        # inside the try: this may import OCP (slow), and a stop signal landing here must cancel the child
-        with_step = step_available() if optional is None else optional.step
-        report["notes"] = [] if with_step else [STEP_SKIPPED]
-        # optional outputs as written or skipped: `check` rebuilds with the same set, so its verdict does not
-        # depend on the checker's install (fabricate/verify.py)
-        report["outputs"] = {"step": "written" if with_step else "skipped: OCP is not installed (extra 'cad')"}
-        enter("exports")
-        exported, parts_report = export_all(design, partset, mechanism, motion, previews=False, step=False,
-                                             with_step=with_step)
-        files.update(exported)
-        report["parts"] = parts_report
-        report["bom"] = list(getattr(partset, "bom", []))
-        stacks = pin_stacks(partset)
-        report["assembly"] = {"pins": stacks_report(stacks), "steps": assembly_steps(stacks, partset.copies)}
-        files["assembly.csv"] = assembly_csv(stacks)
-        files["motion.csv"] = motion_csv(mechanism, motion)
-        files["mechanism.toml"] = mechanism_toml(design, mechanism, result.parts)
-        enter("checks")
-        checks = run_checks(design, partset, mechanism, motion, gear_pairs)
-        report["interference"] = checks.interference
-        failures = list(checks.failures)
-        for pair in gear_pairs:
-            failures += [f"gear {pair.name}: {text}" for text in pair.failures()]
-        enter("strength")
-        strength = run_strength(design, partset, mechanism, motion, gear_pairs, result.parts)
-        report["strength"] = strength.report()
-        if sizing is not None:
-            report["strength"]["sizing"] = sizing
-        failures += strength.failures()
-        # passed is over the checks that ran; those that could not run are listed, never passed
-        not_checked = [dict(entry) for entry in checks.not_checked]
-        if strength.reason is not None:
-            not_checked.append({"check": "strength", "reason": strength.reason})
-        report["checks"] = {"passed": not failures, "failures": failures, "not_checked": not_checked}
-        enter("plots")
-        if strength.findings:
-            files["plots/strength.png"] = strength_plot(strength, mechanism.input_unit)
-        for name, data in sorted(checks.figures().items()):
-            files[f"plots/{name}"] = data
-        files.update(pictures.result())
-    finally:
-        pictures.cancel()
-    return _finish(design, report, files, exit_code=0 if not failures else 1, synthesis=result, motion=motion,
-                   partset=partset, gear_pairs=gear_pairs, checks=checks)
+    return [lambda: synthesis_plots(result), lambda: gear_pictures(gear_pairs),
+            lambda: export_previews(design, partset, motion), step_job]
+
+
+def _record_optional_outputs(run: BuildRun) -> bool:
+    """Whether STEP files are made, recorded in report.json (``notes``, ``outputs``); returned."""
+    from fabricate.export import STEP_SKIPPED
+    from fabricate.export.step import step_available
+
+    with_step = step_available() if run.optional is None else run.optional.step
+    run.report["notes"] = [] if with_step else [STEP_SKIPPED]
+    # optional outputs as written or skipped: `check` rebuilds with the same set, so its verdict does not
+    # depend on the checker's install (fabricate/verify.py)
+    run.report["outputs"] = {"step": "written" if with_step else "skipped: OCP is not installed (extra 'cad')"}
+    return with_step
+
+
+def _export(run: BuildRun, with_step: bool) -> None:
+    """Part files, drawings, plates or sheets, the BOM and assembly, motion.csv and mechanism.toml."""
+    from fabricate.export import assembly_csv, export_all, motion_csv
+    from fabricate.parts.assembly import assembly_steps, pin_stacks, stacks_report
+    from fabricate.synthesis.linkage.exact import mechanism_toml
+
+    run.enter("exports")
+    exported, parts_report = export_all(run.design, run.partset, run.mechanism, run.motion, previews=False,
+                                        step=False, with_step=with_step)
+    run.files.update(exported)
+    run.report["parts"] = parts_report
+    run.report["bom"] = list(getattr(run.partset, "bom", []))
+    stacks = pin_stacks(run.partset)
+    run.report["assembly"] = {"pins": stacks_report(stacks), "steps": assembly_steps(stacks, run.partset.copies)}
+    run.files["assembly.csv"] = assembly_csv(stacks)
+    run.files["motion.csv"] = motion_csv(run.mechanism, run.motion)
+    run.files["mechanism.toml"] = mechanism_toml(run.design, run.mechanism, run.synthesis.parts)
+
+
+def _check(run: BuildRun) -> None:
+    """Interference, gear mesh and printability (report.json's ``interference``), and the gear pairs' own."""
+    from fabricate.checks import run_checks
+
+    run.enter("checks")
+    run.checks = run_checks(run.design, run.partset, run.mechanism, run.motion, run.gear_pairs)
+    run.report["interference"] = run.checks.interference
+    run.failures = list(run.checks.failures)
+    for pair in run.gear_pairs:
+        run.failures += [f"gear {pair.name}: {text}" for text in pair.failures()]
+
+
+def _check_strength(run: BuildRun) -> None:
+    """Every part and pin at the design load: report.json's ``strength`` (with the link sizing, if any)."""
+    from fabricate.strength.check import run_strength
+
+    run.enter("strength")
+    run.strength = run_strength(run.design, run.partset, run.mechanism, run.motion, run.gear_pairs,
+                                run.synthesis.parts)
+    run.report["strength"] = run.strength.report()
+    if run.sizing is not None:
+        run.report["strength"]["sizing"] = run.sizing
+    run.failures += run.strength.failures()
+
+
+def _verdict(run: BuildRun) -> None:
+    """report.json's ``checks``: passed is over the checks that ran; those that could not run are listed,
+    never passed."""
+    not_checked = [dict(entry) for entry in run.checks.not_checked]
+    if run.strength.reason is not None:
+        not_checked.append({"check": "strength", "reason": run.strength.reason})
+    run.report["checks"] = {"passed": not run.failures, "failures": run.failures, "not_checked": not_checked}
+
+
+def _plots(run: BuildRun, pictures: Background) -> None:
+    """The strength and clearance plots, then the pictures the child drew."""
+    from fabricate.strength.plots import strength_plot
+
+    run.enter("plots")
+    if run.strength.findings:
+        run.files["plots/strength.png"] = strength_plot(run.strength, run.mechanism.input_unit)
+    for name, data in sorted(run.checks.figures().items()):
+        run.files[f"plots/{name}"] = data
+    run.files.update(pictures.result())
 
 
 def synthesis_plots(result: SynthesisResult) -> dict[str, bytes]:
@@ -436,4 +584,30 @@ def _finish(design: DesignSpec, report: dict[str, Any], files: dict[str, bytes],
     report["manifest"] = manifest(files)
     report["template_text"] = design.template_text
     files["report.json"] = report_json(report)
-    return BuildOutcome(report=report, files=files, **kw)
+    return BuildOutcome(report=report, files=files, design=design, **kw)
+
+
+# -- arguments of the API face (fabricate.api and BuildOutcome.write) ----------------------------------------
+
+def type_name(value: Any) -> str:
+    """A value's type and the start of its repr, for an error naming a wrong argument."""
+    text = repr(value)
+    return f"{type(value).__name__} {text[:60]}{'...' if len(text) > 60 else ''}"
+
+
+def path_argument(value: Any, argument: str, what: str) -> Path:
+    """``value`` as a Path, or a :class:`SpecError` naming ``argument`` (bytes, numbers, None, a NUL...)."""
+    if isinstance(value, (str, os.PathLike)):
+        try:
+            path = Path(value)
+        except TypeError:  # a PathLike that returns bytes
+            path = None
+        if path is not None and "\0" in str(path):
+            raise SpecError(argument, f"a path cannot hold a NUL character, got {str(path)!r:.80}")
+        try:
+            os.fsencode(path) if path is not None else None
+        except UnicodeError:  # a lone surrogate the file system's encoding cannot write
+            raise SpecError(argument, f"not a name the file system can hold: {str(path)!r:.80}") from None
+        if path is not None and str(value):
+            return path
+    raise SpecError(argument, f"expected {what} (str or pathlib.Path), got {type_name(value)}")

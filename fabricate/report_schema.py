@@ -1,17 +1,24 @@
-"""The schema of report.json, and the validator ``fabricate check`` runs before it reads any field.
+"""The schema of report.json, its version, and the validator ``fabricate check`` runs before it reads any field.
 
 The schema is a JSON Schema document shipped in the package (``fabricate/report_schema.json``, also
-:func:`report_schema`) so outside tools can validate reports with any JSON Schema library. It types every
-key DESIGN.md lists as stable and requires those ``check`` reads; sections it does not name may be added
-freely.
+:func:`report_schema`) so outside tools can validate reports with any JSON Schema library; ``docs/report.md``
+is generated from it (``docs/make_report_docs.py``). It is the contract of report.json: every key it names
+is stable, typed, and has a title and a description; it requires the keys ``check`` reads; sections and keys
+it does not name may be added freely and are not part of the contract.
+
+Every report carries :data:`SCHEMA_VERSION` as its first key, ``schema_version`` ("MAJOR.MINOR"). MINOR
+grows when the schema gains a key or admits a new value that readers may ignore; MAJOR grows when a key is
+removed or renamed or its type or meaning changes. A reader of MAJOR.x reads every report of that MAJOR
+(:func:`version_problem` says why it cannot read another).
 
 The validator here implements the few keywords the schema uses (``type``, ``enum``, ``pattern``,
 ``required``, ``properties``, ``additionalProperties``, ``items``, ``minItems``, ``maxItems``,
 ``minimum``, local ``$ref``) instead of depending on ``jsonschema``: that keeps the core install free of
 its dependency tree (``referencing``, the compiled ``rpds-py``), and its messages name a field the way a
-reader of report.json writes it (``parts[3].holes is not a list``). Two deliberate differences from plain
-JSON Schema, both stricter: a non-finite float is not a number (fabricate writes null for one; ``NaN`` is
-not JSON), and ``true``/``false`` are never numbers.
+reader of report.json writes it (``parts[3].holes is not a list``); a value that misses a pattern is named
+by the schema's ``title`` for it (``is not a relative path inside the output folder``). Two deliberate
+differences from plain JSON Schema, both stricter: a non-finite float is not a number (fabricate writes null
+for one; ``NaN`` is not JSON), and ``true``/``false`` are never numbers.
 """
 
 from __future__ import annotations
@@ -27,6 +34,9 @@ from typing import Any
 
 #: The schema's file name inside the package.
 SCHEMA_FILE = "report_schema.json"
+#: The version of the schema this fabricate writes and reads: report.json's ``schema_version`` (the schema's
+#: ``$id`` ends with it; tests/test_report_schema.py holds the two together).
+SCHEMA_VERSION = "1.0"
 #: Keywords the validator implements; :func:`unsupported_keywords` finds any other in a schema.
 KEYWORDS = frozenset({"type", "enum", "pattern", "required", "properties", "additionalProperties", "items",
                       "minItems", "maxItems", "minimum", "$ref"})
@@ -105,7 +115,7 @@ def _errors(value: Any, schema: Mapping[str, Any], path: str, root: Mapping[str,
         yield f"{where} is not one of {', '.join(json.dumps(v) for v in schema['enum'])}"
     if isinstance(value, str) and "pattern" in schema and not re.search(schema["pattern"], value):
         yield f"{where} {_short(value)} is not " + (
-            schema["description"] if "description" in schema else f"of the form {schema['pattern']}")
+            schema["title"] if "title" in schema else f"of the form {schema['pattern']}")
     if "minimum" in schema and _is(value, "number") and value < schema["minimum"]:
         yield f"{where} is {value}, less than {schema['minimum']}"
     if isinstance(value, list):
@@ -154,6 +164,25 @@ def schema_errors(report: Any, schema: Mapping[str, Any] | None = None, limit: i
     if len(found) > limit:
         found = found[:limit] + [f"(more problems after the first {limit} not listed)"]
     return found
+
+
+def version_problem(report: Mapping[str, Any]) -> str | None:
+    """Why this fabricate cannot read ``report`` by its ``schema_version`` (None: it can).
+
+    A report without one was written before report.json had a version (fabricate 0.1 before Step 13); one of
+    another MAJOR follows a contract this fabricate does not know. A value that is not a version at all is
+    left to :func:`schema_errors`, which names it.
+    """
+    version = report.get("schema_version")
+    if "schema_version" not in report:
+        return "no schema_version: written by an older fabricate, before report.json had a version; build it again"
+    if not isinstance(version, str) or not re.fullmatch(r"[0-9]+\.[0-9]+", version):
+        return None
+    major = SCHEMA_VERSION.split(".")[0]
+    if version.split(".")[0] != major:
+        return (f"schema_version {version}: a report format this fabricate does not read (it reads {major}.x); "
+                "use the fabricate that wrote it (design.fabricate_version)")
+    return None
 
 
 def unsupported_keywords(schema: Any) -> set[str]:

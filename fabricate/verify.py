@@ -2,9 +2,9 @@
 
 Three layers, each naming the file and how it differs:
 
-1. **Manifest.** report.json (at most :data:`REPORT_MAX_BYTES`, validated against its schema,
-   :mod:`fabricate.report_schema`, before any field is read) lists every other file with its size and
-   sha256; each is compared, and a file the manifest does not list is reported.
+1. **Manifest.** report.json (at most :data:`REPORT_MAX_BYTES`, of a ``schema_version`` this fabricate
+   reads, validated against its schema, :mod:`fabricate.report_schema`, before any field is read) lists every
+   other file with its size and sha256; each is compared, and a file the manifest does not list is reported.
 2. **Contents by type.** Every file is parsed as what it claims to be, against the numbers the report
    gives: a part STL is a closed solid of the reported volume, the print plate holds all of them, the 3MF
    has one closed object per part, a part DXF passes ezdxf's audit and cuts exactly the reported holes,
@@ -55,7 +55,7 @@ from typing import Any
 from fabricate.errors import FabricateError, SpecError
 from fabricate.export import copy_name
 from fabricate.output import REPORT, foreign_entries
-from fabricate.report_schema import schema_errors
+from fabricate.report_schema import schema_errors, version_problem
 
 #: Relative tolerance of a mesh volume against the report (the report rounds to 1e-4 mm^3; meshes carry
 #: float32 vertices, 1e-7 relative).
@@ -285,6 +285,9 @@ def _load_report(folder: OutputFolder) -> tuple[dict[str, Any] | None, bytes, li
         return None, raw, [f"{REPORT}: not a fabricate report (no design section)"]
     if report.get("manifest") is None or report.get("manifest") == []:
         return None, raw, [f"{REPORT}: no manifest of the files (written by an older fabricate? build it again)"]
+    version = version_problem(report)  # before the schema: a report of another version fails it for that reason
+    if version is not None:
+        return None, raw, [f"{REPORT}: {version}"]
     errors = schema_errors(report)
     if errors:
         return None, raw, [f"{REPORT}: {text}" for text in errors]

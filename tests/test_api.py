@@ -127,13 +127,11 @@ def test_a_geared_mechanism_built_in_code_is_the_mechanism_built():
 def test_build_takes_a_process_like_the_cli(monkeypatch):
     """build(..., process=) replaces the design's process as `--process` does, for a name and for a design
     already loaded (the pipeline is stubbed: this is about which design reaches it)."""
-    from types import SimpleNamespace
-
     import fabricate.pipeline
 
     seen = []
-    monkeypatch.setattr(fabricate.pipeline, "run_build", lambda design: seen.append(design) or SimpleNamespace(
-        exit_code=0, report={}, files={}))
+    monkeypatch.setattr(fabricate.pipeline, "run_build", lambda design: seen.append(design) or
+                        fabricate.pipeline.BuildOutcome(exit_code=0, report={}, files={}, design=design))
     design = fabricate.load("gear_pair_elliptic")
     assert design.process.name == "sla"
     for given in (design, "gear_pair_elliptic"):
@@ -146,3 +144,28 @@ def test_build_takes_a_process_like_the_cli(monkeypatch):
     assert seen[-1] is design
     with pytest.raises(fabricate.SpecError, match="--process: expected sla, laser or a process profile file"):
         fabricate.build(design, process="cnc")
+
+
+def test_one_result_type_for_the_api_and_the_pipeline(tmp_path):
+    """fabricate.Build is the pipeline's BuildOutcome (one type for one build): what the CLI, check and sweeps
+    get from run_build is what the API returns, with the API's verdict, failures, not-checked and write."""
+    from fabricate.pipeline import BuildOutcome
+    from fabricate.report import report_json
+
+    assert fabricate.Build is BuildOutcome
+    design = fabricate.load("gear_pair_elliptic")
+    report = {"design": {"name": "x", "fabricate_version": fabricate.__version__, "stage": "build"},
+              "checks": {"passed": False, "failures": ["strength: link too thin"],
+                         "not_checked": [{"check": "interference", "reason": "no poses in the motion"}]},
+              "files": ["report.json", "a.txt"]}
+    result = BuildOutcome(exit_code=1, report=report, files={"a.txt": b"x", "report.json": report_json(report)},
+                          design=design)
+    assert not result.passed and result.failures == ["strength: link too thin"]
+    assert result.not_checked == ["interference not checked: no poses in the motion"]
+    out = result.write(tmp_path / "out")
+    assert sorted(p.name for p in out.iterdir()) == ["a.txt", "report.json"]
+    assert BuildOutcome(exit_code=0, report={"checks": {"failures": []}}).passed
+    with pytest.raises(fabricate.SpecError, match="^force: expected True or False"):
+        result.write(tmp_path / "again", force="yes")
+    with pytest.raises(fabricate.SpecError, match="^out: expected an output folder"):
+        result.write(3)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -20,6 +21,7 @@ import trimesh
 from fabricate.cli import main
 from fabricate.output import write_output
 from fabricate.pipeline import run_build
+from fabricate.report_schema import SCHEMA_VERSION
 from fabricate.spec import TEMPLATE_DIR, load_design
 
 FAST = "gear_pair_elliptic"
@@ -556,6 +558,9 @@ def _edit_report(folder: Path, edit: Callable[[dict], None]) -> None:
     (lambda r: r["mechanism"].update(input_range_deg=[0]), "mechanism.input_range_deg has 1 item, not 2"),
     (lambda r: r.update(template_text=7), "template_text is not a string"),
     (lambda r: r["design"].update(process_override={"source": "x"}), "design.process_override.text is missing"),
+    (lambda r: r.update(schema_version="2.0"), "report.json: schema_version 2.0: a report format this fabricate "
+                                               "does not read (it reads 1.x)"),
+    (lambda r: r.pop("schema_version"), "report.json: no schema_version: written by an older fabricate"),
 ])
 def test_a_report_of_the_wrong_shape_is_named_before_it_is_read(copy, capsys, edit, message):
     _edit_report(copy, edit)
@@ -636,13 +641,83 @@ def test_every_shipped_template_writes_a_report_that_matches_its_schema(monkeypa
     monkeypatch.setattr(pipeline, "Background", NoPictures)
     templates = shipped_templates()
     assert len(templates) >= 8
+    metrics = _sweep_metrics()
     for path in templates:
         outcome = run_build(_quick_design(path))  # the module's own: not the cached rebuild of the fixture
         report = json.loads(outcome.files["report.json"])
         assert report["parts"] and report["strength"] and report["outputs"]["step"]
+        assert next(iter(report)) == "schema_version" and report["schema_version"] == SCHEMA_VERSION
         assert schema_errors(report) == [], path.stem
+        _reads_only_schema_keys(report, metrics)
     synth = pipeline.run_synth(load_design("linkage_stephenson"))
     assert schema_errors(json.loads(synth.files["report.json"])) == []
+    # the shipped sweep's own metrics came out as numbers from a report cut down to the schema's keys
+    assert all(not np.isnan(value) for value in metrics["finger_five_bar_ncg"].values())
+
+
+def _schema_only(value, node=None):
+    """``value`` (a parsed report) with only the keys the schema names: what is left is the contract."""
+    from fabricate.report_schema import report_schema
+
+    root = report_schema()
+    node = root if node is None else node
+    while "$ref" in node:
+        target = root
+        for part in node["$ref"][2:].split("/"):
+            target = target[part]
+        node = {**target, **{k: v for k, v in node.items() if k != "$ref"}}
+    if isinstance(value, dict):
+        properties, extra = node.get("properties", {}), node.get("additionalProperties")
+        return {key: _schema_only(item, properties.get(key, extra)) for key, item in value.items()
+                if key in properties or isinstance(extra, dict)}
+    if isinstance(value, list) and isinstance(node.get("items"), dict):
+        return [_schema_only(item, node["items"]) for item in value]
+    return value
+
+
+def _sweep_metrics():
+    """Every metric a shipped sweep or the README reads, and the default ones, by name (``{template: {}}``
+    collects the values read)."""
+    from fabricate.sweep.spec import default_metrics, load_sweep, parse_metric
+
+    names = set(default_metrics("build"))
+    for spec in (TEMPLATE_DIR / "sweeps").glob("*.toml"):
+        names |= {m.name for m in load_sweep(spec).metrics}
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    line = next(text for text in readme.splitlines() if text.startswith("| `--metric"))
+    names |= {token for token in re.findall(r"`([^`]+)`", line) if "." in token and not token.startswith("--")}
+    assert {"synthesis.pose_error_mm.max", "interference.min_clearance_mm"} <= names
+    return {"metrics": [parse_metric(n, "metric") for n in sorted(names)], "finger_five_bar_ncg": {}}
+
+
+def _reads_only_schema_keys(report, metrics) -> None:
+    """What check and sweeps read from a report is the same from the report cut down to the schema's keys:
+    every key they read is in the schema."""
+    from fabricate.report import not_checked, verdict
+    from fabricate.verify import _expected_by_file, _manifest, _recorded_step
+
+    contract = _schema_only(report)
+    assert contract != report  # extras exist (synthesis' method results), so the cut is a real one
+    for read in (_expected_by_file, _manifest, _recorded_step, not_checked, verdict):
+        assert read(contract) == read(report), read.__name__
+    for metric in metrics["metrics"]:
+        full, cut = metric.read(report), metric.read(contract)
+        assert full == cut or (np.isnan(full) and np.isnan(cut)), metric.name
+        if report["design"]["kind"] == "five_bar_ncg":
+            metrics["finger_five_bar_ncg"][metric.name] = cut
+
+
+def test_check_reads_only_what_the_schema_names(copy, laser_built, tmp_path, capsys):
+    """A folder whose report.json holds only the schema's keys passes every check but the rebuild's byte
+    comparison of report.json itself: the manifest, every file's contents and the rebuild read nothing else."""
+    laser = _laser_copy(laser_built, tmp_path)
+    for folder in (copy, laser):
+        report = _report(folder)
+        (folder / "report.json").write_text(json.dumps(_schema_only(report), indent=2))
+        code, out = _check(folder, capsys)
+        assert code == 1
+        assert [line for line in out.splitlines() if line.startswith("  - ")] == [
+            "  - report.json: differs from a rebuild of the embedded template"], out
 
 
 def test_the_full_builds_match_the_schema_too(built, laser_built):
