@@ -23,7 +23,8 @@ from hypothesis import strategies as st
 
 import fabricate
 from fabricate.errors import FabricateError, SpecError
-from fabricate.spec import TEMPLATE_DIR, DesignSpec, read_toml
+from fabricate.spec import DesignSpec
+from fabricate.templates import TEMPLATE_DIR, read_toml
 
 
 class _PathLikeBytes:

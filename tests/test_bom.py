@@ -4,11 +4,14 @@ they exist, bom.csv carrying every column; and the assembly stacks that say what
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 
+import numpy as np
 import pytest
 import shapely
 
+from fabricate.parts.bom import Spacer, bill_of_materials
 from fabricate.pipeline import run_build
 from fabricate.spec import load_design
 
@@ -113,3 +116,17 @@ def test_exploded_picture_shows_every_part(gripper):
         rgb = 0.75 * np.array(PALETTE[colours[part.name]], dtype=float) + 0.25 * 255.0
         close = np.all(np.abs(image - rgb) <= 3.0, axis=2)
         assert close.sum() > 20, part.name
+
+
+def test_spacers_are_printed_by_an_additive_process_and_bought_for_a_cut_one(sla_process, laser_process):
+    """A tube over a skipped layer is a part an additive process prints (no hardware row); a cut process
+    buys it. Washers are bought either way. The technique decides, not the name."""
+    tube = Spacer(joint="A", body="b", centre=np.zeros(2), inner_diameter_mm=2.5, outer_diameter_mm=6.0,
+                  length_mm=3.6, z_mm=3.3, lower_layer=0, washer=False)
+    washer = dataclasses.replace(tube, length_mm=0.3, washer=True)
+    for process, kinds in ((sla_process, {"washer"}), (laser_process, {"spacer", "washer"}),
+                           (dataclasses.replace(sla_process, name="laser"), {"washer"}),
+                           (dataclasses.replace(laser_process, name="sla"), {"spacer", "washer"})):
+        rows = bill_of_materials([], [tube, washer], {}, process, copies=2)
+        assert {r["kind"] for r in rows} == kinds, process.name
+        assert all(r["qty"] == 2 for r in rows)

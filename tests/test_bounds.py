@@ -15,7 +15,8 @@ import pytest
 from fabricate import bounds
 from fabricate.cli import main
 from fabricate.errors import SpecError
-from fabricate.spec import TEMPLATE_DIR, design_from_text, load_design, parse_toml
+from fabricate.spec import design_from_text, load_design
+from fabricate.templates import TEMPLATE_DIR, parse_toml
 from tests.toml_writer import toml_text
 
 
@@ -427,9 +428,10 @@ def test_the_exact_form_of_the_largest_tables_is_a_valid_template() -> None:
 
     from fabricate.bounds import MAX_LINKAGE_TABLE
     from fabricate.errors import SpecError
-    from fabricate.spec import MAX_TEMPLATE_BYTES, design_from_text
+    from fabricate.spec import design_from_text
     from fabricate.synthesis.linkage.exact import mechanism_toml
     from fabricate.synthesis.linkage.mechanism import build_mechanism
+    from fabricate.templates import MAX_TEMPLATE_BYTES
     from fabricate.tomlwrite import dumps
     from tests.test_not_checked import FOUR_BAR
 

@@ -107,7 +107,8 @@ def seed000():
     from fabricate.gears import build_gear_pairs
     from fabricate.parts.build import build_parts
     from fabricate.pipeline import synthesise
-    from fabricate.spec import TEMPLATE_DIR, load_design
+    from fabricate.spec import load_design
+    from fabricate.templates import TEMPLATE_DIR
 
     design = load_design(TEMPLATE_DIR / "finger_five_bar_ncg.toml")
     result = synthesise(design)

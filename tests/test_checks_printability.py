@@ -465,6 +465,20 @@ def test_laser_part_too_large_and_too_thick_gives_both_messages(laser_process):
     assert not result.parts[0].fits
 
 
+def test_the_sheet_rules_follow_the_layout_not_the_name(laser_process, sla_process):
+    """A sheet layout under another name keeps the sheet's rules (4 mm on a 3 mm sheet fails on thickness);
+    the laser's name on a plate layout is judged by the build height (4 mm under 3 mm fails as 'build volume')."""
+    router = dataclasses.replace(laser_process, name="router")
+    result = check_printability([box_part("link", (50, 20), thickness=4.0)], router)
+    assert result.failures == ("printability: link is 4 mm thick, the sheet 3 mm",) and result.process == "router"
+    plate = dataclasses.replace(laser_process, layout="plate")
+    result = check_printability([box_part("link", (50, 20), thickness=4.0, process="laser")], plate)
+    assert result.failures == ("printability: link (50.0 × 20.0 × 4 mm) does not fit the build volume "
+                               "600 × 400 × 3 mm",)
+    named_sla = dataclasses.replace(sla_process, name="laser")  # additive on plates, whatever it is called
+    assert check_printability([box_part("link", (50, 20), thickness=100.0)], named_sla).passed
+
+
 def test_laser_sheet_area_boundary(laser_process):
     """Sheet 600 x 400: 600 x 400 fits, 600 + 1e-6 does not."""
     assert check_printability([box_part("p", (600, 400), process="laser")], laser_process).passed

@@ -10,7 +10,7 @@ import pytest
 
 from fabricate.cli import main
 from fabricate.output import write_atomically
-from fabricate.spec import shipped_templates
+from fabricate.templates import shipped_templates
 
 REPORT_KEYS = {"design", "mechanism", "synthesis", "gears", "parts", "interference", "strength", "checks", "files"}
 

@@ -19,7 +19,7 @@ from fabricate.gears.law import FormulaLaw, elliptic_law
 from fabricate.gears.pitch import PitchCurves
 from fabricate.gears.spec import parse_gear_spec
 from fabricate.planar import rotation
-from fabricate.spec import Table
+from fabricate.table import Table
 
 DATA = json.loads((Path(__file__).parent / "data" / "gears_expected.json").read_text())
 TWO_PI = 2 * np.pi

@@ -19,7 +19,8 @@ import pytest
 from fabricate.cli import main
 from fabricate.errors import LockupError, SpecError
 from fabricate.pipeline import synthesise
-from fabricate.spec import TEMPLATE_DIR, design_from_text, load_design
+from fabricate.spec import design_from_text, load_design
+from fabricate.templates import TEMPLATE_DIR
 
 if sys.version_info >= (3, 11):
     import tomllib

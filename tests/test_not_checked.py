@@ -23,7 +23,7 @@ import pytest
 import fabricate
 from fabricate.cli import _summary, main
 from fabricate.report import not_checked_notes, report_json, verdict
-from fabricate.spec import TEMPLATE_DIR
+from fabricate.templates import TEMPLATE_DIR
 from fabricate.tomlwrite import dumps
 
 NO_MATERIALS = "no materials in the profile"

@@ -74,7 +74,7 @@ def test_force_replaces_a_foreign_folder(tmp_path):
 def test_the_templates_own_folder_is_refused_even_with_force(tmp_path, capsys):
     src = tmp_path / "designs"
     src.mkdir()
-    from fabricate.spec import TEMPLATE_DIR
+    from fabricate.templates import TEMPLATE_DIR
 
     template = src / "mine.toml"
     template.write_bytes((TEMPLATE_DIR / f"{FAST}.toml").read_bytes())
@@ -425,7 +425,7 @@ def test_writers_of_a_and_a_b_both_end_complete(tmp_path):
 
 
 def test_force_never_removes_the_process_profile(tmp_path, capsys):
-    from fabricate.spec import TEMPLATE_DIR
+    from fabricate.templates import TEMPLATE_DIR
 
     folder = tmp_path / "pforce"
     folder.mkdir()

@@ -22,7 +22,7 @@ from fabricate.parts.model import BulgePath
 from fabricate.parts.profiles import circle_hull, fuse_polygons, offset_path
 from fabricate.parts.spec import PartsSpec, parse_parts_spec
 from fabricate.planar import polygon_area, relative_poses, rotation, transform_points
-from fabricate.spec import Table
+from fabricate.table import Table
 
 DATA = json.loads((Path(__file__).parent / "data" / "parts_expected.json").read_text())
 
@@ -449,7 +449,7 @@ def test_overlapping_holes_name_the_pin_and_the_largest_that_fits(four_bar, sla_
 
 
 def test_pad_segment_is_the_circular_segment():
-    from fabricate.parts.build import pad_segment
+    from fabricate.parts.features import pad_segment
     from fabricate.planar import polygon_area
 
     centre = np.array([40.0, 36.0])

@@ -24,15 +24,13 @@ from fabricate.parts.build import (
     CONFLICT_CHORD_MM,
     SlottedPart,
     _check_pin_webs,
-    _guide_spacing,
-    _segment_distance,
     build_parts,
     gear_outline_in_body,
     merge_coincident_pins,
     overlapping_cuts,
-    pad_segment,
     swept_region,
 )
+from fabricate.parts.features import _guide_spacing, _segment_distance, pad_segment
 from fabricate.parts.model import BulgePath, Hole, Part
 from fabricate.parts.profiles import circle_hull
 from fabricate.parts.spec import PartsSpec

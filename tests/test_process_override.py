@@ -1,9 +1,11 @@
 """``--process laser|sla|PATH`` overrides a template's process: every shipped template builds for the laser
 (or fails naming what the process cannot make), a profile file with ``arcs = "segments"`` gives DXFs that
-OpenSCAD reads with the reported areas, and ``check`` rebuilds with the same profile."""
+OpenSCAD reads with the reported areas, and ``check`` rebuilds with the same profile. What a process makes
+follows from what it can do (``technique``, ``layout``), never from its name: a new profile needs no code."""
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import json
 import shutil
@@ -16,7 +18,11 @@ import shapely
 import shapely.ops
 
 from fabricate.cli import main
-from fabricate.spec import TEMPLATE_DIR, load_design, read_toml, shipped_templates
+from fabricate.errors import SpecError
+from fabricate.process import ProcessOverride, parse_process, process_override
+from fabricate.spec import design_from_text, load_design
+from fabricate.table import Table
+from fabricate.templates import TEMPLATE_DIR, read_toml, shipped_templates
 
 TEMPLATES = [p.stem for p in shipped_templates()]
 
@@ -108,3 +114,102 @@ def test_segment_arcs_give_openscad_the_reported_areas(tmp_path):
         # prints 6 significant digits (1e-4 mm here) and its holes are 720-gons
         bound = (tol + 1e-4) * perimeter + 2e-5 * part["area_mm2"]
         assert abs(_even_odd_area(rings) - part["area_mm2"]) <= bound, part["name"]
+
+
+# -- Step 13: a process is what it can do (technique, layout), never its name -----------------------------------
+
+def _without_capabilities(text: str) -> str:
+    """A profile as written before ``technique`` and ``layout`` existed."""
+    return "\n".join(line for line in text.splitlines() if not line.startswith(("technique", "layout")))
+
+
+def test_a_new_shipped_profile_needs_no_code_change(tmp_path, monkeypatch):
+    """A profile file dropped into templates/ (here an FDM printer) is a template's ``profile`` and a
+    ``--process`` name, named in the errors that list the choices, and keeps the capabilities it states."""
+    import fabricate.process as process_module
+
+    shipped = tmp_path / "templates"
+    shipped.mkdir()
+    for path in TEMPLATE_DIR.glob("process_*.toml"):
+        shutil.copy(path, shipped)
+    sla = (TEMPLATE_DIR / "process_sla.toml").read_text(encoding="utf-8")
+    assert sla.count('method = "sla"') == 1
+    (shipped / "process_fdm.toml").write_text(sla.replace('method = "sla"', 'method = "fdm"')
+                                              .replace("min_feature_mm = 0.3", "min_feature_mm = 0.4"))
+    monkeypatch.setattr(process_module, "TEMPLATE_DIR", shipped)
+    assert process_module.shipped_profiles() == ("sla", "fdm", "laser")  # the default first
+
+    text = (TEMPLATE_DIR / "gear_pair_elliptic.toml").read_text(encoding="utf-8")
+    assert text.count('profile = "sla"') == 1
+    fdm = design_from_text(text.replace('profile = "sla"', 'profile = "fdm"'), "g.toml").process
+    assert (fdm.name, fdm.technique, fdm.layout, fdm.min_feature_mm) == ("fdm", "additive", "plate", 0.4)
+    assert process_override("fdm").text == (shipped / "process_fdm.toml").read_text(encoding="utf-8")
+    with pytest.raises(SpecError, match="expected sla, fdm, laser or a process profile file"):
+        process_override("waterjet")
+    with pytest.raises(SpecError, match="expected one of 'sla', 'fdm', 'laser'") as info:
+        design_from_text(text.replace('profile = "sla"', 'profile = "waterjet"'), "g.toml")
+    assert info.value.path == "process.profile"
+
+
+def test_a_profile_without_capabilities_takes_those_of_its_method_or_states_them():
+    """A ``--process`` file older than the capability fields (embedded in an old build's report.json, which
+    ``check`` rebuilds from) takes them from the shipped profile of its ``method``; a method of its own must
+    state them, and a method is a plain name."""
+    old = _without_capabilities((TEMPLATE_DIR / "process_laser.toml").read_text(encoding="utf-8"))
+    assert old.count('method = "laser"') == 1
+    laser = parse_process(Table({}, "process"), ProcessOverride("old.toml", old))
+    assert (laser.name, laser.technique, laser.layout) == ("laser", "cut", "sheet")
+    router = old.replace('method = "laser"', 'method = "router"')
+    with pytest.raises(SpecError) as info:
+        parse_process(Table({}, "process"), ProcessOverride("router.toml", router))
+    assert info.value.path == "--process router.toml.technique" and info.value.message == "missing required field"
+    spec = parse_process(Table({}, "process"),
+                         ProcessOverride("router.toml", 'technique = "cut"\nlayout = "sheet"\n' + router))
+    assert (spec.name, spec.technique, spec.layout) == ("router", "cut", "sheet")
+    with pytest.raises(SpecError, match="expected one of 'additive', 'cut'") as info:
+        parse_process(Table({"technique": "milled"}, "process"))
+    assert info.value.path == "process.technique"
+    with pytest.raises(SpecError, match="expected a process name") as info:
+        parse_process(Table({}, "process"), ProcessOverride("x.toml", old.replace('method = "laser"',
+                                                                                  'method = "../laser"')))
+    assert info.value.path == "--process x.toml.method"
+
+
+def test_what_is_made_follows_the_capabilities_not_the_name(four_bar, laser_process):
+    """The laser's numbers under another name make the same cut files and sheets; under the laser's name
+    but additive on plates they make print plates and no cut file. The web round a hole is at least the
+    stock only for a cut process."""
+    from fabricate.export import export_all
+    from fabricate.parts.build import build_parts, derive_sizes
+    from fabricate.parts.spec import PartsSpec
+
+    motion = four_bar.sweep(37)
+    base = load_design("gear_pair_elliptic")
+
+    def made(process):
+        design = dataclasses.replace(base, process=process, parts=PartsSpec(gif_frames=4))
+        partset = build_parts(design, four_bar, motion, [])
+        files, entries = export_all(design, partset, four_bar, motion, previews=False, step=False,
+                                    with_step=False)
+        return partset, files, entries
+
+    laser, files, entries = made(laser_process)
+    router, router_files, router_entries = made(dataclasses.replace(laser_process, name="router"))
+    assert set(router_files) == set(files) and any(f.startswith("cut/sheet_") for f in files)
+    assert router_files["cut/sheet_1.svg"] == files["cut/sheet_1.svg"]
+    assert [e["sheet"] for e in router_entries] == [e["sheet"] for e in entries]
+    assert {r["kind"] for r in router.bom if r["kind"].endswith(" part")} == {"cut part"}
+    assert {r["process"] for r in router.bom if r["kind"].endswith(" part")} == {"router"}  # the label
+
+    printed, printed_files, printed_entries = made(dataclasses.replace(laser_process, technique="additive",
+                                                                       layout="plate"))
+    assert not any(f.startswith("cut/") for f in printed_files)
+    assert any(f.startswith("plates/plate_") for f in printed_files)
+    assert all("plate" in e and "sheet" not in e and e["cut_dxf"] is None for e in printed_entries)
+    assert {r["kind"] for r in printed.bom if r["kind"].endswith(" part")} == {"printed part"}
+
+    thick_cut = dataclasses.replace(laser_process, name="router", thickness_mm=5.0)
+    thick_printed = dataclasses.replace(thick_cut, technique="additive", layout="plate")
+    hole = derive_sizes(thick_cut, PartsSpec(), {}).hole_mm
+    assert derive_sizes(thick_cut, PartsSpec(), {}).boss_radius_mm == pytest.approx(hole / 2 + 5.0)
+    assert derive_sizes(thick_printed, PartsSpec(), {}).boss_radius_mm == pytest.approx(hole / 2 + 3.0)

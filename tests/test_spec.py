@@ -10,7 +10,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from fabricate.errors import SpecError
-from fabricate.spec import Table, check_array, check_number, find_template, parse_process, shipped_templates
+from fabricate.process import parse_process
+from fabricate.table import Table, check_array, check_number
+from fabricate.templates import find_template, shipped_templates
 
 
 def test_number_errors_name_the_path():
@@ -106,7 +108,8 @@ def test_gear_bore_must_match_the_pin(tmp_path):
 def test_a_missing_required_key_names_its_misspelling():
     """The whole message of the issue's example, from a shipped template with the typo: the unread key that
     looks like the missing one is named with the key it should be."""
-    from fabricate.spec import TEMPLATE_DIR, design_from_text
+    from fabricate.spec import design_from_text
+    from fabricate.templates import TEMPLATE_DIR
 
     text = (TEMPLATE_DIR / "finger_five_bar_ncg.toml").read_text(encoding="utf-8")
     assert text.count("\nlengths_mm =") == 1
@@ -206,7 +209,8 @@ def test_design_names_that_make_folders_are_kept(name):
 
 
 def test_a_nul_in_the_template_design_name_is_a_spec_error():
-    from fabricate.spec import TEMPLATE_DIR, design_from_text
+    from fabricate.spec import design_from_text
+    from fabricate.templates import TEMPLATE_DIR
 
     text = (TEMPLATE_DIR / "gear_pair_elliptic.toml").read_text(encoding="utf-8")
     with pytest.raises(SpecError, match=r'got "gear\\u0000pair"') as info:
@@ -215,7 +219,8 @@ def test_a_nul_in_the_template_design_name_is_a_spec_error():
 
 
 def test_integers_past_a_float_are_spec_errors():
-    from fabricate.spec import TEMPLATE_DIR, design_from_text
+    from fabricate.spec import design_from_text
+    from fabricate.templates import TEMPLATE_DIR
 
     text = (TEMPLATE_DIR / "gear_pair_elliptic.toml").read_text(encoding="utf-8")
     assert "\nmodule_mm = 1.0\n" in text
@@ -231,7 +236,7 @@ def test_integers_past_a_float_are_spec_errors():
 
 
 def test_paths_the_system_refuses_are_spec_errors():
-    from fabricate.spec import process_override
+    from fabricate.process import process_override
 
     for argument, call in (("template", find_template), ("--process", process_override)):
         with pytest.raises(SpecError, match="File name too long") as info:

@@ -18,7 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fabricate.cli import main
-from fabricate.spec import parse_toml, shipped_templates
+from fabricate.templates import parse_toml, shipped_templates
 from tests.toml_writer import toml_text
 
 TEMPLATES = {p.name: p.read_text(encoding="utf-8") for p in shipped_templates()}

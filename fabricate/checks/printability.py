@@ -1,9 +1,9 @@
 """Can the parts be made with the chosen process?
 
-Checks against the process profile (:class:`fabricate.spec.ProcessSpec`):
+Checks against the process profile (:class:`fabricate.process.ProcessSpec`), by what the process can do:
 
 - *wall around holes*: the web between every hole and the outline or the next hole is at least
-  ``min_wall_mm`` (for laser profiles the minimum web, at least the sheet thickness);
+  ``min_wall_mm`` (for a cut process the minimum web, at least the sheet thickness);
 - *smallest feature*: a morphological opening of the plate by a disc of diameter ``min_feature_mm``
   (erode, then dilate) removes every feature thinner than that disc. A corner of angle θ is only cut
   back by ``r (1/sin(θ/2) - 1)``, at most ``r`` for θ ≥ 60°, so any point of the outline left more than
@@ -12,9 +12,9 @@ Checks against the process profile (:class:`fabricate.spec.ProcessSpec`):
 - *tooth tip land*: the narrowest tooth tip of every gear pair (from the gears package) is at least
   ``min_feature_mm``;
 - *pins*: at least ``min_pin_mm`` in diameter;
-- *build volume / sheet*: SLA parts lie flat within the build area (their smallest rotated bounding
-  rectangle, either way round) and are no taller than the build height; laser parts fit the sheet and
-  are as thick as it (spacers are tubes, not cut from the sheet).
+- *build volume / sheet*: on a plate layout parts lie flat within the build area (their smallest rotated
+  bounding rectangle, either way round) and are no taller than the build height; on a sheet layout they
+  fit the sheet and are as thick as it (spacers are tubes, not cut from the sheet).
 
 Webs around holes are exact (circle to circle, hole to the outline's true lines and arcs); the files
 are polygonised at the chord tolerance (chords inside the outline's arcs, holes' polygons inside their
@@ -32,7 +32,7 @@ import numpy as np
 import shapely
 
 from fabricate.parts.model import Part
-from fabricate.spec import ProcessSpec
+from fabricate.process import ProcessSpec
 
 
 @dataclass(frozen=True)
@@ -163,15 +163,16 @@ def check_printability(parts: Sequence[Part], process: ProcessSpec, gear_pairs: 
         long_side, short_side = footprint(part, tol)
         in_area = long_side <= build[0] + 1e-9 and short_side <= build[1] + 1e-9
         height = float(process.build_volume_mm[2])
-        if process.name == "laser":
+        sheet = process.layout == "sheet"
+        if sheet:
             thick_ok = part.role == "spacer" or abs(part.thickness_mm - height) <= 1e-6
             if not thick_ok:
                 failures.append(f"printability: {part.name} is {part.thickness_mm:g} mm thick, the sheet "
                                 f"{height:g} mm")
         else:
             thick_ok = part.thickness_mm <= height + 1e-9
-        if not in_area or (process.name != "laser" and not thick_ok):
-            where = "sheet" if process.name == "laser" else "build volume"
+        if not in_area or (not sheet and not thick_ok):
+            where = "sheet" if sheet else "build volume"
             failures.append(f"printability: {part.name} ({long_side:.1f} × {short_side:.1f} × "
                             f"{part.thickness_mm:g} mm) does not fit the {where} "
                             f"{' × '.join(f'{v:g}' for v in process.build_volume_mm)} mm")

@@ -1,4 +1,4 @@
-"""Exporters: parts to STL / 3MF (SLA), DXF (laser and CAD), preview pictures, bill of materials.
+"""Exporters: parts to STL / 3MF (printing), DXF and SVG (cutting and CAD), preview pictures, bill of materials.
 
 :func:`export_all` is what the pipeline calls: it returns every file as bytes keyed by its path relative
 to the output directory, and the ``parts`` section of report.json. Nothing here writes files.
@@ -22,10 +22,14 @@ from __future__ import annotations
 
 import csv
 import io
-from typing import Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from fabricate.errors import GeometryError
-from fabricate.export.layout import fits
+from fabricate.export.layout import Placement, fits
+
+if TYPE_CHECKING:  # ezdxf loads with fabricate.export.dxf: only when a DXF is made
+    from fabricate.export.dxf import DxfStyle
 
 #: bom.csv's leading columns; any other key of the report's BOM rows follows, sorted by name.
 BOM_COLUMNS = ("item", "kind", "qty", "process", "material", "thickness_mm", "volume_mm3", "mass_g",
@@ -112,95 +116,29 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
     GeometryError
         When a written STL does not read back as a closed solid (a bug, never a design finding).
     """
-    from fabricate.export.dxf import DxfStyle, kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
+    from fabricate.export.dxf import kinematic_dxf
     from fabricate.export.step import step_available
-    from fabricate.export.stl import (
-        SolidCache,
-        assembly_3mf,
-        mesh_volume,
-        model_3mf,
-        part_stl,
-        placed_flat_mesh,
-        plate_layout,
-        plate_stl,
-        validate_stl,
-    )
-    from fabricate.export.svg import part_svg, sheet_svg
+    from fabricate.export.stl import SolidCache, assembly_3mf
 
-    process = design.process
-    spec = design.parts
-    parts = list(partset.parts)
-    copies = max(1, int(getattr(partset, "copies", 1) or 1))
-    laser = process.name == "laser"  # cut sheets, else print plates
-    kerf = process.kerf_mm
-    min_text = float(getattr(process, "min_text_mm", 0.0))
-    arcs = getattr(process, "arcs", "bulge")
-    drawing = DxfStyle(arcs, partset.chord_tolerance_mm)  # for CAD: every label
-    cutting = DxfStyle(arcs, partset.chord_tolerance_mm, min_text)  # only labels the process can engrave
-    colours = (getattr(process, "cut_colour", "#ff0000"), getattr(process, "engrave_colour", "#0000ff"))
-    cache = SolidCache(partset.chord_tolerance_mm)
-    files: dict[str, bytes] = {}
-    entries: list[dict[str, Any]] = []
-    area = (float(process.build_volume_mm[0]), float(process.build_volume_mm[1]))
-    # every copy of every part is made: a three-finger gripper prints or cuts three finger sets
-    made = [part for part in parts for _ in range(copies)]
-    if laser:
-        margin = spec.sheet_margin_mm
-        placements = sheet_layout(made, kerf, area, margin, spec.sheet_spacing_mm)
-    else:
-        margin = spec.plate_spacing_mm
-        placements = plate_layout(made, cache, area, margin)
-    where: dict[str, list[Any]] = {}
-    for part, placement in zip(made, placements, strict=True):
-        where.setdefault(part.name, []).append(placement)
     if with_step is None:  # optional extra `cad` (OCP); without it no STEP files, "step": None
         with_step = step_available()
+    making = _Making.of(design, partset)
+    cache = SolidCache(partset.chord_tolerance_mm)
+    parts = list(partset.parts)
+    # every copy of every part is made: a three-finger gripper prints or cuts three finger sets
+    made = [part for part in parts for _ in range(making.copies)]
+    placements = _lay_out(made, making, cache)
+    where: dict[str, list[Placement]] = {}
+    for part, placement in zip(made, placements, strict=True):
+        where.setdefault(part.name, []).append(placement)
+    files: dict[str, bytes] = {}
+    entries: list[dict[str, Any]] = []
     for part in parts:
-        stl_path, dxf_path = f"parts/{part.name}.stl", f"drawings/{part.name}.dxf"
-        stl = part_stl(part, cache)
-        problems = validate_stl(stl)
-        vertices, faces = cache.flat_mesh(part)
-        if problems:
-            raise GeometryError(f"part {part.name}: STL {', '.join(problems)}")
-        files[stl_path] = stl
-        files[dxf_path] = part_dxf(part, 0.0, drawing)  # finished size, for CAD
-        cut_dxf = cut_svg = None
-        if laser:
-            cut_dxf, cut_svg = f"cut/{part.name}.dxf", f"cut/{part.name}.svg"
-            files[cut_dxf] = part_dxf(part, kerf, cutting)
-            files[cut_svg] = part_svg(part, kerf, min_text_mm=min_text, colours=colours)
-        placed = where[part.name]
-        entries.append({
-            "name": part.name, "process": part.process, "stl": stl_path, "dxf": dxf_path,
-            "cut_dxf": cut_dxf, "cut_svg": cut_svg,
-            "step": f"parts/{part.name}.step" if with_step else None,
-            "copies": copies,
-            "volume_mm3": round(part.volume_mm3(), 4), "stl_volume_mm3": round(mesh_volume(vertices, faces), 4),
-            "layer": part.layer,
-            "holes": [{"joint": h.joint, "diameter_mm": round(h.diameter_mm, 6),
-                       "cut_diameter_mm": round(h.diameter_mm - kerf, 6)} for h in part.holes],
-            "role": part.role, "body": part.body, "thickness_mm": part.thickness_mm,
-            "z_mm": round(part.z_mm, 6), "area_mm2": round(part.area_mm2(), 4), "gear": part.gear,
-            "slots": len(getattr(part, "slots", ())), "stl_problems": problems,
-            ("sheet" if laser else "plate"): {"index": [pl.sheet + 1 for pl in placed],
-                                              "fits": all(fits(pl, area, margin) for pl in placed)},
-            "warnings": [w for w in getattr(partset, "warnings", ()) if w.startswith(f"part {part.name}:")],
-        })
-    for number in sorted({pl.sheet for pl in placements}):
-        on_it = [(part, pl, k) for k, (part, pl) in enumerate(zip(made, placements, strict=True))
-                 if pl.sheet == number]
-        if laser:
-            sheet_parts, sheet_places = [part for part, _, _ in on_it], [pl for _, pl, _ in on_it]
-            files[f"cut/sheet_{number + 1}.dxf"] = sheet_dxf(sheet_parts, kerf, sheet_places, area, number, cutting)
-            files[f"cut/sheet_{number + 1}.svg"] = sheet_svg(sheet_parts, kerf, sheet_places, area, number,
-                                                             title=f"{design.name} sheet", min_text_mm=min_text,
-                                                             colours=colours)
-        else:
-            meshes = [placed_flat_mesh(part, cache, pl) for part, pl, _ in on_it]
-            names = [copy_name(part.name, k % copies, copies) for part, _, k in on_it]
-            files[f"plates/plate_{number + 1}.stl"] = plate_stl(meshes)
-            files[f"plates/plate_{number + 1}.3mf"] = model_3mf(
-                [(name, *mesh) for name, mesh in zip(names, meshes, strict=True)], f"{design.name} plate {number + 1}")
+        part_files, problems, stl_volume = _part_files(part, making, cache)
+        files.update(part_files)
+        entries.append(_part_entry(part, problems, stl_volume, where[part.name], making, with_step,
+                                   getattr(partset, "warnings", ())))
+    files.update(_layout_files(made, placements, making, cache, design.name))
     first = motion.poses_at(0)
     files["assembly.3mf"] = assembly_3mf(parts, cache, first, title=design.name)
     if with_step and step:
@@ -210,6 +148,150 @@ def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews:
         files.update(export_previews(design, partset, motion))
     files["bom.csv"] = _bom_csv(list(partset.bom))
     return files, entries
+
+
+@dataclass(frozen=True)
+class _Making:
+    """How the parts are made, as the exporters need it: the process's capabilities and the layout settings.
+
+    Attributes
+    ----------
+    cut : bool
+        The process cuts (``technique = "cut"``): each part also gets its kerf-offset cut path.
+    sheets : bool
+        Parts are nested on sheets (``layout = "sheet"``: sheet DXF and SVG), else laid out on print plates
+        (plate STL and 3MF).
+    kerf_mm, min_text_mm : float
+    area_mm : (float, float)
+        The sheet or the build plate.
+    margin_mm : float
+        The sheet's edge margin, or the gap between parts on a plate (``[parts]``).
+    spacing_mm : float
+        The gap between parts on a sheet.
+    copies : int
+        Identical copies of every part.
+    drawing, cutting : DxfStyle
+        DXF for CAD (every label), and for the cutter (only labels the process can engrave).
+    colours : (str, str)
+        SVG strokes of cuts and of engraving.
+    """
+
+    cut: bool
+    sheets: bool
+    kerf_mm: float
+    min_text_mm: float
+    area_mm: tuple[float, float]
+    margin_mm: float
+    spacing_mm: float
+    copies: int
+    drawing: DxfStyle
+    cutting: DxfStyle
+    colours: tuple[str, str]
+
+    @classmethod
+    def of(cls, design: Any, partset: Any) -> _Making:
+        from fabricate.export.dxf import DxfStyle
+
+        process, spec = design.process, design.parts
+        sheets = process.layout == "sheet"
+        tol, min_text = partset.chord_tolerance_mm, float(process.min_text_mm)
+        return cls(cut=process.technique == "cut", sheets=sheets, kerf_mm=process.kerf_mm, min_text_mm=min_text,
+                   area_mm=(float(process.build_volume_mm[0]), float(process.build_volume_mm[1])),
+                   margin_mm=spec.sheet_margin_mm if sheets else spec.plate_spacing_mm,
+                   spacing_mm=spec.sheet_spacing_mm, copies=max(1, int(getattr(partset, "copies", 1) or 1)),
+                   drawing=DxfStyle(process.arcs, tol), cutting=DxfStyle(process.arcs, tol, min_text),
+                   colours=(process.cut_colour, process.engrave_colour))
+
+
+def _lay_out(made: list[Any], making: _Making, cache: Any) -> list[Placement]:
+    """Where every made part goes: nested on sheets (by its cut outline), or laid out on print plates."""
+    if making.sheets:
+        from fabricate.export.dxf import sheet_layout
+
+        return sheet_layout(made, making.kerf_mm, making.area_mm, making.margin_mm, making.spacing_mm)
+    from fabricate.export.stl import plate_layout
+
+    return plate_layout(made, cache, making.area_mm, making.margin_mm)
+
+
+def _part_files(part: Any, making: _Making, cache: Any) -> tuple[dict[str, bytes], list[str], float]:
+    """A part's own files: its STL, its DXF at finished size (for CAD) and, for a cut process, its cut path.
+
+    Returns
+    -------
+    files : dict[str, bytes]
+    stl_problems : list of str
+        Always empty: a written STL that does not read back as a closed solid raises.
+    stl_volume_mm3 : float
+        The polygonised solid's volume.
+    """
+    from fabricate.export.dxf import part_dxf
+    from fabricate.export.stl import mesh_volume, part_stl, validate_stl
+    from fabricate.export.svg import part_svg
+
+    stl = part_stl(part, cache)
+    problems = validate_stl(stl)
+    vertices, faces = cache.flat_mesh(part)
+    if problems:
+        raise GeometryError(f"part {part.name}: STL {', '.join(problems)}")
+    files = {f"parts/{part.name}.stl": stl, f"drawings/{part.name}.dxf": part_dxf(part, 0.0, making.drawing)}
+    if making.cut:
+        files[f"cut/{part.name}.dxf"] = part_dxf(part, making.kerf_mm, making.cutting)
+        files[f"cut/{part.name}.svg"] = part_svg(part, making.kerf_mm, min_text_mm=making.min_text_mm,
+                                                 colours=making.colours)
+    return files, problems, mesh_volume(vertices, faces)
+
+
+def _part_entry(part: Any, problems: list[str], stl_volume: float, placed: list[Placement], making: _Making,
+                with_step: bool, warnings: Any) -> dict[str, Any]:
+    """A part's entry in the report's ``parts`` (see :func:`export_all`); ``placed``: where its copies went."""
+    kerf = making.kerf_mm
+    cut_dxf, cut_svg = (f"cut/{part.name}.dxf", f"cut/{part.name}.svg") if making.cut else (None, None)
+    return {
+        "name": part.name, "process": part.process, "stl": f"parts/{part.name}.stl",
+        "dxf": f"drawings/{part.name}.dxf", "cut_dxf": cut_dxf, "cut_svg": cut_svg,
+        "step": f"parts/{part.name}.step" if with_step else None,
+        "copies": making.copies,
+        "volume_mm3": round(part.volume_mm3(), 4), "stl_volume_mm3": round(stl_volume, 4),
+        "layer": part.layer,
+        "holes": [{"joint": h.joint, "diameter_mm": round(h.diameter_mm, 6),
+                   "cut_diameter_mm": round(h.diameter_mm - kerf, 6)} for h in part.holes],
+        "role": part.role, "body": part.body, "thickness_mm": part.thickness_mm,
+        "z_mm": round(part.z_mm, 6), "area_mm2": round(part.area_mm2(), 4), "gear": part.gear,
+        "slots": len(getattr(part, "slots", ())), "stl_problems": problems,
+        ("sheet" if making.sheets else "plate"): {
+            "index": [pl.sheet + 1 for pl in placed],
+            "fits": all(fits(pl, making.area_mm, making.margin_mm) for pl in placed)},
+        "warnings": [w for w in warnings if w.startswith(f"part {part.name}:")],
+    }
+
+
+def _layout_files(made: list[Any], placements: list[Placement], making: _Making, cache: Any,
+                  title: str) -> dict[str, bytes]:
+    """One file pair per sheet (cut DXF and SVG) or per print plate (STL and 3MF, each copy named)."""
+    from fabricate.export.dxf import sheet_dxf
+    from fabricate.export.stl import model_3mf, placed_flat_mesh, plate_stl
+    from fabricate.export.svg import sheet_svg
+
+    files: dict[str, bytes] = {}
+    kerf, area, copies = making.kerf_mm, making.area_mm, making.copies
+    for number in sorted({pl.sheet for pl in placements}):
+        on_it = [(part, pl, k) for k, (part, pl) in enumerate(zip(made, placements, strict=True))
+                 if pl.sheet == number]
+        if making.sheets:
+            sheet_parts, sheet_places = [part for part, _, _ in on_it], [pl for _, pl, _ in on_it]
+            files[f"cut/sheet_{number + 1}.dxf"] = sheet_dxf(sheet_parts, kerf, sheet_places, area, number,
+                                                             making.cutting)
+            files[f"cut/sheet_{number + 1}.svg"] = sheet_svg(sheet_parts, kerf, sheet_places, area, number,
+                                                             title=f"{title} sheet", min_text_mm=making.min_text_mm,
+                                                             colours=making.colours)
+        else:
+            meshes = [placed_flat_mesh(part, cache, pl) for part, pl, _ in on_it]
+            names = [copy_name(part.name, k % copies, copies) for part, _, k in on_it]
+            files[f"plates/plate_{number + 1}.stl"] = plate_stl(meshes)
+            files[f"plates/plate_{number + 1}.3mf"] = model_3mf(
+                [(name, *mesh) for name, mesh in zip(names, meshes, strict=True)], f"{title} plate {number + 1}")
+    return files
 
 
 def copy_name(name: str, index: int, copies: int) -> str:

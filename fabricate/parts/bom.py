@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from fabricate.parts.layers import layer_z, skipped_gap, stack_span
+from fabricate.process import Material, ProcessSpec
 
 
 @dataclass(frozen=True)
@@ -126,13 +127,14 @@ def _group(rows: list[dict[str, Any]], key: tuple[str, ...]) -> list[dict[str, A
     return list(merged.values())
 
 
-def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Mapping[str, Any], process: str,
-                      copies: int = 1, mounting: int = 0,
+def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Mapping[str, Any],
+                      process: ProcessSpec, copies: int = 1, mounting: int = 0,
                       mounting_mm: float = 3.0) -> list[dict[str, Any]]:
     """Bill of materials rows (JSON-ready), quantities multiplied by ``copies``.
 
     Rows have ``item``, ``kind`` (``pin``, ``spacer``, ``washer``, ``spring``, ``screw``, ``purchased``),
-    ``qty``, a human ``description`` and the sizes in mm where they apply.
+    ``qty``, a human ``description`` and the sizes in mm where they apply. An additive process prints its
+    spacers with the parts (they are part rows, see :func:`part_rows`); a cut process buys them.
     """
     rows: list[dict[str, Any]] = []
     for pin in pins:
@@ -142,7 +144,7 @@ def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Map
                      "description": "steel dowel pin, cut to the stack; retain with adhesive or clips"})
     for sp in spacers:
         kind = "washer" if sp.washer else "spacer"
-        if not sp.washer and process == "sla":
+        if not sp.washer and process.technique == "additive":
             continue  # printed with the parts: a part row of its own (see part_rows)
         made = "purchased"
         rows.append({"item": f"{kind} {sp.inner_diameter_mm:g}/{sp.outer_diameter_mm:g} x {sp.length_mm:.2f} mm",
@@ -174,12 +176,12 @@ def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Map
     return rows
 
 
-def part_rows(parts: Sequence[Any], process: Any, copies: int = 1) -> list[dict[str, Any]]:
+def part_rows(parts: Sequence[Any], process: ProcessSpec, copies: int = 1) -> list[dict[str, Any]]:
     """One BOM row per printed or cut part: process, material, quantity (all copies), volume and mass.
 
     Mass is the exact volume (profile area x thickness, mm^3) times the profile's density (g/cm^3).
     """
-    kind = "cut part" if process.name == "laser" else "printed part"
+    kind = "cut part" if process.technique == "cut" else "printed part"
     rows = []
     for part in parts:
         volume = float(part.volume_mm3())
@@ -191,7 +193,7 @@ def part_rows(parts: Sequence[Any], process: Any, copies: int = 1) -> list[dict[
     return rows
 
 
-def _material_name(process: Any) -> str:
+def _material_name(process: ProcessSpec) -> str:
     """The part material for people: the profile material's name, else its key."""
-    material = process.part_material() if hasattr(process, "part_material") else None
+    material: Material | None = process.part_material()
     return material.name if material is not None else process.material

@@ -44,12 +44,13 @@ import shapely
 from fabricate.errors import GeometryError, SpecError
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
 from fabricate.parts.bom import Pin, Spacer, bill_of_materials, part_rows, pins_and_spacers
+from fabricate.parts.features import pad_segment, slider_guides
 from fabricate.parts.layers import assign_layers, conflict_graph, layer_z, order_layers, pin_crossings
 from fabricate.parts.model import BulgePath, Hole, Part, circle_polygon
 from fabricate.parts.profiles import circle_hull, fuse_polygons
 from fabricate.parts.spec import PartsSpec
-from fabricate.planar import polygon_area, rotation, wrap_angle
-from fabricate.spec import ProcessSpec
+from fabricate.planar import rotation
+from fabricate.process import ProcessSpec
 
 #: Chord tolerance (mm) of the coarse outlines used only for the layer conflict test.
 CONFLICT_CHORD_MM = 0.05
@@ -93,7 +94,7 @@ class PartSet:
     layers : dict[str, int]
         Body name -> layer index.
     process : str
-        ``"sla"`` or ``"laser"``.
+        The process's name (a label: :class:`~fabricate.process.ProcessSpec` says what it can do).
     chord_tolerance_mm : float
         Polygonisation tolerance for meshes.
     copies : int
@@ -152,8 +153,8 @@ def derive_sizes(process: ProcessSpec, parts: PartsSpec, hints: Mapping[str, Any
     pin = process.pin_diameter_mm
     hole = pin + 2.0 * process.running_clearance_mm + process.hole_compensation_mm
     wall = parts.boss_wall_mm if parts.boss_wall_mm is not None else max(process.min_wall_mm, 0.5 * pin)
-    if process.name == "laser":
-        wall = max(wall, process.thickness_mm)  # minimum web >= sheet thickness
+    if process.technique == "cut":
+        wall = max(wall, process.thickness_mm)  # a web cut from sheet stock is at least the stock thick
     radius = hole / 2.0 + wall
     width = parts.link_width_mm if parts.link_width_mm is not None else hints.get("link_width_mm")
     if width is not None:
@@ -199,26 +200,6 @@ def gear_outline_in_body(mechanism: Mechanism, pair: Any, side: str) -> tuple[st
     return body, axis, outline @ rotation(beta).T + u_axis
 
 
-def _slider_geometry(mechanism: Mechanism, motion: Motion, joint: Slider, sizes: Sizes
-                     ) -> tuple[np.ndarray, np.ndarray, float, float]:
-    """Guide pin spacing and slot ends for a slider.
-
-    Returns
-    -------
-    axis_a : (2,) unit axis in the reference body; axis_b : (2,) the same axis in the rod body;
-    s_min, s_max : float, travel of the rod point along the axis (mm) over the motion.
-    """
-    axis_a = np.asarray(joint.axis, dtype=np.float64)
-    axis_a = axis_a / np.hypot(*axis_a)
-    axis_b = rotation(-joint.angle) @ axis_a
-    pa = motion.point(joint.name, joint.body_a)
-    pb = motion.point(joint.name, joint.body_b)
-    theta_a = motion.pose(joint.body_a)[:, 2]
-    axis_world = np.einsum("nij,j->ni", rotation(theta_a), axis_a)
-    travel = np.einsum("ni,ni->n", pb - pa, axis_world)
-    return axis_a, axis_b, float(travel.min()), float(travel.max())
-
-
 def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: Sequence[Any],
                 hints: Mapping[str, Any] | None = None) -> PartSet:
     """Turn a solved mechanism into parts.
@@ -250,13 +231,69 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
     gear_hub = getattr(getattr(design, "gears", None), "hub_diameter_mm", None)
     sizes = derive_sizes(process, parts_spec, hints, gear_hub)
     tol = process.chord_tolerance_mm
-    radius = sizes.boss_radius_mm
 
-    holes: dict[str, list[Hole]] = {b.name: [] for b in mechanism.bodies}
-    circles: dict[str, list[tuple[np.ndarray, float]]] = {
-        b.name: [(b.point(p), radius) for p in b.points] for b in mechanism.bodies}
-    slots: dict[str, list[BulgePath]] = {b.name: [] for b in mechanism.bodies}
-    pin_joints: list[tuple[str, tuple[str, ...]]] = []  # (pin name, bodies it joins; the first holds it)
+    drawing = _Drawing.start(mechanism, sizes.boss_radius_mm)
+    pin_joints = _add_joints(drawing, mechanism, motion, sizes, process)
+    _add_pads(drawing, mechanism, dict(hints.get("pads", {})), parts_spec, sizes.boss_radius_mm, tol)
+    _add_gears(drawing, mechanism, gear_pairs, sizes.hub_mm, tol)
+    outlines = _outlines(drawing, mechanism, motion, sizes, parts_spec, process)
+    layers = _layers(outlines, drawing.holes, pin_joints, mechanism, motion, gear_pairs, sizes.boss_radius_mm,
+                     process.running_clearance_mm)
+
+    parts = _body_parts(drawing, mechanism, outlines, layers, process)
+    pins, spacers = pins_and_spacers(pin_joints, layers, sizes.pin_mm, sizes.hole_mm, 2.0 * sizes.boss_radius_mm,
+                                     process.thickness_mm, process.layer_gap_mm,
+                                     {(body, h.joint): h.centre for body, hs in drawing.holes.items() for h in hs})
+    parts += _printed_spacers(spacers, process, sizes.pin_mm)
+    _check_pin_webs(parts, process)
+    warnings = overlapping_cuts(parts)
+    names = [p.name for p in parts]
+    if len(set(names)) != len(names):
+        raise GeometryError(f"part names collide after sanitising: {sorted(names)}")
+    copies = int(hints.get("copies", 1) or 1)
+    mounting = sum(1 for h in drawing.holes[mechanism.ground] if h.joint.startswith("mount_"))
+    bom = part_rows(parts, process, copies) + bill_of_materials(pins, spacers, hints, process, copies,
+                                                                 mounting=mounting,
+                                                                 mounting_mm=parts_spec.mounting_hole_mm)
+    return PartSet(parts=tuple(parts), bom=bom, pins=tuple(pins), spacers=tuple(spacers), layers=layers,
+                   process=process.name, chord_tolerance_mm=tol, thickness_mm=process.thickness_mm,
+                   layer_gap_mm=process.layer_gap_mm, kerf_mm=process.kerf_mm, copies=copies, hints=hints,
+                   warnings=tuple(warnings))
+
+
+@dataclass
+class _Drawing:
+    """The parts as :func:`build_parts` draws them up, per body name; each step adds to it.
+
+    ``circles`` (centre, radius) span an outline's convex hull, ``fused`` polygons (gears, hubs, pad arcs)
+    are united with it, ``holes`` and ``slots`` go through it; ``gears`` names the gear pairs a body carries.
+    """
+
+    circles: dict[str, list[tuple[np.ndarray, float]]]
+    holes: dict[str, list[Hole]]
+    slots: dict[str, list[BulgePath]]
+    fused: dict[str, list[np.ndarray]]
+    gears: dict[str, list[str]]
+
+    @classmethod
+    def start(cls, mechanism: Mechanism, radius: float) -> _Drawing:
+        """A boss of ``radius`` round every point of every body, and nothing else yet."""
+        names = [b.name for b in mechanism.bodies]
+        return cls(circles={b.name: [(b.point(p), radius) for p in b.points] for b in mechanism.bodies},
+                   holes={n: [] for n in names}, slots={n: [] for n in names}, fused={n: [] for n in names},
+                   gears={n: [] for n in names})
+
+
+def _add_joints(drawing: _Drawing, mechanism: Mechanism, motion: Motion, sizes: Sizes,
+                process: ProcessSpec) -> list[tuple[str, tuple[str, ...]]]:
+    """A pin hole in both bodies of every revolute joint, guide pins and a slot for every slider; joints at
+    one spot of a body (a compound hinge) share one hole and one pin.
+
+    Returns
+    -------
+    list of (pin name, bodies it joins; the first holds it)
+    """
+    pin_joints: list[tuple[str, tuple[str, ...]]] = []
     pin_holes: list[tuple[str, str, np.ndarray]] = []  # (pin name, body, centre): a round hole for the pin
     for joint in mechanism.joints:
         if isinstance(joint, Revolute):
@@ -264,129 +301,133 @@ def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: S
                 pin_holes.append((joint.name, body, mechanism.body(body).point(joint.name)))
             pin_joints.append((joint.name, (joint.body_a, joint.body_b)))
         elif isinstance(joint, Slider):
-            axis_a, axis_b, s_min, s_max = _slider_geometry(mechanism, motion, joint, sizes)
-            ref_point = mechanism.body(joint.body_a).point(joint.name)
-            rod_point = mechanism.body(joint.body_b).point(joint.name)
-            spacing = _guide_spacing(mechanism.body(joint.body_b), joint.name, rod_point, axis_b, s_min, s_max,
-                                     2.0 * radius + 2.0 * process.min_wall_mm)
-            for k, offset in enumerate((0.0, spacing)):
-                name = joint.name if k == 0 else f"{joint.name}_guide"
-                centre = ref_point + offset * axis_a
+            guides = slider_guides(mechanism, motion, joint, sizes.boss_radius_mm, sizes.hole_mm, process.min_wall_mm)
+            drawing.circles[joint.body_a] += [(centre, sizes.boss_radius_mm) for _, centre in guides.pins]
+            drawing.slots[joint.body_b].append(guides.slot)
+            drawing.circles[joint.body_b] += [(end, sizes.boss_radius_mm) for end in guides.ends]
+            for name, centre in guides.pins:
                 pin_holes.append((name, joint.body_a, centre))
-                circles[joint.body_a].append((centre, radius))
                 pin_joints.append((name, (joint.body_a, joint.body_b)))
-            # a guide pin at ref + e*axis sits at rod_point - (s - e)*axis_b in the rod: one slot covers both
-            ends = np.array([rod_point - (s_max - min(spacing, 0.0)) * axis_b,
-                             rod_point - (s_min - max(spacing, 0.0)) * axis_b])
-            slot = circle_hull(ends, sizes.hole_mm / 2.0)
-            for other in mechanism.body(joint.body_b).points:
-                centre = mechanism.body(joint.body_b).point(other)
-                if other != joint.name and _segment_distance(centre, ends) < sizes.hole_mm:
-                    raise GeometryError(f"slider {joint.name}: the guide slot in {joint.body_b!r} runs into its "
-                                        f"point {other!r}; move the slider point or shorten the stroke")
-            slots[joint.body_b].append(slot)
-            circles[joint.body_b] += [(ends[0], radius), (ends[1], radius)]
-    # joints at one spot of a body (a compound hinge) share one hole and one pin
     pin_joints, pin_holes = merge_coincident_pins(pin_joints, pin_holes)
     for name, body, centre in pin_holes:
-        holes[body].append(Hole(name, centre, sizes.hole_mm, sizes.pin_mm))
+        drawing.holes[body].append(Hole(name, centre, sizes.hole_mm, sizes.pin_mm))
+    return pin_joints
 
-    fused_polys: dict[str, list[np.ndarray]] = {b.name: [] for b in mechanism.bodies}
-    for body, pad in dict(hints.get("pads", {})).items():
-        if body not in circles:
+
+def _add_pads(drawing: _Drawing, mechanism: Mechanism, pads: Mapping[str, Any], parts_spec: PartsSpec,
+              radius: float, tol: float) -> None:
+    """Fingertip pads (the ``pads`` hint): a circle round the pad's point, or on a curved face the circular
+    segment between two named points on the circle."""
+    for body, pad in pads.items():
+        if body not in drawing.circles:
             raise GeometryError(f"pad hint names unknown body {body!r}")
         points = mechanism.body(body).points
         if pad.get("point") not in points:
             raise GeometryError(f"pad hint: body {body!r} has no point {pad.get('point')!r}")
         r_pad = parts_spec.pad_radius_mm or float(pad.get("radius_mm", radius))
         centre = mechanism.body(body).point(pad["point"])
-        if "arc" in pad:  # a curved face: the circular segment between two named points on the circle
+        if "arc" in pad:
             ends = [mechanism.body(body).point(name) for name in pad["arc"]]
-            circles[body] += [(ends[0], radius), (ends[1], radius)]
+            drawing.circles[body] += [(ends[0], radius), (ends[1], radius)]
             segment = pad_segment(centre, ends[0], ends[1], tol)
             if len(segment) >= 3:  # an arc within the chord tolerance of its chord adds nothing to the hull
-                fused_polys[body].append(segment)
+                drawing.fused[body].append(segment)
         else:
-            circles[body].append((centre, max(r_pad, radius)))
+            drawing.circles[body].append((centre, max(r_pad, radius)))
 
-    gear_of: dict[str, list[str]] = {b.name: [] for b in mechanism.bodies}
+
+def _add_gears(drawing: _Drawing, mechanism: Mechanism, gear_pairs: Sequence[Any], hub_mm: float,
+               tol: float) -> None:
+    """Each gear of each pair, with a hub round its axis, fused to the body that carries it."""
     for pair in gear_pairs:
         for side in ("a", "b"):
             body, axis, outline = gear_outline_in_body(mechanism, pair, side)
             centre = mechanism.body(body).point(axis)
-            fused_polys[body] += [outline, circle_polygon(centre, sizes.hub_mm, tol)]
-            gear_of[body].append(pair.name)
+            drawing.fused[body] += [outline, circle_polygon(centre, hub_mm, tol)]
+            drawing.gears[body].append(pair.name)
 
-    ground = mechanism.ground
 
-    def profile(body: str) -> BulgePath:
-        centres = np.array([c for c, _ in circles[body]]) if circles[body] else np.zeros((1, 2))
-        radii = np.array([r for _, r in circles[body]]) if circles[body] else np.array([radius])
-        path = circle_hull(centres, radii)
-        return fuse_polygons(path, fused_polys[body], tol) if fused_polys[body] else path
+def _outline(drawing: _Drawing, body: str, radius: float, tol: float) -> BulgePath:
+    """A body's outline: the exact hull of its circles (one boss of ``radius`` if none), fused with its polygons."""
+    circles = drawing.circles[body]
+    centres = np.array([c for c, _ in circles]) if circles else np.zeros((1, 2))
+    radii = np.array([r for _, r in circles]) if circles else np.array([radius])
+    path = circle_hull(centres, radii)
+    return fuse_polygons(path, drawing.fused[body], tol) if drawing.fused[body] else path
 
-    # moving bodies first: the ground's mounting holes keep clear of where they sweep
-    outlines: dict[str, BulgePath] = {b.name: profile(b.name) for b in mechanism.bodies if b.name != ground}
-    _add_mounting(mechanism, motion, ground, circles, holes, fused_polys, sizes, parts_spec,
+
+def _outlines(drawing: _Drawing, mechanism: Mechanism, motion: Motion, sizes: Sizes, parts_spec: PartsSpec,
+              process: ProcessSpec) -> dict[str, BulgePath]:
+    """Every body's outline, in body order, and the ground's mounting holes.
+
+    The moving bodies are drawn first: the mounting holes keep clear of the region they sweep, and the
+    ground's outline then takes in the mounting bosses.
+    """
+    ground, radius, tol = mechanism.ground, sizes.boss_radius_mm, process.chord_tolerance_mm
+    outlines = {b.name: _outline(drawing, b.name, radius, tol) for b in mechanism.bodies if b.name != ground}
+    _add_mounting(mechanism, motion, ground, drawing.circles, drawing.holes, drawing.fused, sizes, parts_spec,
                   swept_region(outlines, motion), process.running_clearance_mm)
-    outlines[ground] = profile(ground)
-    outlines = {b.name: outlines[b.name] for b in mechanism.bodies}
+    outlines[ground] = _outline(drawing, ground, radius, tol)
+    return {b.name: outlines[b.name] for b in mechanism.bodies}
 
+
+def _layers(outlines: Mapping[str, BulgePath], holes: Mapping[str, Sequence[Hole]],
+            pin_joints: Sequence[tuple[str, tuple[str, ...]]], mechanism: Mechanism, motion: Motion,
+            gear_pairs: Sequence[Any], radius: float, clearance_mm: float) -> dict[str, int]:
+    """Body name -> layer (see :mod:`fabricate.parts.layers`).
+
+    Bodies that come within the clearance of each other anywhere over the motion, or share a pin, get
+    different layers; meshing gears share one. The layers are then ordered so that no body sweeps over a
+    pin between the two layers it joins (a spacer fills the skipped layers there).
+    """
     coarse = {n: p.polygon(CONFLICT_CHORD_MM) for n, p in outlines.items()}
     holes_at = {(body, h.joint): h.centre for body, hs in holes.items() for h in hs}
     poses = {n: motion.pose(n) for n in mechanism.body_names}
     on_one_pin = [(a, b) for _, bodies in pin_joints for i, a in enumerate(bodies) for b in bodies[i + 1:]]
-    graph = conflict_graph(coarse, poses, process.running_clearance_mm + CONFLICT_CHORD_MM, always=on_one_pin)
+    graph = conflict_graph(coarse, poses, clearance_mm + CONFLICT_CHORD_MM, always=on_one_pin)
     same = [(p.body_a, p.body_b) for p in gear_pairs]
     layers = assign_layers(graph, list(mechanism.body_names), same)
-    # a pin through skipped layers carries a spacer: keep bodies that sweep over it out of that range
     # each pair's pin in the frame of its own body a (on a compound pin that is not always bodies[0])
     crossings = pin_crossings(coarse, poses, [(holes_at[(a, name)], a, b) for name, bodies in pin_joints
                                               for i, a in enumerate(bodies) for b in bodies[i + 1:]],
-                              radius, process.running_clearance_mm + CONFLICT_CHORD_MM)
-    layers = order_layers(layers, crossings)
+                              radius, clearance_mm + CONFLICT_CHORD_MM)
+    return order_layers(layers, crossings)
 
+
+def _body_parts(drawing: _Drawing, mechanism: Mechanism, outlines: Mapping[str, BulgePath],
+                layers: Mapping[str, int], process: ProcessSpec) -> list[Part]:
+    """One part per body, in body order, on its layer; a body with slots (a push rod) is a :class:`SlottedPart`."""
     thickness, gap = process.thickness_mm, process.layer_gap_mm
     parts: list[Part] = []
     for b in mechanism.bodies:
-        role = "ground" if b.name == ground else ("gear" if gear_of[b.name] else
-                                                  ("rod" if slots[b.name] else "link"))
+        gears, slots = drawing.gears[b.name], drawing.slots[b.name]
+        role = "ground" if b.name == mechanism.ground else ("gear" if gears else ("rod" if slots else "link"))
         common = dict(name=safe_name(b.name), body=b.name, outline=outlines[b.name],
-                      holes=tuple(holes[b.name]), thickness_mm=thickness,
+                      holes=tuple(drawing.holes[b.name]), thickness_mm=thickness,
                       z_mm=layer_z(layers[b.name], thickness, gap), layer=layers[b.name],
-                      process=process.name, role=role, gear=",".join(gear_of[b.name]))
-        if slots[b.name]:
-            parts.append(SlottedPart(**common, slots=tuple(slots[b.name])))
-        else:
-            parts.append(Part(**common))
-    centres = {(body, h.joint): h.centre for body, hs in holes.items() for h in hs}
-    pins, spacers = pins_and_spacers(pin_joints, layers, sizes.pin_mm, sizes.hole_mm,
-                                     2.0 * radius, thickness, gap, centres)
-    if process.name == "sla":
-        printed = [sp for sp in spacers if sp.length_mm >= process.thickness_mm - 1e-9]  # thin gaps: washers
-        per_pin = {j: sum(q.joint == j for q in printed) for j in {q.joint for q in printed}}
-        seen: dict[str, int] = {}
-        for sp in printed:
-            seen[sp.joint] = seen.get(sp.joint, 0) + 1
-            suffix = f"_{seen[sp.joint]}" if per_pin[sp.joint] > 1 else ""
-            parts.append(Part(name=safe_name(f"spacer_{sp.joint}{suffix}"), body=sp.body,
-                              outline=circle_hull(sp.centre[None, :], sp.outer_diameter_mm / 2.0),
-                              holes=(Hole(sp.joint, sp.centre, sp.inner_diameter_mm, sizes.pin_mm),),
-                              thickness_mm=sp.length_mm, z_mm=sp.z_mm, layer=sp.lower_layer + 1,
-                              process=process.name, role="spacer"))
-    _check_pin_webs(parts, process)
-    warnings = overlapping_cuts(parts)
-    names = [p.name for p in parts]
-    if len(set(names)) != len(names):
-        raise GeometryError(f"part names collide after sanitising: {sorted(names)}")
-    copies = int(hints.get("copies", 1) or 1)
-    mounting = sum(1 for h in holes[ground] if h.joint.startswith("mount_"))
-    bom = part_rows(parts, process, copies) + bill_of_materials(pins, spacers, hints, process.name, copies,
-                                                                 mounting=mounting,
-                                                                 mounting_mm=parts_spec.mounting_hole_mm)
-    return PartSet(parts=tuple(parts), bom=bom, pins=tuple(pins), spacers=tuple(spacers), layers=layers,
-                   process=process.name, chord_tolerance_mm=tol, thickness_mm=thickness, layer_gap_mm=gap,
-                   kerf_mm=process.kerf_mm, copies=copies, hints=hints, warnings=tuple(warnings))
+                      process=process.name, role=role, gear=",".join(gears))
+        parts.append(SlottedPart(**common, slots=tuple(slots)) if slots else Part(**common))
+    return parts
+
+
+def _printed_spacers(spacers: Sequence[Spacer], process: ProcessSpec, pin_mm: float) -> list[Part]:
+    """The spacers an additive process prints with the parts: those at least a plate thick (thinner gaps take
+    washers). A cut process makes none (its spacers are tubes, bought)."""
+    if process.technique != "additive":
+        return []
+    printed = [sp for sp in spacers if sp.length_mm >= process.thickness_mm - 1e-9]
+    per_pin = {j: sum(q.joint == j for q in printed) for j in {q.joint for q in printed}}
+    seen: dict[str, int] = {}
+    parts = []
+    for sp in printed:
+        seen[sp.joint] = seen.get(sp.joint, 0) + 1
+        suffix = f"_{seen[sp.joint]}" if per_pin[sp.joint] > 1 else ""
+        parts.append(Part(name=safe_name(f"spacer_{sp.joint}{suffix}"), body=sp.body,
+                          outline=circle_hull(sp.centre[None, :], sp.outer_diameter_mm / 2.0),
+                          holes=(Hole(sp.joint, sp.centre, sp.inner_diameter_mm, pin_mm),),
+                          thickness_mm=sp.length_mm, z_mm=sp.z_mm, layer=sp.lower_layer + 1,
+                          process=process.name, role="spacer"))
+    return parts
 
 
 def _check_pin_webs(parts: Sequence[Part], process: ProcessSpec) -> None:
@@ -434,32 +475,6 @@ def overlapping_cuts(parts: Sequence[Part]) -> list[str]:
                 if ring.distance(shapely.Point(a.centre)) < 0.5 * a.diameter_mm:
                     found.append(f"part {part.name}: hole {a.joint} runs into a guide slot")
     return found
-
-
-def _segment_distance(point: np.ndarray, ends: np.ndarray) -> float:
-    """Distance (mm) from a point to the segment between two ends (2, 2)."""
-    d = ends[1] - ends[0]
-    t = float(np.clip(np.dot(point - ends[0], d) / max(float(np.dot(d, d)), 1e-30), 0.0, 1.0))
-    return float(np.hypot(*(point - ends[0] - t * d)))
-
-
-def _guide_spacing(rod: Any, slider: str, rod_point: np.ndarray, axis_b: np.ndarray, s_min: float,
-                   s_max: float, spacing: float) -> float:
-    """Signed offset (mm, along the slide axis in the reference body) of the second guide pin.
-
-    The slot in the rod covers where both guide pins travel; the second pin goes on the side that keeps
-    the slot furthest from the rod's other points (its pin holes).
-    """
-    others = [rod.point(p) for p in rod.points if p != slider]
-    if not others:
-        return spacing
-    best = (-math.inf, spacing)
-    for e in (spacing, -spacing):
-        ends = np.array([rod_point - (s_max - min(e, 0.0)) * axis_b, rod_point - (s_min - max(e, 0.0)) * axis_b])
-        clearance = min(_segment_distance(p, ends) for p in others)
-        if clearance > best[0] + 1e-9:
-            best = (clearance, e)
-    return best[1]
 
 
 def merge_coincident_pins(pin_joints: Sequence[tuple[str, tuple[str, ...]]],
@@ -517,23 +532,6 @@ def swept_region(outlines: Mapping[str, BulgePath], motion: Motion, poses: int =
         for pose in motion.pose(body)[pick]:
             shapes.append(shapely.Polygon(outline @ rotation(pose[2]).T + pose[:2]))
     return shapely.union_all(shapes) if shapes else shapely.Polygon()
-
-
-def pad_segment(centre: np.ndarray, start: np.ndarray, end: np.ndarray, chord_tolerance_mm: float) -> np.ndarray:
-    """The circular segment cut from the circle about ``centre`` by the chord ``start``–``end`` (the minor
-    arc's side), as a CCW polygon (n, 2) whose arc has sagitta ≤ the tolerance.
-
-    Raises
-    ------
-    GeometryError
-        When the two points are not on one circle about ``centre``.
-    """
-    r0, r1 = float(np.hypot(*(start - centre))), float(np.hypot(*(end - centre)))
-    if abs(r0 - r1) > 1e-6 * max(r0, 1.0) or r0 == 0.0:
-        raise GeometryError(f"pad arc ends are {r0:.4g} and {r1:.4g} mm from the pad centre: not one circle")
-    turn = float(wrap_angle(np.arctan2(*(end - centre)[::-1]) - np.arctan2(*(start - centre)[::-1])))
-    ring = BulgePath(np.array([start, end]), np.array([np.tan(turn / 4.0), 0.0])).polygon(chord_tolerance_mm)
-    return ring if polygon_area(ring) > 0 else ring[::-1]
 
 
 def _add_mounting(mechanism: Mechanism, motion: Motion, ground: str,

@@ -32,7 +32,7 @@ from typing import Any
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository: tests/ helpers
 
 from fabricate import bounds  # noqa: E402
-from fabricate.spec import TEMPLATE_DIR, parse_toml  # noqa: E402
+from fabricate.templates import TEMPLATE_DIR, parse_toml  # noqa: E402
 from tests.toml_writer import toml_text  # noqa: E402
 
 #: Environment variables that set the thread count of the BLAS libraries numpy and scipy may load.
@@ -262,12 +262,13 @@ def worst_exact(copies: int = bounds.MAX_COPIES) -> str:
     """The worst exact form: the poses-worst linkage's ``mechanism.toml`` (every body at the point bound, laws
     by their coefficients or samples) with ``hints.copies`` at its bound, as the build writes it.
 
-    The driver's table is halved until the file fits :data:`fabricate.spec.MAX_TEMPLATE_BYTES` (a guard: at
+    The driver's table is halved until the file fits :data:`fabricate.templates.MAX_TEMPLATE_BYTES` (a guard: at
     the bound of 4000 samples in all the table writes 0.44 MB of PCHIP coefficients and fits as it is).
     """
-    from fabricate.spec import MAX_TEMPLATE_BYTES, design_from_text
+    from fabricate.spec import design_from_text
     from fabricate.synthesis.linkage.exact import mechanism_toml
     from fabricate.synthesis.linkage.mechanism import build_mechanism
+    from fabricate.templates import MAX_TEMPLATE_BYTES
 
     table = bounds.MAX_LINKAGE_TABLE
     while True:

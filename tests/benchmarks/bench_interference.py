@@ -31,7 +31,8 @@ def seed000(poses: int):
     from fabricate.gears import build_gear_pairs
     from fabricate.parts.build import build_parts
     from fabricate.pipeline import synthesise
-    from fabricate.spec import TEMPLATE_DIR, load_design
+    from fabricate.spec import load_design
+    from fabricate.templates import TEMPLATE_DIR
 
     design = load_design(TEMPLATE_DIR / "finger_five_bar_ncg.toml")
     result = synthesise(design)
@@ -95,7 +96,8 @@ def main() -> None:
               f"{r['ratio']:6.0f}x {'yes' if r['same'] else 'NO':4s}  {r['collisions']}")
     if not args.four_bar:
         from fabricate.pipeline import run_build
-        from fabricate.spec import TEMPLATE_DIR, load_design
+        from fabricate.spec import load_design
+        from fabricate.templates import TEMPLATE_DIR
 
         design = load_design(TEMPLATE_DIR / "finger_five_bar_ncg.toml")
         t0 = time.perf_counter()

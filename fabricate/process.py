@@ -1,0 +1,306 @@
+"""The manufacturing process: a profile's numbers, its materials, and what the process can do.
+
+A process profile is ``templates/process_<name>.toml`` (every such file is a profile a template may name as
+``[process] profile``, or ``--process`` may pick), or any file given to ``--process``. A template's
+``[process]`` table names the profile and overrides any of its fields.
+
+Capabilities
+------------
+Modules downstream never test a process by its name; they read what it can do:
+
+``technique``  ``"additive"``: parts are built up layer by layer, so a spacer at least a plate thick prints
+               with the parts and the BOM lists "printed part"s. ``"cut"``: parts are cut through sheet
+               stock, so the web round a hole is at least the stock thickness, spacers are bought (tubes,
+               not cut from the sheet), each part gets a cut path offset by the kerf (``cut/NAME.dxf``,
+               ``.svg``) and the BOM lists "cut part"s.
+``layout``     ``"plate"``: parts lie on print plates of ``build_volume_mm[:2]``, none taller than
+               ``build_volume_mm[2]`` (``plates/plate_N.stl``, ``.3mf``). ``"sheet"``: parts are nested on
+               sheets of ``build_volume_mm[:2]``, each as thick as the sheet, ``build_volume_mm[2]``
+               (``cut/sheet_N.dxf``, ``.svg``).
+plus the numbers every process has: ``min_feature_mm``, ``min_wall_mm``, ``min_pin_mm``, the fits
+(``running_clearance_mm``, ``hole_compensation_mm``, ``kerf_mm``) and ``min_text_mm``.
+
+A profile that leaves a capability out (a ``--process`` file written before the field existed) takes it from
+the shipped profile of its ``method``; a profile with a method of its own must state both.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from fabricate.errors import SpecError
+from fabricate.table import Table, _quote
+from fabricate.templates import TEMPLATE_DIR, parse_toml, path_kind, read_text, read_toml
+
+#: The profile of a template that names none.
+DEFAULT_PROFILE = "sla"
+#: How a process shapes a part, and how it lays the parts out (see the module docstring).
+TECHNIQUES = ("additive", "cut")
+LAYOUTS = ("plate", "sheet")
+#: A process name (``method``; a shipped profile's file is ``process_<name>.toml``).
+_PROCESS_NAME = re.compile(r"[a-z][a-z0-9_-]{0,39}")
+
+
+def shipped_profiles() -> tuple[str, ...]:
+    """Names of the shipped process profiles (``templates/process_<name>.toml``), the default first."""
+    names = sorted(p.stem[len("process_"):] for p in TEMPLATE_DIR.glob("process_*.toml"))
+    return tuple(sorted((n for n in names if _PROCESS_NAME.fullmatch(n)), key=lambda n: n != DEFAULT_PROFILE))
+
+
+@dataclass(frozen=True)
+class Material:
+    """Strength data of one material (MPa = N/mm²).
+
+    Attributes
+    ----------
+    key, name : str
+        Profile key and a description for people (the BOM's material).
+    tensile_MPa, flexural_MPa, compressive_MPa, shear_MPa : float
+        Ultimate strengths: tension governs net sections, flexure in-plane bending and tooth roots,
+        compression bearing and contact, shear pins and tear-out.
+    modulus_MPa, poisson : float
+        Elastic constants (Hertz contact).
+    density_g_cm3 : float
+    """
+
+    key: str
+    name: str
+    tensile_MPa: float
+    flexural_MPa: float
+    compressive_MPa: float
+    shear_MPa: float
+    modulus_MPa: float
+    poisson: float
+    density_g_cm3: float
+
+
+def parse_materials(table: Table) -> dict[str, Material]:
+    """Read a profile's ``[materials]`` table (``{}`` when absent) into ``{key: Material}``.
+
+    Every number's source is a comment in the profile.
+    """
+    out = {}
+    for key in sorted(table.data):
+        t = table.table(key)
+        out[key] = Material(
+            key=key, name=t.string("name", key.replace("_", " ")),
+            tensile_MPa=t.number("tensile_MPa", positive=True, max=1e5),
+            flexural_MPa=t.number("flexural_MPa", positive=True, max=1e5),
+            compressive_MPa=t.number("compressive_MPa", positive=True, max=1e5),
+            shear_MPa=t.number("shear_MPa", positive=True, max=1e5),
+            modulus_MPa=t.number("modulus_MPa", positive=True, max=1e7),
+            poisson=t.number("poisson", min=0.0, max=0.5),
+            density_g_cm3=t.number("density_g_cm3", positive=True, max=25.0),
+        )
+        t.finish()
+    return out
+
+
+def pick_material(materials: Mapping[str, Material], key: str, field: str) -> Material:
+    """The profile's material ``key``; a SpecError naming ``field`` if the profile has none such."""
+    if key not in materials:
+        known = ", ".join(sorted(materials)) or "none"
+        raise SpecError(field, f"unknown material \"{key}\" (this process profile has: {known})")
+    return materials[key]
+
+
+@dataclass(frozen=True)
+class ProcessSpec:
+    """Manufacturing process profile. Lengths in mm.
+
+    Attributes
+    ----------
+    name : str
+        The profile's ``method`` (``"sla"``, ``"laser"``...): a label for reports, never a switch.
+    running_clearance_mm : float
+        Radial clearance between a pin and its hole, and between moving faces.
+    hole_compensation_mm : float
+        Added to a hole's diameter in the model (SLA holes print undersize); a cut process uses kerf instead.
+    min_wall_mm, min_pin_mm, layer_gap_mm : float
+        Smallest wall around a hole, smallest pin diameter, axial gap between stacked layers.
+    thickness_mm : float
+        Plate thickness of a link layer, or the sheet thickness.
+    kerf_mm : float
+        Cut width (0 for an additive process); cut outlines are offset out and holes in by kerf / 2.
+    min_feature_mm : float
+        Smallest feature the process resolves (tooth tip land, web).
+    build_volume_mm : tuple of float
+        Build volume (x, y, z) of a plate layout, or the sheet (x, y, thickness) of a sheet layout.
+    pin_diameter_mm : float
+        Nominal pin diameter used at joints.
+    chord_tolerance_mm : float
+        Polygonisation sagitta for meshes.
+    technique : str
+        ``"additive"`` or ``"cut"`` (see the module docstring).
+    layout : str
+        ``"plate"`` or ``"sheet"`` (see the module docstring).
+    material : str
+        What parts are made of (BOM); ``density_g_cm3`` its density (part masses).
+    min_text_mm : float
+        Smallest label the process engraves or embosses legibly; smaller labels are left out.
+    arcs : str
+        ``"bulge"`` (exact LWPOLYLINE arcs) or ``"segments"`` (arcs as lines within the chord tolerance,
+        for OpenSCAD and older laser software that ignore bulges).
+    cut_colour, engrave_colour : str
+        SVG stroke colours ("#rrggbb") of the two operations.
+    materials : Mapping
+        The profile's ``[materials]``: key -> :class:`Material`.
+    pin_material : str
+        Key of the dowel pins' material.
+    """
+
+    name: str
+    running_clearance_mm: float
+    hole_compensation_mm: float
+    min_wall_mm: float
+    min_pin_mm: float
+    layer_gap_mm: float
+    thickness_mm: float
+    kerf_mm: float
+    min_feature_mm: float
+    build_volume_mm: tuple[float, float, float]
+    pin_diameter_mm: float
+    chord_tolerance_mm: float
+    technique: str = "additive"  # the default profile's (process_sla.toml)
+    layout: str = "plate"
+    material: str = ""
+    density_g_cm3: float = 1.2
+    min_text_mm: float = 1.0
+    arcs: str = "bulge"
+    cut_colour: str = "#ff0000"
+    engrave_colour: str = "#0000ff"
+    materials: Mapping[str, Material] = field(default_factory=dict, compare=False)
+    pin_material: str = ""
+
+    def part_material(self) -> Material | None:
+        """The :class:`Material` of the parts (None if the profile has none)."""
+        return self.materials.get(self.material)
+
+    def pin_material_spec(self) -> Material | None:
+        """The :class:`Material` of the dowel pins (None if not given)."""
+        return self.materials.get(self.pin_material)
+
+
+@dataclass(frozen=True)
+class ProcessOverride:
+    """A process chosen on the command line (``--process NAME|PATH``) instead of the template's.
+
+    Attributes
+    ----------
+    source : str
+        A shipped profile's name (``"sla"``, ``"laser"``...) or the profile file's name.
+    text : str
+        The profile's TOML text (embedded in report.json so ``check`` rebuilds with it).
+    """
+
+    source: str
+    text: str
+
+
+def process_override(name_or_path: str | Path) -> ProcessOverride:
+    """Resolve ``--process``: a shipped profile name or a profile file."""
+    profiles = shipped_profiles()
+    if not isinstance(name_or_path, (str, Path)):
+        named = ", ".join(f'"{p}"' for p in profiles)
+        raise SpecError("process", f"expected {named} or a process profile file (str or pathlib.Path), "
+                                   f"got {type(name_or_path).__name__}")
+    if name_or_path in profiles:
+        return ProcessOverride(name_or_path, read_text(TEMPLATE_DIR / f"process_{name_or_path}.toml"))
+    path = Path(name_or_path)
+    if path_kind(path, "--process") != "file":
+        raise SpecError("--process", f"expected {', '.join(profiles)} or a process profile file, "
+                                     f"got {_quote(str(name_or_path))}")
+    return ProcessOverride(path.name, read_text(path))
+
+
+#: Fields a template keeps when --process replaces its profile: which dowel pins the design uses is a
+#: choice of the design, everything else (clearances, kerf, sheet, thickness) belongs to the process.
+DESIGN_PROCESS_FIELDS = ("pin_diameter_mm",)
+
+
+def parse_process(table: Table, override: ProcessOverride | None = None) -> ProcessSpec:
+    """Read ``[process]``: a profile name plus overrides of the profile's fields.
+
+    With ``override`` (``--process``) the profile is the override's and of the template's own fields only
+    :data:`DESIGN_PROCESS_FIELDS` are kept.
+    """
+    from fabricate.bounds import MIN_CHORD_TOLERANCE_MM
+
+    profile = table.string("profile", DEFAULT_PROFILE, choices=shipped_profiles())
+    if override is None:
+        base_path = TEMPLATE_DIR / f"process_{profile}.toml"
+        base = read_toml(base_path) if base_path.is_file() else {}
+        path = table.path or "process"
+    else:
+        base = parse_toml(override.text, override.source)
+        path = f"--process {override.source}"
+    merged = dict(base)
+    for key in table.data:
+        if key != "profile":
+            table._used.add(key)
+            if override is None or key in DESIGN_PROCESS_FIELDS:
+                merged[key] = table.data[key]
+    t = Table(merged, path)
+    name = t.string("method", profile) if override is None else t.string("method")
+    if not _PROCESS_NAME.fullmatch(name):
+        raise SpecError(t.field("method"), "expected a process name of lower-case letters, digits, _ and - "
+                                           f"(\"sla\", \"laser\"...), got {_quote(name)}")
+    materials = parse_materials(t.table("materials", {}))
+    material = t.string("material", "")
+    pin_material = t.string("pin_material", "")
+    density = 1.2
+    if materials:
+        density = pick_material(materials, material, t.field("material")).density_g_cm3
+        pick_material(materials, pin_material, t.field("pin_material"))
+    # every length is bounded (bounds.MAX_LENGTH_MM and tighter where the process makes sense): a
+    # huge pin or wall turns into geometry no kernel can build; the chord tolerance's lower bound
+    # caps the vertex count of every polygonised arc (memory and time grow as 1/sqrt(tolerance))
+    spec = ProcessSpec(
+        name=name,
+        running_clearance_mm=t.number("running_clearance_mm", min=0.0, max=5.0),
+        hole_compensation_mm=t.number("hole_compensation_mm", 0.0, min=-2.0, max=2.0),
+        min_wall_mm=t.number("min_wall_mm", positive=True, max=50.0),
+        min_pin_mm=t.number("min_pin_mm", positive=True, max=50.0),
+        layer_gap_mm=t.number("layer_gap_mm", min=0.0, max=50.0),
+        thickness_mm=t.number("thickness_mm", positive=True, max=100.0),
+        kerf_mm=t.number("kerf_mm", 0.0, min=0.0, max=2.0),
+        min_feature_mm=t.number("min_feature_mm", positive=True, max=10.0),
+        build_volume_mm=tuple(t.array("build_volume_mm", shape=(3,), positive=True, max=10000.0).tolist()),
+        pin_diameter_mm=t.number("pin_diameter_mm", positive=True, max=50.0),
+        chord_tolerance_mm=t.number("chord_tolerance_mm", 0.005, min=MIN_CHORD_TOLERANCE_MM, max=1.0),
+        technique=_capability(t, "technique", name, TECHNIQUES),
+        layout=_capability(t, "layout", name, LAYOUTS),
+        material=material,
+        density_g_cm3=t.number("density_g_cm3", density, positive=True, max=25.0),
+        min_text_mm=t.number("min_text_mm", 1.0, min=0.0, max=20.0),
+        arcs=t.string("arcs", "bulge", choices=("bulge", "segments")),
+        cut_colour=_colour(t, "cut_colour", "#ff0000"),
+        engrave_colour=_colour(t, "engrave_colour", "#0000ff"),
+        materials=materials,
+        pin_material=pin_material,
+    )
+    t.finish()
+    if spec.pin_diameter_mm < spec.min_pin_mm:
+        raise SpecError(t.field("pin_diameter_mm"),
+                        f"pin {spec.pin_diameter_mm:g} mm is below the process minimum {spec.min_pin_mm:g} mm")
+    return spec
+
+
+def _capability(t: Table, key: str, name: str, choices: tuple[str, ...]) -> str:
+    """A capability field: the profile's value; if it has none, the shipped profile's of the same ``method``
+    (``process_<name>.toml``: a ``--process`` file older than the field); else it is required."""
+    if not t.has(key) and name in shipped_profiles():
+        default = read_toml(TEMPLATE_DIR / f"process_{name}.toml").get(key)
+        if isinstance(default, str) and default in choices:
+            return t.string(key, default, choices=choices)
+    return t.string(key, choices=choices)
+
+
+def _colour(t: Table, key: str, default: str) -> str:
+    value = t.string(key, default)
+    if not (len(value) == 7 and value[0] == "#" and all(c in "0123456789abcdefABCDEF" for c in value[1:])):
+        raise SpecError(t.field(key), f'expected a colour "#rrggbb", got {_quote(value)}')
+    return value.lower()
