@@ -2,9 +2,9 @@
 
 A template is checked field by field by the spec parsers (each field's own range uses the constants
 here, so the documented limit and the enforced one are the same number). Where a single bound is not
-enough, because the cost is a product of several fields, :func:`preflight` estimates the cost of the
-validated design before any work starts and raises a :class:`~fabricate.errors.SpecError` naming the
-field and the estimate.
+enough, because the cost is a product of several fields, the kind's own ``preflight`` (see
+:mod:`fabricate.kinds`) estimates the cost of the validated design before any work starts, with the
+constants here, and raises a :class:`~fabricate.errors.SpecError` naming the field and the estimate.
 
 The budget: the worst valid template of each kind (every bounded count at its maximum) builds within
 :data:`TIME_BUDGET_S` seconds and :data:`MEMORY_BUDGET_MB` of peak resident memory on two cores
@@ -103,7 +103,7 @@ MAX_EXACT_LAW_ORDER = 8
 #: Characters of a gear law expression: ``linkage.gears[].expression`` and ``gear_pair.law``. A formula is
 #: evaluated node by node in Python at every solver step, twice (value and slope) per gear: a 49 kB
 #: ``gear_pair.law`` took 108 s, and 8 linkage gears of 1000 characters cost 4.2 ms per Jacobian against
-#: 0.55 ms with constant ratios (so their product with the poses is bounded too: :func:`preflight`).
+#: 0.55 ms with constant ratios (so their product with the poses is bounded too, by the linkage's preflight).
 MAX_EXPRESSION_LENGTH = 1000
 #: Nesting depth of a gear law expression's syntax tree. Compiling and evaluating it takes one Python frame a
 #: level: 998 unary minus signs overflowed the interpreter's stack (1000 frames); a sum of n terms is n deep.
@@ -152,187 +152,6 @@ MAX_GRID_POINTS = 1.0e12
 #: k1 × k2 × phi01 values × path samples tabulated by the certified search (1.6e8 took 4.5 s and
 #: 0.36 GB in all).
 MAX_SPRING_TABLE = 2.0e8
-
-
-def preflight(design: Any) -> None:
-    """Estimate the cost of a validated design and refuse one that would exceed the budget.
-
-    Products of counts that the field bounds alone do not cap:
-
-    - compliant gripper: the optimisation grid (points per axis and in all);
-    - Watt six-bar: the solution region's d samples × d0 samples × statics samples;
-    - gear pair: sweep poses and GIF frames × teeth;
-    - linkage (declared and exact form): poses × bodies, the solver's steps × the cost of a step (sliders,
-      gears, drivers, characters of gear expressions), and the teeth of its gear pairs, alone and × poses
-      and GIF frames.
-
-    (The gear mesh check's steps × teeth is refused where the tooth counts are known, in
-    :mod:`fabricate.gears.pair`.)
-
-    Parameters
-    ----------
-    design : fabricate.spec.DesignSpec
-
-    Raises
-    ------
-    SpecError
-        Naming the field that drives the estimate, the estimate and the largest value that fits.
-    """
-    method = design.method
-    grid = getattr(method, "grid", None)
-    if grid is not None:
-        axes = [(name, len(getattr(grid, name))) for name in _GRID_FIELDS]
-        total = 1.0
-        for _, count in axes:
-            total *= count
-        if total > MAX_GRID_POINTS:
-            largest = max(axes, key=lambda item: item[1])[0]
-            raise SpecError(f"optimisation.{_GRID_FIELDS[largest]}",
-                            f"the grid has {total:.3g} points, over the bound of {MAX_GRID_POINTS:.0e}; "
-                            "use a larger step on this axis")
-        # the certified search tabulates every (k1, k2, phi01) triple along each contact path
-        triples = len(grid.k1) * len(grid.k2) * len(grid.phi01)
-        work = float(triples) * method.path_samples
-        if work > MAX_SPRING_TABLE:
-            raise SpecError("optimisation.path_samples" if triples * 31 <= MAX_SPRING_TABLE
-                            else "optimisation.k1_Nmm_per_deg",
-                            f"{len(grid.k1)} × {len(grid.k2)} × {len(grid.phi01)} spring triples × "
-                            f"{method.path_samples} path samples = {work:.3g}, over the bound of "
-                            f"{MAX_SPRING_TABLE:.0e}; at most {int(MAX_SPRING_TABLE // triples)} path samples "
-                            "with these axes, or larger steps on k1, k2, phi01")
-    if design.kind == "gear_pair":
-        _gear_pair_work(design)
-    if design.kind == "linkage":
-        _linkage_pose_work(design)
-        _linkage_solver_work(design)
-        _linkage_gear_work(design)
-    if design.kind == "watt_six_bar":
-        counts = [int((box[1] - box[0]) / method.step_mm + 1e-9) + 1 for box in (method.box("d"), method.box("d0"))]
-        work = float(counts[0] * counts[1] * method.statics_samples)
-        if work > MAX_REGION_WORK:
-            most = int(MAX_REGION_WORK / (counts[0] * counts[1]))
-            fix = (f"at most {most} statics samples at this step" if most >= 3
-                   else "use a larger region.step_mm")
-            raise SpecError("region.statics_samples" if most >= 3 else "region.step_mm",
-                            f"{counts[0]} × {counts[1]} region samples × {method.statics_samples} statics samples "
-                            f"= {work:.3g}, over the bound of {MAX_REGION_WORK:.0e} (about "
-                            f"{REGION_MB_PER_WORK * work / 1024:.1f} GB estimated against "
-                            f"{MEMORY_BUDGET_MB / 1024:.0f} GB); {fix}")
-
-
-def _gear_pair_work(design: Any) -> None:
-    """Poses and picture frames × teeth of a standalone gear pair (its outlines dominate every stage)."""
-    teeth = design.gears.teeth or getattr(design.method, "teeth", None)
-    # without tooth counts the module decides them after synthesis: assume the most teeth allowed
-    total = sum(teeth) if teeth else 2 * MAX_TEETH
-    for field, count, bound, what in (
-            ("checks.sweep_poses", design.checks.sweep_poses, MAX_POSE_TEETH, "poses"),
-            ("parts.gif_frames", design.parts.gif_frames, MAX_FRAME_TEETH, "GIF frames")):
-        if count * total > bound:
-            raise SpecError(field, f"{count} {what} × {total} teeth = {count * total}, over the bound of {bound} "
-                                   f"(every pose moves both toothed outlines); at most {max(1, bound // total)} "
-                                   f"{what} with {total} teeth")
-
-
-def _linkage_pose_work(design: Any) -> None:
-    """Poses × bodies of a linkage (the interference sweep and the statics visit every pose of every part)."""
-    spec = design.method
-    bodies = len(spec.mechanism.bodies) if hasattr(spec, "mechanism") else len(spec.bodies)
-    poses = int(design.checks.sweep_poses)
-    if poses * bodies > MAX_LINKAGE_POSE_BODIES:
-        raise SpecError("checks.sweep_poses", f"{poses} poses × {bodies} bodies = {poses * bodies}, over the bound of "
-                                              f"{MAX_LINKAGE_POSE_BODIES} (the checks go through every pose of every "
-                                              f"part); at most {MAX_LINKAGE_POSE_BODIES // bodies} poses with "
-                                              f"{bodies} bodies")
-
-
-def _linkage_solver_work(design: Any) -> None:
-    """The sweep's estimated CPU time: continuation steps × Jacobians a step × the cost of one Jacobian."""
-    spec = design.method
-    mech = getattr(spec, "mechanism", None)
-    if mech is not None:  # the exact form: laws by coefficients (cheap), joints as the mechanism has them
-        sliders = sum(type(j).__name__ != "Revolute" for j in mech.joints)
-        gears, drivers, expressions = len(mech.gears), len(mech.drivers), []
-    else:
-        sliders = sum(j.type != "revolute" for j in spec.joints)
-        gears, drivers = len(spec.gears), len(spec.drivers)
-        # an elliptic law is a formula too (at most 60 characters: fabricate.gears.law.elliptic_formula)
-        expressions = [(k, len(g.expression) if g.expression is not None else 60) for k, g in enumerate(spec.gears)
-                       if g.law in ("expression", "elliptic")]
-    chars = sum(n for _, n in expressions)
-    if chars > MAX_LINKAGE_EXPRESSION_CHARS:
-        raise SpecError(f"linkage.gears[{max(expressions, key=lambda e: e[1])[0]}].expression",
-                        f"the gear expressions have {chars} characters in all, over the bound of "
-                        f"{MAX_LINKAGE_EXPRESSION_CHARS} (each is evaluated at every step of the motion and "
-                        "throughout gear cutting); shorten them")
-    jacobian = (SOLVER_JACOBIAN_S + SOLVER_SLIDER_S * sliders + SOLVER_GEAR_S * gears + SOLVER_DRIVER_S * drivers
-                + SOLVER_EXPRESSION_CHAR_S * chars)
-    step = SOLVER_JACOBIANS_PER_STEP * jacobian
-    poses = int(design.checks.sweep_poses)
-    seconds = max(poses - 1, 360) * step
-    if seconds <= MAX_SOLVER_S:
-        return
-    what = (f"{sliders} slider{'s' if sliders != 1 else ''}, {gears} gear pair{'s' if gears != 1 else ''}"
-            + (f" ({chars} characters of gear expressions)" if chars else "")
-            + f", {drivers} driver{'s' if drivers != 1 else ''}")
-    most = int(MAX_SOLVER_S / step) + 1
-    if most > 361:
-        raise SpecError("checks.sweep_poses", f"{poses} poses of a linkage with {what}: about {seconds:.0f} s of "
-                                              f"solving estimated, over the budget of {MAX_SOLVER_S:.0f} s; at most "
-                                              f"{most} poses")
-    field = (f"linkage.gears[{max(expressions, key=lambda e: e[1])[0]}].expression" if chars
-             else "linkage.joints")
-    raise SpecError(field, f"a linkage with {what}: about {seconds:.0f} s of solving estimated even at 360 steps, "
-                           f"over the budget of {MAX_SOLVER_S:.0f} s; "
-                           + ("shorten the gear expressions" if chars else "use fewer sliders"))
-
-
-def _linkage_gear_work(design: Any) -> None:
-    """Teeth of a linkage's gear pairs (estimated before any is cut), alone and × poses and GIF frames."""
-    import math
-
-    spec = design.method
-    mech = getattr(spec, "mechanism", None)
-    gear = design.gears
-    pairs = []  # (centre distance, fraction of a turn, closed)
-    if mech is not None:
-        for g in mech.gears:
-            carrier = mech.body(g.carrier)
-            a = math.dist(carrier.points[g.axis_a], carrier.points[g.axis_b])
-            span = abs(g.working_range[1] - g.working_range[0]) / (2 * math.pi)
-            pairs.append((a, span, span >= 1.0 - 1e-9))
-    else:
-        points = {b.name: dict(b.points) for b in spec.bodies}
-        for g in spec.gears:
-            a = math.dist(points[g.carrier][g.axes[0]], points[g.carrier][g.axes[1]])
-            pairs.append((a, (g.working_range_deg[1] - g.working_range_deg[0]) / 360.0, g.closed))
-    if not pairs:
-        return
-    total = 0
-    for a, span, closed in pairs:
-        if closed and gear.teeth is not None:
-            total += sum(gear.teeth)
-        elif closed and gear.module_mm is None:
-            continue  # the gear layer asks for teeth or a module (exit 2) before cutting any
-        else:  # whole pitch curves of 2a / m teeth (r_a + r_b = a), a sector's share and its spare teeth
-            module = gear.module_or(0.5)
-            share = 1.0 if closed else min(1.0, span)
-            total += min(2 * MAX_TEETH, int(2 * a / module * share) + (0 if closed else 4 * gear.spare_teeth + 6))
-    field = "gears.teeth" if gear.teeth is not None else "gears.module_mm"
-    if total > MAX_LINKAGE_GEAR_TEETH:
-        raise SpecError(field, f"{len(pairs)} gear pair{'s' if len(pairs) != 1 else ''} with about {total} teeth in "
-                               f"all, over the bound of {MAX_LINKAGE_GEAR_TEETH}; fewer teeth (a larger module)")
-    for field, count, bound, what in (
-            ("checks.sweep_poses", design.checks.sweep_poses, MAX_LINKAGE_POSE_TEETH, "poses"),
-            ("parts.gif_frames", design.parts.gif_frames, MAX_FRAME_TEETH, "GIF frames")):
-        if count * total > bound:
-            raise SpecError(field, f"{count} {what} × about {total} teeth of the linkage's gears = {count * total}, "
-                                   f"over the bound of {bound} (every pose moves every toothed outline); at most "
-                                   f"{max(1, bound // total)} {what} with {total} teeth")
-
-
-_GRID_FIELDS = {"alpha": "alpha_deg", "c": "c_mm", "k1": "k1_Nmm_per_deg", "k2": "k2_Nmm_per_deg",
-                "phi01": "phi01_deg", "phi02": "phi02_deg"}
 
 
 def check_expression(text: str, path: str) -> None:

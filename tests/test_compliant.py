@@ -1,4 +1,4 @@
-"""Compliant gripper (seed 003): force model, paper numbers, optimiser, mechanism."""
+"""Compliant spring-hinge gripper: force model, paper numbers, optimiser, mechanism."""
 
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ import tomllib
 
 from fabricate.errors import SpecError
 from fabricate.planar import cross2
-from fabricate.spec import Table
 from fabricate.synthesis import compliant as cg
+from fabricate.synthesis.compliant.closing import no_load_closing
 from fabricate.synthesis.compliant.grid_search import (
     ParameterGrid,
     brute_force,
@@ -32,6 +32,7 @@ from fabricate.synthesis.compliant.model import (
     spring_torques,
     static_forces,
 )
+from fabricate.table import Table
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = json.loads((Path(__file__).parent / "data" / "compliant_paper.json").read_text())
@@ -188,7 +189,7 @@ def test_grid_optimum_no_worse_than_paper_point():
 
 def test_no_load_closing_solves_eqs_1_and_2():
     strokes = np.linspace(0.0, 18.0, 37)
-    phi = cg.no_load_closing(GEOM, PAPER, strokes)
+    phi = no_load_closing(GEOM, PAPER, strokes)
     st = finger_state(GEOM, phi[:, 0], phi[:, 1])
     assert np.allclose(st.stroke, strokes, atol=1e-6)
     s1, s2 = spring_torques(PAPER, phi[:, 0], phi[:, 1])

@@ -1,4 +1,4 @@
-"""Compliant gripper force model (seed 003) against an independent hand computation.
+"""Compliant spring-hinge gripper force model against an independent hand computation.
 
 Every expected value here comes from ``_pose`` / ``_matrix`` below, which rebuild the finger from its
 dimensions with plain rotations, find the pad-on-can pose by bisection, take moments as 2D cross

@@ -39,17 +39,20 @@ from fabricate.export.stl import (
     plate_stl,
     validate_stl,
 )
+from fabricate.kinds import KINDS
 from fabricate.parts.build import build_parts
 from fabricate.parts.spec import PartsSpec
-from fabricate.spec import ProcessSpec, load_design, shipped_templates
-from fabricate.synthesis import KINDS
+from fabricate.process import ProcessSpec
+from fabricate.spec import load_design
+from fabricate.templates import shipped_templates
 
 SLA = ProcessSpec(name="sla", running_clearance_mm=0.25, hole_compensation_mm=0.2, min_wall_mm=0.8,
                   min_pin_mm=1.5, layer_gap_mm=0.3, thickness_mm=3.0, kerf_mm=0.0, min_feature_mm=0.3,
                   build_volume_mm=(130.0, 80.0, 160.0), pin_diameter_mm=2.0, chord_tolerance_mm=0.005)
 LASER = ProcessSpec(name="laser", running_clearance_mm=0.1, hole_compensation_mm=0.0, min_wall_mm=3.0,
                     min_pin_mm=2.0, layer_gap_mm=0.5, thickness_mm=3.0, kerf_mm=0.2, min_feature_mm=0.5,
-                    build_volume_mm=(600.0, 400.0, 3.0), pin_diameter_mm=3.0, chord_tolerance_mm=0.005)
+                    build_volume_mm=(600.0, 400.0, 3.0), pin_diameter_mm=3.0, chord_tolerance_mm=0.005,
+                    technique="cut", layout="sheet")
 PROCESSES = {"sla": SLA, "laser": LASER}
 FIXTURES = ("four_bar", "slider_crank", "geared_four_bar")
 TEMPLATES = tuple(p.stem for p in shipped_templates())

@@ -1,4 +1,4 @@
-"""Seed 000: five-bar finger with a non-circular gear pair (fabricate.synthesis.five_bar).
+"""Five-bar NCG finger: five-bar finger with a non-circular gear pair (fabricate.synthesis.five_bar).
 
 Expected numbers come from the paper (tests/data/five_bar_paper.json); tolerances are stated at each
 assert. The IO-equation test re-derives the closed form (eqs 20-25) here, independently of the solver.
@@ -19,9 +19,11 @@ from hypothesis import strategies as st
 
 from fabricate.errors import LockupError, SpecError, SynthesisError
 from fabricate.planar import transform_points
-from fabricate.spec import TEMPLATE_DIR, Table, read_toml
 from fabricate.synthesis import five_bar as fb
 from fabricate.synthesis.five_bar import kinematic_mapping as km
+from fabricate.synthesis.five_bar.targets import finger_targets
+from fabricate.table import Table
+from fabricate.templates import TEMPLATE_DIR, read_toml
 
 PAPER = json.loads((Path(__file__).parent / "data" / "five_bar_paper.json").read_text())
 TEMPLATE = TEMPLATE_DIR / "finger_five_bar_ncg.toml"
@@ -162,7 +164,7 @@ def test_conic_intersections_find_the_base_points(offsets, u, v):
 
 def test_finger_dyad_dc_is_an_exact_solution():
     """The finger's own dyad D-C (D fixed in O-D, C in the distal body) satisfies every row of M."""
-    targets = fb.finger_targets(fb.parse_spec(Table(template_root())))
+    targets = finger_targets(fb.parse_spec(Table(template_root())))
     m = km.constraint_matrix(km.image_coordinates(targets.displacements))
     p = km.circle_vector(np.array([40.0, 0.0]), np.array([-20.0, 0.0]), 28.0)
     assert np.max(np.abs(m @ p)) < 1e-9 * np.abs(m).max() * np.abs(p).max()
@@ -418,7 +420,7 @@ def test_four_poses_give_an_exact_family():
     root = template_root()
     root["finger"]["poses_deg"] = root["finger"]["poses_deg"][:4]
     spec = fb.parse_spec(Table(root))
-    targets = fb.finger_targets(spec)
+    targets = finger_targets(spec)
     m = km.constraint_matrix(km.image_coordinates(targets.displacements))
     values, vectors = km.family_basis(m)
     assert np.all(np.abs(values[:4]) < 1e-9 * values[-1])

@@ -16,8 +16,9 @@ from shapely.geometry import Polygon
 from fabricate.errors import SpecError
 from fabricate.gears import GearSpec, build_gear_pairs, make_gear_pair, mesh_check
 from fabricate.gears.law import FormulaLaw, samples_law
-from fabricate.spec import TEMPLATE_DIR, load_design
-from fabricate.synthesis import KINDS
+from fabricate.kinds import KINDS
+from fabricate.spec import load_design
+from fabricate.templates import TEMPLATE_DIR
 
 DATA = json.loads((Path(__file__).parent / "data" / "gears_expected.json").read_text())
 ELLIPTIC = DATA["elliptic_template"]

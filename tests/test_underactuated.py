@@ -1,4 +1,4 @@
-"""Underactuated stacked four-bar finger (seed 001): mobility, velocity recursion, statics, closing."""
+"""Underactuated stacked four-bar finger: mobility, velocity recursion, statics, closing."""
 
 from __future__ import annotations
 
@@ -14,8 +14,9 @@ from hypothesis import strategies as st
 
 from fabricate.errors import SpecError
 from fabricate.planar import circle_circle_intersection, unit
-from fabricate.spec import Table
 from fabricate.synthesis import underactuated as ua
+from fabricate.synthesis.underactuated.closing import ClosingMotion, closing_motion
+from fabricate.synthesis.underactuated.mechanism import build_mechanism, mobility
 from fabricate.synthesis.underactuated.model import (
     contact_forces,
     crank_rate,
@@ -28,6 +29,8 @@ from fabricate.synthesis.underactuated.model import (
     transmission_ratios,
     virtual_work_forces,
 )
+from fabricate.synthesis.underactuated.settler import Settler, face_clearance, face_geometry
+from fabricate.table import Table
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = json.loads((Path(__file__).parent / "data" / "underactuated_closing.json").read_text())
@@ -48,13 +51,13 @@ angles = st.tuples(*[st.floats(0.0, 0.6) for _ in range(3)])
 
 @pytest.mark.parametrize("n", [2, 3, 4, 5])
 def test_mobility_is_n(n):
-    assert ua.mobility(n)["dof"] == n
-    assert ua.mobility(n)["underactuation"] == n - 1
+    assert mobility(n)["dof"] == n
+    assert mobility(n)["underactuation"] == n - 1
 
 
 def test_mechanism_mobility_counts_like_the_chapter():
-    motion = ua.ClosingMotion(np.linspace(0, 5, 5), np.zeros((5, 3)), np.zeros((5, 3), bool), [], [], False)
-    mech = ua.build_mechanism(SPEC, motion, "f")
+    motion = ClosingMotion(np.linspace(0, 5, 5), np.zeros((5, 3)), np.zeros((5, 3), bool), [], [], False)
+    mech = build_mechanism(SPEC, motion, "f")
     assert mech.degrees_of_freedom() == 3
     assert len(mech.drivers) == 3          # slide + two phalanx angles
 
@@ -134,7 +137,7 @@ def test_closing_on_cylinder_sequence_and_forces():
                        sweep.relative_angle("phalanx3", "phalanx2")], -1)
     assert np.allclose(q_mech, motion.q, atol=1e-6)
     final = finger_pose(DESIGN, motion.q[-1])
-    gaps, _ = ua.face_clearance(DESIGN, final, SPEC.cylinder_centre, SPEC.cylinder_radius)
+    gaps, _ = face_clearance(DESIGN, final, SPEC.cylinder_centre, SPEC.cylinder_radius)
     assert np.all(np.abs(gaps) < 1e-3)
     pngs = res.figures()
     assert set(pngs) == {"closing.png", "joint_angles.png"}
@@ -187,15 +190,15 @@ def test_closed_form_stroke_gradient_matches_differences():
 def test_face_clearance_gradient_matches_differences():
     qs = np.random.default_rng(11).uniform(0.0, 0.9, (20, 3))
     centre, radius = SPEC.cylinder_centre, SPEC.cylinder_radius
-    gaps, points, grads = ua.face_geometry(DESIGN, finger_poses(DESIGN, qs), centre, radius)
+    gaps, points, grads = face_geometry(DESIGN, finger_poses(DESIGN, qs), centre, radius)
     h = 1e-6
     for i in range(3):
         dq = np.zeros(3)
         dq[i] = h
-        hi = ua.face_geometry(DESIGN, finger_poses(DESIGN, qs + dq), centre, radius)[0]
-        lo = ua.face_geometry(DESIGN, finger_poses(DESIGN, qs - dq), centre, radius)[0]
+        hi = face_geometry(DESIGN, finger_poses(DESIGN, qs + dq), centre, radius)[0]
+        lo = face_geometry(DESIGN, finger_poses(DESIGN, qs - dq), centre, radius)[0]
         assert np.allclose(grads[:, :, i], (hi - lo) / (2 * h), atol=1e-6)
-    single = ua.face_clearance(DESIGN, finger_pose(DESIGN, qs[3]), centre, radius)
+    single = face_clearance(DESIGN, finger_pose(DESIGN, qs[3]), centre, radius)
     assert np.allclose(single[0], gaps[3], atol=1e-12) and np.allclose(single[1], points[3], atol=1e-12)
 
 
@@ -209,9 +212,9 @@ def test_newton_equilibria_match_slsqp(with_object):
     """Every stroke sample of the closing (stops, contacts and frozen joints included) is the one SLSQP
     finds on the same problem from the same start. At 21 samples the stroke after the lock lies beyond
     the push link's reach, where Newton gives up and SLSQP (once) confirms the lock."""
-    motion = ua.closing_motion(SPEC, with_object=with_object, samples=21)
+    motion = closing_motion(SPEC, with_object=with_object, samples=21)
     assert motion.fallbacks == (1 if with_object else 0)
-    settler = ua._Settler(SPEC, with_object)
+    settler = Settler(SPEC, with_object)
     last = len(motion.strokes) - (2 if with_object else 1)        # the lock sample comes from bisection
     for idx in range(1, last + 1):
         frozen = _frozen_before(motion.touching, idx) if with_object else 0
@@ -232,7 +235,7 @@ def test_events_located_and_driver_laws_match_a_dense_solve():
     independent reference whose contact strokes are late by at most one step)."""
     res = ua.synthesise(types.SimpleNamespace(method=SPEC, name="finger"))
     motion = res.data["motion"]
-    dense = ua.closing_motion(SPEC, samples=601, locate_events=False)
+    dense = closing_motion(SPEC, samples=601, locate_events=False)
     step = SPEC.stroke / 600
     assert dense.contact_order == motion.contact_order
     for coarse, fine in zip(motion.contact_strokes, dense.contact_strokes, strict=True):
@@ -251,5 +254,5 @@ def test_events_located_and_driver_laws_match_a_dense_solve():
         assert np.allclose(law(x, 1), fd, atol=1e-5)
         assert isinstance(law(1.0), float)
     # without locating, the coarse grid snaps the first contact to a sample 0.3 mm late
-    snapped = ua.closing_motion(SPEC, locate_events=False)
+    snapped = closing_motion(SPEC, locate_events=False)
     assert snapped.contact_strokes[0] - dense.contact_strokes[0] > 0.3

@@ -1,4 +1,4 @@
-"""Underactuated finger kernel (seed 001, ``synthesis/underactuated/model.py``) against independent computations.
+"""Underactuated stacked four-bar finger kernel (``synthesis/underactuated/model.py``) against independent computations.
 
 Every expected value comes from code in this file that does not call the function under test:
 

@@ -1,4 +1,4 @@
-"""Watt-I six-bar finger (seed 004): curves, region, K, selection, mechanism.
+"""Watt-I six-bar finger: curves, region, K, selection, mechanism.
 
 Expected numbers are in tests/data/watt_six_bar_paper.json (paper tables plus values measured with the
 printed Table 2, each with the tolerance stated where it is asserted).
@@ -16,7 +16,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fabricate.errors import SpecError
-from fabricate.spec import TEMPLATE_DIR, Table, read_toml
 from fabricate.synthesis import watt_six_bar as wsb
 from fabricate.synthesis.watt_six_bar.burmester import (
     cubic_real_roots,
@@ -25,12 +24,15 @@ from fabricate.synthesis.watt_six_bar.burmester import (
     grid_in_range,
     sample_curve,
 )
+from fabricate.synthesis.watt_six_bar.mechanism import _load_on_distal, build_mechanism, virtual_work_check
+from fabricate.synthesis.watt_six_bar.method import synthesise_spec
 from fabricate.synthesis.watt_six_bar.region import (
     RegionInputs,
     finger_positions,
     solution_region,
     stage_two_curves,
 )
+from fabricate.synthesis.watt_six_bar.spec import WattSixBarSpec
 from fabricate.synthesis.watt_six_bar.statics import (
     JOINTS,
     SixBarBatch,
@@ -40,6 +42,8 @@ from fabricate.synthesis.watt_six_bar.statics import (
     joint_loads,
     lagrange_joint_forces,
 )
+from fabricate.table import Table
+from fabricate.templates import TEMPLATE_DIR, read_toml
 
 DATA = json.loads((Path(__file__).parent / "data" / "watt_six_bar_paper.json").read_text())
 TEMPLATE = TEMPLATE_DIR / "finger_watt_six_bar.toml"
@@ -69,7 +73,7 @@ def _template_root(path: Path = TEMPLATE, edit=None) -> Table:
     return root
 
 
-def _paper_spec() -> wsb.WattSixBarSpec:
+def _paper_spec() -> WattSixBarSpec:
     root = _template_root()
     spec = wsb.parse_spec(root)
     root.finish()
@@ -85,7 +89,7 @@ def _inputs(case: dict) -> RegionInputs:
 
 @pytest.fixture(scope="module")
 def paper_result():
-    return wsb.synthesise_spec(_paper_spec())
+    return synthesise_spec(_paper_spec())
 
 
 @pytest.fixture(scope="module")
@@ -221,7 +225,7 @@ def test_circuit_defect_is_seen_by_the_generic_solver(paper_region):
     j = int(np.flatnonzero(np.isfinite(region.K) & (region.K < 20))[0])
     finger = finger_positions(np.asarray(DATA["phalanx_lengths_mm"]), np.radians(DATA["theta_deg"]))
     angles = np.radians(np.asarray(DATA["theta_deg"]))
-    mech = wsb.build_mechanism("defect", finger, angles, region.d[j], region.e[j], region.f[j], region.d0[j])
+    mech = build_mechanism("defect", finger, angles, region.d[j], region.e[j], region.f[j], region.d0[j])
     motion = mech.sweep(np.linspace(0.0, -40.0, 41))
     tips = motion.point("c")[[0, 10, 25, 40]]
     err = np.hypot(*(tips - finger.c).T)
@@ -236,9 +240,9 @@ def test_statics_agrees_with_virtual_work_on_many_mechanisms(paper_region):
     finger = finger_positions(np.asarray(DATA["phalanx_lengths_mm"]), np.radians(DATA["theta_deg"]))
     angles = np.radians(np.asarray(DATA["theta_deg"]))
     for j in finite[np.linspace(0, len(finite) - 1, 4).astype(int)]:
-        mech = wsb.build_mechanism("check", finger, angles, region.d[j], region.e[j], region.f[j], region.d0[j])
+        mech = build_mechanism("check", finger, angles, region.d[j], region.e[j], region.f[j], region.d0[j])
         theta = np.linspace(0.0, -40.0, 41)
-        check = wsb.virtual_work_check(mech, theta, 1.0)
+        check = virtual_work_check(mech, theta, 1.0)
         assert check["K"] == pytest.approx(region.K[j], rel=1e-8)
         batch = SixBarBatch(finger.a[0], finger.b[0], finger.c[0], region.d[j:j + 1], region.e[j:j + 1],
                             region.f[j:j + 1], region.d0[j:j + 1], 0.0)
@@ -253,7 +257,7 @@ def test_lagrange_forces_match_link_by_link_statics_joint_by_joint(paper_result)
     mech = paper_result.mechanism
     motion = mech.sweep(np.array([0.0, -17.0]))
     poses = motion.poses_at(1)
-    point, load = wsb._load_on_distal(mech, poses, 1.0)
+    point, load = _load_on_distal(mech, poses, 1.0)
     forces, torque = lagrange_joint_forces(mech, poses, point, load)
     batch = SixBarBatch(finger.a[0], finger.b[0], finger.c[0], choice.d[None], choice.e[None], choice.f[None],
                         choice.d0[None], 0.0)
@@ -304,7 +308,7 @@ def test_another_finger_gets_an_exact_defect_free_region_point():
                    angles_deg=tuple(tuple(r) for r in case["theta_deg"]),
                    boxes=tuple((k, tuple(v)) for k, v in case["boxes"].items()), rule="least_k", target=None,
                    reference=())
-    res = wsb.synthesise_spec(spec, "other")
+    res = synthesise_spec(spec, "other")
     rep = res.report
     assert rep["selection"]["exact_region_point"] is True
     assert rep["refined"] is None  # exact points qualify: no approximate refinement
@@ -369,7 +373,7 @@ def test_boxes_that_no_joint_can_reach_raise_synthesis_error():
     spec = _paper_spec()
     boxes = tuple((name, (200.0, 210.0, -20.0, 20.0)) if name == "d" else (name, box) for name, box in spec.boxes)
     with pytest.raises(SynthesisError, match="region: 0 points"):
-        wsb.synthesise_spec(replace(spec, boxes=boxes))
+        synthesise_spec(replace(spec, boxes=boxes))
 
 
 def test_grid_starts_at_the_box_edge_and_stays_inside():

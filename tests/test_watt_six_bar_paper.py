@@ -1,4 +1,4 @@
-"""Seed 004's Watt-I finger against the paper, checked independently of the synthesis code.
+"""The Watt-I six-bar finger against its paper, checked independently of the synthesis code.
 
 The Burmester condition is rewritten here from scratch: a point ``X`` of the proximal plane and a point
 ``Y`` of the distal plane keep their distance over the four positions exactly when ``Y`` is the centre
@@ -30,9 +30,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fabricate.spec import TEMPLATE_DIR, Table, read_toml
 from fabricate.synthesis import watt_six_bar as wsb
 from fabricate.synthesis.watt_six_bar.burmester import distance_to_curve, dyad_curve, sample_curve
+from fabricate.synthesis.watt_six_bar.method import synthesise_spec
 from fabricate.synthesis.watt_six_bar.region import (
     RegionInputs,
     coupler_motion,
@@ -40,6 +40,8 @@ from fabricate.synthesis.watt_six_bar.region import (
     solution_region,
     stage_two_curves,
 )
+from fabricate.table import Table
+from fabricate.templates import TEMPLATE_DIR, read_toml
 from tests.test_watt_six_bar import assert_grid_count
 
 DATA = json.loads((Path(__file__).parent / "data" / "watt_six_bar_paper.json").read_text())
@@ -261,7 +263,7 @@ def test_fitted_angles_select_an_exact_region_point_next_to_mechanism_1():
         if root.has(generic):
             root.table(generic)
     spec = wsb.parse_spec(root)
-    res = wsb.synthesise_spec(replace(spec, angles_deg=tuple(tuple(r) for r in FITTED)), "fitted")
+    res = synthesise_spec(replace(spec, angles_deg=tuple(tuple(r) for r in FITTED)), "fitted")
     rep = res.report
     sel = FIT["selected"]
     assert rep["selection"]["exact_region_point"] is True and rep["refined"] is None

@@ -1,37 +1,19 @@
-"""Synthesis methods, one module per seed mechanism.
+"""Synthesis methods: one package per kind of design (the registry of kinds is :mod:`fabricate.kinds`).
 
-Each kind module provides
+Every kind package has one shape:
 
-``parse_spec(root: fabricate.spec.Table) -> object``
-    Read the kind's own top-level tables from the template root (every key it reads is marked used;
-    unknown keys are errors) and return a frozen dataclass.
-``synthesise(design: fabricate.spec.DesignSpec) -> SynthesisResult``
-    Pure computation; raises :class:`~fabricate.errors.SynthesisError` when nothing is feasible.
+``__init__.py``
+    What the kind is (its paper, its template tables) and its entry points only: ``parse_spec``,
+    ``preflight`` and ``synthesise`` (see :mod:`fabricate.kinds` for their contracts).
+``spec.py``
+    The kind's template tables -> its frozen spec (``parse_spec``) and the cost estimate of a validated
+    design (``preflight``, with the constants of :mod:`fabricate.bounds`).
+``method.py``
+    ``synthesise``: the method from the spec to a :class:`~fabricate.synthesis.base.SynthesisResult` (its
+    report section, figures and parts hints), with the method's own modules beside it (the five-bar's
+    kinematic mapping, the six-bar's Burmester curves and solution region, ...).
+``mechanism.py``
+    The :class:`~fabricate.mechanism.Mechanism` the method builds.
+``plots.py``
+    Its figures (PNG bytes; matplotlib is imported only there, lazily).
 """
-
-from __future__ import annotations
-
-import importlib
-from types import ModuleType
-
-
-class _Kinds(dict):
-    """Lazy registry: kind name -> module (imported on first use, so a kind's imports stay local)."""
-
-    _modules = {
-        "five_bar_ncg": "fabricate.synthesis.five_bar",
-        "watt_six_bar": "fabricate.synthesis.watt_six_bar",
-        "underactuated": "fabricate.synthesis.underactuated",
-        "compliant_gripper": "fabricate.synthesis.compliant",
-        "gear_pair": "fabricate.synthesis.gear_pair",
-        "linkage": "fabricate.synthesis.linkage",
-    }
-
-    def __init__(self) -> None:
-        super().__init__({k: None for k in self._modules})
-
-    def __getitem__(self, kind: str) -> ModuleType:
-        return importlib.import_module(self._modules[kind])
-
-
-KINDS = _Kinds()

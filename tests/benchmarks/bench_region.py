@@ -15,12 +15,15 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "2")
 
 import numpy as np  # noqa: E402
 
-from fabricate.spec import TEMPLATE_DIR, Table, read_toml  # noqa: E402
 from fabricate.synthesis import watt_six_bar as wsb  # noqa: E402
+from fabricate.synthesis.watt_six_bar.method import synthesise_spec  # noqa: E402
 from fabricate.synthesis.watt_six_bar.region import finger_positions, solution_region, stage_one  # noqa: E402
+from fabricate.synthesis.watt_six_bar.spec import WattSixBarSpec  # noqa: E402
+from fabricate.table import Table  # noqa: E402
+from fabricate.templates import TEMPLATE_DIR, read_toml  # noqa: E402
 
 
-def _spec() -> wsb.WattSixBarSpec:
+def _spec() -> WattSixBarSpec:
     root = Table(read_toml(TEMPLATE_DIR / "finger_watt_six_bar.toml"))
     for generic in ("design", "process", "checks", "gears", "parts", "load"):
         if root.has(generic):
@@ -47,7 +50,7 @@ def main() -> None:
     t, region = _best_of(lambda: solution_region(inputs, spec.k_max))
     rows.append(("whole region + K (41 angles) + defects", t, len(region)))
     rows.append((f"  of which K <= {spec.k_max:g}", float("nan"), int(np.sum(region.K <= spec.k_max))))
-    t, result = _best_of(lambda: wsb.synthesise_spec(spec), repeat=1)
+    t, result = _best_of(lambda: synthesise_spec(spec), repeat=1)
     rows.append(("synthesise (region, refinement, mechanism, checks)", t, result.report["refined"]["candidates"]))
     print(f"{'stage':<54}{'time (s)':>10}{'points':>10}")
     for name, seconds, count in rows:

@@ -69,7 +69,7 @@ MODULES: dict[str, tuple[str, list[str]]] = {
                                             "tests/test_mechanism_solver.py"]),
     "checks/interference": ("fabricate/checks/interference.py", CHECK_TESTS),
     "checks/distance": ("fabricate/checks/distance.py", CHECK_TESTS),
-    # test_checks.py synthesises the seed-000 finger (tens of seconds): the property tests drive the check
+    # test_checks.py synthesises the five-bar NCG finger (tens of seconds): the property tests drive the check
     "checks/gear_mesh": ("fabricate/checks/gear_mesh.py",
                          ["tests/test_gears_properties.py", "tests/test_checks_gear_mesh.py"]),
     "checks/printability": ("fabricate/checks/printability.py",

@@ -1,4 +1,4 @@
-"""Static force model of the compliant two-hinge gripper finger (seed 003, eqs 1-10).
+"""Static force model of a finger of the compliant spring-hinge gripper (its paper's eqs 1-10).
 
 Frame and names follow the paper (Fig 2): origin at the finger mount A, x horizontal pointing away
 from the palm centre, y up. The root phalanx A-B (a1) hangs at the fixed angle ``alpha`` below the

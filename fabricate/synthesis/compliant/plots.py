@@ -2,26 +2,18 @@
 
 from __future__ import annotations
 
-import io
-
 import numpy as np
+
+from fabricate.plotting import png_bytes, pyplot
 
 
 def _png(fig) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, metadata={"Software": None})
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
-    return buf.getvalue()
+    return png_bytes(fig, 110)
 
 
 def compliant_figures(spec, path, grasp, motion, optimum) -> dict[str, bytes]:
     """``{file name: PNG bytes}``: grasp_force.png (Fig 3) and closing.png (finger poses)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from fabricate.synthesis.compliant.model import finger_state, grasp_force_curve
 

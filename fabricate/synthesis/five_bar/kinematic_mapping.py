@@ -1,4 +1,4 @@
-"""Planar kinematic mapping and the dyad-family synthesis of seed 000 (eqs 1-14).
+"""Planar kinematic mapping and the dyad-family synthesis of the five-bar NCG finger (its paper's eqs 1-14).
 
 A planar displacement (rotation ``v``, translation ``(e, f)``) maps to homogeneous image coordinates
 ``Z = (Z1, Z2, Z3, Z4)`` (eq 2). A point ``b`` fixed in the moving frame stays on a circle of the fixed

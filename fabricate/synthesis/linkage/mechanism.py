@@ -24,7 +24,7 @@ from fabricate.gears.law import FormulaLaw, check_ratio, elliptic_formula
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
 
 if TYPE_CHECKING:
-    from fabricate.synthesis.linkage import DriverSpec, JointSpec, LinkageGearSpec, LinkageSpec
+    from fabricate.synthesis.linkage.declared import DriverSpec, JointSpec, LinkageGearSpec, LinkageSpec
 
 
 # -- laws ------------------------------------------------------------------------------------------

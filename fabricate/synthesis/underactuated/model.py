@@ -1,4 +1,5 @@
-"""Kinematics and statics of the push-rod driven underactuated finger of stacked four-bars (seed 001).
+"""Kinematics and statics of the underactuated stacked four-bar finger, driven by one push rod (its paper's
+chapter).
 
 Topology (the chapter's Fig 2.4-2.6, our names)
 -----------------------------------------------

@@ -1,4 +1,4 @@
-"""Generalized Burmester curves for four-position dyad synthesis (seed 004, eqs 1-6).
+"""Generalized Burmester curves for four-position dyad synthesis (the Watt-I six-bar finger paper, eqs 1-6).
 
 A dyad B-M joins two moving planes pi^1 and pi^2 (either may be the ground). Over four positions the
 point ``X`` of pi^1 and its partner ``Y`` of pi^2 must keep their distance. With the displacement

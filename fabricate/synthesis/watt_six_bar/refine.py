@@ -1,4 +1,4 @@
-"""Approximate refinement of region points that suffer a circuit defect (extension to seed 004).
+"""Approximate refinement of region points that suffer a circuit defect (our extension to the Watt-I six-bar paper).
 
 Every point of the solution region passes the four positions *exactly* on some assembly of each loop,
 but not necessarily on one continuous branch: when a loop must switch branch between two positions

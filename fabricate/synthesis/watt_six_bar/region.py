@@ -1,4 +1,4 @@
-"""The solution region of the Watt-I six-bar finger (seed 004, section 1.2-1.3), vectorised.
+"""The solution region of the Watt-I six-bar finger (its paper's sections 1.2-1.3), vectorised.
 
 Stage 1: the dyad d-e between the proximal plane (a0, theta1) and the distal plane (b, theta3) over the
 four positions gives the cubic C_d (and C_e, the partner curve). Stage 2: for every feasible d (both d

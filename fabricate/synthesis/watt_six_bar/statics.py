@@ -1,6 +1,6 @@
 """Position analysis and statics of the Watt-I six-bar finger, vectorised over many mechanisms.
 
-Bodies (seed 004, Fig. 3): ground (a0, d0); proximal a0-a-d (driven by theta1); middle a-b; distal
+Bodies (the paper's Fig. 3): ground (a0, d0); proximal a0-a-d (driven by theta1); middle a-b; distal
 b-c-e (c is the fingertip); coupler d-e-f; rocker d0-f. Two four-bar loops close in turn:
 
 1. ground-proximal-coupler-rocker: ``f`` from circles about ``d`` and ``d0``;

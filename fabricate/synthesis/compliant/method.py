@@ -1,0 +1,134 @@
+"""The compliant gripper's synthesis: the grasp of the paper's procedure, the grasp force against stroke (Fig
+3), the certified optimum over the Table 1 grid, the closing motion, the mechanism, the report's ``synthesis``
+section and the parts hints (springs, rods, the drive shared by the fingers)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fabricate.errors import SynthesisError
+from fabricate.synthesis.base import SynthesisResult
+from fabricate.synthesis.compliant.closing import closing_motion
+from fabricate.synthesis.compliant.grid_search import OptimumResult, optimise
+from fabricate.synthesis.compliant.mechanism import build_mechanism
+from fabricate.synthesis.compliant.model import (
+    ContactPath,
+    Grasp,
+    GripperGeometry,
+    Springs,
+    contact_path,
+    finger_state,
+    grasp_force_curve,
+    solve_grasp,
+    spring_torques,
+)
+from fabricate.synthesis.compliant.spec import CompliantSpec
+
+#: Drive parts shared by all fingers (paper Fig 1): two lead-screw steppers move the tip and root
+#: drive plates along two guide posts.
+DRIVE_PARTS = (
+    {"item": "stepper motor with lead screw", "qty": 2, "note": "tip drive (1) and root drive (2), Fig 1"},
+    {"item": "guide post", "qty": 2, "note": "joins the motor plate and the finger-base plate (4)"},
+    {"item": "linear bearing", "qty": 4, "note": "each guide post through both drive plates (5)"},
+    {"item": "lead-screw nut", "qty": 2, "note": "one per drive plate (8)"},
+    {"item": "lead-screw support bearing", "qty": 2, "note": "in the finger-base plate (12)"},
+)
+
+
+def paper_point(spec: CompliantSpec) -> tuple[ContactPath, Grasp]:
+    """Grasp of the template's own parameters (the paper's optimum in the shipped template)."""
+    path = contact_path(spec.geometry, spec.load.radius, spec.load.mu, n=max(spec.path_samples, 721),
+                        pad_arc=spec.pad_arc)
+    grasp = solve_grasp(path, spec.springs, spec.load)
+    if grasp is None:
+        raise SynthesisError("compliant_gripper: the hover force never reaches F_n2 = mg/(3 mu s) on the "
+                             "physical branch (finger closing on the can, rod pushing)")
+    return path, grasp
+
+
+def _optimum_report(spec: CompliantSpec, result: OptimumResult) -> dict:
+    g = spec.geometry
+    geom = GripperGeometry(g.a1, g.a2, g.a3, g.b, result.c, g.d, g.l1, g.l2, g.r, result.alpha)
+    springs = Springs(result.k1, result.k2, result.phi01, result.phi02)
+    path = contact_path(geom, spec.load.radius, spec.load.mu, n=1441, pad_arc=spec.pad_arc)
+    exact = solve_grasp(path, springs, spec.load)
+    return {
+        "alpha_rad": result.alpha, "c_mm": result.c, "k1": result.k1, "k2": result.k2,
+        "phi01_rad": result.phi01, "phi02_rad": result.phi02,
+        "delta_N_N": exact.delta_n if exact is not None else result.delta_n,
+        "F_n1_N": exact.fn_static if exact is not None else None,
+        "stroke_mm": exact.stroke if exact is not None else None,
+        "grid_delta_N_N": result.delta_n,
+        "certificate": {
+            "grid_points": result.grid_points, "points_enumerated": result.points_evaluated,
+            "paths": result.paths, "paths_searched": result.paths_searched,
+            "intervals": result.intervals, "intervals_searched": result.intervals_searched,
+            "points_verified": result.points_verified, "lower_bound_N": result.lower_bound,
+            "pruned_bound_N": result.pruned_bound,
+            "path_samples": spec.path_samples, "min_hinge_deg": float(np.degrees(spec.min_hinge)),
+            "method": "exact lower bound of Delta N per (alpha, c, path interval); intervals below the "
+                      "incumbent searched in bound order, every grid point crossing there valued exactly "
+                      "(phi02 ranges from the running minimum of the hover threshold); the rest is "
+                      "bounded by pruned_bound_N >= the optimum"},
+    }
+
+
+def synthesise(design) -> SynthesisResult:
+    """Grasp, Fig-3 curve, optimum, closing motion, mechanism and parts hints."""
+    spec: CompliantSpec = design.method
+    path, grasp = paper_point(spec)
+    strokes, f_static, f_hover = grasp_force_curve(path, spec.springs, spec.load.mu)
+    motion = closing_motion(spec, path, grasp)
+    mech = build_mechanism(spec, motion, design.name)
+    st = finger_state(spec.geometry, grasp.phi1, grasp.phi2)
+    s1, s2 = spring_torques(spec.springs, grasp.phi1, grasp.phi2)
+    report = {
+        "F_n2_N": spec.load.hover_force,
+        "paper_optimum": {"F_n1_N": grasp.fn_static, "F_n2_N": grasp.fn_hover, "delta_N_N": grasp.delta_n},
+        "paper_printed": {"F_n1_N": 4.50, "F_n2_N": 3.78, "delta_N_N": 0.72,
+                          "note": "read off the paper's Fig 3; eqs 3-6 at the hover pose give F_n1 above"},
+        "grasp": {"stroke_mm": grasp.stroke, "first_touch_stroke_mm": grasp.contact_stroke,
+                  "phi1_deg": float(np.degrees(grasp.phi1)), "phi2_deg": float(np.degrees(grasp.phi2)),
+                  "rod_force_static_N": grasp.fd_static, "rod_force_hover_N": grasp.fd_hover,
+                  "beta_deg": float(np.degrees(st.beta)), "gamma_deg": float(np.degrees(st.gamma)),
+                  "spring_torques_Nmm": [float(s1), float(s2)]},
+        "grasp_force_curve": {"stroke_mm": strokes[::10].tolist(), "F_static_N": f_static[::10].tolist(),
+                              "F_hover_N": f_hover[::10].tolist()},
+        "fingers": spec.fingers,
+        "drive_parts": [dict(item) for item in DRIVE_PARTS],
+    }
+    optimum = None
+    if spec.grid is not None:
+        optimum = optimise(spec.geometry, spec.grid, spec.load, samples=spec.path_samples,
+                           hinge_margin=spec.min_hinge)
+        report["optimum"] = _optimum_report(spec, optimum)
+    g = spec.geometry
+    parts = {
+        "springs": [
+            {"joint": "C", "rate_Nmm_per_deg": spec.springs.k1, "preload_deg": float(np.degrees(spec.springs.phi01)),
+             "legs_mm": spec.spring_legs, "note": "small torsion spring, tip hinge (k1)"},
+            {"joint": "B", "rate_Nmm_per_deg": spec.springs.k2, "preload_deg": float(np.degrees(spec.springs.phi02)),
+             "legs_mm": spec.spring_legs, "note": "large torsion spring, middle hinge (k2)"},
+        ],
+        # the fingertip arc of radius r runs from its tangent point on the phalanx to the tip
+        "pads": {"tip": {"point": "pad", "radius_mm": g.r, "arc": ["pad_start", "tip"]}},
+        # per finger (the BOM layer multiplies these by "copies")
+        "purchased": [
+            {"item": "tip drive rod, 4 mm steel, threaded end", "qty": 1, "note": "pushes the two-force rod"},
+            {"item": "root push rod, 4 mm steel, threaded end", "qty": 1, "note": "sets the root angle alpha"},
+            {"item": "adjusting knob", "qty": 1, "note": "sets the tip spring preload"},
+        ],
+        # once per gripper, shared by the fingers: listed apart so they are not multiplied
+        "purchased_shared": list(DRIVE_PARTS),
+        "copies": spec.fingers,
+        "copy_angle_deg": 360.0 / spec.fingers,
+        "tip_point": "tip",
+    }
+
+    def figures() -> dict[str, bytes]:
+        from fabricate.synthesis.compliant.plots import compliant_figures
+        return compliant_figures(spec, path, grasp, motion, optimum)
+
+    data = {"path": path, "grasp": grasp, "motion": motion, "optimum": optimum,
+            "force_curve": (strokes, f_static, f_hover)}
+    return SynthesisResult(mechanism=mech, report=report, figures=figures, data=data, parts=parts)
