@@ -349,9 +349,9 @@ def _add_gears(drawing: _Drawing, mechanism: Mechanism, gear_pairs: Sequence[Any
 
 def _outline(drawing: _Drawing, body: str, radius: float, tol: float) -> BulgePath:
     """A body's outline: the exact hull of its circles (one boss of ``radius`` if none), fused with its polygons."""
-    circles = drawing.circles[body]
-    centres = np.array([c for c, _ in circles]) if circles else np.zeros((1, 2))
-    radii = np.array([r for _, r in circles]) if circles else np.array([radius])
+    circles = drawing.circles
+    centres = np.array([c for c, _ in circles[body]]) if circles[body] else np.zeros((1, 2))
+    radii = np.array([r for _, r in circles[body]]) if circles[body] else np.array([radius])
     path = circle_hull(centres, radii)
     return fuse_polygons(path, drawing.fused[body], tol) if drawing.fused[body] else path
 
@@ -415,7 +415,7 @@ def _printed_spacers(spacers: Sequence[Spacer], process: ProcessSpec, pin_mm: fl
     washers). A cut process makes none (its spacers are tubes, bought)."""
     if process.technique != "additive":
         return []
-    printed = [sp for sp in spacers if sp.length_mm >= process.thickness_mm - 1e-9]
+    printed = [sp for sp in spacers if sp.length_mm >= process.thickness_mm - 1e-9]  # thin gaps: washers
     per_pin = {j: sum(q.joint == j for q in printed) for j in {q.joint for q in printed}}
     seen: dict[str, int] = {}
     parts = []

@@ -60,7 +60,8 @@ def slider_guides(mechanism: Mechanism, motion: Motion, joint: Slider, boss_radi
     ends = np.array([rod_point - (s_max - min(spacing, 0.0)) * axis_b,
                      rod_point - (s_min - max(spacing, 0.0)) * axis_b])
     for other in rod.points:
-        if other != joint.name and _segment_distance(rod.point(other), ends) < hole_mm:
+        centre = rod.point(other)
+        if other != joint.name and _segment_distance(centre, ends) < hole_mm:
             raise GeometryError(f"slider {joint.name}: the guide slot in {joint.body_b!r} runs into its "
                                 f"point {other!r}; move the slider point or shorten the stroke")
     return SliderGuides(pins=pins, slot=circle_hull(ends, hole_mm / 2.0), ends=ends)
