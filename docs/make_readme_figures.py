@@ -357,9 +357,9 @@ def run_points(indices: Sequence[int]) -> list[dict[str, Any]]:
 
 def template_own(spec: Any) -> dict[str, Any]:
     """The shipped template built as it is (the paper's hinge A), for the README's comparison."""
-    from fabricate.spec import find_template, read_text
     from fabricate.sweep.spec import Metric, parse_metric
     from fabricate.sweep.task import evaluate
+    from fabricate.templates import find_template, read_text
 
     code, reason, report, _ = evaluate(read_text(find_template(spec.template)), "build")
     metric: Metric = parse_metric(SAFETY, "metric")

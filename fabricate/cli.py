@@ -312,6 +312,7 @@ def _default_output(name: str, template: Path, stage: str) -> Path:
 def _build(args: argparse.Namespace) -> int:
     from fabricate.output import check_output_dir, write_output
     from fabricate.pipeline import run_build, run_synth
+    from fabricate.process import shipped_profiles
     from fabricate.spec import load_design
 
     design = load_design(args.template, args.process)
@@ -319,7 +320,7 @@ def _build(args: argparse.Namespace) -> int:
     default = None if args.output else _default_output(design.name, Path(design.template), stage)
     # inputs the build reads: never inside the folder replaced, even with --force
     protect = {Path(design.template): "the template being built"}
-    if args.process and args.process not in ("sla", "laser"):
+    if args.process and args.process not in shipped_profiles():
         protect[Path(args.process)] = "the process profile in use"
     # refuse a bad output folder before the work, and again under the lock when writing
     out = check_output_dir(args.output or default, force=args.force, stage=stage, protect=protect)
@@ -333,7 +334,8 @@ def _build(args: argparse.Namespace) -> int:
 
 def _check(args: argparse.Namespace) -> int:
     from fabricate.pipeline import run_build
-    from fabricate.spec import find_template, load_design, path_kind
+    from fabricate.spec import load_design
+    from fabricate.templates import find_template, path_kind
 
     target = Path(args.target)
     path_kind(target, "TARGET")  # a name the system refuses to look at (too long) is exit 2, not an OSError
@@ -366,7 +368,7 @@ def _check(args: argparse.Namespace) -> int:
 
 def _value(text: str, where: str, many: bool) -> Any:
     """A command-line value: TOML (``[1, 2]``, ``0.5``, ``"x"``), else ``a,b,c`` or a bare word."""
-    from fabricate.spec import parse_toml
+    from fabricate.templates import parse_toml
 
     try:
         return parse_toml(f"v = {text}", where)["v"]
@@ -391,8 +393,8 @@ def _assignments(items: list[str], flag: str, many: bool) -> dict[str, Any]:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from fabricate.spec import parse_toml, read_text
     from fabricate.sweep.spec import find_sweep, sweep_from_tables
+    from fabricate.templates import parse_toml, read_text
 
     source = find_sweep(args.spec)
     if source is not None:
@@ -427,7 +429,7 @@ def _sweep(args: argparse.Namespace) -> int:
 
     out = args.output or Path("outputs") / f"{spec.name}-sweep"
     # the inputs (spec file, base template) are never inside the sweep's folder (as sweep_from_tables finds them)
-    from fabricate.spec import find_template
+    from fabricate.templates import find_template
 
     near = base_dir / spec.template if base_dir is not None else None
     template = near if near is not None and near.is_file() else find_template(spec.template)
@@ -456,12 +458,12 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _list() -> int:
-    from fabricate.spec import read_toml, shipped_templates
+    from fabricate.templates import read_toml, shipped_templates
 
     for path in shipped_templates():
         design = read_toml(path).get("design", {})
         print(f"{path.stem:28s} {design.get('kind', '?'):18s} {design.get('description', '')}")
-    from fabricate.spec import TEMPLATE_DIR
+    from fabricate.templates import TEMPLATE_DIR
 
     for path in sorted((TEMPLATE_DIR / "sweeps").glob("*.toml")):
         sweep = read_toml(path).get("sweep", {})
@@ -471,7 +473,8 @@ def _list() -> int:
 
 
 def _init(args: argparse.Namespace) -> int:
-    from fabricate.spec import design_from_text, find_template, read_text
+    from fabricate.spec import design_from_text
+    from fabricate.templates import find_template, read_text
 
     name = args.name[:-5] if args.name.endswith(".toml") else args.name
     if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}", name):

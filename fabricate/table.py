@@ -2,7 +2,7 @@
 
 Its own module so that the parsers of the generic tables (``fabricate.gears.spec``, ``fabricate.parts.spec``)
 and of each synthesis method read templates without importing :mod:`fabricate.spec`, which imports them
-(the loop spec -> gears.spec -> spec is gone). :mod:`fabricate.spec` re-exports these names.
+(the loop spec -> gears.spec -> spec is gone). Import these names from here.
 """
 
 from __future__ import annotations

@@ -1,8 +1,7 @@
-"""Materials (from the process profile) and the design load (the template's ``[load]`` table).
+"""The design load (the template's ``[load]`` table).
 
-Process profiles carry ``[materials.<key>]`` tables; the profile's ``material`` names the part material
-and ``pin_material`` the dowel pins (a template may pick another of the profile's materials with
-``[process] material = "<key>"``). Every number's source is a comment in the profile.
+The materials the stresses are held to belong to the process profile (:class:`fabricate.process.Material`,
+``[materials.<key>]`` of ``templates/process_<name>.toml``).
 
 ``[load]`` (every key optional; the default is no external load, which fails nothing):
 
@@ -30,52 +29,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fabricate.errors import SpecError
-
-
-@dataclass(frozen=True)
-class Material:
-    """Strength data of one material (MPa = N/mm²).
-
-    Attributes
-    ----------
-    key, name : str
-        Profile key and a description for people (the BOM's material).
-    tensile_MPa, flexural_MPa, compressive_MPa, shear_MPa : float
-        Ultimate strengths: tension governs net sections, flexure in-plane bending and tooth roots,
-        compression bearing and contact, shear pins and tear-out.
-    modulus_MPa, poisson : float
-        Elastic constants (Hertz contact).
-    density_g_cm3 : float
-    """
-
-    key: str
-    name: str
-    tensile_MPa: float
-    flexural_MPa: float
-    compressive_MPa: float
-    shear_MPa: float
-    modulus_MPa: float
-    poisson: float
-    density_g_cm3: float
-
-
-def parse_materials(table) -> dict[str, Material]:
-    """Read a profile's ``[materials]`` table (``{}`` when absent) into ``{key: Material}``."""
-    out = {}
-    for key in sorted(table.data):
-        t = table.table(key)
-        out[key] = Material(
-            key=key, name=t.string("name", key.replace("_", " ")),
-            tensile_MPa=t.number("tensile_MPa", positive=True, max=1e5),
-            flexural_MPa=t.number("flexural_MPa", positive=True, max=1e5),
-            compressive_MPa=t.number("compressive_MPa", positive=True, max=1e5),
-            shear_MPa=t.number("shear_MPa", positive=True, max=1e5),
-            modulus_MPa=t.number("modulus_MPa", positive=True, max=1e7),
-            poisson=t.number("poisson", min=0.0, max=0.5),
-            density_g_cm3=t.number("density_g_cm3", positive=True, max=25.0),
-        )
-        t.finish()
-    return out
 
 
 @dataclass(frozen=True)
@@ -127,10 +80,3 @@ def parse_load(table) -> LoadSpec:
                                                     "an actuator effort the tip force is what it produces")
     return spec
 
-
-def pick_material(materials: dict[str, Material], key: str, field: str) -> Material:
-    """The profile's material ``key``; a SpecError naming ``field`` if the profile has none such."""
-    if key not in materials:
-        known = ", ".join(sorted(materials)) or "none"
-        raise SpecError(field, f"unknown material \"{key}\" (this process profile has: {known})")
-    return materials[key]

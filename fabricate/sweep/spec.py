@@ -420,7 +420,8 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None, *
     user gave the entries that did not come from the file: with ``{"vary.gears.module_mm": "--vary
     gears.module_mm"}`` an error in that entry ends "(given as --vary gears.module_mm)".
     """
-    from fabricate.spec import design_from_text, find_template, parse_toml, path_kind, read_text
+    from fabricate.spec import design_from_text
+    from fabricate.templates import find_template, parse_toml, path_kind, read_text
 
     origins = origins or {}
     if not isinstance(tables, Mapping):
@@ -595,7 +596,7 @@ def _is_numeric(f: Field) -> bool:
 def find_sweep(path: str | Path) -> Path | None:
     """The sweep spec file ``path`` names (a path, or a shipped spec's name from ``templates/sweeps/``), or
     None when ``path`` is not a sweep spec (a design template, say)."""
-    from fabricate.spec import TEMPLATE_DIR, parse_toml, path_kind, read_text
+    from fabricate.templates import TEMPLATE_DIR, parse_toml, path_kind, read_text
 
     if not isinstance(path, (str, Path)):
         raise SpecError("spec", "expected a sweep spec's name or path (str or pathlib.Path), got "
@@ -613,7 +614,7 @@ def find_sweep(path: str | Path) -> Path | None:
 
 def load_sweep(path: str | Path) -> SweepSpec:
     """Read and validate a sweep spec file (a path, or a shipped spec's name from ``templates/sweeps/``)."""
-    from fabricate.spec import parse_toml, read_text
+    from fabricate.templates import parse_toml, read_text
 
     source = find_sweep(path)
     if source is None:
