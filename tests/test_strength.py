@@ -16,10 +16,10 @@ from conftest import make_four_bar
 from test_parts import slider_crank
 
 from fabricate.cli import main
-from fabricate.spec import TEMPLATE_DIR
 from fabricate.strength.check import body_loads, design_loads, solved_loads
 from fabricate.strength.spec import LoadSpec
 from fabricate.strength.statics import BodyTorque, PointForce, solve_statics
+from fabricate.templates import TEMPLATE_DIR
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -279,7 +279,7 @@ def test_auto_link_width_is_the_smallest_width_that_passes():
 def test_link_width_auto_is_read_and_other_words_are_refused():
     from fabricate.errors import SpecError
     from fabricate.parts.spec import parse_parts_spec
-    from fabricate.spec import Table
+    from fabricate.table import Table
 
     assert parse_parts_spec(Table({"link_width_mm": "auto"}, "parts")).link_width_mm == "auto"
     with pytest.raises(SpecError, match="parts.link_width_mm"):
@@ -289,7 +289,7 @@ def test_link_width_auto_is_read_and_other_words_are_refused():
 def test_local_pitch_radius_is_the_curvature_radius_of_an_ellipse():
     """The Lewis/Hertz radius at a contact point against an ellipse's closed form
     rho = (a^2 sin^2 t + b^2 cos^2 t)^(3/2) / (a b), either way round the curve."""
-    from fabricate.strength.check import _local_radius
+    from fabricate.strength.features import local_radius
 
     a, b = 20.0, 12.0
     t = np.linspace(0.0, 2.0 * np.pi, 4001)[:-1]
@@ -297,8 +297,8 @@ def test_local_pitch_radius_is_the_curvature_radius_of_an_ellipse():
     probe_t = np.linspace(0.1, 6.0, 25)
     probe = np.column_stack([a * np.cos(probe_t), b * np.sin(probe_t)])
     expected = (a ** 2 * np.sin(probe_t) ** 2 + b ** 2 * np.cos(probe_t) ** 2) ** 1.5 / (a * b)
-    np.testing.assert_allclose(_local_radius(curve, probe), expected, rtol=2e-3)  # nearest of 4000 vertices
-    np.testing.assert_allclose(_local_radius(curve[::-1], probe), expected, rtol=2e-3)
+    np.testing.assert_allclose(local_radius(curve, probe), expected, rtol=2e-3)  # nearest of 4000 vertices
+    np.testing.assert_allclose(local_radius(curve[::-1], probe), expected, rtol=2e-3)
 
 
 def test_gear_contact_point_lies_on_both_pitch_curves_over_the_motion():
@@ -357,7 +357,8 @@ def test_zero_load_and_no_materials_are_not_checked_never_passed():
 
 def test_an_unloaded_part_has_a_null_safety_factor_not_inf():
     """Within a checked run a part the load does not reach (zero stress) is written as null, never inf."""
-    from fabricate.strength.check import Finding, StrengthResult
+    from fabricate.strength.check import StrengthResult
+    from fabricate.strength.features import Finding
 
     result = StrengthResult([Finding("idle", "pin shear", "pin", 0.0, 50.0, 0, "no load", "none"),
                              Finding("busy", "pin shear", "pin", 10.0, 50.0, 1, "5 N", "thicker")],

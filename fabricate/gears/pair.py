@@ -109,7 +109,8 @@ class GearPair:
         return self.module
 
     def report(self) -> dict[str, Any]:
-        """JSON-ready entry of report.json's ``gears`` list (DESIGN.md keys first)."""
+        """JSON-ready entry of report.json's ``gears`` list (fabricate/report_schema.json: its stable keys
+        first, ``gears[]`` in docs/report.md)."""
         c = self.checks
         mesh = self.mesh.summary() if self.mesh is not None else {}
         out: dict[str, Any] = {
@@ -256,6 +257,35 @@ def _deviation_um(main: GearTeeth, other: GearTeeth) -> float:
     return float(np.max(best) * 1000.0)
 
 
+@dataclass(frozen=True)
+class _Layout:
+    """Where the teeth go: the pitch curves, the module, the tooth centres along the rolled arc length of
+    each gear and the range of ``x_a`` the outlines cover (``periods``: the closed gears' turns, else None)."""
+
+    pitch: PitchCurves
+    module: float
+    centres_a: np.ndarray
+    centres_b: np.ndarray
+    x_cover: np.ndarray
+    periods: tuple[float, float] | None = None
+
+    @property
+    def teeth(self) -> tuple[int, int]:
+        return len(self.centres_a), len(self.centres_b)
+
+
+@dataclass(frozen=True)
+class _Cut:
+    """Both gears cut from one rack, and what they were cut with."""
+
+    rack: Any
+    bore: float
+    hub: float
+    common: dict[str, Any]
+    a: GearTeeth
+    b: GearTeeth
+
+
 def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tuple[float, float],
                    spec: GearSpec, *, closed: bool, name: str = "pair", chord_tolerance_mm: float = 0.005,
                    coupling: str = "", carrier: str = "", body_a: str = "gear_a", body_b: str = "gear_b",
@@ -284,71 +314,106 @@ def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tupl
     """
     lo, hi = (float(v) for v in working_range)
     a = float(center_distance_mm)
+    _check_request(law, lo, hi, a, working_range, spec, name)
+    layout = _closed_layout(law, lo, a, spec, name) if closed else _sector_layout(law, lo, hi, a, spec, name)
+    z_a, z_b = layout.teeth
+    module, pitch, x_cover = layout.module, layout.pitch, layout.x_cover
+    _check_teeth(z_a, z_b, module, spec)
+    curv = curvature_summary(pitch, x_cover)
+    check_feasible(curv, module, spec)
+    cut = _cut_teeth(layout, spec, closed, chord_tolerance_mm)
+    checks = _pair_checks(law, lo, hi, layout, spec, curv, cut, _method_deviation_um(layout, spec, cut))
+    pitch_a, pitch_b = _pitch_outlines(layout, lo, closed)
+    pair = GearPair(name=name, coupling=coupling or name, carrier=carrier, body_a=body_a, body_b=body_b,
+                    axis_a=axis_a, axis_b=axis_b, center_distance_mm=a, teeth=(int(z_a), int(z_b)),
+                    module=float(module), method=spec.method, closed=closed, working_range=(lo, hi), law=law,
+                    outline_a=cut.a.outline, outline_b=cut.b.outline, pitch_a=pitch_a, pitch_b=pitch_b,
+                    bore_a_mm=float(cut.bore), bore_b_mm=float(cut.bore), hub_diameter_mm=float(cut.hub), spec=spec,
+                    pitch_model=pitch, cut_a=cut.a, cut_b=cut.b, rack_origin=0.0, checks=checks)
+    if run_mesh_check:
+        pair = replace(pair, mesh=mesh_check(pair))
+    return pair
+
+
+def _check_request(law: Callable, lo: float, hi: float, a: float, working_range: tuple[float, float],
+                   spec: GearSpec, name: str) -> None:
+    """Refuse a range, centre distance, law or module no pair can be cut for, naming the field."""
     if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
         raise SpecError(f"gears.{name}.working_range", f"expected a finite range lo < hi, got {working_range}")
     if not (np.isfinite(a) and a > 0):
         raise SpecError(f"gears.{name}.center_distance_mm", f"expected a positive distance, got {a}")
     check_ratio(law, np.linspace(lo, hi, 1025), f"gears.{name}.law")
-    alpha = spec.pressure_angle
     if spec.module_mm is not None:
         # the module against the curvature of the working range first: the clearest message
         check_feasible(curvature_summary(_Bare(law, a), np.linspace(lo, hi, 721)), spec.module_mm, spec)
-    if closed:
-        z_a, z_b = _closed_teeth(law, lo, spec, a)
-        periods = (TWO_PI, TWO_PI * z_b / z_a)
-        span = max(periods)
-        ratio_grid = np.linspace(lo, lo + TWO_PI, 721)
-        i0, i1 = -law(ratio_grid, 1), -law(ratio_grid + periods[1], 1)
-        if np.max(np.abs(i0 - i1)) > 1e-7 * np.max(np.abs(i0)):
-            raise SpecError(f"gears.{name}.law", f"the law does not close gear b: its ratio does not repeat "
-                                                 f"after gear b's turn ({np.degrees(periods[1]):.2f} deg of a); "
-                                                 "use a law periodic over that angle")
-        pitch = PitchCurves(law, a, (lo, lo + span), lo, periods)
-        module = pitch.perimeter_a / (np.pi * z_a)
-        if min(z_a, z_b) < spec.min_teeth:
-            largest = pitch.perimeter_a / (np.pi * spec.min_teeth * max(1.0, z_a / min(z_a, z_b)))
-            raise SpecError("gears.teeth", f"{min(z_a, z_b)} teeth is below min_teeth = {spec.min_teeth}: "
-                                           f"use at least {spec.min_teeth} teeth (module <= {largest:.3g} mm)")
-        p = np.pi * module
-        centres_a = np.arange(z_a) * p
-        centres_b = np.arange(z_b) * p + 0.5 * p
-        x_cover = np.linspace(lo, lo + span, 2049)
-    else:
-        if spec.teeth is not None:
-            raise SpecError("gears.teeth", "tooth counts apply to closed pairs; a sector's teeth follow from "
-                                           "its working range and module (leave teeth out or set closed = true)")
-        module = spec.module_or(DEFAULT_SECTOR_MODULE_MM)
-        p = np.pi * module
-        margin = (1.25 + spec.spare_teeth + 2.5) * p + 5 * module
-        r_min = float(np.min(_Bare(law, a).radii(np.linspace(lo, hi, 257), "a")[0]))
-        grow = 1.3 * margin / max(r_min, 1e-6)
-        for _ in range(8):
-            try:
-                pitch = PitchCurves(law, a, (lo - grow, hi + grow), lo)
-            except SpecError as exc:
-                raise SpecError(f"gears.{name}.law", f"{exc.message} (the law is extended "
-                                f"{np.degrees(grow):.1f} deg beyond the working range for the spare teeth; "
-                                "widen the law's range or use fewer spare_teeth)") from exc
-            s_lo, s_hi = 0.0, float(pitch.s_of_x(np.array([hi]))[0])
-            if pitch.s_nodes[0] < s_lo - margin and pitch.s_nodes[-1] > s_hi + margin:
-                break
-            grow *= 1.5
-        reach = (1.25 + spec.spare_teeth) * p
-        _check_teeth(int((s_hi - s_lo + 2 * reach) / p), int((s_hi - s_lo + 2 * reach) / p), module, spec)
-        k_a = np.arange(np.ceil((s_lo - reach) / p), np.floor((s_hi + reach) / p) + 1)
-        k_b = np.arange(np.ceil((s_lo - reach) / p - 0.5), np.floor((s_hi + reach) / p - 0.5) + 1)
-        centres_a, centres_b = k_a * p, (k_b + 0.5) * p
-        z_a, z_b = len(centres_a), len(centres_b)
-        s_ends = np.array([min(centres_a[0], centres_b[0]) - p, max(centres_a[-1], centres_b[-1]) + p])
-        x_ends = pitch.x_of_s(s_ends)
-        x_cover = np.linspace(x_ends[0], x_ends[1], 2049)
-        sweep_b = abs(float(law(x_ends[1]) - law(x_ends[0])))
-        if x_ends[1] - x_ends[0] >= TWO_PI or sweep_b >= TWO_PI:
-            raise SpecError(f"gears.{name}.closed", "the sector with its spare teeth spans a full turn; "
-                                                    "use closed = true")
-    _check_teeth(z_a, z_b, module, spec)
-    curv = curvature_summary(pitch, x_cover)
-    check_feasible(curv, module, spec)
+
+
+def _closed_layout(law: Callable, lo: float, a: float, spec: GearSpec, name: str) -> _Layout:
+    """Closed gears: whole numbers of teeth on both perimeters, the module following from gear a's."""
+    z_a, z_b = _closed_teeth(law, lo, spec, a)
+    periods = (TWO_PI, TWO_PI * z_b / z_a)
+    span = max(periods)
+    ratio_grid = np.linspace(lo, lo + TWO_PI, 721)
+    i0, i1 = -law(ratio_grid, 1), -law(ratio_grid + periods[1], 1)
+    if np.max(np.abs(i0 - i1)) > 1e-7 * np.max(np.abs(i0)):
+        raise SpecError(f"gears.{name}.law", f"the law does not close gear b: its ratio does not repeat "
+                                             f"after gear b's turn ({np.degrees(periods[1]):.2f} deg of a); "
+                                             "use a law periodic over that angle")
+    pitch = PitchCurves(law, a, (lo, lo + span), lo, periods)
+    module = pitch.perimeter_a / (np.pi * z_a)
+    if min(z_a, z_b) < spec.min_teeth:
+        largest = pitch.perimeter_a / (np.pi * spec.min_teeth * max(1.0, z_a / min(z_a, z_b)))
+        raise SpecError("gears.teeth", f"{min(z_a, z_b)} teeth is below min_teeth = {spec.min_teeth}: "
+                                       f"use at least {spec.min_teeth} teeth (module <= {largest:.3g} mm)")
+    p = np.pi * module
+    centres_a = np.arange(z_a) * p
+    centres_b = np.arange(z_b) * p + 0.5 * p
+    x_cover = np.linspace(lo, lo + span, 2049)
+    return _Layout(pitch, module, centres_a, centres_b, x_cover, periods)
+
+
+def _sector_layout(law: Callable, lo: float, hi: float, a: float, spec: GearSpec, name: str) -> _Layout:
+    """Sectors: every tooth that engages within the working range plus ``spare_teeth`` at each end, on pitch
+    curves extended beyond the range far enough to hold them."""
+    if spec.teeth is not None:
+        raise SpecError("gears.teeth", "tooth counts apply to closed pairs; a sector's teeth follow from "
+                                       "its working range and module (leave teeth out or set closed = true)")
+    module = spec.module_or(DEFAULT_SECTOR_MODULE_MM)
+    p = np.pi * module
+    margin = (1.25 + spec.spare_teeth + 2.5) * p + 5 * module
+    r_min = float(np.min(_Bare(law, a).radii(np.linspace(lo, hi, 257), "a")[0]))
+    grow = 1.3 * margin / max(r_min, 1e-6)
+    for _ in range(8):
+        try:
+            pitch = PitchCurves(law, a, (lo - grow, hi + grow), lo)
+        except SpecError as exc:
+            raise SpecError(f"gears.{name}.law", f"{exc.message} (the law is extended "
+                            f"{np.degrees(grow):.1f} deg beyond the working range for the spare teeth; "
+                            "widen the law's range or use fewer spare_teeth)") from exc
+        s_lo, s_hi = 0.0, float(pitch.s_of_x(np.array([hi]))[0])
+        if pitch.s_nodes[0] < s_lo - margin and pitch.s_nodes[-1] > s_hi + margin:
+            break
+        grow *= 1.5
+    reach = (1.25 + spec.spare_teeth) * p
+    _check_teeth(int((s_hi - s_lo + 2 * reach) / p), int((s_hi - s_lo + 2 * reach) / p), module, spec)
+    k_a = np.arange(np.ceil((s_lo - reach) / p), np.floor((s_hi + reach) / p) + 1)
+    k_b = np.arange(np.ceil((s_lo - reach) / p - 0.5), np.floor((s_hi + reach) / p - 0.5) + 1)
+    centres_a, centres_b = k_a * p, (k_b + 0.5) * p
+    s_ends = np.array([min(centres_a[0], centres_b[0]) - p, max(centres_a[-1], centres_b[-1]) + p])
+    x_ends = pitch.x_of_s(s_ends)
+    x_cover = np.linspace(x_ends[0], x_ends[1], 2049)
+    sweep_b = abs(float(law(x_ends[1]) - law(x_ends[0])))
+    if x_ends[1] - x_ends[0] >= TWO_PI or sweep_b >= TWO_PI:
+        raise SpecError(f"gears.{name}.closed", "the sector with its spare teeth spans a full turn; "
+                                                "use closed = true")
+    return _Layout(pitch, module, centres_a, centres_b, x_cover)
+
+
+def _cut_teeth(layout: _Layout, spec: GearSpec, closed: bool, chord_tolerance_mm: float) -> _Cut:
+    """Both gears cut by one rack with the backlash split between them, and their bores checked."""
+    module, pitch = layout.module, layout.pitch
+    p = np.pi * module
+    alpha = spec.pressure_angle
     delta = spec.backlash_mm * np.cos(alpha) / 4.0
     if spec.backlash_mm > 0.25 * p:
         raise SpecError("gears.backlash_mm", f"backlash {spec.backlash_mm:g} mm is too large for module "
@@ -358,24 +423,37 @@ def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tupl
     hub = spec.hub_diameter_mm if spec.hub_diameter_mm is not None else max(bore + 2.0, bore + 4 * module)
     common = dict(delta=delta, addendum_mm=spec.addendum * module, closed=closed, rack_origin=0.0,
                   hub_radius_mm=0.5 * hub, chord_tolerance_mm=chord_tolerance_mm)
-    cut_a = cut_gear(pitch, "a", rack, centres_a, method=spec.method, **common)
-    cut_b = cut_gear(pitch, "b", rack, centres_b, method=spec.method, **common)
+    cut_a = cut_gear(pitch, "a", rack, layout.centres_a, method=spec.method, **common)
+    cut_b = cut_gear(pitch, "b", rack, layout.centres_b, method=spec.method, **common)
     for gear, cut in (("a", cut_a), ("b", cut_b)):
         if cut.root_radius_min_mm <= 0.5 * bore:
             raise SpecError("gears.bore_mm", f"bore {bore:g} mm cuts into the root of gear {gear} (root radius "
                                              f"{cut.root_radius_min_mm:.3g} mm); use a smaller bore or module")
-    deviation = None
-    if spec.compare_methods:
-        other = "approx" if spec.method == "exact" else "exact"
-        dev = [_deviation_um(main, cut_gear(pitch, g, rack, c, method=other, decimate=False, **common))
-               for g, main, c in (("a", cut_a, centres_a), ("b", cut_b, centres_b))]
-        deviation = float(max(dev))
+    return _Cut(rack, bore, hub, common, cut_a, cut_b)
+
+
+def _method_deviation_um(layout: _Layout, spec: GearSpec, cut: _Cut) -> float | None:
+    """With ``compare_methods``: the largest distance (µm) of the other tooth method's outlines from these."""
+    if not spec.compare_methods:
+        return None
+    pitch, rack, common = layout.pitch, cut.rack, cut.common
+    centres_a, centres_b, cut_a, cut_b = layout.centres_a, layout.centres_b, cut.a, cut.b
+    other = "approx" if spec.method == "exact" else "exact"
+    dev = [_deviation_um(main, cut_gear(pitch, g, rack, c, method=other, decimate=False, **common))
+           for g, main, c in (("a", cut_a, centres_a), ("b", cut_b, centres_b))]
+    return float(max(dev))
+
+
+def _pair_checks(law: Callable, lo: float, hi: float, layout: _Layout, spec: GearSpec, curv: dict[str, Any],
+                 cut: _Cut, deviation: float | None) -> dict[str, Any]:
+    """The boolean-free checks over the working range (:attr:`GearPair.checks`)."""
+    module, pitch, cut_a, cut_b = layout.module, layout.pitch, cut.a, cut.b
     x_work = np.linspace(lo, hi, 721)
     ratio = -law(x_work, 1)
     limit = undercut_limit_mm(module, spec)
     rho_min = min(curv["min_radius_of_curvature_a_mm"], curv["min_radius_of_curvature_b_mm"])
     eps = local_contact_ratio(pitch, x_work, module, spec)
-    checks: dict[str, Any] = {
+    return {
         "transmission_ratio": _range(ratio),
         "pitch_radius_a_mm": _range(pitch.radii(x_work, "a")[0]),
         "pitch_radius_b_mm": _range(pitch.radii(x_work, "b")[0]),
@@ -389,19 +467,16 @@ def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tupl
         "tip_land_min_mm": float(min(cut_a.tip_land_min_mm, cut_b.tip_land_min_mm)),
         "exact_vs_approx_max_deviation_um": deviation,
     }
+
+
+def _pitch_outlines(layout: _Layout, lo: float, closed: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Both pitch curves as polylines, counter-clockwise like the outlines (a closed gear's whole turn)."""
+    pitch, x_cover, periods = layout.pitch, layout.x_cover, layout.periods
     pitch_a = pitch.curve(x_cover if not closed else np.linspace(lo, lo + TWO_PI, 721)[:-1], "a")
     pitch_b = pitch.curve(x_cover if not closed else np.linspace(lo, lo + periods[1], 721)[:-1], "b")
     if not closed:
         pitch_a, pitch_b = pitch_a[::-1].copy(), pitch_b  # CCW like the outlines
-    pair = GearPair(name=name, coupling=coupling or name, carrier=carrier, body_a=body_a, body_b=body_b,
-                    axis_a=axis_a, axis_b=axis_b, center_distance_mm=a, teeth=(int(z_a), int(z_b)),
-                    module=float(module), method=spec.method, closed=closed, working_range=(lo, hi), law=law,
-                    outline_a=cut_a.outline, outline_b=cut_b.outline, pitch_a=pitch_a, pitch_b=pitch_b,
-                    bore_a_mm=float(bore), bore_b_mm=float(bore), hub_diameter_mm=float(hub), spec=spec,
-                    pitch_model=pitch, cut_a=cut_a, cut_b=cut_b, rack_origin=0.0, checks=checks)
-    if run_mesh_check:
-        pair = replace(pair, mesh=mesh_check(pair))
-    return pair
+    return pitch_a, pitch_b
 
 
 class _Bare(PitchCurves):

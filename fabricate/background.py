@@ -1,0 +1,137 @@
+"""Jobs returning ``{relative path: bytes}`` run in a forked child while the build goes on (the pictures).
+
+The pipeline's pictures take as long as everything else, so :class:`Background` draws them on the second
+core; whatever happens to the child (no ``fork``, a daemon process, a crash, a kill), the caller gets the
+same bytes, computed here if need be.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import os
+from collections.abc import Callable
+from typing import Any
+
+
+def _run_jobs(jobs: list[Callable[[], dict[str, bytes]]]) -> dict[str, bytes]:
+    files: dict[str, bytes] = {}
+    for job in jobs:
+        files.update(job())
+    return files
+
+
+def _die_with_parent(parent: int) -> None:
+    """Make this forked child die with ``parent``, even when the parent is killed by SIGKILL.
+
+    On Linux the kernel sends SIGKILL when the parent goes (``PR_SET_PDEATHSIG``); the parent may have died
+    between the fork and this call, so the parent is looked at again after the signal is armed. The death
+    signal fires when the forking *thread* ends: :class:`Background` is collected or cancelled by the thread
+    that made it, which therefore outlives the child.
+    """
+    import signal
+    import sys
+
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        pr_set_pdeathsig = 1
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):  # no prctl in this libc: the getppid check below still holds
+            pass
+    if os.getppid() != parent:  # orphaned already: nobody will read the result
+        os._exit(1)
+
+
+def _detach_from_caller() -> None:
+    """Let the caller's signals kill the child at once, and give its stdout/stderr back.
+
+    The CLI's handlers (SIGTERM or SIGHUP raised as an exception) are copied by the fork; in the child the
+    default action is right, since it holds no file to clean up. A signal the caller ignores stays ignored.
+    The child's fds 1 and 2 go to /dev/null, so a caller reading this process's output to the end never
+    waits for the child, and the parent's unflushed buffers copied by the fork are not printed twice.
+    """
+    import signal
+
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        number = getattr(signal, name, None)
+        if number is not None and callable(signal.getsignal(number)):
+            signal.signal(number, signal.SIG_DFL)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        for fd in (1, 2):
+            os.dup2(devnull, fd)
+    finally:
+        os.close(devnull)
+
+
+def _child(jobs: list[Callable[[], dict[str, bytes]]], conn: Any, parent: int = 0, receiver: Any = None) -> None:
+    try:
+        if parent:
+            _die_with_parent(parent)
+        _detach_from_caller()
+        if receiver is not None:
+            # the fork copied the parent's end of the pipe: holding it, this child would block forever on a
+            # full pipe once the parent is gone, instead of failing with EPIPE
+            receiver.close()
+        conn.send((True, _run_jobs(jobs)))
+    except BaseException as exc:  # the parent redoes the work serially and raises there
+        with contextlib.suppress(BaseException):  # the parent may be gone: nothing is left to tell
+            conn.send((False, repr(exc)))
+    finally:
+        conn.close()
+
+
+class Background:
+    """Run jobs returning ``{path: bytes}`` in a forked child process while the caller goes on.
+
+    Where ``fork`` is unavailable, or ``FABRICATE_SERIAL`` is set, or this process is a daemon (a Dask
+    worker), or the child fails, the jobs run in the calling process when :meth:`result` is asked for, so
+    the outcome never depends on it. Call :meth:`cancel` in a ``finally``: the child is killed and reaped
+    however the caller ends; on Linux it also dies with its parent (a SIGKILL of the parent included) and
+    never holds the parent's stdout or stderr.
+    """
+
+    def __init__(self, jobs: list[Callable[[], dict[str, bytes]]]) -> None:
+        self.jobs = jobs
+        self._process = None
+        if os.environ.get("FABRICATE_SERIAL") or "fork" not in multiprocessing.get_all_start_methods():
+            return
+        if multiprocessing.current_process().daemon:  # e.g. a Dask worker: daemons may not have children
+            return
+        ctx = multiprocessing.get_context("fork")
+        self._conn, sender = ctx.Pipe(duplex=False)
+        self._process = ctx.Process(target=_child, args=(jobs, sender, os.getpid(), self._conn), daemon=True)
+        try:
+            self._process.start()
+        except OSError:  # no fork now (EAGAIN, ENOMEM): the jobs run here when asked for
+            self._process = None
+            self._conn.close()
+        finally:
+            sender.close()
+
+    def result(self) -> dict[str, bytes]:
+        if self._process is not None:
+            try:
+                ok, payload = self._conn.recv()
+            except Exception:  # noqa: BLE001 - EOF (the child died), a broken or unreadable pickle: redo it here
+                ok, payload = False, None
+            self._conn.close()
+            self._process.join()
+            self._process = None
+            if ok:
+                return payload
+        return _run_jobs(self.jobs)
+
+    def cancel(self) -> None:
+        """Kill the child if its result was never collected (the build failed or was interrupted).
+
+        SIGKILL, not SIGTERM: the child writes no file, so nothing is lost, and no handler it may have
+        inherited can delay it.
+        """
+        if self._process is not None:
+            self._process.kill()
+            self._process.join()
+            self._conn.close()
+            self._process = None
