@@ -20,11 +20,11 @@ from fabricate import __version__
 from fabricate.background import Background
 from fabricate.bounds import blas_threads
 from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
+from fabricate.kinds import KINDS
 from fabricate.mechanism import Mechanism, Motion
 from fabricate.report import SYNTH_ONLY, not_checked_notes, report_json, report_markdown
 from fabricate.report_schema import SCHEMA_VERSION
 from fabricate.spec import DesignSpec
-from fabricate.synthesis import KINDS
 from fabricate.synthesis.base import SynthesisResult
 
 if TYPE_CHECKING:

@@ -594,7 +594,8 @@ def _rebuild(folder: OutputFolder, report: Mapping[str, Any], raw: bytes, progre
              notes: list[str]) -> tuple[list[str], dict[str, Any] | None]:
     from fabricate.export.step import step_available
     from fabricate.pipeline import OptionalOutputs, run_build, run_synth
-    from fabricate.spec import ProcessOverride, design_from_text
+    from fabricate.process import ProcessOverride
+    from fabricate.spec import design_from_text
 
     text = report.get("template_text")
     design_info = report.get("design", {})

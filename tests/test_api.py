@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import fabricate
-from fabricate.spec import TEMPLATE_DIR, read_toml
+from fabricate.templates import TEMPLATE_DIR, read_toml
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 
@@ -65,7 +65,7 @@ def test_load_takes_a_dict_and_names_a_bad_field():
     design = fabricate.load(tables)
     assert design.name == "gear_pair_elliptic" and design.kind == "gear_pair"
     # the text it embeds reads back as the same tables
-    from fabricate.spec import parse_toml
+    from fabricate.templates import parse_toml
 
     assert parse_toml(design.template_text, "x") == tables
     tables["gears"]["module_mm"] = -1.0

@@ -22,7 +22,8 @@ from fabricate.cli import main
 from fabricate.output import write_output
 from fabricate.pipeline import run_build
 from fabricate.report_schema import SCHEMA_VERSION
-from fabricate.spec import TEMPLATE_DIR, load_design
+from fabricate.spec import load_design
+from fabricate.templates import TEMPLATE_DIR
 
 FAST = "gear_pair_elliptic"
 
@@ -626,7 +627,7 @@ def _quick_design(path: Path):
 def test_every_shipped_template_writes_a_report_that_matches_its_schema(monkeypatch):
     import fabricate.pipeline as pipeline
     from fabricate.report_schema import schema_errors
-    from fabricate.spec import shipped_templates
+    from fabricate.templates import shipped_templates
 
     class NoPictures:  # pictures and STEP files add files, not report keys: skip their time
         def __init__(self, _jobs):
