@@ -232,11 +232,11 @@ class Mechanism:
         """
         if inputs is None:
             inputs = 361
-        if np.isscalar(inputs):
+        if isinstance(inputs, (int, np.integer)):
             inputs = np.linspace(self.input_range[0], self.input_range[1], int(inputs))
         inputs = np.asarray(inputs, dtype=np.float64)
         # synthesis, parts and checks sweep the same motion: solve it once per mechanism object
-        cache = self.__dict__.setdefault("_sweep_cache", {})
+        cache: dict[bytes, Motion] = self.__dict__.setdefault("_sweep_cache", {})
         key = inputs.tobytes()
         if key in cache:
             return cache[key]
@@ -307,11 +307,13 @@ class Motion:
         body = body or self.mechanism.point_owner(name)
         local = self.mechanism.body(body).point(name)
         pose = self.pose(body)
-        return np.einsum("nij,j->ni", rotation(pose[:, 2]), local) + pose[:, :2]
+        world: np.ndarray = np.einsum("nij,j->ni", rotation(pose[:, 2]), local) + pose[:, :2]
+        return world
 
     def relative_angle(self, body: str, reference: str) -> np.ndarray:
         """theta_body - theta_reference over the sweep (n,), rad."""
-        return self.pose(body)[:, 2] - self.pose(reference)[:, 2]
+        angle: np.ndarray = self.pose(body)[:, 2] - self.pose(reference)[:, 2]
+        return angle
 
 
 class _System:
@@ -451,7 +453,7 @@ class _System:
                 angle_row(d.body, d.reference)
                 res.append(self._pose(q, d.body)[2] - self._pose(q, d.reference)[2] - value)
             else:
-                slider = next(j for j in self.mech.joints if j.name == d.joint)
+                slider = next(j for j in self.mech.joints if j.name == d.joint and isinstance(j, Slider))
                 projection(d.reference, d.body, self.bodies[d.reference].point(d.joint),
                            self.bodies[d.body].point(d.joint), np.asarray(slider.axis, dtype=np.float64))
                 res[-1] -= value
@@ -459,7 +461,7 @@ class _System:
         jac = np.array(rows).reshape(len(res), n)
         return np.asarray(res), jac, np.asarray(dres_ds)
 
-    def newton(self, q: np.ndarray, s: float, max_iter: int = 30):
+    def newton(self, q: np.ndarray, s: float, max_iter: int = 30) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
         """Gauss-Newton from ``q``.
 
         Returns
@@ -484,7 +486,7 @@ class _System:
         return q, bool(np.max(np.abs(res)) < tol), jac, ds
 
     def assemble(self, s: float) -> np.ndarray:
-        guess = []
+        guess: list[float] = []
         for name in self.free:
             if name not in self.mech.assembly:
                 raise SpecError(f"mechanism.assembly.{name}", "missing assembly guess for body")
@@ -542,6 +544,7 @@ class _System:
 def _solve_square(jac: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """Solve a square system; a singular Jacobian gives a non-finite step (treated as failure)."""
     try:
-        return np.linalg.solve(jac, rhs)
+        step: np.ndarray = np.linalg.solve(jac, rhs)
+        return step
     except np.linalg.LinAlgError:
         return np.full_like(rhs, np.nan)

@@ -112,7 +112,8 @@ def read_regular(path: Path, limit: int) -> bytes | None:
         st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode) or (st.st_dev, st.st_ino) != (before.st_dev, before.st_ino):
             return None
-        chunks, total = [], 0
+        chunks: list[bytes] = []
+        total = 0
         while total <= limit:  # bounded even if the file grows while it is read
             chunk = os.read(fd, min(1 << 20, limit + 1 - total))
             if not chunk:
@@ -337,7 +338,7 @@ def _locked(parent: Path, name: str) -> Iterator[_Lock]:
                 raise
             fd = None
         st = os.fstat(fd) if fd is not None else None
-        if st is None or not stat.S_ISREG(st.st_mode):
+        if fd is None or st is None or not stat.S_ISREG(st.st_mode):
             if fd is not None:
                 os.close(fd)
             raise _refuse(parent / name, f"its lock file {path} is not a plain file; fabricate makes it and "
@@ -425,7 +426,7 @@ def remove_leftovers(parent: Path, name: str, made: Mapping[str, Collection[Iden
             continue
         ident = (st.st_dev, st.st_ino)
         mine = parsed is not None and stat.S_ISDIR(st.st_mode) and (uid is None or st.st_uid == uid)
-        if mine and ident in idents:
+        if mine and parsed is not None and ident in idents:
             shutil.rmtree(path, ignore_errors=True)
             if _identity(path) == ident:
                 found.stuck.append(f"{parsed[1]} {ident[0]} {ident[1]}")

@@ -166,7 +166,7 @@ def planar_clearance(a: Outline, b: Outline, rel: RelativePoses, search_mm: floa
             d = _clipped_distance(a, polys[i], bb[i], search_mm)
         if d <= search_mm:
             out[i] = d
-        previous, previous_index = d, i
+        previous, previous_index = d, int(i)
     return out
 
 

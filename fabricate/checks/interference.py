@@ -33,6 +33,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -41,6 +42,10 @@ from fabricate.errors import GeometryError, SpecError
 from fabricate.mechanism import Motion
 from fabricate.parts.model import Part, circle_polygon
 from fabricate.planar import polygon_area
+
+if TYPE_CHECKING:
+    from fabricate.parts.bom import Pin, Spacer
+    from fabricate.parts.model import Hole
 
 #: Planar clearances beyond this (mm) are not resolved exactly (curves show a lower bound there).
 DEFAULT_SEARCH_MM = 2.0
@@ -84,7 +89,8 @@ class SweepItem:
     z1: float
     joints: frozenset[str]          # joints of its holes (parts) or its own joint (pins)
     gear: str = ""
-    source: object = field(default=None, compare=False, repr=False)
+    # what the item was made of, read by kind: the Part, the PinSolid or the parts layer's Spacer
+    source: Any = field(default=None, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -217,7 +223,7 @@ class InterferenceResult:
         ends = np.concatenate([idx[breaks], [idx[-1]]])
         return [(float(self.inputs[s]), float(self.inputs[e])) for s, e in zip(starts, ends, strict=True)]
 
-    def report(self) -> dict:
+    def report(self) -> dict[str, Any]:
         """The ``interference`` section of report.json (DESIGN.md keys plus extras)."""
         collisions = []
         for p in self.collisions:
@@ -240,7 +246,7 @@ class InterferenceResult:
             "pairs": [self.pair_row(p) for p in self.pairs],
         }
 
-    def pair_row(self, p: PairResult) -> dict:
+    def pair_row(self, p: PairResult) -> dict[str, Any]:
         """One row of the per-pair table."""
         return {
             "a": p.a, "b": p.b, "relation": p.relation,
@@ -274,7 +280,7 @@ def part_items(parts: Sequence[Part], chord_tolerance_mm: float) -> list[SweepIt
 def pins_from_holes(parts: Sequence[Part]) -> list[PinSolid]:
     """One pin per joint whose holes take a pin: through every part with that joint's hole, fixed in
     the body of the lowest of them, diameter the holes' nominal pin diameter."""
-    by_joint: dict[str, list[tuple[Part, object]]] = {}
+    by_joint: dict[str, list[tuple[Part, Hole]]] = {}
     for p in parts:
         for h in p.holes:
             if h.pin_diameter_mm > 0:
@@ -292,7 +298,7 @@ def pins_from_holes(parts: Sequence[Part]) -> list[PinSolid]:
     return pins
 
 
-def pins_from_parts_layer(pins: Sequence[object], parts: Sequence[Part]) -> list[PinSolid]:
+def pins_from_parts_layer(pins: Sequence[PinSolid | Pin], parts: Sequence[Part]) -> list[PinSolid]:
     """PinSolids from the parts layer's pins (``joint``, ``bodies``, ``diameter_mm``, ``length_mm``,
     ``z_mm``): each fixed in the first of its bodies, on the axis of that body's hole for the joint.
     Objects that already are :class:`PinSolid` pass through."""
@@ -327,12 +333,12 @@ def pin_items(pins: Sequence[PinSolid], chord_tolerance_mm: float) -> list[Sweep
             for p in pins]
 
 
-def spacer_items(spacers: Sequence[object], parts: Sequence[Part], chord_tolerance_mm: float) -> list[SweepItem]:
+def spacer_items(spacers: Sequence[Spacer], parts: Sequence[Part], chord_tolerance_mm: float) -> list[SweepItem]:
     """Tubes and washers of the parts layer (``joint``, ``body``, ``centre``, ``inner_diameter_mm``,
     ``outer_diameter_mm``, ``z_mm``, ``length_mm``) as rings; those already modelled as spacer parts
     (a part of role ``"spacer"`` on that body with a hole for the joint) are not repeated."""
     modelled = {(p.body, h.joint) for p in parts if p.role == "spacer" for h in p.holes}
-    out = []
+    out: list[SweepItem] = []
     for k, sp in enumerate(spacers):
         if (sp.body, sp.joint) in modelled or sp.length_mm <= 0.0:
             continue
@@ -383,8 +389,8 @@ def _outline(item: SweepItem) -> Outline:
 
 # -- the sweep -------------------------------------------------------------------------------------
 def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance_mm: float,
-                       min_clearance_mm: float, pins: Sequence[PinSolid] | None = None,
-                       spacers: Sequence[object] = (), search_length_mm: float | None = None,
+                       min_clearance_mm: float, pins: Sequence[PinSolid | Pin] | None = None,
+                       spacers: Sequence[Spacer] = (), search_length_mm: float | None = None,
                        use_kernel: bool = True) -> InterferenceResult:
     """Check every pair of parts and pins for collision and clearance at every pose of ``motion``.
 
@@ -569,8 +575,8 @@ def _shortcut(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, rel: Relativ
     return None
 
 
-def _posed_pair(a: SweepItem, b: SweepItem, pose_a: np.ndarray, pose_b: np.ndarray, cache: dict,
-                tol: float):
+def _posed_pair(a: SweepItem, b: SweepItem, pose_a: np.ndarray, pose_b: np.ndarray, cache: dict[str, Any],
+                tol: float) -> list[Any]:
     # manifold3d is imported here and in the parts adapter only (kernel isolation)
     from fabricate.parts.solids import extrude_polygons, posed
 
@@ -583,8 +589,8 @@ def _posed_pair(a: SweepItem, b: SweepItem, pose_a: np.ndarray, pose_b: np.ndarr
 
 
 def naive_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance_mm: float,
-                       pins: Sequence[PinSolid] | None = None,
-                       spacers: Sequence[object] = ()) -> dict[tuple[str, str], np.ndarray]:
+                       pins: Sequence[PinSolid | Pin] | None = None,
+                       spacers: Sequence[Spacer] = ()) -> dict[tuple[str, str], np.ndarray]:
     """Reference: the boolean intersection of every non-rigid pair at every pose (manifold3d only).
 
     Returns

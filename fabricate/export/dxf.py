@@ -221,9 +221,9 @@ def kinematic_dxf(mechanism: Any, poses: Mapping[str, np.ndarray]) -> bytes:
     sizes = {"dimtxt": text_h, "dimasz": text_h, "dimdec": 3, "dimlfac": 1.0, "dimexo": 0.5 * text_h,
              "dimexe": 0.5 * text_h, "dimgap": 0.3 * text_h, "dimtad": 1}
     doc.dimstyles.new(DIMSTYLE, dxfattribs=dict(sizes))  # ezdxf adds its name to the dict it is given
-    for key, value in sizes.items():
-        doc.header[f"${key.upper()}"] = value
-    drawn: set[tuple[str, str]] = set()
+    for variable, value in sizes.items():
+        doc.header[f"${variable.upper()}"] = value
+    drawn: set[tuple[str, ...]] = set()
     for body in mechanism.bodies:
         names = [n for n in body.points if n in joint_names] or list(body.points)
         for i, a in enumerate(names):

@@ -275,7 +275,7 @@ def _downcast(kind: str, shape: Any) -> Any:
     from OCP import TopoDS as topods_module
 
     caster = topods_module.TopoDS
-    return getattr(caster, kind, None)(shape) if hasattr(caster, kind) else getattr(caster, f"{kind}_s")(shape)
+    return getattr(caster, kind)(shape) if hasattr(caster, kind) else getattr(caster, f"{kind}_s")(shape)
 
 
 def _volume(shape: Any) -> float:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import io
 import zipfile
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import trimesh
@@ -152,8 +152,10 @@ def read_3mf(data: bytes) -> tuple[dict[str, trimesh.Trimesh], list[str]]:
     for obj in model.iter(f"{ns}object"):
         name = obj.get("name") or f"object {obj.get('id')}"
         try:
-            vertices = np.array([[float(v.get(k)) for k in "xyz"] for v in obj.iter(f"{ns}vertex")])
-            faces = np.array([[int(t.get(k)) for k in ("v1", "v2", "v3")] for t in obj.iter(f"{ns}triangle")])
+            # a missing attribute is None: float(None) raises the TypeError reported below
+            vertices = np.array([[float(cast(str, v.get(k))) for k in "xyz"] for v in obj.iter(f"{ns}vertex")])
+            faces = np.array([[int(cast(str, t.get(k))) for k in ("v1", "v2", "v3")]
+                              for t in obj.iter(f"{ns}triangle")])
         except (TypeError, ValueError) as exc:
             problems.append(f"object {name}: unreadable mesh ({exc})")
             continue

@@ -180,7 +180,7 @@ def cut_section(rings: list[np.ndarray] | shapely.Polygon, point: np.ndarray, di
                    centroid_mm=p0 + centroid_s * u)
 
 
-def side_of_cut(points: np.ndarray, point: np.ndarray, direction: np.ndarray) -> np.ndarray:
+def side_of_cut(points: np.ndarray, point: np.ndarray, direction: np.ndarray) -> np.ndarray | float:
     """Signed distances of points from the cut line, positive on the left of ``direction``.
 
     Parameters

@@ -184,7 +184,7 @@ def _value_at_crossing(tab: _PathTable, i: np.ndarray, e0: np.ndarray, e1: np.nd
     return np.where(ok, dn, np.nan)
 
 
-def _excess(tab: _PathTable, j: int | np.ndarray, k1: np.ndarray, k2: np.ndarray, phi01: np.ndarray,
+def _excess(tab: _PathTable, j: int | np.ndarray | slice, k1: np.ndarray, k2: np.ndarray, phi01: np.ndarray,
             phi02: np.ndarray) -> np.ndarray:
     """N*pi/180 - target at sample(s) j: >= 0 once the hover force has reached F_n2."""
     n1 = k2 * (tab.phi2[j] + phi02) * tab.h1[j] - k1 * (tab.phi1[j] + phi01) * tab.h2[j]
@@ -228,9 +228,9 @@ def brute_force(geom: GripperGeometry, grid: ParameterGrid, load: Load, samples:
     Only for small grids (tests): the work is grid.size x samples."""
     out = np.full([len(a) for a in (grid.alpha, grid.c, grid.k1, grid.k2, grid.phi01, grid.phi02)], np.nan)
     mesh = np.meshgrid(grid.k1, grid.k2, grid.phi01, grid.phi02, indexing="ij")
-    flat = [m.ravel() for m in mesh]
+    k1, k2, phi01, phi02 = (m.ravel() for m in mesh)
     for ia, ic, tab in build_tables(geom, grid, load, samples, hinge_margin):
-        out[ia, ic] = evaluate_points(tab, *flat, load, hinge_margin).reshape(mesh[0].shape)
+        out[ia, ic] = evaluate_points(tab, k1, k2, phi01, phi02, load, hinge_margin).reshape(mesh[0].shape)
     return out
 
 

@@ -134,7 +134,7 @@ def rest_drive_depth(geom: GripperGeometry) -> float:
     return float(_rod_top(geom, E)[1][1])
 
 
-def finger_state(geom: GripperGeometry, phi1: np.ndarray, phi2: np.ndarray,
+def finger_state(geom: GripperGeometry, phi1: np.ndarray | float, phi2: np.ndarray | float,
                  can_radius: float | None = None) -> FingerState:
     """Positions, angles and moment arms of eqs 1-10 at configurations (phi1, phi2) (rad, any shape)."""
     phi1 = np.asarray(phi1, dtype=np.float64)
@@ -162,7 +162,8 @@ def finger_state(geom: GripperGeometry, phi1: np.ndarray, phi2: np.ndarray,
                        contact_radius, stroke)
 
 
-def spring_torques(springs: Springs, phi1: np.ndarray, phi2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def spring_torques(springs: Springs, phi1: np.ndarray | float,
+                   phi2: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
     """Left sides of eqs 1-6: ``k * 180/pi * (phi + phi0)`` at hinges C and B (N·mm)."""
     s1 = springs.k1 * DEG_PER_RAD * (np.asarray(phi1) + springs.phi01)
     s2 = springs.k2 * DEG_PER_RAD * (np.asarray(phi2) + springs.phi02)
@@ -191,7 +192,7 @@ def delta_n_factor(state: FingerState, mu: float) -> np.ndarray:
         return mu * (state.d12 * state.h2 - state.d22 * state.h1) / den_s
 
 
-def phi1_on_can(geom: GripperGeometry, phi2: np.ndarray, can_radius: float) -> np.ndarray:
+def phi1_on_can(geom: GripperGeometry, phi2: np.ndarray | float, can_radius: float) -> np.ndarray:
     """phi1 that puts the pad on the can for each phi2 (eq 7 solved in closed form), NaN if none.
 
     Eq 7 reads ``(b + a3) cos t3 + r sin t3 = W``; with rho = hypot(b + a3, r), psi = atan2(r, b + a3)

@@ -133,6 +133,7 @@ def _evaluate(spec: FiveBarSpec, targets: FingerTargets, p: np.ndarray, kappa: f
         return status, None
     a_prox, b_dist = one.family.centre[0], one.family.point[0]
     _, law = gear_check(spec, targets, a_prox, b_dist)
+    assert law is not None  # hinge_domain's status 0 includes the gear check
     return 0, SelectedDyad(p=p, kappa=kappa, a_proximal=a_prox, b_distal=b_dist, law=law,
                            length_error=float(one.length_error[0]))
 
@@ -155,6 +156,7 @@ def select_dyad(spec: FiveBarSpec, targets: FingerTargets, domain: HingeDomain, 
         return float(targets.proximal_to_world(km.dyad_from_vector(p)[0])[0, 0])
 
     if spec.select == "x_A":
+        assert spec.x_A_mm is not None  # the parser requires it for this rule
         goal = float(spec.x_A_mm)
         found: list[SelectedDyad] = []
         for j in feasible:

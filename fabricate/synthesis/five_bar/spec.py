@@ -109,9 +109,9 @@ def parse_spec(root: Table) -> FiveBarSpec:
                         "the proximal angle (first column) must change strictly monotonically over the poses")
     syn = root.table("synthesis")
     spec = FiveBarSpec(
-        lengths_mm=tuple(float(v) for v in lengths),
-        origin_mm=tuple(float(v) for v in origin),
-        poses_deg=tuple(tuple(float(v) for v in row) for row in poses),
+        lengths_mm=(float(lengths[0]), float(lengths[1]), float(lengths[2])),
+        origin_mm=(float(origin[0]), float(origin[1])),
+        poses_deg=tuple((float(row[0]), float(row[1]), float(row[2])) for row in poses),
         pad_radius_mm=pad,
         kappa_samples=syn.integer("kappa_samples", 2001, min=50, max=MAX_KAPPA_SAMPLES),
         curve_step_mm=syn.number("curve_step_mm", 0.25, min=MIN_CURVE_STEP_MM, max=MAX_LENGTH_MM),

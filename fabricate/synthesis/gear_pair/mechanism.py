@@ -21,11 +21,13 @@ PAIR_NAME = "pair"
 def make_law(spec: GearPairSpec) -> tuple[Callable, str]:
     """The coupling law (external pair: negative slope) and a description of it."""
     if spec.family == "elliptic":
+        assert spec.eccentricity is not None  # the parser reads it for this family
         text = elliptic_formula(spec.eccentricity)
         return FormulaLaw(text, sign=-1.0, path="gear_pair.family"), f"elliptic e = {spec.eccentricity:g}: {text}"
     if spec.family == "samples":
         arr = np.radians(np.asarray(spec.samples_deg))
         return samples_law(arr[:, 0], -arr[:, 1], "gear_pair.law_samples_deg"), "cubic spline through samples"
+    assert spec.formula is not None  # the parser reads it for this family
     return FormulaLaw(spec.formula, sign=-1.0, path="gear_pair.law"), spec.formula
 
 
@@ -55,5 +57,5 @@ def build_mechanism(name: str, spec: GearPairSpec, law: Callable, a: float) -> M
     return Mechanism(name=name, bodies=(carrier, gear_a, gear_b), ground="carrier",
                      joints=(Revolute("OA", "carrier", "gear_a"), Revolute("OB", "carrier", "gear_b")),
                      gears=(coupling,), drivers=(Driver("angle", "gear_a", "carrier"),),
-                     input_range=tuple(spec.working_range_deg), input_unit="deg",
+                     input_range=(spec.working_range_deg[0], spec.working_range_deg[1]), input_unit="deg",
                      assembly={"gear_a": (0.0, 0.0, lo), "gear_b": (a, 0.0, float(law(lo)))})

@@ -90,7 +90,7 @@ def exact_linkage(mechanism: Mechanism, hints: Mapping[str, Any]) -> tuple[dict[
         joints.append(entry)
     gears = []
     for g in mechanism.gears:
-        law, ok = law_table(g.law, tuple(g.working_range) if g.working_range[1] != g.working_range[0]
+        law, ok = law_table(g.law, g.working_range if g.working_range[1] != g.working_range[0]
                             else (-math.pi, math.pi))
         exact &= ok
         gears.append({"name": g.name, "carrier": g.carrier, "bodies": [g.gear_a, g.gear_b],

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -46,6 +46,8 @@ class PeriodicTableLaw:
     x: tuple[float, ...]
     y: tuple[float, ...]
     sign: float = -1.0
+    _slope: float = field(init=False, repr=False, compare=False)
+    _spline: CubicSpline = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         x, y = np.asarray(self.x), np.asarray(self.y)
@@ -67,13 +69,18 @@ class PeriodicTableLaw:
 
 def gear_law(g: LinkageGearSpec, path: str) -> tuple[Callable, str]:
     """The coupling law ``x_b = law(x_a)`` (rad; an external pair: negative slope) and its description."""
+    # the parser sets the fields of the law it read (and only those)
     if g.law == "constant":
+        assert g.ratio is not None
         return LinearLaw(slope=-float(g.ratio)), f"constant ratio {g.ratio:g}"
     if g.law == "elliptic":
+        assert g.eccentricity is not None
         text = elliptic_formula(g.eccentricity)
         return FormulaLaw(text, sign=-1.0, path=f"{path}.eccentricity"), f"elliptic e = {g.eccentricity:g}: {text}"
     if g.law == "expression":
+        assert g.expression is not None
         return FormulaLaw(g.expression, sign=-1.0, path=f"{path}.expression"), g.expression
+    assert g.x_deg is not None and g.y_deg is not None and g.spline is not None
     x, y = np.radians(g.x_deg), np.radians(g.y_deg)
     if g.spline == "periodic":
         return PeriodicTableLaw(tuple(x), tuple(y)), f"periodic cubic spline through {len(x)} samples"
@@ -114,6 +121,7 @@ def _driver_law(d: DriverSpec, joint: JointSpec, at_reference: float) -> Callabl
     if d.law == "linear":
         slope = math.pi / 180.0 if joint.type == "revolute" else 1.0
         return LinearLaw(slope=slope, offset=at_reference - slope * d.reference)
+    assert d.input is not None and d.value is not None and d.spline is not None  # a sampled law's table
     value = np.radians(d.value) if joint.type == "revolute" else np.asarray(d.value)
     return sampled_law(d.input, tuple(value + at_reference), d.spline)
 
@@ -196,6 +204,7 @@ def build_mechanism(name: str, spec: LinkageSpec) -> LinkageMechanism:
         if j.type == "revolute":
             joints.append(Revolute(j.name, j.bodies[0], j.bodies[1]))
         else:  # both frames are the world's at the reference pose: the relative angle is locked at 0
+            assert j.axis is not None  # the parser requires a slider's axis
             joints.append(Slider(j.name, j.bodies[0], j.bodies[1], axis=j.axis, angle=0.0))
     gears = []
     for k, g in enumerate(spec.gears):
@@ -210,6 +219,7 @@ def build_mechanism(name: str, spec: LinkageSpec) -> LinkageMechanism:
         j = joints_by_name[d.joint]
         offset = 0.0
         if j.type == "slider":
+            assert j.axis is not None
             pa, pb = (np.asarray(dict(b.points)[j.name]) for b in (bodies_spec[j.bodies[0]], bodies_spec[j.bodies[1]]))
             offset = float(np.dot(pb - pa, j.axis))
         law = _driver_law(d, j, offset)
@@ -217,8 +227,9 @@ def build_mechanism(name: str, spec: LinkageSpec) -> LinkageMechanism:
         drivers.append(Driver(kind, body=j.bodies[1], reference=j.bodies[0], joint=j.name if kind == "slide" else "",
                               law=law))
     zero = {b.name: (0.0, 0.0, 0.0) for b in spec.bodies if b.name != spec.ground}
-    common = dict(name=name, bodies=bodies, ground=spec.ground, joints=tuple(joints), gears=tuple(gears),
-                  drivers=tuple(drivers), input_unit=spec.input_unit, driven=tuple(d.joint for d in spec.drivers))
+    common: dict[str, Any] = dict(name=name, bodies=bodies, ground=spec.ground, joints=tuple(joints),
+                                  gears=tuple(gears), drivers=tuple(drivers), input_unit=spec.input_unit,
+                                  driven=tuple(d.joint for d in spec.drivers))
     start, reference = spec.input_range[0], spec.reference
     if reference == start:
         return LinkageMechanism(input_range=spec.input_range, assembly=zero, **common)
@@ -231,5 +242,8 @@ def build_mechanism(name: str, spec: LinkageSpec) -> LinkageMechanism:
                                                    f"{reference:g}) to the start of the range: "
                                                    f"{str(exc).rsplit(' (at input', 1)[0]}")
         return LinkageMechanism(input_range=spec.input_range, assembly=zero, unreachable=unreachable, **common)
-    assembly = {b: tuple(float(v) for v in motion.pose(b)[-1]) for b in zero}
+    assembly: dict[str, tuple[float, float, float]] = {}
+    for b in zero:
+        x, y, theta = (float(v) for v in motion.pose(b)[-1])
+        assembly[b] = (x, y, theta)
     return LinkageMechanism(input_range=spec.input_range, assembly=assembly, **common)

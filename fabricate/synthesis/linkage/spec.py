@@ -344,6 +344,7 @@ def _check_reference_pose(spec: LinkageSpec) -> None:
             gap = float(np.hypot(*(pb - pa)))
             what = "apart"
         else:  # off the slide line through a's point
+            assert j.axis is not None  # the parser requires a slider's axis
             normal = np.array([-j.axis[1], j.axis[0]])
             gap = abs(float(np.dot(pb - pa, normal)))
             what = "off the slide line"
@@ -361,6 +362,7 @@ def _check_reference_pose(spec: LinkageSpec) -> None:
                                                    "gears are at 0 (shift the law so that y(0) = 0)")
     for k, d in enumerate(spec.drivers):
         if d.law == "table":
+            assert d.input is not None and d.value is not None and d.spline is not None  # the parser read the table
             if not d.input[0] <= d.reference <= d.input[-1]:
                 raise SpecError(f"linkage.drivers[{k}].input", f"joint \"{d.joint}\": the table does not reach the "
                                                                f"reference input {d.reference:g}")

@@ -88,6 +88,7 @@ def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: i
                 events.append(s_new)
             if with_object:
                 pose = finger_pose(d, q)
+                assert pose is not None  # the settler only accepts poses that close
                 touch = face_clearance(d, pose, spec.cylinder_centre, spec.cylinder_radius)[0] < 1e-4
                 touch[:frozen] = True
                 hit = np.nonzero(touch)[0]
@@ -123,6 +124,7 @@ def final_contact_forces(spec: UnderactuatedSpec, motion: ClosingMotion) -> dict
     """Contact forces (N) at the end of the closing for the template's push force."""
     d = spec.design
     pose = finger_pose(d, motion.q[-1])
+    assert pose is not None  # the closing motion only holds poses that close
     _, points = face_clearance(d, pose, spec.cylinder_centre, spec.cylinder_radius)
     torque = spec.spring_rates * (motion.q[-1] + spec.spring_preloads)
     forces, links = contact_forces(d, pose, spec.push_force, torque, points)

@@ -18,6 +18,7 @@ def build_mechanism(spec: UnderactuatedSpec, motion: ClosingMotion, name: str) -
     d = spec.design
     n = d.n
     open_pose = finger_pose(d, np.zeros(n))
+    assert open_pose is not None  # assembled by construction: FingerDesign takes the couplers from it
     g = open_pose.G
     bodies = []
     palm = {"G1": (0.0, 0.0), "G1r": (0.0, 0.0), "rod": (float(open_pose.S[0]) - 10.0, d.rod_y)}

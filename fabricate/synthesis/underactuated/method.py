@@ -28,6 +28,7 @@ def synthesise(design) -> SynthesisResult:
     mech = build_mechanism(spec, motion, design.name)
     pose_end = final["pose"]
     open_pose = finger_pose(d, np.zeros(d.n))
+    assert open_pose is not None  # assembled by construction: FingerDesign takes the couplers from it
     report = {
         "mobility": {**mobility(d.n), "mechanism_dof": mech.degrees_of_freedom()},
         "phalanx_lengths_mm": d.lengths.tolist(),

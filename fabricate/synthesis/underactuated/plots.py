@@ -23,6 +23,7 @@ def closing_figures(spec, motion, free, final) -> dict[str, bytes]:
     ax.add_patch(plt.Circle(spec.cylinder_centre, spec.cylinder_radius, color="0.85"))
     for k in np.linspace(0, len(motion.strokes) - 1, 5).astype(int):
         pose = finger_pose(d, motion.q[k])
+        assert pose is not None  # the closing motion only holds poses that close
         ax.plot(pose.G[:, 0], pose.G[:, 1], "-o", ms=3, lw=2, color=f"C{k % 10}")
         for i in range(d.n - 1):
             ax.plot([pose.G[i, 0], pose.Q[i, 0], pose.P[i, 0]], [pose.G[i, 1], pose.Q[i, 1], pose.P[i, 1]],

@@ -167,9 +167,9 @@ class Settler:
                 held = [i for i in lower | upper if ds[i] > 0.0]
                 if not held:
                     break
-                release = min(held, key=lambda i: self.rates[i] * (x[i] + self.preloads[i]) / ds[i])
-                lower.discard(release)
-                upper.discard(release)
+                yielding = min(held, key=lambda i: self.rates[i] * (x[i] + self.preloads[i]) / ds[i])
+                lower.discard(yielding)
+                upper.discard(yielding)
                 continue
             x[list(lower)] = 0.0
             x[list(upper)] = _UPPER_STOP
@@ -200,7 +200,8 @@ class Settler:
             for mu, j in zip(mult[1:], cs, strict=True):
                 residual = residual - mu * ev["dgaps"][0, j]
             scale = 1e-9 * float(np.max(self.rates) + 1.0)
-            worst, release = -scale, None
+            worst = -scale
+            release: tuple[str, int] | None = None
             for i in lower:
                 if residual[i] < worst:
                     worst, release = residual[i], ("lower", i)

@@ -4,6 +4,8 @@ distal, coupler, rocker; one angle driver proximal vs ground in degrees), and it
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute
@@ -63,21 +65,23 @@ def _load_on_distal(mech: Mechanism, poses: dict[str, np.ndarray], force: float)
     return 0.5 * (e + c), force * n
 
 
-def virtual_work_check(mech: Mechanism, theta_deg: np.ndarray, force: float) -> dict[str, float]:
+def virtual_work_check(mech: Mechanism, theta_deg: np.ndarray, force: float) -> dict[str, Any]:
     """K and the input torque by the generic solver + constraint multipliers + virtual power."""
     from fabricate.synthesis.watt_six_bar.statics import virtual_work_torque
 
     motion = mech.sweep(theta_deg)
-    k_max, torques, power_torques = 0.0, [], []
+    k_max = 0.0
+    torque_rows: list[float] = []
+    power_torques: list[float] = []
     local_mid = 0.5 * (mech.body("distal").point("e") + mech.body("distal").point("c"))
     for i in range(len(theta_deg)):
         poses = motion.poses_at(i)
         point, load = _load_on_distal(mech, poses, force)
         forces, torque = lagrange_joint_forces(mech, poses, point, load)
         k_max = max(k_max, max(forces[j] for j in JOINTS) / force)
-        torques.append(torque)
+        torque_rows.append(torque)
         power_torques.append(virtual_work_torque(mech, motion, local_mid, "distal",
                                                  lambda p: _load_on_distal(mech, p, force), i))
-    torques = np.asarray(torques)
+    torques = np.asarray(torque_rows)
     power = np.asarray(power_torques)
     return {"K": float(k_max), "torque_Nmm": torques, "torque_virtual_power_Nmm": power}

@@ -240,8 +240,9 @@ def select_point(region: SolutionRegion, rule: str, target: tuple[float, float] 
     if not len(idx):
         return -1
     if rule == "least_k":
-        key = (region.K[idx],)
+        key: tuple[np.ndarray, ...] = (region.K[idx],)
     else:
+        assert target is not None, "rule 'nearest' needs a target"
         dist = np.hypot(region.d[idx, 0] - target[0], region.d0[idx, 0] - target[1])
         # the region plane repeats (d_x, d0_x) across branches: round to break ties by K
         key = (region.K[idx], np.round(dist, 9))

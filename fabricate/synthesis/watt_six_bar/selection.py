@@ -66,6 +66,7 @@ def choose(spec: WattSixBarSpec, region: SolutionRegion, refined: RefinedCandida
     if spec.rule == "least_k":
         order = np.lexsort((~exact[pick], k[pick]))
     else:
+        assert spec.target is not None  # the parser requires it for rule "nearest"
         dist = np.round(np.hypot(d[pick, 0] - spec.target[0], d0[pick, 0] - spec.target[1]), 6)
         order = np.lexsort((k[pick], ~exact[pick], dist))
     j = int(pick[order[0]])
@@ -91,6 +92,7 @@ def refine_candidates(spec: WattSixBarSpec, region: SolutionRegion, finger: Fing
     """
     usable = np.flatnonzero(np.isfinite(region.K) & ~region.passes)
     if spec.rule == "nearest":
+        assert spec.target is not None  # the parser requires it for this rule
         key = np.hypot(region.d[usable, 0] - spec.target[0], region.d0[usable, 0] - spec.target[1])
     else:
         key = region.K[usable]
@@ -123,6 +125,7 @@ def refine_candidates(spec: WattSixBarSpec, region: SolutionRegion, finger: Fing
     anchor = start.copy()
     pull = np.full(8, 0.002)
     if spec.rule == "nearest":
+        assert spec.target is not None  # the parser requires it for this rule
         anchor[:, 0], anchor[:, 6] = spec.target
         pull[[0, 6]] = 0.05
     second = refine_region(start, first.seed[ok], *args, iterations=100, pull=pull, anchor=anchor)

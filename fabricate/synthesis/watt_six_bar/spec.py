@@ -88,7 +88,7 @@ def parse_spec(root: Table) -> WattSixBarSpec:
         box = boxes_t.array(name, shape=(4,), min=-MAX_LENGTH_MM, max=MAX_LENGTH_MM)
         if not (box[0] < box[1] and box[2] < box[3]):
             raise SpecError(boxes_t.field(name), "expected [x_min, x_max, y_min, y_max] with min < max")
-        boxes.append((name, tuple(float(v) for v in box)))
+        boxes.append((name, (float(box[0]), float(box[1]), float(box[2]), float(box[3]))))
     boxes_t.finish()
 
     region = root.table("region", {})
@@ -101,8 +101,8 @@ def parse_spec(root: Table) -> WattSixBarSpec:
     region.finish()
     box_d = dict(boxes)["d"]
     box_d0 = dict(boxes)["d0"]
-    for name, box in (("d", box_d), ("d0", box_d0)):
-        if (box[1] - box[0]) / step > MAX_REGION_SAMPLES:
+    for name, extent in (("d", box_d), ("d0", box_d0)):
+        if (extent[1] - extent[0]) / step > MAX_REGION_SAMPLES:
             raise SpecError(region.field("step_mm"),
                             f"step too fine for the {name} box (over {MAX_REGION_SAMPLES} samples)")
 
@@ -134,7 +134,7 @@ def parse_spec(root: Table) -> WattSixBarSpec:
         ref.finish()
 
     return WattSixBarSpec(
-        phalanx_lengths_mm=tuple(float(v) for v in lengths),
+        phalanx_lengths_mm=(float(lengths[0]), float(lengths[1]), float(lengths[2])),
         angles_deg=tuple(tuple(float(v) for v in row) for row in angles),
         boxes=tuple(boxes), tip_pad_radius_mm=pad, step_mm=step, k_max=k_max, force_N=force,
         statics_samples=samples, tip_tolerance_mm=tol, min_pin_to_middle_mm=clearance, rule=rule, target=target,
