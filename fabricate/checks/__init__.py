@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -26,6 +26,11 @@ from fabricate.checks.gear_mesh import GearMeshResult, check_gear_mesh, check_ge
 from fabricate.checks.interference import DEFAULT_SEARCH_MM, InterferenceResult, sweep_interference
 from fabricate.checks.printability import PrintabilityResult, check_printability
 from fabricate.mechanism import Mechanism, Motion
+
+if TYPE_CHECKING:
+    from fabricate.gears.pair import GearPair
+    from fabricate.parts.build import PartSet
+    from fabricate.spec import DesignSpec
 
 __all__ = ["CheckReport", "run_checks", "sweep_interference", "check_gear_mesh", "check_printability"]
 
@@ -97,8 +102,8 @@ class CheckReport:
         return "\n".join(lines)
 
 
-def run_checks(design: Any, partset: Any, mechanism: Mechanism, motion: Motion,
-               gear_pairs: Sequence[Any]) -> CheckReport:
+def run_checks(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motion: Motion,
+               gear_pairs: Sequence[GearPair]) -> CheckReport:
     """Run every check of a build.
 
     Parameters

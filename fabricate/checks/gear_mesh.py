@@ -10,11 +10,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from fabricate.mechanism import Motion
+
+if TYPE_CHECKING:
+    from fabricate.gears.pair import GearPair
 
 #: The assembly must follow the pair's law to this (rad): the solver's tolerance, with margin.
 LAW_TOLERANCE_RAD = 1e-6
@@ -89,7 +92,7 @@ class GearMeshResult:
         }
 
 
-def check_gear_mesh(pair: Any, motion: Motion) -> GearMeshResult:
+def check_gear_mesh(pair: GearPair, motion: Motion) -> GearMeshResult:
     """Run the pair's mesh check at the assembly's relative angles and judge it.
 
     Parameters
@@ -151,6 +154,6 @@ def check_gear_mesh(pair: Any, motion: Motion) -> GearMeshResult:
         failures=tuple(failures))
 
 
-def check_gear_meshes(gear_pairs: Sequence[Any], motion: Motion) -> list[GearMeshResult]:
+def check_gear_meshes(gear_pairs: Sequence[GearPair], motion: Motion) -> list[GearMeshResult]:
     """:func:`check_gear_mesh` for every pair."""
     return [check_gear_mesh(pair, motion) for pair in gear_pairs]

@@ -26,13 +26,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
 
 from fabricate.parts.model import Part
 from fabricate.process import ProcessSpec
+
+if TYPE_CHECKING:
+    from fabricate.gears.pair import GearPair
+    from fabricate.parts.bom import Pin
 
 
 @dataclass(frozen=True)
@@ -133,8 +137,8 @@ def footprint(part: Part, chord_tolerance_mm: float) -> tuple[float, float]:
     return float(max(sides[0], sides[1])), float(min(sides[0], sides[1]))
 
 
-def check_printability(parts: Sequence[Part], process: ProcessSpec, gear_pairs: Sequence[Any] = (),
-                       pins: Sequence[Any] = ()) -> PrintabilityResult:
+def check_printability(parts: Sequence[Part], process: ProcessSpec, gear_pairs: Sequence[GearPair] = (),
+                       pins: Sequence[Pin] = ()) -> PrintabilityResult:
     """Judge every part, gear pair and pin against the process profile.
 
     Parameters

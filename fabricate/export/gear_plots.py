@@ -7,11 +7,14 @@ Gears are drawn in the carrier frame: axis A at the origin, axis B at ``(a, 0)``
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from fabricate.plotting import figure, gif_bytes, png_bytes
+
+if TYPE_CHECKING:
+    from fabricate.gears.pair import GearPair
 
 
 def _figure(size: tuple[float, float] = (6.0, 4.0), dpi: int = 100) -> tuple[Any, Any]:
@@ -19,7 +22,7 @@ def _figure(size: tuple[float, float] = (6.0, 4.0), dpi: int = 100) -> tuple[Any
     return fig, fig.add_subplot(1, 1, 1)
 
 
-def _placed(pair: Any, x_a: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _placed(pair: GearPair, x_a: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Outlines and pitch curves of both gears at driving angle ``x_a`` in the carrier frame."""
     from fabricate.planar import rotation
 
@@ -30,7 +33,7 @@ def _placed(pair: Any, x_a: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, 
             pair.pitch_a @ ra.T, pair.pitch_b @ rb.T + centre_b)
 
 
-def _draw_pair(ax: Any, pair: Any, x_a: float, zoom: bool) -> None:
+def _draw_pair(ax: Any, pair: GearPair, x_a: float, zoom: bool) -> None:
     out_a, out_b, pitch_a, pitch_b = _placed(pair, x_a)
     ax.fill(out_a[:, 0], out_a[:, 1], color="#4c72b0", alpha=0.55, lw=0.6, ec="#1f3b63")
     ax.fill(out_b[:, 0], out_b[:, 1], color="#dd8452", alpha=0.55, lw=0.6, ec="#7a3d17")
@@ -48,7 +51,7 @@ def _draw_pair(ax: Any, pair: Any, x_a: float, zoom: bool) -> None:
         ax.set_ylim(-0.45 * w, 0.45 * w)
 
 
-def pair_png(pair: Any, x_a: float) -> bytes:
+def pair_png(pair: GearPair, x_a: float) -> bytes:
     """The pair in mesh at driving angle ``x_a`` (rad): whole pair and a zoom on the pitch point."""
     fig = figure((10.0, 4.6), 110)
     ax1, ax2 = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
@@ -68,7 +71,7 @@ def pair_png(pair: Any, x_a: float) -> bytes:
     return png_bytes(fig)
 
 
-def pair_gif(pair: Any, frames: int, size_px: int = 384, frame_ms: int = 80) -> bytes:
+def pair_gif(pair: GearPair, frames: int, size_px: int = 384, frame_ms: int = 80) -> bytes:
     """The pair turning through its working range, ``frames`` frames, as an animated GIF.
 
     Drawn with Pillow on a fixed palette (no per-frame quantising): fast and deterministic. The

@@ -7,14 +7,18 @@ colour, holes as background discs.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from fabricate.parts.model import Part, circle_polygon
 from fabricate.planar import transform_points
 from fabricate.plotting import gif_bytes, png_bytes, pyplot
+
+if TYPE_CHECKING:
+    from fabricate.mechanism import Motion
+    from fabricate.parts.assembly import PinStack
 
 #: Layer colours (RGB 0-255), cycled.
 PALETTE = [(31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189),
@@ -57,7 +61,7 @@ def _shapes(parts: Sequence[Part]) -> list[tuple[Part, np.ndarray, list[tuple[np
              + [(s.vertices.mean(axis=0), 0.0) for s in getattr(p, "slots", ())]) for p in ordered]
 
 
-def _extent(shapes: list, motion: Any, indices: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
+def _extent(shapes: list[Any], motion: Motion, indices: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
     pts = []
     for i in indices:
         poses = motion.poses_at(i)
@@ -69,7 +73,7 @@ def _extent(shapes: list, motion: Any, indices: Sequence[int]) -> tuple[np.ndarr
     return lo - pad, hi + pad
 
 
-def assembly_png(parts: Sequence[Part], motion: Any, poses: int = 4, tip_point: str | None = None,
+def assembly_png(parts: Sequence[Part], motion: Motion, poses: int = 4, tip_point: str | None = None,
                  title: str = "") -> bytes:
     """PNG of the assembly at ``poses`` poses spread over the motion, one panel each.
 
@@ -134,7 +138,7 @@ def assembly_png(parts: Sequence[Part], motion: Any, poses: int = 4, tip_point: 
     return png_bytes(fig, 100)
 
 
-def motion_gif(parts: Sequence[Part], motion: Any, frames: int = 24, size_px: int = 360,
+def motion_gif(parts: Sequence[Part], motion: Motion, frames: int = 24, size_px: int = 360,
                frame_ms: int = 80) -> bytes:
     """Animated GIF of the motion there and back, drawn with Pillow.
 
@@ -189,7 +193,8 @@ def motion_gif(parts: Sequence[Part], motion: Any, frames: int = 24, size_px: in
     return gif_bytes(sequence, frame_ms, optimize=False, disposal=1)
 
 
-def exploded_png(parts: Sequence[Part], poses: Any, stacks: Sequence[Any], title: str = "") -> bytes:
+def exploded_png(parts: Sequence[Part], poses: Mapping[str, np.ndarray], stacks: Sequence[PinStack],
+                 title: str = "") -> bytes:
     """PNG of the assembly at one pose, exploded along the pins and drawn in oblique projection.
 
     Each part lies at its assembly height stretched so the layers stand apart; every pin is a dashed

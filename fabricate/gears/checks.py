@@ -14,12 +14,11 @@ Limits used
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from fabricate.errors import SpecError
 from fabricate.gears.pitch import PitchCurves
+from fabricate.gears.spec import GearSpec
 
 
 def curvature_summary(pitch: PitchCurves, x: np.ndarray) -> dict[str, float]:
@@ -36,13 +35,13 @@ def curvature_summary(pitch: PitchCurves, x: np.ndarray) -> dict[str, float]:
     return out
 
 
-def undercut_limit_mm(module: float, spec: Any) -> float:
+def undercut_limit_mm(module: float, spec: GearSpec) -> float:
     """Smallest pitch radius of curvature free of undercut, mm."""
     straight = spec.dedendum - spec.root_fillet * (1.0 - np.sin(spec.pressure_angle))
     return float(straight * module / np.sin(spec.pressure_angle) ** 2)
 
 
-def check_feasible(curv: dict[str, float], module: float, spec: Any, path: str = "gears.module_mm") -> None:
+def check_feasible(curv: dict[str, float], module: float, spec: GearSpec, path: str = "gears.module_mm") -> None:
     """Raise :class:`SpecError` naming the quantity and the fix when the module cannot be cut."""
     rho = min(curv["min_radius_of_curvature_a_mm"], curv["min_radius_of_curvature_b_mm"])
     needed = 2.0 * rho / spec.min_teeth
@@ -59,7 +58,7 @@ def check_feasible(curv: dict[str, float], module: float, spec: Any, path: str =
                               f"{concave:.3g} mm; needs module <= {concave / (2 * spec.dedendum):.3g} mm")
 
 
-def local_contact_ratio(pitch: PitchCurves, x: np.ndarray, module: float, spec: Any) -> np.ndarray:
+def local_contact_ratio(pitch: PitchCurves, x: np.ndarray, module: float, spec: GearSpec) -> np.ndarray:
     """Contact ratio of the osculating spur pair at each ``x`` (rack limit where a curve is flat or
     concave): ``(L_a + L_b) / (p cos alpha)`` with ``L = sqrt((rho + h_a)^2 - (rho cos alpha)^2) -
     rho sin alpha``."""
@@ -78,7 +77,7 @@ def local_contact_ratio(pitch: PitchCurves, x: np.ndarray, module: float, spec: 
     return total / (np.pi * module * np.cos(alpha))
 
 
-def pressure_angle_range_deg(pitch: PitchCurves, x: np.ndarray, spec: Any) -> dict[str, list[float]]:
+def pressure_angle_range_deg(pitch: PitchCurves, x: np.ndarray, spec: GearSpec) -> dict[str, list[float]]:
     """Working pressure angle of each flank over ``x`` (deg, [min, max]): the angle between its line
     of action and the perpendicular to the line of centres.
 

@@ -25,10 +25,14 @@ Backlash is the circumferential free play at the pitch curve, ``(free_plus + fre
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
+
+if TYPE_CHECKING:  # fabricate.gears.pair builds on this module
+    from fabricate.gears.pair import GearPair
+    from fabricate.mechanism import Law
 
 #: Driving flank pairs whose gap is within this of the smallest count as touching together (rad).
 CONTACT_TOLERANCE_RAD = 2e-6
@@ -126,7 +130,7 @@ def _polar_tables(table: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
 MESH_VERTICES_PER_CHUNK = 4_000_000
 
 
-def flank_reach(pair: Any) -> float:
+def flank_reach(pair: GearPair) -> float:
     """Half-width of the window of rack flanks :func:`free_play` compares, mm along the pitch line.
 
     A flank pair touches, with the pitch point at rack abscissa ``s``, where the normal of its rack line
@@ -166,7 +170,7 @@ def flank_reach(pair: Any) -> float:
     return float(reach)
 
 
-def free_play(pair: Any, x_a: np.ndarray, return_contacts: bool = False) -> tuple[np.ndarray, ...]:
+def free_play(pair: GearPair, x_a: np.ndarray, return_contacts: bool = False) -> tuple[np.ndarray, ...]:
     """Free rotation of gear b (rad) both ways at each ``x_a``; see the module docstring.
 
     Vectorised over steps: gear a's flanks within :func:`flank_reach` of the pitch point (along the
@@ -261,7 +265,7 @@ def _rotate_all(angles: np.ndarray, points: np.ndarray) -> np.ndarray:
     return np.stack([c * points[:, 0] - sn * points[:, 1], sn * points[:, 0] + c * points[:, 1]], -1)
 
 
-def interference_areas(pair: Any, x_a: np.ndarray) -> np.ndarray:
+def interference_areas(pair: GearPair, x_a: np.ndarray) -> np.ndarray:
     """Overlap area (mm^2) of the two outlines at each ``x_a`` (vectorised shapely booleans)."""
     theta_b = np.asarray(pair.law(x_a), dtype=np.float64)
     a = pair.center_distance_mm
@@ -283,7 +287,7 @@ def interference_areas(pair: Any, x_a: np.ndarray) -> np.ndarray:
     return np.asarray(shapely.area(shapely.intersection(win_a, win_b)), dtype=np.float64)
 
 
-def mesh_check(pair: Any, x_a_values: np.ndarray | None = None, steps: int | None = None) -> MeshResult:
+def mesh_check(pair: GearPair, x_a_values: np.ndarray | None = None, steps: int | None = None) -> MeshResult:
     """Turn ``pair`` through its working range (or through ``x_a_values``, rad) and measure.
 
     Parameters
@@ -321,7 +325,7 @@ def mesh_check(pair: Any, x_a_values: np.ndarray | None = None, steps: int | Non
                       teeth_in_contact=contacts)
 
 
-def designed_lag(pair: Any, x_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def designed_lag(pair: GearPair, x_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Free rotation of gear b the designed backlash alone allows on each flank (rad): ``2 delta /
     d_B`` with ``d_B`` the distance from axis B to that flank's line of action (module docstring)."""
     alpha = pair.spec.pressure_angle
@@ -360,7 +364,7 @@ def _window_chains(outline: np.ndarray, centre_angles: np.ndarray, half_angle: f
     return np.stack([np.vstack([c, np.repeat(c[-1:], width - len(c), 0)]) for c in chains])
 
 
-def free_play_outlines(outline_a: np.ndarray, outline_b: np.ndarray, law: Any, center_distance: float,
+def free_play_outlines(outline_a: np.ndarray, outline_b: np.ndarray, law: Law, center_distance: float,
                        x_a: np.ndarray, module: float, max_angle: float = 0.02,
                        tolerance: float = 1e-9) -> tuple[np.ndarray, np.ndarray]:
     """Free rotation of gear b both ways (rad) from outlines alone, by bisection on 2D booleans.

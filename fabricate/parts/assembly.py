@@ -8,7 +8,10 @@ Nothing here draws or writes.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from fabricate.parts.build import PartSet
 
 
 @dataclass(frozen=True)
@@ -45,7 +48,7 @@ def _joints(pin_name: str) -> set[str]:
     return set(pin_name.split("+"))
 
 
-def pin_stacks(partset: Any) -> list[PinStack]:
+def pin_stacks(partset: PartSet) -> list[PinStack]:
     """The stack on every pin of a part set, bottom to top, in the part set's pin order.
 
     A body part is on a pin when the pin joins its body (through a hole at one of the pin's joints, or in
@@ -71,9 +74,9 @@ def pin_stacks(partset: Any) -> list[PinStack]:
             kind = "washer" if spacer.washer else "spacer"
             z = (round(spacer.z_mm, 6), round(spacer.z_mm + spacer.length_mm, 6))
             # a spacer printed with the parts goes by its part name; a bought one by its size
-            name = printed.get(z[0]) if not spacer.washer else None
+            printed_name = printed.get(z[0]) if not spacer.washer else None
             size = f"{spacer.inner_diameter_mm:g}/{spacer.outer_diameter_mm:g} x {spacer.length_mm:.2f} mm"
-            name = name or f"{kind} {size}"
+            name = printed_name or f"{kind} {size}"
             items.append(StackItem(name, kind, z))
         items.sort(key=lambda s: (s.z_mm[0], s.z_mm[1], s.item))
         stacks.append(PinStack(pin.joint, float(pin.diameter_mm), float(pin.length_mm), float(pin.z_mm),

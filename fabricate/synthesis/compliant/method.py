@@ -4,6 +4,8 @@ section and the parts hints (springs, rods, the drive shared by the fingers)."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from fabricate.errors import SynthesisError
@@ -23,6 +25,9 @@ from fabricate.synthesis.compliant.model import (
     spring_torques,
 )
 from fabricate.synthesis.compliant.spec import CompliantSpec
+
+if TYPE_CHECKING:
+    from fabricate.spec import DesignSpec
 
 #: Drive parts shared by all fingers (paper Fig 1): two lead-screw steppers move the tip and root
 #: drive plates along two guide posts.
@@ -73,7 +78,7 @@ def _optimum_report(spec: CompliantSpec, result: OptimumResult) -> dict:
     }
 
 
-def synthesise(design) -> SynthesisResult:
+def synthesise(design: DesignSpec) -> SynthesisResult:
     """Grasp, Fig-3 curve, optimum, closing motion, mechanism and parts hints."""
     spec: CompliantSpec = design.method
     path, grasp = paper_point(spec)

@@ -4,7 +4,7 @@ its gear law, the solved mechanism, and the report's ``synthesis`` section."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -17,6 +17,9 @@ from fabricate.synthesis.five_bar.domain import HingeDomain, hinge_domain, selec
 from fabricate.synthesis.five_bar.mechanism import DISTAL, LINK_AB, SelectedDyad, build_mechanism, pose_errors
 from fabricate.synthesis.five_bar.spec import FiveBarSpec
 from fabricate.synthesis.five_bar.targets import FingerTargets, finger_targets
+
+if TYPE_CHECKING:
+    from fabricate.spec import DesignSpec
 
 
 @dataclass(frozen=True)
@@ -100,7 +103,7 @@ def build_report(data: FiveBarData) -> dict[str, Any]:
     }
 
 
-def synthesise(design: Any) -> SynthesisResult:
+def synthesise(design: DesignSpec) -> SynthesisResult:
     """Synthesise the five-bar gear finger of a :class:`~fabricate.spec.DesignSpec`.
 
     Raises

@@ -5,7 +5,7 @@ law."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -14,6 +14,9 @@ from fabricate.gears.law import FormulaLaw, elliptic_formula, samples_law
 from fabricate.gears.pitch import PitchCurves
 from fabricate.mechanism import Body, Driver, GearCoupling, Mechanism, Revolute
 from fabricate.synthesis.gear_pair.spec import GearPairSpec
+
+if TYPE_CHECKING:
+    from fabricate.spec import DesignSpec
 
 PAIR_NAME = "pair"
 
@@ -31,7 +34,7 @@ def make_law(spec: GearPairSpec) -> tuple[Callable, str]:
     return FormulaLaw(spec.formula, sign=-1.0, path="gear_pair.law"), spec.formula
 
 
-def center_distance(spec: GearPairSpec, design: Any, law: Callable, lo: float) -> float:
+def center_distance(spec: GearPairSpec, design: DesignSpec, law: Callable, lo: float) -> float:
     """Centre distance: given, or from whole teeth of the requested module (closed pairs)."""
     if spec.center_distance_mm is not None:
         return spec.center_distance_mm

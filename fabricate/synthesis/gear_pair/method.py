@@ -3,7 +3,7 @@ distance, the carrier with its two gears, and the report's ``synthesis`` section
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -13,8 +13,11 @@ from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.gear_pair.mechanism import build_mechanism, center_distance, make_law
 from fabricate.synthesis.gear_pair.spec import GearPairSpec
 
+if TYPE_CHECKING:
+    from fabricate.spec import DesignSpec
 
-def synthesise(design: Any) -> SynthesisResult:
+
+def synthesise(design: DesignSpec) -> SynthesisResult:
     """Build the carrier + two gears mechanism for the template's law."""
     spec: GearPairSpec = design.method
     if spec.teeth is not None and design.gears.teeth is not None and tuple(spec.teeth) != tuple(design.gears.teeth):

@@ -4,7 +4,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from fabricate.mechanism import Mechanism
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,6 @@ class ExactLinkageSpec:
     """The exact form (``[linkage] exact = true``, what every build writes as ``mechanism.toml``): the
     mechanism as it was, and the parts hints it came with (see :mod:`fabricate.synthesis.linkage.exact`)."""
 
-    mechanism: Any
+    mechanism: Mechanism
     hints: dict
     tip_point: str | None = None

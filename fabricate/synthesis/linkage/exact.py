@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -37,6 +37,9 @@ from fabricate.bounds import (
 )
 from fabricate.errors import SpecError
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
+
+if TYPE_CHECKING:
+    from fabricate.spec import DesignSpec
 
 #: Samples of a law written approximately (a law of a kind this file cannot write exactly).
 SAMPLED_LAW_POINTS = 2001
@@ -115,9 +118,9 @@ def exact_linkage(mechanism: Mechanism, hints: Mapping[str, Any]) -> tuple[dict[
     return table, exact
 
 
-def mechanism_toml(design: Any, mechanism: Mechanism, hints: Mapping[str, Any]) -> bytes:
+def mechanism_toml(design: DesignSpec, mechanism: Mechanism, hints: Mapping[str, Any]) -> bytes:
     """``mechanism.toml`` of a build: see the module docstring."""
-    from fabricate.spec import parse_toml
+    from fabricate.templates import parse_toml
     from fabricate.tomlwrite import dumps
 
     linkage, exact = exact_linkage(mechanism, hints)

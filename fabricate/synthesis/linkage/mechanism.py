@@ -21,7 +21,7 @@ from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from fabricate.errors import LockupError, SpecError
 from fabricate.gears.law import FormulaLaw, check_ratio, elliptic_formula
-from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
+from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Motion, Revolute, Slider
 
 if TYPE_CHECKING:
     from fabricate.synthesis.linkage.declared import DriverSpec, JointSpec, LinkageGearSpec, LinkageSpec
@@ -139,7 +139,7 @@ class LinkageMechanism(Mechanism):
     unreachable: LockupError | None = None
     driven: tuple[str, ...] = ()
 
-    def sweep(self, inputs: np.ndarray | int | None = None) -> Any:
+    def sweep(self, inputs: np.ndarray | int | None = None) -> Motion:
         if self.unreachable is not None:
             raise self.unreachable
         try:

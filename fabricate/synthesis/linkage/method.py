@@ -5,19 +5,22 @@ form) becomes the :class:`~fabricate.mechanism.Mechanism`, solved once over the 
 from __future__ import annotations
 
 import contextlib
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from fabricate.bounds import blas_threads
 from fabricate.errors import LockupError, SpecError
-from fabricate.mechanism import Mechanism
+from fabricate.mechanism import Mechanism, Motion
 from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.linkage.declared import ExactLinkageSpec, LinkageSpec
 from fabricate.synthesis.linkage.mechanism import build_mechanism, gear_law
 
+if TYPE_CHECKING:
+    from fabricate.spec import DesignSpec
 
-def _check_gear_ranges(spec: LinkageSpec, mech: Mechanism, motion: Any) -> None:
+
+def _check_gear_ranges(spec: LinkageSpec, mech: Mechanism, motion: Motion) -> None:
     """A sector pair's gear a must stay inside its working range over the motion."""
     for k, g in enumerate(spec.gears):
         if g.closed:
@@ -30,7 +33,7 @@ def _check_gear_ranges(spec: LinkageSpec, mech: Mechanism, motion: Any) -> None:
                             f"outside its working range [{lo:g}, {hi:g}]")
 
 
-def synthesise(design: Any) -> SynthesisResult:
+def synthesise(design: DesignSpec) -> SynthesisResult:
     """Build the declared linkage (no synthesis: the template is the design)."""
     spec: LinkageSpec = design.method
     sweep_poses = max(int(getattr(getattr(design, "checks", None), "sweep_poses", 360)), 2)
@@ -71,7 +74,7 @@ def _exact_form(spec: ExactLinkageSpec, sweep_poses: int) -> SynthesisResult:
     return SynthesisResult(mechanism=spec.mechanism, report=report, parts=dict(spec.hints))
 
 
-def _report(spec: LinkageSpec, mech: Mechanism, motion: Any) -> dict[str, Any]:
+def _report(spec: LinkageSpec, mech: Mechanism, motion: Motion | None) -> dict[str, Any]:
     """The ``synthesis`` section: the linkage as declared, its mobility and (when it moved) the tip's path."""
     laws = {g.name: gear_law(g, f"linkage.gears[{k}]")[1] for k, g in enumerate(spec.gears)}
     report: dict[str, Any] = {

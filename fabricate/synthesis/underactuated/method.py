@@ -4,6 +4,8 @@ actuator)."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from fabricate.errors import SynthesisError
@@ -13,8 +15,11 @@ from fabricate.synthesis.underactuated.mechanism import build_mechanism, mobilit
 from fabricate.synthesis.underactuated.model import crank_rate, distal_rate, finger_pose, transmission_ratios
 from fabricate.synthesis.underactuated.spec import UnderactuatedSpec
 
+if TYPE_CHECKING:
+    from fabricate.spec import DesignSpec
 
-def synthesise(design) -> SynthesisResult:
+
+def synthesise(design: DesignSpec) -> SynthesisResult:
     """Closing motion, contact sequence, final forces, velocity ratios and the mechanism."""
     spec: UnderactuatedSpec = design.method
     d = spec.design
