@@ -20,7 +20,8 @@ import pytest
 from fabricate import cli
 from fabricate.cli import main
 from fabricate.output import write_output
-from fabricate.pipeline import Background, BuildOutcome, manifest
+from fabricate.background import Background
+from fabricate.pipeline import BuildOutcome, manifest
 
 ROOT = Path(__file__).resolve().parent.parent
 FAST = "gear_pair_elliptic"

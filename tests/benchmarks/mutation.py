@@ -78,6 +78,7 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "checks/run": ("fabricate/checks/__init__.py", ["tests/test_checks_run.py", "tests/test_checks.py"]),
     "parts/profiles": ("fabricate/parts/profiles.py", PARTS_TESTS),
     "parts/build": ("fabricate/parts/build.py", PARTS_TESTS),
+    "parts/features": ("fabricate/parts/features.py", PARTS_TESTS),
     "export/dxf": ("fabricate/export/dxf.py", EXPORT_TESTS),
     "export/stl": ("fabricate/export/stl.py", EXPORT_TESTS),
     "synthesis/kinematic_mapping": ("fabricate/synthesis/five_bar/kinematic_mapping.py",
