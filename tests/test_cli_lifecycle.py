@@ -18,9 +18,9 @@ from pathlib import Path
 import pytest
 
 from fabricate import cli
+from fabricate.background import Background
 from fabricate.cli import main
 from fabricate.output import write_output
-from fabricate.background import Background
 from fabricate.pipeline import BuildOutcome, manifest
 
 ROOT = Path(__file__).resolve().parent.parent
