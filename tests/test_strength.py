@@ -238,13 +238,15 @@ def test_unknown_material_exits_2_naming_the_field(tmp_path, capsys):
 
 
 def _four_bar_design(link_width, tip_force_N: float):
+    from fabricate.gears.spec import GearSpec
     from fabricate.parts.spec import PartsSpec
     from fabricate.spec import ChecksSpec, load_design
 
-    process = load_design("finger_watt_six_bar").process  # the SLA profile with its materials, 3 mm pins
-    return SimpleNamespace(name="four_bar", process=process, parts=PartsSpec(link_width_mm=link_width),
-                           gears=SimpleNamespace(hub_diameter_mm=None), checks=ChecksSpec(),
-                           load=LoadSpec(tip_force_N=tip_force_N))
+    # a real DesignSpec: the SLA profile of a shipped template (its materials, 3 mm pins), default gears and
+    # checks, the parts and load under test (the kind's own spec is not read by the parts or the check)
+    return dataclasses.replace(load_design("finger_watt_six_bar"), name="four_bar", gears=GearSpec(),
+                               parts=PartsSpec(link_width_mm=link_width), checks=ChecksSpec(),
+                               load=LoadSpec(tip_force_N=tip_force_N))
 
 
 def test_auto_link_width_is_the_smallest_width_that_passes():

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -31,9 +31,12 @@ from fabricate.gears.checks import (
 from fabricate.gears.law import check_ratio
 from fabricate.gears.mesh import MeshResult, mesh_check
 from fabricate.gears.pitch import PitchCurves
-from fabricate.gears.rack import basic_rack
+from fabricate.gears.rack import RackProfile, basic_rack
 from fabricate.gears.spec import GearSpec
 from fabricate.gears.teeth import GearTeeth, cut_gear
+
+if TYPE_CHECKING:
+    from fabricate.mechanism import Mechanism
 
 #: Default module of a sector when the template leaves it open (SLA-sized), mm.
 DEFAULT_SECTOR_MODULE_MM = 0.5
@@ -217,6 +220,7 @@ def _closed_teeth(law: Callable, x0: float, spec: GearSpec, center_distance: flo
     if np.max(np.abs(ratio - law(grid + TWO_PI, 1))) > 1e-7 * np.max(np.abs(ratio)):
         raise SpecError("gears.closed", "the law does not close gear a: its ratio does not repeat after a full "
                                         "turn of a; use a law periodic over 360 deg of a (or closed = false)")
+    z_b: float  # whole teeth given; a candidate count of b (z_a / turns) below
     if spec.teeth is not None:
         z_a, z_b = spec.teeth
         if abs(z_a / z_b - turns) > 1e-6 * turns:
@@ -278,7 +282,7 @@ class _Layout:
 class _Cut:
     """Both gears cut from one rack, and what they were cut with."""
 
-    rack: Any
+    rack: RackProfile
     bore: float
     hub: float
     common: dict[str, Any]
@@ -473,7 +477,11 @@ def _pitch_outlines(layout: _Layout, lo: float, closed: bool) -> tuple[np.ndarra
     """Both pitch curves as polylines, counter-clockwise like the outlines (a closed gear's whole turn)."""
     pitch, x_cover, periods = layout.pitch, layout.x_cover, layout.periods
     pitch_a = pitch.curve(x_cover if not closed else np.linspace(lo, lo + TWO_PI, 721)[:-1], "a")
-    pitch_b = pitch.curve(x_cover if not closed else np.linspace(lo, lo + periods[1], 721)[:-1], "b")
+    x_b = x_cover
+    if closed:
+        assert periods is not None  # a closed layout has the gears' turns
+        x_b = np.linspace(lo, lo + periods[1], 721)[:-1]
+    pitch_b = pitch.curve(x_b, "b")
     if not closed:
         pitch_a, pitch_b = pitch_a[::-1].copy(), pitch_b  # CCW like the outlines
     return pitch_a, pitch_b
@@ -487,7 +495,7 @@ class _Bare(PitchCurves):
         self.a = float(center_distance)
 
 
-def build_gear_pairs(mechanism: Any, spec: GearSpec, chord_tolerance_mm: float) -> list[GearPair]:
+def build_gear_pairs(mechanism: Mechanism, spec: GearSpec, chord_tolerance_mm: float) -> list[GearPair]:
     """One checked :class:`GearPair` per gear coupling of ``mechanism``.
 
     The centre distance is the distance between the coupling's axis points in the carrier; a

@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -44,6 +44,12 @@ from fabricate.strength.features import (
     tooth_push_by_axis,
 )
 from fabricate.strength.statics import BodyTorque, DriverEffort, PointForce, Statics, solve_statics
+
+if TYPE_CHECKING:
+    from fabricate.gears.pair import GearPair
+    from fabricate.parts.build import PartSet
+    from fabricate.spec import DesignSpec
+    from fabricate.strength.spec import LoadSpec
 
 
 @dataclass(frozen=True)
@@ -149,9 +155,10 @@ def _joint_between(mechanism: Mechanism, a: str, b: str) -> Revolute | None:
     return None
 
 
-def design_loads(design: Any, mechanism: Mechanism, motion: Motion, hints: Mapping[str, Any]) -> Loads:
+def design_loads(design: DesignSpec, mechanism: Mechanism, motion: Motion, hints: Mapping[str, Any]) -> Loads:
     """The template's ``[load]`` and the synthesis' springs as loads over the motion."""
     load = design.load
+    assert load is not None  # load_design reads [load] always (its defaults when the table is absent)
     forces: list[PointForce] = []
     torques: list[BodyTorque] = []
     efforts: list[DriverEffort] = []
@@ -185,7 +192,7 @@ def design_loads(design: Any, mechanism: Mechanism, motion: Motion, hints: Mappi
     return Loads(tuple(forces), tuple(torques), tuple(efforts), tuple(said), reaction)
 
 
-def _tip_load(load: Any, mechanism: Mechanism, motion: Motion, hints: Mapping[str, Any],
+def _tip_load(load: LoadSpec, mechanism: Mechanism, motion: Motion, hints: Mapping[str, Any],
               actuated: bool) -> tuple[PointForce, str]:
     """The tip force, or with a known actuator effort the object's reaction at the tip (a unit direction per
     pose; the statics solve its magnitude), and its words."""
@@ -238,7 +245,7 @@ def _spring_torques(mechanism: Mechanism, motion: Motion,
     return out
 
 
-def _actuator_effort(load: Any, mechanism: Mechanism, motion: Motion) -> tuple[DriverEffort, str]:
+def _actuator_effort(load: LoadSpec, mechanism: Mechanism, motion: Motion) -> tuple[DriverEffort, str]:
     """The actuator's known force or torque on the first driver, pushing the way the motion goes."""
     n = len(motion.inputs)
     driver = mechanism.drivers[0]
@@ -262,6 +269,7 @@ def _actuator_effort(load: Any, mechanism: Mechanism, motion: Motion) -> tuple[D
 def solved_loads(loads: Loads, magnitude: np.ndarray) -> Loads:
     """``loads`` with the object's solved reaction made a known force (for the free bodies)."""
     r = loads.reaction
+    assert r is not None  # called only for loads with a reaction
     force = PointForce(r.body, r.local, np.asarray(r.force) * np.asarray(magnitude)[:, None], name=r.name)
     k = int(np.argmax(np.abs(magnitude)))
     said = tuple(d if not d.startswith("the object at") else
@@ -296,9 +304,9 @@ def body_loads(mechanism: Mechanism, motion: Motion, statics: Statics, loads: Lo
     for k, d in enumerate(mechanism.drivers):
         carried = statics.driver_efforts[:, k]  # torque (angle) or force (slide) the driver puts on its body
         if d.kind == "angle":
-            j = _joint_between(mechanism, d.body, d.reference)
-            body_couples.setdefault(d.body, []).append((carried, j.name if j else ""))
-            body_couples.setdefault(d.reference, []).append((-carried, j.name if j else ""))
+            joint = _joint_between(mechanism, d.body, d.reference)
+            body_couples.setdefault(d.body, []).append((carried, joint.name if joint else ""))
+            body_couples.setdefault(d.reference, []).append((-carried, joint.name if joint else ""))
         else:
             slider = next(s for s in mechanism.joints if isinstance(s, Slider) and s.name == d.joint)
             axis = np.asarray(slider.axis, dtype=np.float64) / math.hypot(*slider.axis)
@@ -326,7 +334,8 @@ def body_loads(mechanism: Mechanism, motion: Motion, statics: Statics, loads: Lo
     return body_point_loads, body_couples
 
 
-def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion, gear_pairs: list[Any],
+def run_strength(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motion: Motion,
+                 gear_pairs: list[GearPair],
                  hints: Mapping[str, Any]) -> StrengthResult:
     """Every part and pin at the design load over ``motion``; see the module docstring."""
     required = float(design.checks.min_safety_factor)
@@ -352,6 +361,7 @@ def run_strength(design: Any, partset: Any, mechanism: Mechanism, motion: Motion
     result.statics = statics
     if loads.reaction is not None:
         solved = statics.reaction_N
+        assert solved is not None  # solve_statics solves the reaction it is given
         loads = solved_loads(loads, solved)
         result.loads = loads.described
     chord = partset.chord_tolerance_mm

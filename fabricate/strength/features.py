@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
@@ -21,6 +21,12 @@ from fabricate.planar import rotation
 from fabricate.strength import models
 from fabricate.strength.section import cut_section, plate_polygon
 from fabricate.strength.statics import Statics
+
+if TYPE_CHECKING:
+    from fabricate.gears.pair import GearPair
+    from fabricate.parts.bom import Pin
+    from fabricate.parts.model import Hole, Part
+    from fabricate.process import Material
 
 #: Directions at which each hole's edge distance is measured (the worse neighbour between them).
 _EDGE_DIRECTIONS = 72
@@ -45,7 +51,7 @@ class Finding:
 
     @property
     def safety_factor(self) -> float:
-        return models.safety_factor(self.allowable_MPa, self.stress_MPa)
+        return float(models.safety_factor(self.allowable_MPa, self.stress_MPa))  # of two floats: a float
 
 
 @dataclass(frozen=True)
@@ -118,7 +124,7 @@ def _edge_along(values: np.ndarray, directions: np.ndarray, pick: Any = np.minim
     return pick(values[k0], values[k1])
 
 
-def tooth_push_by_axis(gear_pairs: list[Any], statics: Statics, motion: Motion) -> dict[str, np.ndarray]:
+def tooth_push_by_axis(gear_pairs: list[GearPair], statics: Statics, motion: Motion) -> dict[str, np.ndarray]:
     """The tooth normal force of every gear pair at each of its two axes (summed per axis), N per pose.
 
     The gear coupling is a torque relation: the tooth force's push on the two axes comes on top of the
@@ -133,7 +139,7 @@ def tooth_push_by_axis(gear_pairs: list[Any], statics: Statics, motion: Motion) 
     return tooth_push
 
 
-def pin_findings(pin: Any, parts: list[Any], loaded: FeatureLoads, pin_material: Any) -> list[Finding]:
+def pin_findings(pin: Pin, parts: list[Part], loaded: FeatureLoads, pin_material: Material) -> list[Finding]:
     """Shear and bending of one pin under the largest joint force it carries, from the real stack on it."""
     revolutes, statics, motion, tooth_push = loaded.revolutes, loaded.statics, loaded.motion, loaded.tooth_push
     joints = [j for j in pin.joint.split("+") if j in revolutes]
@@ -175,8 +181,8 @@ def pin_findings(pin: Any, parts: list[Any], loaded: FeatureLoads, pin_material:
     return found
 
 
-def part_findings(part: Any, parts: list[Any], carried: set[str], chord: float, loaded: FeatureLoads,
-                   material: Any) -> list[Finding]:
+def part_findings(part: Part, parts: list[Part], carried: set[str], chord: float, loaded: FeatureLoads,
+                   material: Material) -> list[Finding]:
     """Every hole that carries a joint (bearing, tear-out, net section) and every section at and between
     those holes of one part, under its share of its body's loads."""
     share = sum(1 for p in parts if p.body == part.body) or 1
@@ -198,7 +204,7 @@ def part_findings(part: Any, parts: list[Any], carried: set[str], chord: float, 
     return found
 
 
-def _hole_findings(part: Any, h: Any, rings: list[np.ndarray], plate: Any, t: float, share: int,
+def _hole_findings(part: Part, h: Hole, rings: list[np.ndarray], plate: Any, t: float, share: int,
                    loads_local: list[tuple[np.ndarray, np.ndarray, str]], loaded: FeatureLoads,
                    material: Any) -> list[Finding]:
     """Bearing, tear-out and the net section across one pin-loaded hole, each at its governing pose."""
@@ -244,7 +250,7 @@ def _hole_findings(part: Any, h: Any, rings: list[np.ndarray], plate: Any, t: fl
     return found
 
 
-def _sections_between_holes(part: Any, holes: list[Any], plate: Any, t: float,
+def _sections_between_holes(part: Part, holes: list[Hole], plate: Any, t: float,
                             loads_local: list[tuple[np.ndarray, np.ndarray, str]],
                             couples: list[tuple[np.ndarray, str]], material: Any, load_name: str) -> list[Finding]:
     """Sections at and between every pair of holes: free body on one side of the cut."""
@@ -306,18 +312,18 @@ def _section_finding(part, sec, point, u, station, ha, hb, loads_local, couples,
                    "a wider link (parts.link_width_mm) or a thicker plate (process.thickness_mm)", stress)
 
 
-def _joints_of(hole: Any) -> set[str]:
+def _joints_of(hole: Hole) -> set[str]:
     """The joints a hole serves (a pin shared by coincident joints is named "A+B")."""
     return set(hole.joint.split("+"))
 
 
-def _pressure_angle(pair: Any) -> float:
+def _pressure_angle(pair: GearPair) -> float:
     """The pair's rack pressure angle (rad)."""
     spec = getattr(pair, "spec", None)
     return math.radians(float(getattr(spec, "pressure_angle_deg", 20.0)))
 
 
-def _tooth_normal_force(pair: Any, torque_b: np.ndarray, motion: Motion) -> np.ndarray:
+def _tooth_normal_force(pair: GearPair, torque_b: np.ndarray, motion: Motion) -> np.ndarray:
     """Tooth normal force (N) of a pair at every pose from the torque on gear b (pitch point on the line of
     centres, pressure angle from the pair)."""
     xa = motion.relative_angle(pair.body_a, pair.carrier)
@@ -327,8 +333,8 @@ def _tooth_normal_force(pair: Any, torque_b: np.ndarray, motion: Motion) -> np.n
     return np.abs(torque_b) / np.maximum(r_b, 1e-9) / math.cos(phi)
 
 
-def gear_findings(pair: Any, torque_b: np.ndarray, mechanism: Mechanism, motion: Motion, parts: list[Any],
-                  material: Any) -> list[Finding]:
+def gear_findings(pair: GearPair, torque_b: np.ndarray, mechanism: Mechanism, motion: Motion, parts: list[Part],
+                  material: Material) -> list[Finding]:
     """Lewis root bending and Hertz contact of one gear pair at every pose, under the statics' torque.
 
     At each pose the pitch point lies on the line of centres, ``r_a = a i / (1 + i)`` from axis a (``i`` the

@@ -12,8 +12,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable, Mapping
-from types import SimpleNamespace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,18 +20,20 @@ from fabricate.mechanism import Mechanism, Motion
 from fabricate.parts.spec import MAX_AUTO_WIDTH_MM
 from fabricate.strength.check import run_strength
 
+if TYPE_CHECKING:
+    from fabricate.gears.pair import GearPair
+    from fabricate.parts.build import PartSet
+    from fabricate.spec import DesignSpec
+
 #: Width resolution of the search (mm).
 RESOLUTION_MM = 0.1
 #: Most poses one trial checks (the final check runs over the whole motion).
 MAX_SEARCH_POSES = 120
 
 
-def _with_width(design: Any, width: float | None) -> Any:
-    """``design`` with ``parts.link_width_mm = width`` (a DesignSpec, or any namespace of its fields)."""
-    parts = dataclasses.replace(design.parts, link_width_mm=width)
-    if dataclasses.is_dataclass(design):
-        return dataclasses.replace(design, parts=parts)
-    return SimpleNamespace(**{**vars(design), "parts": parts})
+def _with_width(design: DesignSpec, width: float | None) -> DesignSpec:
+    """``design`` with ``parts.link_width_mm = width``."""
+    return dataclasses.replace(design, parts=dataclasses.replace(design.parts, link_width_mm=width))
 
 
 def _coarse(motion: Motion, stride: int) -> Motion:
@@ -41,8 +42,8 @@ def _coarse(motion: Motion, stride: int) -> Motion:
     return dataclasses.replace(motion, inputs=motion.inputs[idx], q=motion.q[idx])
 
 
-def size_link_width(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: list[Any],
-                    hints: Mapping[str, Any], build: Callable[[Any], Any], stride: int = 4
+def size_link_width(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_pairs: list[GearPair],
+                    hints: Mapping[str, Any], build: Callable[[DesignSpec], PartSet], stride: int = 4
                     ) -> tuple[float, list[tuple[float, float]]]:
     """Smallest link width (mm, a multiple of :data:`RESOLUTION_MM`) whose links and holes keep
     ``design.checks.min_safety_factor``; :data:`MAX_AUTO_WIDTH_MM` if none does.
