@@ -21,6 +21,7 @@ def _example() -> str:
     return match.group(1)
 
 
+@pytest.mark.slow
 def test_readme_api_example_runs_and_writes_its_files(tmp_path, capsys):
     """README's example as written; the folder it writes holds exactly the build's files (the CLI writes
     through the same run_build and write_output), and its motion.csv is the mechanism's sweep."""

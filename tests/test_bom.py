@@ -17,8 +17,8 @@ from fabricate.spec import load_design
 
 
 @pytest.fixture(scope="module")
-def gripper():
-    return run_build(load_design("gripper_compliant"))
+def gripper(shipped_build):
+    return shipped_build("gripper_compliant")
 
 
 @pytest.fixture(scope="module")
@@ -26,6 +26,7 @@ def five_bar_laser():
     return run_build(load_design("finger_five_bar_ncg", "laser"))
 
 
+@pytest.mark.slow
 def test_every_part_is_in_the_bom_with_its_mass(gripper, five_bar_laser):
     for outcome, kind in ((gripper, "printed part"), (five_bar_laser, "cut part")):
         process = load_design(outcome.report["design"]["template"].removesuffix(".toml"),
@@ -45,6 +46,7 @@ def test_every_part_is_in_the_bom_with_its_mass(gripper, five_bar_laser):
     assert gripper.partset.copies == 3  # three fingers: three of every part
 
 
+@pytest.mark.slow
 def test_springs_only_where_the_rate_is_above_zero(gripper):
     springs = [r for r in gripper.report["bom"] if r["kind"] == "spring"]
     rates = {s["joint"]: s["rate_Nmm_per_deg"] for s in gripper.partset.hints["springs"]}
@@ -53,6 +55,7 @@ def test_springs_only_where_the_rate_is_above_zero(gripper):
     assert all(s["rate_Nmm_per_deg"] > 0 and s["qty"] == 3 for s in springs)
 
 
+@pytest.mark.slow
 def test_bom_csv_carries_every_column_of_the_report(gripper):
     rows = list(csv.DictReader(io.StringIO(gripper.files["bom.csv"].decode())))
     bom = gripper.report["bom"]
@@ -68,6 +71,7 @@ def test_bom_csv_carries_every_column_of_the_report(gripper):
                 assert row[key] == str(value)
 
 
+@pytest.mark.slow
 def test_printed_spacers_are_parts_not_hardware(gripper):
     bom = gripper.report["bom"]
     spacer_parts = [p.name for p in gripper.partset.parts if p.role == "spacer"]
@@ -76,6 +80,7 @@ def test_printed_spacers_are_parts_not_hardware(gripper):
     assert not any(r["kind"] == "spacer" for r in bom)  # no second count of the same spacers
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("which", ["gripper", "five_bar_laser"])
 def test_each_pin_stack_fills_its_pin_exactly(which, request):
     outcome = request.getfixturevalue(which)
@@ -103,6 +108,7 @@ def test_each_pin_stack_fills_its_pin_exactly(which, request):
     assert "## Assembly" in outcome.files["report.md"].decode()
 
 
+@pytest.mark.slow
 def test_exploded_picture_shows_every_part(gripper):
     import numpy as np
     from PIL import Image

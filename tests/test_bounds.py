@@ -80,6 +80,7 @@ def test_sweep_poses_of_the_issue_are_refused(tmp_path: Path, capsys) -> None:
     _assert_refused(path, "checks.sweep_poses", tmp_path, capsys)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("angle", [10, 24, 30, 35])
 def test_every_documented_pressure_angle_builds(angle: int, tmp_path: Path, capsys) -> None:
     # steep angles narrow the rack's tooth space: the default root fillet (and dedendum) adapt, and

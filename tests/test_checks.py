@@ -175,6 +175,7 @@ def test_gear_mesh_check_fails_when_the_assembly_leaves_the_law(seed000):
     assert gears.collides and len(gears.collision_indices) > len(motion.inputs) // 2
 
 
+@pytest.mark.slow
 def test_colliding_build_exits_1_with_files_and_reason(tmp_path, monkeypatch):
     """``fabricate build`` of the default finger with the middle phalanx forced onto the gear layer
     (the parts layer patched): exit code 1, every file written, report.json names the pair, the

@@ -80,26 +80,26 @@ TEMPLATES = [p.stem for p in shipped_templates()]
 
 @pytest.fixture(scope="module")
 def builds(tmp_path_factory):
-    """Each shipped template built twice (determinism) — cached for the module."""
-    cache: dict[str, tuple[int, Path, int, Path]] = {}
+    """Each shipped template built by the command into a folder: ``(exit code, folder)``, cached for the module
+    (the second build, for determinism, is the session's in-memory ``shipped_build``)."""
+    cache: dict[str, tuple[int, Path]] = {}
 
     def get(name: str):
         if name not in cache:
-            root = tmp_path_factory.mktemp(name)
-            code1 = main(["build", name, "-o", str(root / "one"), "-q"])
-            code2 = main(["build", name, "-o", str(root / "two"), "-q"])
-            cache[name] = (code1, root / "one", code2, root / "two")
+            out = tmp_path_factory.mktemp(name) / "out"
+            cache[name] = (main(["build", name, "-o", str(out), "-q"]), out)
         return cache[name]
 
     return get
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", TEMPLATES)
-def test_template_states_its_load_and_every_part_keeps_a_safety_factor_of_two(builds, name):
+def test_template_states_its_load_and_every_part_keeps_a_safety_factor_of_two(shipped_build, name):
     """Issue 12: every shipped template states a design load and builds with every part and pin at a
     safety factor of at least 2 over the whole motion."""
-    _, out, _, _ = builds(name)
-    report = json.loads((out / "report.json").read_text())
+    files = shipped_build(name).files
+    report = json.loads(files["report.json"])
     strength = report["strength"]
     assert strength["loads"], "the template states no [load]"
     assert strength["required_safety_factor"] == 2.0 and strength["passed"] is True
@@ -116,13 +116,14 @@ def test_template_states_its_load_and_every_part_keeps_a_safety_factor_of_two(bu
     # would pass vacuously)
     finite = [e["min_safety_factor"] for e in rated.values() if e["min_safety_factor"] is not None]
     assert finite and min(finite) < 50.0
-    assert (out / "plots" / "strength.png").is_file()
-    assert "## Strength" in (out / "report.md").read_text()
+    assert "plots/strength.png" in files
+    assert "## Strength" in files["report.md"].decode()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", TEMPLATES)
 def test_template_builds_and_passes(builds, name):
-    code, out, _, _ = builds(name)
+    code, out = builds(name)
     report = json.loads((out / "report.json").read_text())
     assert code == 0, report["checks"]["failures"]
     assert REPORT_KEYS <= set(report)
@@ -139,13 +140,15 @@ def test_template_builds_and_passes(builds, name):
     assert inter["poses"] >= 360 and inter["collisions"] == []
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", TEMPLATES)
-def test_same_template_gives_byte_identical_files(builds, name):
-    _, one, _, two = builds(name)
+def test_same_template_gives_byte_identical_files(builds, shipped_build, name):
+    """Two builds of one template, one by the command into a folder and one in memory, give the same files."""
+    _, one = builds(name)
+    two = shipped_build(name).files
     files_one = sorted(p.relative_to(one).as_posix() for p in one.rglob("*") if p.is_file())
-    files_two = sorted(p.relative_to(two).as_posix() for p in two.rglob("*") if p.is_file())
-    assert files_one == files_two
-    differing = [rel for rel in files_one if (one / rel).read_bytes() != (two / rel).read_bytes()]
+    assert files_one == sorted(two)
+    differing = [rel for rel in files_one if (one / rel).read_bytes() != two[rel]]
     assert differing == []
 
 
@@ -166,10 +169,11 @@ def test_lockup_inside_the_range_is_a_design_failure(monkeypatch):
         assert {"report.json", "report.md"} <= set(outcome.files)
 
 
+@pytest.mark.slow
 def test_default_finger_rebuilt_from_its_mechanism_toml_gives_identical_parts(builds, tmp_path):
     """Issue 13: every build writes mechanism.toml, a linkage template of the same mechanism; built, it
     gives the default finger's parts, drawings, plates and gears byte for byte (and writes itself again)."""
-    _, out, _, _ = builds("finger_five_bar_ncg")
+    _, out = builds("finger_five_bar_ncg")
     template = tmp_path / "mechanism.toml"
     template.write_bytes((out / "mechanism.toml").read_bytes())
     assert "every law is written exactly" in template.read_text()
@@ -188,6 +192,7 @@ def test_default_finger_rebuilt_from_its_mechanism_toml_gives_identical_parts(bu
         [line for line in second if not line.startswith("description")]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", TEMPLATES)
 def test_every_build_writes_a_mechanism_toml_that_rebuilds_its_motion(builds, name, tmp_path):
     """Every template's mechanism.toml loads as a linkage and moves as the build did: its points against the
@@ -200,7 +205,7 @@ def test_every_build_writes_a_mechanism_toml_that_rebuilds_its_motion(builds, na
     from fabricate.pipeline import synthesise
     from fabricate.spec import load_design
 
-    _, out, _, _ = builds(name)
+    _, out = builds(name)
     path = tmp_path / "mechanism.toml"
     path.write_bytes((out / "mechanism.toml").read_bytes())
     design = load_design(path)

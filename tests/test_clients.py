@@ -11,8 +11,6 @@ from pathlib import Path
 import pytest
 
 from fabricate.output import write_output
-from fabricate.pipeline import run_build
-from fabricate.spec import load_design
 
 pytestmark = pytest.mark.skipif(shutil.which("admesh") is None, reason="admesh not installed")
 
@@ -30,9 +28,10 @@ def _admesh(path: Path) -> dict[str, float]:
     return stats
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("template", ["gear_pair_elliptic", "finger_five_bar_ncg"])
-def test_admesh_reads_every_part_whole_without_repair(template, tmp_path):
-    outcome = run_build(load_design(template))
+def test_admesh_reads_every_part_whole_without_repair(template, tmp_path, shipped_build):
+    outcome = shipped_build(template)
     write_output(outcome.files, tmp_path / "out")
     parts = outcome.report["parts"]
     for part in parts:
@@ -53,9 +52,10 @@ def test_admesh_reads_every_part_whole_without_repair(template, tmp_path):
                                                              rel=1e-5)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which("librecad") is None or shutil.which("pdftoppm") is None,
                     reason="LibreCAD or poppler-utils not installed")
-def test_librecad_draws_dimension_text_at_least_2_5_mm(tmp_path):
+def test_librecad_draws_dimension_text_at_least_2_5_mm(tmp_path, shipped_build):
     """LibreCAD sizes dimension text by the drawing's header and dimension style, not by per-entity
     overrides: its PDF, printed at 1:1 and rasterised at 10 px/mm, shows dimension digits >= 2.5 mm."""
     import os
@@ -66,7 +66,7 @@ def test_librecad_draws_dimension_text_at_least_2_5_mm(tmp_path):
 
     from fabricate.export.dxf import MIN_DRAWING_TEXT_MM
 
-    outcome = run_build(load_design("finger_five_bar_ncg"))
+    outcome = shipped_build("finger_five_bar_ncg")
     dxf = tmp_path / "kinematic.dxf"
     dxf.write_bytes(outcome.files["drawings/kinematic.dxf"])
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "XDG_RUNTIME_DIR": str(tmp_path)}

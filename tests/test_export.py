@@ -59,6 +59,11 @@ TEMPLATES = tuple(p.stem for p in shipped_templates())
 CASES = [f"{m}-{p}" for m in FIXTURES + TEMPLATES for p in PROCESSES]
 
 
+def _marked(names: list[str]) -> list:
+    """``names`` as parameters; a shipped template's case (its whole part set and every export) is slow."""
+    return [pytest.param(n, marks=pytest.mark.slow) if n.rsplit("-", 1)[0] in TEMPLATES else n for n in names]
+
+
 @cache
 def _synthesised(template: str):
     design = load_design(template)
@@ -152,7 +157,7 @@ def offset_area(vertices, bulges, distance_mm: float) -> tuple[float, float]:
 
 # -- STL ----------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize("name", _marked(CASES))
 def test_stl_round_trip(name):
     c = case(name)
     tol = c.partset.chord_tolerance_mm
@@ -175,7 +180,7 @@ def test_stl_round_trip(name):
         assert mesh.bounds[1][2] == pytest.approx(part.thickness_mm, abs=1e-5)
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize("name", _marked(CASES))
 def test_plates_hold_every_copy_inside_the_build_area(name):
     c = case(name)
     plates = sorted(k for k in c.files if k.startswith("plates/") and k.endswith(".stl"))
@@ -215,7 +220,7 @@ def test_plates_hold_every_copy_inside_the_build_area(name):
     assert abs(volume - total) <= bound + 1e-5 * total
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize("name", _marked(CASES))
 def test_assembly_3mf(name):
     c = case(name)
     with zipfile.ZipFile(io.BytesIO(c.files["assembly.3mf"])) as archive:
@@ -280,7 +285,7 @@ def lwpolyline_area(entity) -> float:
     return area
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize("name", _marked(CASES))
 def test_part_dxf_round_trip(name):
     c = case(name)
     kerf = c.process.kerf_mm
@@ -336,7 +341,7 @@ def test_binary_link_dxf_is_exact_rounded_slot():
     assert crank.outline.area() == pytest.approx(2 * (r - 0.1) * 15.0 + math.pi * (r - 0.1) ** 2, rel=1e-12)
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize("name", _marked(CASES))
 def test_cut_sheets_nest_every_copy_without_overlap(name):
     c = case(name)
     sheets = sorted(k for k in c.files if k.startswith("cut/sheet_") and k.endswith(".dxf"))
@@ -371,7 +376,7 @@ def test_cut_sheets_nest_every_copy_without_overlap(name):
     assert sorted(names) == sorted(legible)
 
 
-@pytest.mark.parametrize("name", [n for n in CASES if n.endswith("-laser")])
+@pytest.mark.parametrize("name", _marked([n for n in CASES if n.endswith("-laser")]))
 def test_drawings_are_at_the_finished_size(name):
     """drawings/ is for CAD: the part as it is once cut (no kerf), unlike cut/."""
     c = case(name)
@@ -387,7 +392,7 @@ def test_drawings_are_at_the_finished_size(name):
         assert abs(lwpolyline_area(outline) - expected) <= slack
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize("name", _marked(CASES))
 def test_kinematic_dxf(name):
     c = case(name)
     data = c.files["drawings/kinematic.dxf"]
@@ -424,7 +429,7 @@ def test_kinematic_dxf(name):
 
 # -- pictures, report, determinism ------------------------------------------------------------------
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize("name", _marked(CASES))
 def test_previews_and_report_entries(name):
     c = case(name)
     png = Image.open(io.BytesIO(c.files["previews/assembly.png"]))
@@ -440,7 +445,7 @@ def test_previews_and_report_entries(name):
     assert c.files["bom.csv"].startswith(b"item,kind,qty")
 
 
-@pytest.mark.parametrize("name", [CASES[0], CASES[-1]])
+@pytest.mark.parametrize("name", _marked([CASES[0], CASES[-1]]))
 def test_same_input_gives_identical_bytes(name):
     c = case(name)
     again = build_parts(c.design, c.mechanism, c.motion, c.gear_pairs, c.hints)
@@ -490,7 +495,7 @@ TOOL_CASES = ["four_bar-laser", "slider_crank-sla", "geared_four_bar-sla"] + [
 
 
 @pytest.mark.skipif(shutil.which("openscad") is None, reason="OpenSCAD not installed")
-@pytest.mark.parametrize("name", TOOL_CASES)
+@pytest.mark.parametrize("name", _marked(TOOL_CASES))
 def test_openscad_imports_every_dxf(name, tmp_path):
     """OpenSCAD imports each DXF's CUT layer (and the kinematic drawing's joints) without an error.
 
@@ -528,7 +533,7 @@ def test_openscad_imports_every_dxf(name, tmp_path):
 
 
 @pytest.mark.skipif(shutil.which("prusa-slicer") is None, reason="PrusaSlicer not installed")
-@pytest.mark.parametrize("name", TOOL_CASES)
+@pytest.mark.parametrize("name", _marked(TOOL_CASES))
 def test_prusaslicer_reports_manifold_without_repair(name, tmp_path):
     c = case(name)
     stls = {k: v for k, v in c.files.items() if k.endswith(".stl")}
@@ -582,6 +587,7 @@ for key in sorted(c.files):
 """
 
 
+@pytest.mark.slow
 def test_bytes_do_not_depend_on_the_hash_seed():
     """Two processes with different string-hash seeds write identical files (ezdxf keeps some records
     in sets; the encoders fix their order)."""

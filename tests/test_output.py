@@ -50,17 +50,20 @@ def _siblings(parent: Path) -> list[str]:
 
 # -- what -o may be -----------------------------------------------------------------------------------
 
-def test_a_folder_with_user_files_is_refused_before_any_work(tmp_path, capsys):
+def test_a_folder_with_user_files_is_refused_before_any_work(tmp_path, capsys, monkeypatch):
+    import fabricate.pipeline as pipeline
+
     out = tmp_path / "x"
     out.mkdir()
     (out / "notes.txt").write_text("keep")
-    start = time.perf_counter()
+    started = []
+    monkeypatch.setattr(pipeline, "run_build", lambda *args, **kwargs: started.append(args))
     assert main(["build", FAST, "-o", str(out), "-q"]) == 2
     err = capsys.readouterr().err
     assert "notes.txt" in err and str(out) in err and "--force" in err
     assert _tree(out) == {"notes.txt": b"keep"}
     assert _siblings(tmp_path) == ["x"]
-    assert time.perf_counter() - start < 2.0  # refused before synthesis (a build takes several seconds)
+    assert started == []  # refused before the build began (not timed: a busy machine is slow at anything)
 
 
 def test_force_replaces_a_foreign_folder(tmp_path):
@@ -168,6 +171,7 @@ def test_a_previous_output_is_replaced_but_not_with_a_user_file_in_it(tmp_path):
     assert previous_output(out)["tag"] == "b"
 
 
+@pytest.mark.slow
 def test_synth_never_replaces_a_build(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["build", FAST, "-q"]) == 0
@@ -191,7 +195,7 @@ def test_leftovers_of_killed_runs_are_removed_by_the_next_run(tmp_path):
         "import fabricate.output as o\n"
         "real = o._write_tree\n"
         "def slow(files, root):\n"  # half the files written, then held until killed
-        "    real(dict(sorted(files.items())[:20]), root); open(sys.argv[2], 'w').close(); time.sleep(60)\n"
+        "    real(dict(sorted(files.items())[:20]), root); open(sys.argv[2], 'w').close(); time.sleep(600)\n"
         "o._write_tree = slow\n"
         "from tests.test_output import fake_output\n"
         "o.write_output(fake_output('b', 40), sys.argv[1])\n"
@@ -200,7 +204,7 @@ def test_leftovers_of_killed_runs_are_removed_by_the_next_run(tmp_path):
     child = subprocess.Popen([sys.executable, "-c", script, str(out), str(marker)],
                              cwd=Path(__file__).resolve().parent.parent)
     try:
-        deadline = time.monotonic() + 60
+        deadline = time.monotonic() + 600
         while not marker.exists():
             assert child.poll() is None and time.monotonic() < deadline
             time.sleep(0.02)
@@ -231,7 +235,7 @@ def test_concurrent_writers_are_serialised(tmp_path):
     for w in workers:
         w.start()
     for w in workers:
-        w.join(120)
+        w.join(600)
     found = []
     while not errors.empty():
         found.append(errors.get())
@@ -256,6 +260,7 @@ sys.exit(main(["build", "gear_pair_elliptic", "-o", sys.argv[2]]))
 """
 
 
+@pytest.mark.slow
 def test_ctrl_c_exits_130_with_one_line_and_the_previous_output_intact(tmp_path):
     out = tmp_path / "out"
     write_output(fake_output("a"), out)
@@ -265,12 +270,12 @@ def test_ctrl_c_exits_130_with_one_line_and_the_previous_output_intact(tmp_path)
     child = subprocess.Popen([sys.executable, "-c", CTRL_C_CHILD, str(marker), str(out)],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                              preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    deadline = time.monotonic() + 120
+    deadline = time.monotonic() + 600
     while not marker.exists():  # wait until the build is under way: no race with a fast machine
         assert child.poll() is None and time.monotonic() < deadline, child.communicate()
         time.sleep(0.05)
     child.send_signal(signal.SIGINT)
-    stdout, stderr = child.communicate(timeout=60)
+    stdout, stderr = child.communicate(timeout=600)
     assert child.returncode == 130, (stdout, stderr)
     assert "Traceback" not in stderr and len(stderr.strip().splitlines()) == 1
     assert "interrupted" in stderr
@@ -408,7 +413,7 @@ def test_writers_of_a_and_a_b_both_end_complete(tmp_path):
     for w in workers:
         w.start()
     for w in workers:
-        w.join(180)
+        w.join(600)
     found = []
     while not errors.empty():
         found.append(errors.get())

@@ -42,6 +42,7 @@ def _run(site: Path, cwd: Path, *args: str) -> subprocess.CompletedProcess:
                           text=True, timeout=300)
 
 
+@pytest.mark.slow
 def test_the_wheel_carries_every_template(installed):
     wheel, _ = installed
     names = set(zipfile.ZipFile(wheel).namelist())
@@ -54,6 +55,7 @@ def test_the_wheel_carries_every_template(installed):
         assert data == (ROOT / "templates" / name).read_bytes()  # the one source, packaged as it is
 
 
+@pytest.mark.slow
 def test_installed_it_lists_and_builds_from_a_foreign_folder(installed, tmp_path):
     _, site = installed
     foreign = tmp_path / "elsewhere"
@@ -121,6 +123,7 @@ def _files(folder: Path) -> dict[str, bytes]:
     return {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
+@pytest.mark.slow
 def test_the_outputs_readme_rebuild_recipe_works_as_written(built_linkage, tmp_path):
     """Issue 23: outputs/README.md's recipe, run as written from the folder holding outputs/, exits 0 and
     writes where the README says; the build it came from is left as it was (nothing nested in it), a plain

@@ -27,6 +27,7 @@ from fabricate.templates import TEMPLATE_DIR, read_toml, shipped_templates
 TEMPLATES = [p.stem for p in shipped_templates()]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("template", TEMPLATES)
 def test_every_template_builds_for_the_laser_or_names_what_it_cannot_make(template, tmp_path, capsys):
     out = tmp_path / "out"
@@ -57,6 +58,7 @@ def test_a_bad_process_is_named(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.slow
 def test_check_rebuilds_with_the_process_it_was_built_with(tmp_path, capsys):
     profile = tmp_path / "thick.toml"
     profile.write_text((TEMPLATE_DIR / "process_laser.toml").read_text()

@@ -67,6 +67,7 @@ def test_a_stale_readme_or_recording_is_named(figures, record):
     assert len(problems) == 1 and problems[0].startswith(f"point {fresh[1]['point']} ")
 
 
+@pytest.mark.slow
 def test_recorded_verdicts_hold_for_a_passing_a_failing_and_an_infeasible_point(figures, record, monkeypatch):
     """The quickest recorded point of each verdict, re-run in this process through the function a sweep's
     Dask task runs: the same exit code, safety factor (as the table prints it) and failing checks. A code

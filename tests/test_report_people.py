@@ -13,13 +13,11 @@ from PIL import Image
 
 from fabricate.export.dxf import DIMSTYLE, MIN_DRAWING_TEXT_MM
 from fabricate.export.previews import part_colours
-from fabricate.pipeline import run_build
-from fabricate.spec import load_design
 
 
 @pytest.fixture(scope="module")
-def five_bar():
-    return run_build(load_design("finger_five_bar_ncg"))
+def five_bar(shipped_build):
+    return shipped_build("finger_five_bar_ncg")
 
 
 def _rows(markdown: str, header_start: str) -> list[list[str]]:
@@ -33,6 +31,7 @@ def _rows(markdown: str, header_start: str) -> list[list[str]]:
     return rows
 
 
+@pytest.mark.slow
 def test_interference_table_is_worst_first(five_bar):
     md = five_bar.files["report.md"].decode()
     rows = _rows(md, "| a | b | contact | smallest gap mm | required mm | margin mm")
@@ -45,6 +44,7 @@ def test_interference_table_is_worst_first(five_bar):
     assert np.allclose(margins, expected, atol=5e-4 * max(1.0, max(map(abs, expected))))
 
 
+@pytest.mark.slow
 def test_summary_separates_moving_clearance_from_gear_mesh_and_bearing(five_bar):
     md = five_bar.files["report.md"].decode()
     rows = {r[0]: r for r in _rows(md, "| contact | pairs |")}
@@ -69,6 +69,7 @@ def _label_box(frame: Image.Image) -> np.ndarray:
     return np.asarray(frame.convert("L"))[2:14, 2:110]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", ["previews/motion.gif", "gears/sun_planet_turning.gif"])
 def test_gif_frames_carry_their_input(five_bar, path):
     gif = Image.open(io.BytesIO(five_bar.files[path]))
@@ -81,8 +82,9 @@ def test_gif_frames_carry_their_input(five_bar, path):
     assert not np.array_equal(_label_box(first), _label_box(later))  # a different value is written
 
 
-def test_parts_of_a_gear_pair_get_distinct_colours():
-    outcome = run_build(load_design("gear_pair_elliptic"))
+@pytest.mark.slow
+def test_parts_of_a_gear_pair_get_distinct_colours(shipped_build):
+    outcome = shipped_build("gear_pair_elliptic")
     parts = outcome.partset.parts
     colours = part_colours(parts)
     gears = [p.name for p in parts if p.gear]
@@ -93,6 +95,7 @@ def test_parts_of_a_gear_pair_get_distinct_colours():
     assert len(used) >= 2 + len(parts)  # background, outline and one fill per part
 
 
+@pytest.mark.slow
 def test_kinematic_drawing_text_is_at_least_2_5_mm_in_its_dimension_style(five_bar):
     doc = ezdxf.read(io.StringIO(five_bar.files["drawings/kinematic.dxf"].decode()))
     style = doc.dimstyles.get(DIMSTYLE)

@@ -43,8 +43,6 @@ from fabricate.export.step import (  # noqa: E402
 )
 from fabricate.export.stl import read_3mf  # noqa: E402
 from fabricate.parts.model import BulgePath, Hole, Part  # noqa: E402
-from fabricate.pipeline import run_build  # noqa: E402
-from fabricate.spec import load_design  # noqa: E402
 from fabricate.templates import shipped_templates  # noqa: E402
 
 #: Volume agreement asked by the issue (measured: ~1e-12 on every shipped part).
@@ -57,9 +55,9 @@ TEMPLATES = [path.stem for path in shipped_templates()]
 
 
 @pytest.fixture(scope="module", params=TEMPLATES)
-def build(request: pytest.FixtureRequest):
-    """One in-memory build per shipped template with its STEP files read back once."""
-    outcome = run_build(load_design(request.param))
+def build(request: pytest.FixtureRequest, shipped_build):
+    """One in-memory build per shipped template (the session's shared one) with its STEP files read back once."""
+    outcome = shipped_build(request.param)
     assert outcome.partset is not None, f"{request.param}: build failed before the parts"
     read = {path: read_step(data) for path, data in outcome.files.items() if path.endswith(".step")}
     return request.param, outcome, read
@@ -69,6 +67,7 @@ def test_step_available() -> None:
     assert step_available()
 
 
+@pytest.mark.slow
 def test_every_part_step_is_a_valid_solid_with_the_report_volume_and_hole_cylinders(build) -> None:
     name, outcome, read = build
     entries = {entry["name"]: entry for entry in outcome.report["parts"]}
@@ -91,6 +90,7 @@ def test_every_part_step_is_a_valid_solid_with_the_report_volume_and_hole_cylind
         assert solid.bounds[1, 2] == pytest.approx(part.thickness_mm, abs=1e-7)
 
 
+@pytest.mark.slow
 def test_assembly_step_has_one_named_solid_per_part_where_the_3mf_puts_it(build) -> None:
     name, outcome, read = build
     parts = outcome.partset.parts
@@ -199,6 +199,7 @@ for path in sorted(p for p in files if p.endswith(".step")):
 
 
 # one template is enough for the bytes: the quickest to build, with arcs, holes and many parts
+@pytest.mark.slow
 @pytest.mark.parametrize("build", ["finger_watt_six_bar"], indirect=True)
 def test_two_builds_in_separate_processes_give_identical_step_bytes(build) -> None:
     name, outcome, _ = build

@@ -185,6 +185,7 @@ def _template(name: str, **replace: str) -> str:
     return text
 
 
+@pytest.mark.slow
 def test_weakened_finger_fails_naming_part_feature_and_load(tmp_path, capsys):
     """The underactuated finger pushed with 2000 N instead of its rated 20 N: exit 1, the files and a report that
     names the part, the feature, the load and the fix."""

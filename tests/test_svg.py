@@ -12,17 +12,17 @@ import shapely
 
 from fabricate.export.dxf import part_dxf, sheet_layout
 from fabricate.export.svg import CUT_COLOUR, ENGRAVE_COLOUR, part_svg, sheet_svg
-from fabricate.pipeline import run_build
-from fabricate.spec import load_design
 
 svgelements = pytest.importorskip("svgelements")
 
 KERF = 0.2  # a laser kerf: outlines out, holes in by 0.1 mm in both files
 
+pytestmark = pytest.mark.slow  # every test reads two full template builds
+
 
 @pytest.fixture(scope="module", params=["finger_five_bar_ncg", "finger_underactuated"])
-def parts(request):
-    return list(run_build(load_design(request.param)).partset.parts)
+def parts(request, shipped_build):
+    return list(shipped_build(request.param).partset.parts)
 
 
 def _read_svg(data: bytes):

@@ -208,6 +208,7 @@ def test_a_bad_point_is_a_row_with_its_reason():
 
 # -- Dask: local cluster, real scheduler and workers, resume ----------------------------------------------------
 
+@pytest.mark.slow
 def test_local_cluster_sweep_equals_the_points_one_by_one(tmp_path):
     import pyarrow.parquet as pq
 
@@ -285,6 +286,7 @@ def _cli(*args: str, **kw) -> subprocess.Popen:
                             stderr=subprocess.PIPE, text=True, **kw)
 
 
+@pytest.mark.slow
 def test_sweep_through_a_real_scheduler_survives_a_killed_worker(tmp_path):
     """``dask scheduler`` and two ``dask worker`` processes on localhost; one worker is killed (SIGKILL) once
     rows arrive: the sweep still ends with every point exactly once, equal to the points run one by one."""
@@ -303,12 +305,12 @@ def test_sweep_through_a_real_scheduler_survives_a_killed_worker(tmp_path):
                                "--memory-limit", "0", "--death-timeout", "60"))
         out = tmp_path / "out"
         child = _cli("sweep", str(spec_file), "--scheduler", address, "-o", str(out))
-        deadline = time.monotonic() + 120
+        deadline = time.monotonic() + 600
         while len(_journal_points(out / "rows.jsonl")) < 2:
             assert child.poll() is None and time.monotonic() < deadline, child.communicate()
             time.sleep(0.02)
         os.killpg(procs[1].pid, signal.SIGKILL)  # a worker dies mid-sweep
-        stdout, stderr = child.communicate(timeout=180)
+        stdout, stderr = child.communicate(timeout=600)
         assert child.returncode == 0, (stdout, stderr)
         assert "2 Dask workers at " + address in stderr
     finally:
@@ -331,6 +333,7 @@ def test_sweep_through_a_real_scheduler_survives_a_killed_worker(tmp_path):
         check_gear_row(row)
 
 
+@pytest.mark.slow
 def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path):
     from fabricate.sweep.tables import columns, csv_bytes
 
@@ -344,12 +347,12 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path):
     # a terminal's Ctrl-C (SIGINT at its default disposition: pytest-xdist workers ignore it)
     child = _cli("sweep", str(spec_file), "--workers", "1", "-o", str(out),
                  preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    deadline = time.monotonic() + 120
+    deadline = time.monotonic() + 600
     while len(_journal_points(out / "rows.jsonl")) < 2:
         assert child.poll() is None and time.monotonic() < deadline, child.communicate()
         time.sleep(0.02)
     child.send_signal(signal.SIGINT)
-    stdout, stderr = child.communicate(timeout=120)
+    stdout, stderr = child.communicate(timeout=600)
     assert child.returncode == 130, (stdout, stderr)
     assert "Traceback" not in stderr and "run the same command again to resume" in stderr
     first = _journal_points(out / "rows.jsonl")
@@ -360,7 +363,7 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path):
         fh.write('{"point": 9, "id": "tor')
 
     again = _cli("sweep", str(spec_file), "--workers", "1", "-o", str(out))
-    stdout, stderr = again.communicate(timeout=120)
+    stdout, stderr = again.communicate(timeout=600)
     assert again.returncode == 0, (stdout, stderr)
     assert f"({len(set(first))} done earlier)" in stdout
     points = _journal_points(out / "rows.jsonl")

@@ -22,7 +22,8 @@ from fabricate.templates import parse_toml, shipped_templates
 from tests.toml_writer import toml_text
 
 TEMPLATES = {p.name: p.read_text(encoding="utf-8") for p in shipped_templates()}
-#: A build that validates can still take the whole pipeline (a few seconds to ~20 s on two cores).
+#: A build that validates can still take the whole pipeline (a few seconds to ~20 s of CPU). The bound is on
+#: this process's CPU time: busy cores stretch the wall time of a build, not its CPU time.
 MAX_SECONDS = 120.0
 
 
@@ -97,6 +98,7 @@ def mutated(draw: st.DrawFn) -> str:
     return toml_text(data)
 
 
+@pytest.mark.slow
 @settings(max_examples=30, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(text=mutated())
@@ -104,9 +106,9 @@ def test_mutated_templates_exit_with_a_code_and_no_traceback(text: str, tmp_path
     work = tmp_path_factory.mktemp("fuzz")
     template = Path(work) / "mutated.toml"
     template.write_text(text, encoding="utf-8")
-    start = time.perf_counter()
+    start = time.process_time()
     code = main(["build", str(template), "-o", str(Path(work) / "out"), "-q"])
-    elapsed = time.perf_counter() - start
+    elapsed = time.process_time() - start
     captured = capsys.readouterr()
     assert code in (0, 1, 2), captured.err
     assert "Traceback" not in captured.out + captured.err

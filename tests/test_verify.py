@@ -29,9 +29,9 @@ FAST = "gear_pair_elliptic"
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory) -> Path:
+def built(tmp_path_factory, shipped_build) -> Path:
     out = tmp_path_factory.mktemp("built") / FAST
-    outcome = run_build(load_design(FAST))
+    outcome = shipped_build(FAST)
     assert outcome.exit_code == 0
     write_output(outcome.files, out)
     return out
@@ -103,6 +103,7 @@ def _report(directory: Path) -> dict:
     return json.loads((directory / "report.json").read_text())
 
 
+@pytest.mark.slow
 def test_an_untouched_output_passes(copy, capsys):
     code, out = _check(copy, capsys)
     assert code == 0, out
@@ -225,6 +226,7 @@ TAMPERINGS: dict[str, Callable[[Path], str]] = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(TAMPERINGS))
 def test_tampering_is_caught_and_named(copy, capsys, name):
     needle = TAMPERINGS[name](copy)
@@ -233,6 +235,7 @@ def test_tampering_is_caught_and_named(copy, capsys, name):
     assert needle in out, out
 
 
+@pytest.mark.slow
 def test_a_broken_report_is_named(copy, capsys):
     (copy / "report.json").write_text("{ not json")
     code, out = _check(copy, capsys)
@@ -244,6 +247,7 @@ def test_a_folder_without_a_report_is_a_usage_error(tmp_path, capsys):
     assert "not a fabricate output folder" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_the_verdict_depends_neither_on_the_folder_nor_on_later_edits(tmp_path, monkeypatch, capsys):
     designs = tmp_path / "designs"
     designs.mkdir()
@@ -260,6 +264,7 @@ def test_the_verdict_depends_neither_on_the_folder_nor_on_later_edits(tmp_path, 
     assert code == 0, out
 
 
+@pytest.mark.slow
 def test_manifest_sizes_and_hashes_are_those_on_disk(built):
     import hashlib
 
@@ -294,6 +299,7 @@ def _laser_copy(laser_built: Path, tmp_path: Path) -> Path:
     return target
 
 
+@pytest.mark.slow
 def test_a_laser_output_passes_and_its_cut_files_are_verified(laser_built, tmp_path, capsys):
     copy = _laser_copy(laser_built, tmp_path)
     assert (copy / "cut" / "sheet_1.svg").is_file() and not (copy / "plates").exists()
@@ -306,6 +312,7 @@ def test_a_laser_output_passes_and_its_cut_files_are_verified(laser_built, tmp_p
     assert "cut/sheet_1.svg: not readable SVG" in out and "cut/gear_a.dxf: cut holes" in out
 
 
+@pytest.mark.slow
 def test_a_tampered_step_solid_is_named(copy, capsys):
     pytest.importorskip("OCP")
     path = copy / "parts" / "gear_a.step"
@@ -323,6 +330,7 @@ def test_a_tampered_step_solid_is_named(copy, capsys):
     assert "not compared with a rebuild" in out and "differs from a rebuild" not in out
 
 
+@pytest.mark.slow
 def test_without_ocp_a_build_says_step_was_skipped(tmp_path, monkeypatch, capsys):
     import fabricate.export.step as step
 
@@ -361,6 +369,7 @@ def _fabricate_peak_mb(*args: str) -> tuple[int, str, float]:
     return int(code), output, float(peak)
 
 
+@pytest.mark.slow
 def test_a_2gb_sparse_file_is_named_by_its_size_and_never_read(copy):
     listed = {m["path"]: m["bytes"] for m in _report(copy)["manifest"]}
     with open(copy / "motion.csv", "r+b") as fh:
@@ -401,6 +410,7 @@ def _forge_manifest(folder: Path, rel: str, data: bytes, drop_step: bool = False
     (folder / "report.json").write_text(json.dumps(report, indent=2))
 
 
+@pytest.mark.slow
 def test_a_zip_bomb_3mf_is_rejected_without_inflating(copy, tmp_path):
     bomb = _zip_bomb(256)
     assert len(bomb) < 300_000  # the issue's 262 kB bomb: 256 MB of model
@@ -418,6 +428,7 @@ def test_a_zip_bomb_3mf_is_rejected_without_inflating(copy, tmp_path):
     assert peak < REJECT_PEAK_MB, f"{peak:.0f} MB"
 
 
+@pytest.mark.slow
 def test_a_zip_bomb_within_the_manifest_size_is_never_inflated(copy, capsys, monkeypatch):
     import fabricate.export.stl as stl
 
@@ -435,6 +446,7 @@ def test_a_zip_bomb_within_the_manifest_size_is_never_inflated(copy, capsys, mon
     assert True not in inflated
 
 
+@pytest.mark.slow
 def test_a_3mf_with_another_compression_method_is_not_inflated(copy, capsys):
     buffer = io.BytesIO()
     with zipfile.ZipFile(buffer, "w", zipfile.ZIP_BZIP2) as archive:  # bzip2 chunks inflate whole
@@ -444,6 +456,7 @@ def test_a_3mf_with_another_compression_method_is_not_inflated(copy, capsys):
     assert code == 1 and "plates/plate_1.3mf: member '3D/3dmodel.model' is compressed with method 12" in out
 
 
+@pytest.mark.slow
 def test_an_image_declaring_too_many_pixels_is_not_decoded(copy, capsys):
     from PIL import Image
 
@@ -465,6 +478,7 @@ def _outside_copy(copy: Path, rel: str) -> Path:
     return target
 
 
+@pytest.mark.slow
 def test_a_symlink_is_never_followed_even_to_identical_bytes(copy, capsys):
     target = _outside_copy(copy, "bom.csv")
     (copy / "bom.csv").unlink()
@@ -474,6 +488,7 @@ def test_a_symlink_is_never_followed_even_to_identical_bytes(copy, capsys):
     assert f"bom.csv: is a symbolic link to '{target}', not a regular file (check follows no links)" in out
 
 
+@pytest.mark.slow
 def test_a_symlinked_folder_on_the_path_is_never_followed(copy, capsys):
     outside = copy.parent / "elsewhere_parts"
     shutil.copytree(copy / "parts", outside)
@@ -485,6 +500,7 @@ def test_a_symlinked_folder_on_the_path_is_never_followed(copy, capsys):
     assert "parts: not written by fabricate" in out
 
 
+@pytest.mark.slow
 def test_a_folder_in_place_of_a_file_is_named(copy, capsys):
     (copy / "assembly.csv").unlink()
     (copy / "assembly.csv").mkdir()
@@ -492,6 +508,7 @@ def test_a_folder_in_place_of_a_file_is_named(copy, capsys):
     assert code == 1 and "assembly.csv: is a folder, not a regular file" in out
 
 
+@pytest.mark.slow
 def test_a_socket_in_place_of_a_file_is_never_opened(copy, capsys, monkeypatch):
     import socket
 
@@ -505,6 +522,7 @@ def test_a_socket_in_place_of_a_file_is_never_opened(copy, capsys, monkeypatch):
     assert code == 1 and "assembly.csv: is a socket, not a regular file" in out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rel", ["motion.csv", "report.json"])
 def test_a_fifo_is_never_opened(copy, rel):
     if not hasattr(os, "mkfifo"):
@@ -518,6 +536,7 @@ def test_a_fifo_is_never_opened(copy, rel):
     assert "Traceback" not in done.stdout + done.stderr
 
 
+@pytest.mark.slow
 def test_a_symlinked_report_is_never_followed(copy, capsys):
     target = _outside_copy(copy, "report.json")
     (copy / "report.json").unlink()
@@ -529,6 +548,7 @@ def test_a_symlinked_report_is_never_followed(copy, capsys):
 # --- report.json: bounded, then validated against its schema (issue 23, items 3 and 6) ---------------------
 
 
+@pytest.mark.slow
 def test_a_huge_report_is_not_read(copy, capsys):
     from fabricate.verify import REPORT_MAX_BYTES
 
@@ -544,6 +564,7 @@ def _edit_report(folder: Path, edit: Callable[[dict], None]) -> None:
     (folder / "report.json").write_text(json.dumps(report, indent=2))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("edit", "message"), [
     (lambda r: r["parts"][1].update(holes="4 holes"), "report.json: parts[1].holes is not a list (it is a string)"),
     (lambda r: r["parts"][0]["holes"][0].update(diameter_mm=None), "parts[0].holes[0].diameter_mm is not a number"),
@@ -570,6 +591,7 @@ def test_a_report_of_the_wrong_shape_is_named_before_it_is_read(copy, capsys, ed
     assert message in out, out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("text", "message"), [
     ('{"design": {"name": NaN}}', "not valid JSON (NaN is not JSON)"),
     ("[" * 100_000 + "]" * 100_000, "not valid JSON (nested too deeply)"),
@@ -624,6 +646,7 @@ def _quick_design(path: Path):
         design.checks, sweep_poses=min(design.checks.sweep_poses, 24)))
 
 
+@pytest.mark.slow
 def test_every_shipped_template_writes_a_report_that_matches_its_schema(monkeypatch):
     import fabricate.pipeline as pipeline
     from fabricate.report_schema import schema_errors
@@ -708,6 +731,7 @@ def _reads_only_schema_keys(report, metrics) -> None:
             metrics["finger_five_bar_ncg"][metric.name] = cut
 
 
+@pytest.mark.slow
 def test_check_reads_only_what_the_schema_names(copy, laser_built, tmp_path, capsys):
     """A folder whose report.json holds only the schema's keys passes every check but the rebuild's byte
     comparison of report.json itself: the manifest, every file's contents and the rebuild read nothing else."""
@@ -721,6 +745,7 @@ def test_check_reads_only_what_the_schema_names(copy, laser_built, tmp_path, cap
             "  - report.json: differs from a rebuild of the embedded template"], out
 
 
+@pytest.mark.slow
 def test_the_full_builds_match_the_schema_too(built, laser_built):
     from fabricate.report_schema import schema_errors
 
@@ -747,6 +772,7 @@ def built_without_cad(tmp_path_factory) -> Path:
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("built_with", ["cad", "no_cad"], ids=["built_with_cad", "built_without"])
 @pytest.mark.parametrize("checked_with", ["cad", "no_cad"], ids=["checked_with_cad", "checked_without"])
 def test_check_gives_the_same_verdict_on_any_install(built, built_without_cad, tmp_path, monkeypatch, capsys,
