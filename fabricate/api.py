@@ -20,11 +20,14 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fabricate.errors import SpecError
 from fabricate.pipeline import BuildOutcome, path_argument, type_name
 from fabricate.spec import DesignSpec, check_design_name
+
+if TYPE_CHECKING:
+    from fabricate.mechanism import Mechanism
 
 #: What :func:`build` returns: the pipeline's own result type (:class:`fabricate.pipeline.BuildOutcome`),
 #: under the API's name. ``.passed``, ``.failures``, ``.not_checked``, ``.report``, ``.files``, ``.design`` and
@@ -72,7 +75,7 @@ def load(template: str | Path | Mapping[str, Any], process: str | Path | None = 
     return load_design(path_argument(template, "template", "a template name or path"), process)
 
 
-def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | None = None,
+def from_mechanism(mechanism: Mechanism, *, process: str = "sla", tip_point: str | None = None,
                    pads: Mapping[str, Mapping[str, Any]] | None = None,
                    tables: Mapping[str, Any] | None = None) -> DesignSpec:
     """A design from a :class:`~fabricate.mechanism.Mechanism` built in code.
@@ -147,7 +150,7 @@ def from_mechanism(mechanism: Any, *, process: str = "sla", tip_point: str | Non
     return load(template)
 
 
-def _check_assembly(mechanism: Any) -> None:
+def _check_assembly(mechanism: Mechanism) -> None:
     """Every moving body has a first-pose guess of three finite numbers, else a :class:`SpecError` saying
     what to pass (the pose solver has no other way to know which assembly branch is meant)."""
     import math

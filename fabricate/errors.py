@@ -28,7 +28,8 @@ class SpecError(FabricateError, ValueError):
         self.message = message
         super().__init__(f"{path}: {message}" if path else message)
 
-    def __reduce__(self):  # a sweep's worker sends errors across processes: rebuild from both arguments
+    def __reduce__(self) -> tuple[type[SpecError], tuple[str, str]]:
+        # a sweep's worker sends errors across processes: rebuild from both arguments
         return (type(self), (self.path, self.message))
 
 
@@ -52,7 +53,7 @@ class LockupError(FabricateError):
         self.message = message
         super().__init__(f"{message} (at input {input_value:.6g})")
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[type[LockupError], tuple[float, str]]:
         return (type(self), (self.input_value, self.message))
 
 

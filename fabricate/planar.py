@@ -27,7 +27,8 @@ def perp(v: np.ndarray) -> np.ndarray:
 
 def cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """z-component of the cross product of 2D vectors."""
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    z: np.ndarray = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return z
 
 
 def transform_points(pose: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -41,13 +42,15 @@ def transform_points(pose: np.ndarray, points: np.ndarray) -> np.ndarray:
         Points in body coordinates, mm.
     """
     pose = np.asarray(pose, dtype=np.float64)
-    return np.asarray(points, dtype=np.float64) @ rotation(pose[2]).T + pose[:2]
+    world: np.ndarray = np.asarray(points, dtype=np.float64) @ rotation(pose[2]).T + pose[:2]
+    return world
 
 
 def inverse_transform_points(pose: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Map world points into the frame of a body at ``pose`` (inverse of :func:`transform_points`)."""
     pose = np.asarray(pose, dtype=np.float64)
-    return (np.asarray(points, dtype=np.float64) - pose[:2]) @ rotation(pose[2])
+    local: np.ndarray = (np.asarray(points, dtype=np.float64) - pose[:2]) @ rotation(pose[2])
+    return local
 
 
 def pose_matrix(pose: np.ndarray) -> np.ndarray:

@@ -322,8 +322,9 @@ def _manifest(report: Mapping[str, Any]) -> tuple[dict[str, dict[str, Any]], lis
         rel = item.get("path") if isinstance(item, dict) else None
         pure = PurePosixPath(rel) if isinstance(rel, str) else None
         # the schema admits only relative paths, sizes and hashes; this guard keeps it so for any caller
-        if pure is None or pure.is_absolute() or ".." in pure.parts or not isinstance(item.get("sha256"), str) \
-                or not isinstance(item.get("bytes"), int) or isinstance(item.get("bytes"), bool):
+        if not isinstance(rel, str) or pure is None or pure.is_absolute() or ".." in pure.parts \
+                or not isinstance(item.get("sha256"), str) or not isinstance(item.get("bytes"), int) \
+                or isinstance(item.get("bytes"), bool):
             problems.append(f"{REPORT}: malformed manifest entry for {_short(rel)}")
             continue
         entries[rel] = item
@@ -342,7 +343,7 @@ def _expected_by_file(report: Mapping[str, Any]) -> dict[str, Any]:
     sheets: dict[int, list[float]] = {}
     for part in parts:
         volume = part.get("stl_volume_mm3")
-        holes = [h for h in part.get("holes", []) if isinstance(h, dict)]
+        holes: list[dict[str, Any]] = [h for h in part.get("holes", []) if isinstance(h, dict)]
         finished = sorted(float(h.get("diameter_mm", 0.0)) for h in holes)
         cut = sorted(float(h.get("cut_diameter_mm", h.get("diameter_mm", 0.0))) for h in holes)
         if isinstance(part.get("stl"), str) and isinstance(volume, (int, float)):
@@ -352,14 +353,14 @@ def _expected_by_file(report: Mapping[str, Any]) -> dict[str, Any]:
         if isinstance(part.get("cut_dxf"), str):
             expected[part["cut_dxf"]] = cut
         copies = int(part.get("copies", 1) or 1)
-        for key, target in (("plate", plates), ("sheet", sheets)):
+        for key in ("plate", "sheet"):
             indices = part.get(key, {}).get("index", []) if isinstance(part.get(key), dict) else []
             for k, number in enumerate(indices if isinstance(indices, list) else []):
                 name = copy_name(part["name"], k, copies)
                 if key == "plate":
-                    target.setdefault(number, []).append((name, float(volume or 0.0)))
+                    plates.setdefault(number, []).append((name, float(volume or 0.0)))
                 else:
-                    target.setdefault(number, []).extend(cut)
+                    sheets.setdefault(number, []).extend(cut)
     for number, items in plates.items():
         expected[f"plates/plate_{number}.stl"] = sum(v for _, v in items)
         expected[f"plates/plate_{number}.3mf"] = dict(items)
@@ -631,6 +632,7 @@ def _rebuild(folder: OutputFolder, report: Mapping[str, Any], raw: bytes, progre
         if rel not in outcome.files:
             problems.append(f"{rel}: a rebuild of the embedded template does not write it")
             continue
+        same: bool | None
         if rel == REPORT:
             same, why = raw == outcome.files[REPORT], ""
         else:
@@ -686,7 +688,8 @@ def verify_output(directory: str | Path, progress: Callable[[str], None] = lambd
             return problems, None
         progress("files")
         problems += _check_files(folder, report, notes)
-        rebuilt, fresh = [], None
+        rebuilt: list[str] = []
+        fresh: dict[str, Any] | None = None
         if problems:  # the verdict is given: a rebuild (seconds to a minute) would only repeat it per file
             notes.append("not compared with a rebuild: the files already differ from what fabricate wrote")
         else:

@@ -102,7 +102,8 @@ class Outline:
         ring_id = np.repeat(np.arange(len(self.rings)), counts)
         rings = shapely.linearrings(coords, indices=(np.arange(n)[:, None] * len(self.rings)
                                                      + ring_id[None, :]).ravel())
-        return shapely.polygons(rings, indices=np.repeat(np.arange(n), len(self.rings)))
+        polygons: np.ndarray = shapely.polygons(rings, indices=np.repeat(np.arange(n), len(self.rings)))
+        return polygons
 
 
 def _clean_ring(ring: np.ndarray) -> np.ndarray:

@@ -449,7 +449,7 @@ def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
 
 
 def _sweep_pair(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, pose_a: np.ndarray, pose_b: np.ndarray,
-                relation: str, required: float, search: float, solids: dict | None,
+                relation: str, required: float, search: float, solids: dict[str, Any] | None,
                 tol: float) -> PairResult:
     n = len(pose_a)
     z_gap = max(a.z0, b.z0) - min(a.z1, b.z1)

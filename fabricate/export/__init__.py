@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import csv
 import io
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -30,6 +31,12 @@ from fabricate.export.layout import Placement, fits
 
 if TYPE_CHECKING:  # ezdxf loads with fabricate.export.dxf: only when a DXF is made
     from fabricate.export.dxf import DxfStyle
+    from fabricate.export.stl import SolidCache
+    from fabricate.mechanism import Mechanism, Motion
+    from fabricate.parts.assembly import PinStack
+    from fabricate.parts.build import PartSet
+    from fabricate.parts.model import Part
+    from fabricate.spec import DesignSpec
 
 #: bom.csv's leading columns; any other key of the report's BOM rows follows, sorted by name.
 BOM_COLUMNS = ("item", "kind", "qty", "process", "material", "thickness_mm", "volume_mm3", "mass_g",
@@ -50,7 +57,7 @@ def _bom_csv(rows: list[dict[str, Any]]) -> bytes:
     return buffer.getvalue().encode("utf-8")
 
 
-def assembly_csv(stacks: list[Any]) -> bytes:
+def assembly_csv(stacks: list[PinStack]) -> bytes:
     """assembly.csv: one row per item on a pin, bottom to top (pin, position, item, kind, z in mm)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
@@ -63,7 +70,7 @@ def assembly_csv(stacks: list[Any]) -> bytes:
     return buffer.getvalue().encode("utf-8")
 
 
-def motion_csv(mechanism: Any, motion: Any) -> bytes:
+def motion_csv(mechanism: Mechanism, motion: Motion) -> bytes:
     """motion.csv: column ``input`` (the mechanism's input unit), then ``NAME_x``, ``NAME_y`` (mm, world) of
     every named point in body order, one row per swept pose. A point shared by several bodies (a joint) is
     taken from its first body; the solver holds the others on it to 1e-12 mm."""
@@ -78,7 +85,7 @@ def motion_csv(mechanism: Any, motion: Any) -> bytes:
     return buffer.getvalue().encode("utf-8")
 
 
-def export_all(design: Any, partset: Any, mechanism: Any, motion: Any, previews: bool = True,
+def export_all(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motion: Motion, previews: bool = True,
                step: bool = True, with_step: bool | None = None) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
     """Every export of a part set.
 
@@ -189,7 +196,7 @@ class _Making:
     colours: tuple[str, str]
 
     @classmethod
-    def of(cls, design: Any, partset: Any) -> _Making:
+    def of(cls, design: DesignSpec, partset: PartSet) -> _Making:
         from fabricate.export.dxf import DxfStyle
 
         process, spec = design.process, design.parts
@@ -203,7 +210,7 @@ class _Making:
                    colours=(process.cut_colour, process.engrave_colour))
 
 
-def _lay_out(made: list[Any], making: _Making, cache: Any) -> list[Placement]:
+def _lay_out(made: list[Part], making: _Making, cache: SolidCache) -> list[Placement]:
     """Where every made part goes: nested on sheets (by its cut outline), or laid out on print plates."""
     if making.sheets:
         from fabricate.export.dxf import sheet_layout
@@ -214,7 +221,7 @@ def _lay_out(made: list[Any], making: _Making, cache: Any) -> list[Placement]:
     return plate_layout(made, cache, making.area_mm, making.margin_mm)
 
 
-def _part_files(part: Any, making: _Making, cache: Any) -> tuple[dict[str, bytes], list[str], float]:
+def _part_files(part: Part, making: _Making, cache: SolidCache) -> tuple[dict[str, bytes], list[str], float]:
     """A part's own files: its STL, its DXF at finished size (for CAD) and, for a cut process, its cut path.
 
     Returns
@@ -242,8 +249,8 @@ def _part_files(part: Any, making: _Making, cache: Any) -> tuple[dict[str, bytes
     return files, problems, mesh_volume(vertices, faces)
 
 
-def _part_entry(part: Any, problems: list[str], stl_volume: float, placed: list[Placement], making: _Making,
-                with_step: bool, warnings: Any) -> dict[str, Any]:
+def _part_entry(part: Part, problems: list[str], stl_volume: float, placed: list[Placement], making: _Making,
+                with_step: bool, warnings: Sequence[str]) -> dict[str, Any]:
     """A part's entry in the report's ``parts`` (see :func:`export_all`); ``placed``: where its copies went."""
     kerf = making.kerf_mm
     cut_dxf, cut_svg = (f"cut/{part.name}.dxf", f"cut/{part.name}.svg") if making.cut else (None, None)
@@ -266,7 +273,7 @@ def _part_entry(part: Any, problems: list[str], stl_volume: float, placed: list[
     }
 
 
-def _layout_files(made: list[Any], placements: list[Placement], making: _Making, cache: Any,
+def _layout_files(made: list[Part], placements: list[Placement], making: _Making, cache: SolidCache,
                   title: str) -> dict[str, bytes]:
     """One file pair per sheet (cut DXF and SVG) or per print plate (STL and 3MF, each copy named)."""
     from fabricate.export.dxf import sheet_dxf
@@ -299,7 +306,7 @@ def copy_name(name: str, index: int, copies: int) -> str:
     return name if copies == 1 else f"{name} ({index + 1} of {copies})"
 
 
-def export_step(design: Any, partset: Any, motion: Any) -> dict[str, bytes]:
+def export_step(design: DesignSpec, partset: PartSet, motion: Motion) -> dict[str, bytes]:
     """``parts/NAME.step`` and ``assembly.step`` (B-rep solids, first pose); empty without OCP."""
     from fabricate.export.step import step_available, step_files
 
@@ -312,7 +319,7 @@ def export_step(design: Any, partset: Any, motion: Any) -> dict[str, bytes]:
 STEP_SKIPPED = "STEP skipped: OCP is not installed (pip install 'fabricate[cad]' for parts/*.step and assembly.step)"
 
 
-def export_previews(design: Any, partset: Any, motion: Any) -> dict[str, bytes]:
+def export_previews(design: DesignSpec, partset: PartSet, motion: Motion) -> dict[str, bytes]:
     """The assembly at several poses (PNG) and its motion (GIF), keyed by relative path."""
     from fabricate.export.previews import assembly_png, exploded_png, motion_gif
     from fabricate.parts.assembly import pin_stacks

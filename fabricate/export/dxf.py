@@ -16,7 +16,7 @@ import io
 from collections import OrderedDict
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import ezdxf
 import numpy as np
@@ -28,6 +28,9 @@ from fabricate.export.layout import Placement, shelf_pack
 from fabricate.parts.model import BulgePath, Part
 from fabricate.parts.profiles import offset_path
 from fabricate.planar import transform_points
+
+if TYPE_CHECKING:
+    from fabricate.mechanism import Mechanism
 
 #: Smallest text in a drawing (mm): ISO 3098 / ASME Y14.2 ask for at least 2.5 mm on printed drawings.
 MIN_DRAWING_TEXT_MM = 2.5
@@ -198,7 +201,7 @@ def sheet_dxf(parts: Sequence[Part], kerf_mm: float, placements: Sequence[Placem
     return document_bytes(doc)
 
 
-def kinematic_dxf(mechanism: Any, poses: Mapping[str, np.ndarray]) -> bytes:
+def kinematic_dxf(mechanism: Mechanism, poses: Mapping[str, np.ndarray]) -> bytes:
     """Kinematic drawing at one pose: joints, link centre lines, link-length and joint-coordinate dimensions.
 
     Parameters

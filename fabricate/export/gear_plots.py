@@ -6,7 +6,6 @@ Gears are drawn in the carrier frame: axis A at the origin, axis B at ``(a, 0)``
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -15,6 +14,7 @@ from fabricate.plotting import figure, gif_bytes, png_bytes
 
 if TYPE_CHECKING:
     from fabricate.gears.pair import GearPair
+    from fabricate.mechanism import Law
 
 
 def _figure(size: tuple[float, float] = (6.0, 4.0), dpi: int = 100) -> tuple[Any, Any]:
@@ -115,7 +115,7 @@ def pair_gif(pair: GearPair, frames: int, size_px: int = 384, frame_ms: int = 80
     return gif_bytes(images, frame_ms, optimize=False, disposal=1)
 
 
-def law_png(law: Callable, working_range: tuple[float, float], center_distance_mm: float) -> bytes:
+def law_png(law: Law, working_range: tuple[float, float], center_distance_mm: float) -> bytes:
     """The ratio law: driven against driving angle, and the transmission ratio."""
     lo, hi = working_range
     x = np.linspace(lo, hi, 400)

@@ -40,7 +40,8 @@ class Placement:
 
     def apply(self, points: np.ndarray) -> np.ndarray:
         """Map part points (n, 2) onto the plate / sheet."""
-        return np.asarray(points, dtype=np.float64) @ rotation(self.angle).T + self.offset
+        placed: np.ndarray = np.asarray(points, dtype=np.float64) @ rotation(self.angle).T + self.offset
+        return placed
 
 
 def best_angle(points: np.ndarray, steps: int = 180) -> float:

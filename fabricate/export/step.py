@@ -547,7 +547,7 @@ def _label_name(label: Any) -> str:
 
     attribute = TDataStd_Name()
     if label.FindAttribute(TDataStd_Name.GetID_s(), attribute):
-        return attribute.Get().ToExtString()
+        return str(attribute.Get().ToExtString())
     return ""
 
 

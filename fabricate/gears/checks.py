@@ -74,7 +74,8 @@ def local_contact_ratio(pitch: PitchCurves, x: np.ndarray, module: float, spec: 
         r = rho[finite]
         part[finite] = np.sqrt((r + ha) ** 2 - (r * np.cos(alpha)) ** 2) - r * np.sin(alpha)
         total += part
-    return total / (np.pi * module * np.cos(alpha))
+    ratio: np.ndarray = total / (np.pi * module * np.cos(alpha))
+    return ratio
 
 
 def pressure_angle_range_deg(pitch: PitchCurves, x: np.ndarray, spec: GearSpec) -> dict[str, list[float]]:

@@ -17,11 +17,15 @@ import ast
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
 from fabricate.errors import SpecError
+
+if TYPE_CHECKING:
+    from fabricate.mechanism import Law
 
 #: Functions a formula may call (all analytic, so the complex step differentiates them exactly).
 FUNCTIONS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
@@ -158,7 +162,7 @@ def samples_law(x_a: np.ndarray, x_b: np.ndarray, path: str = "law_samples") -> 
     return CubicSpline(x_a, x_b)
 
 
-def law_derivative(law: Callable, x: np.ndarray, nu: int) -> np.ndarray:
+def law_derivative(law: Law, x: np.ndarray, nu: int) -> np.ndarray:
     """``law(x, nu)`` as a float array; falls back to central differences of ``nu-1`` when the law
     does not provide that derivative (e.g. ``nu=3`` of a user callable)."""
     x = np.asarray(x, dtype=np.float64)
@@ -169,10 +173,11 @@ def law_derivative(law: Callable, x: np.ndarray, nu: int) -> np.ndarray:
     except (TypeError, ValueError):
         pass
     h = 1e-4
-    return (law_derivative(law, x + h, nu - 1) - law_derivative(law, x - h, nu - 1)) / (2 * h)
+    central: np.ndarray = (law_derivative(law, x + h, nu - 1) - law_derivative(law, x - h, nu - 1)) / (2 * h)
+    return central
 
 
-def check_ratio(law: Callable, x: np.ndarray, path: str = "law") -> np.ndarray:
+def check_ratio(law: Law, x: np.ndarray, path: str = "law") -> np.ndarray:
     """Transmission ratio ``i = -law'(x)`` on ``x``; raises when it is not finite or not positive.
 
     Raises

@@ -12,7 +12,6 @@ with the centre distance fixed the module follows (``m = perimeter_a / (pi z_a)`
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -36,7 +35,7 @@ from fabricate.gears.spec import GearSpec
 from fabricate.gears.teeth import GearTeeth, cut_gear
 
 if TYPE_CHECKING:
-    from fabricate.mechanism import Mechanism
+    from fabricate.mechanism import Law, Mechanism
 
 #: Default module of a sector when the template leaves it open (SLA-sized), mm.
 DEFAULT_SECTOR_MODULE_MM = 0.5
@@ -91,7 +90,7 @@ class GearPair:
     method: str
     closed: bool
     working_range: tuple[float, float]
-    law: Callable
+    law: Law
     outline_a: np.ndarray
     outline_b: np.ndarray
     pitch_a: np.ndarray
@@ -184,7 +183,7 @@ def _finite(value: float) -> float | None:
     return float(value) if np.isfinite(value) else None
 
 
-def _range(values: np.ndarray) -> list[float]:
+def _range(values: np.ndarray | float) -> list[float]:
     return [float(np.min(values)), float(np.max(values))]
 
 
@@ -207,7 +206,7 @@ def _check_teeth(z_a: int, z_b: int, module: float, spec: GearSpec) -> None:
                         f"at most {max(720, MAX_MESH_STEP_TEETH // (z_a + z_b))} steps")
 
 
-def _closed_teeth(law: Callable, x0: float, spec: GearSpec, center_distance: float) -> tuple[int, int]:
+def _closed_teeth(law: Law, x0: float, spec: GearSpec, center_distance: float) -> tuple[int, int]:
     """Tooth counts of a closed pair from the template (teeth or module) and the law's closure."""
     turns = -(float(law(x0 + TWO_PI)) - float(law(x0))) / TWO_PI
     if not np.isfinite(turns) or turns <= 0:
@@ -290,7 +289,7 @@ class _Cut:
     b: GearTeeth
 
 
-def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tuple[float, float],
+def make_gear_pair(law: Law, center_distance_mm: float, working_range: tuple[float, float],
                    spec: GearSpec, *, closed: bool, name: str = "pair", chord_tolerance_mm: float = 0.005,
                    coupling: str = "", carrier: str = "", body_a: str = "gear_a", body_b: str = "gear_b",
                    axis_a: str = "", axis_b: str = "", run_mesh_check: bool = True) -> GearPair:
@@ -339,7 +338,7 @@ def make_gear_pair(law: Callable, center_distance_mm: float, working_range: tupl
     return pair
 
 
-def _check_request(law: Callable, lo: float, hi: float, a: float, working_range: tuple[float, float],
+def _check_request(law: Law, lo: float, hi: float, a: float, working_range: tuple[float, float],
                    spec: GearSpec, name: str) -> None:
     """Refuse a range, centre distance, law or module no pair can be cut for, naming the field."""
     if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
@@ -352,7 +351,7 @@ def _check_request(law: Callable, lo: float, hi: float, a: float, working_range:
         check_feasible(curvature_summary(_Bare(law, a), np.linspace(lo, hi, 721)), spec.module_mm, spec)
 
 
-def _closed_layout(law: Callable, lo: float, a: float, spec: GearSpec, name: str) -> _Layout:
+def _closed_layout(law: Law, lo: float, a: float, spec: GearSpec, name: str) -> _Layout:
     """Closed gears: whole numbers of teeth on both perimeters, the module following from gear a's."""
     z_a, z_b = _closed_teeth(law, lo, spec, a)
     periods = (TWO_PI, TWO_PI * z_b / z_a)
@@ -376,7 +375,7 @@ def _closed_layout(law: Callable, lo: float, a: float, spec: GearSpec, name: str
     return _Layout(pitch, module, centres_a, centres_b, x_cover, periods)
 
 
-def _sector_layout(law: Callable, lo: float, hi: float, a: float, spec: GearSpec, name: str) -> _Layout:
+def _sector_layout(law: Law, lo: float, hi: float, a: float, spec: GearSpec, name: str) -> _Layout:
     """Sectors: every tooth that engages within the working range plus ``spare_teeth`` at each end, on pitch
     curves extended beyond the range far enough to hold them."""
     if spec.teeth is not None:
@@ -448,7 +447,7 @@ def _method_deviation_um(layout: _Layout, spec: GearSpec, cut: _Cut) -> float | 
     return float(max(dev))
 
 
-def _pair_checks(law: Callable, lo: float, hi: float, layout: _Layout, spec: GearSpec, curv: dict[str, Any],
+def _pair_checks(law: Law, lo: float, hi: float, layout: _Layout, spec: GearSpec, curv: dict[str, Any],
                  cut: _Cut, deviation: float | None) -> dict[str, Any]:
     """The boolean-free checks over the working range (:attr:`GearPair.checks`)."""
     module, pitch, cut_a, cut_b = layout.module, layout.pitch, cut.a, cut.b
@@ -490,7 +489,7 @@ def _pitch_outlines(layout: _Layout, lo: float, closed: bool) -> tuple[np.ndarra
 class _Bare(PitchCurves):
     """Radii only (no arc-length table), for sizing the extended domain."""
 
-    def __init__(self, law: Callable, center_distance: float) -> None:  # noqa: D107
+    def __init__(self, law: Law, center_distance: float) -> None:  # noqa: D107
         self.law = law
         self.a = float(center_distance)
 

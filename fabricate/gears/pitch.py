@@ -16,11 +16,15 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
 from fabricate.gears.law import check_ratio, law_derivative
+
+if TYPE_CHECKING:
+    from fabricate.mechanism import Law
 
 # 8-point Gauss-Legendre rule on [0, 1]: arc length to ~1e-14 relative per grid interval
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
@@ -59,7 +63,7 @@ class PitchCurves:
         Quadrature grid size.
     """
 
-    def __init__(self, law: Callable, center_distance: float, x_domain: tuple[float, float],
+    def __init__(self, law: Law, center_distance: float, x_domain: tuple[float, float],
                  x_ref: float = 0.0, periods: tuple[float, float] | None = None,
                  intervals: int = 2048) -> None:
         self.law = law
@@ -77,7 +81,8 @@ class PitchCurves:
         self.s_nodes = cumulative - self.s_of_x(np.array([self.x_ref]))[0]
         # x(s) as a cubic Hermite spline with the exact slope 1/speed at the nodes: interpolation
         # error ~ h^4 max|x''''| / 384, about 1e-13 rad for the default grid (no Newton steps needed)
-        self._x_of_s = CubicHermiteSpline(self.s_nodes, self.nodes, 1.0 / self.speed(self.nodes))
+        self._x_of_s: Callable[[np.ndarray], np.ndarray] = CubicHermiteSpline(self.s_nodes, self.nodes,
+                                                                              1.0 / self.speed(self.nodes))
         if periods is not None:
             self.perimeter_a = float(self.s_of_x(np.array([self.x_ref + periods[0]]))[0])
             self.perimeter_b = float(self.s_of_x(np.array([self.x_ref + periods[1]]))[0])
@@ -97,7 +102,8 @@ class PitchCurves:
     def speed(self, x: np.ndarray) -> np.ndarray:
         """``ds/dx_a`` (mm/rad), the same for both gears (rolling without slip)."""
         r, dr, _, _, _ = self.radii(x, "a")
-        return np.hypot(r, dr)
+        speed: np.ndarray = np.hypot(r, dr)
+        return speed
 
     # -- arc length ------------------------------------------------------------------------------
     def s_of_x(self, x: np.ndarray) -> np.ndarray:
@@ -107,7 +113,8 @@ class PitchCurves:
         x0 = self.nodes[k]
         h = x - x0
         xq = x0[..., None] + h[..., None] * _GL_X
-        return self.s_nodes[k] + (self.speed(xq) * _GL_W).sum(axis=-1) * h
+        s: np.ndarray = self.s_nodes[k] + (self.speed(xq) * _GL_W).sum(axis=-1) * h
+        return s
 
     def x_of_s(self, s: np.ndarray) -> np.ndarray:
         """Inverse of :meth:`s_of_x` (Hermite interpolation, see ``__init__``)."""
@@ -118,7 +125,8 @@ class PitchCurves:
         if self.periods is None:
             return np.asarray(s, dtype=np.float64)
         perimeter = self.perimeter_a if gear == "a" else self.perimeter_b
-        return np.mod(s, perimeter)
+        wrapped: np.ndarray = np.mod(s, perimeter)
+        return wrapped
 
     # -- frames ----------------------------------------------------------------------------------
     def frames_at_x(self, x: np.ndarray, gear: str) -> PitchFrames:
@@ -135,7 +143,7 @@ class PitchCurves:
         return r[..., None] * np.stack([np.cos(th), np.sin(th)], -1)
 
 
-def pitch_radii(law: Callable, center_distance: float, x: np.ndarray, gear: str
+def pitch_radii(law: Law, center_distance: float, x: np.ndarray, gear: str
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Polar pitch radius of ``gear`` (``"a"`` or ``"b"``) and its first two x-derivatives, the polar angle
     and its x-derivative, at driving angles ``x`` (rad), from rolling without slip.
@@ -159,7 +167,7 @@ def pitch_radii(law: Callable, center_distance: float, x: np.ndarray, gear: str
     return rb, drb, ddrb, np.pi - np.asarray(law(x), dtype=np.float64), i
 
 
-def pitch_frames(law: Callable, center_distance: float, x: np.ndarray, gear: str) -> PitchFrames:
+def pitch_frames(law: Law, center_distance: float, x: np.ndarray, gear: str) -> PitchFrames:
     """Pitch point, tangent (direction of increasing s), outward normal and curvature (positive where
     the curve is convex) of ``gear`` at driving angles ``x`` (rad)."""
     r, dr, ddr, th, dth = pitch_radii(law, center_distance, x, gear)

@@ -172,13 +172,15 @@ def offset_profile(points: np.ndarray, normals: np.ndarray, delta: float, gear: 
 
 def contact_abscissa(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """Rack abscissa ``s`` of the pitch point when each profile point is in contact, mm."""
-    return points[:, 0] - points[:, 1] * normals[:, 0] / normals[:, 1]
+    s: np.ndarray = points[:, 0] - points[:, 1] * normals[:, 0] / normals[:, 1]
+    return s
 
 
 def envelope(points: np.ndarray, s: np.ndarray, frames: PitchFrames, gear: str) -> np.ndarray:
     """Map rack points in contact at pitch abscissa ``s`` into the gear frame, (n, 2) mm."""
     v = points[:, 1] if gear == "a" else -points[:, 1]
-    return frames.point + (points[:, 0] - s)[:, None] * frames.tangent + v[:, None] * frames.normal
+    mapped: np.ndarray = frames.point + (points[:, 0] - s)[:, None] * frames.tangent + v[:, None] * frames.normal
+    return mapped
 
 
 def osculating_frames(s: np.ndarray, centre_s: np.ndarray, centre: PitchFrames) -> PitchFrames:

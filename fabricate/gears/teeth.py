@@ -116,7 +116,8 @@ def simplify_ring(ring: np.ndarray, tolerance: float) -> np.ndarray:
     first = _douglas_peucker(ring[:far + 1], tolerance)
     second = _douglas_peucker(np.vstack([ring[far:], ring[:1]]), tolerance) + far
     idx = np.concatenate([first, second[1:-1]])
-    return ring[idx]
+    kept: np.ndarray = ring[idx]
+    return kept
 
 
 def circle_points(radius: float, chord_tolerance: float, start: float = 0.0) -> np.ndarray:

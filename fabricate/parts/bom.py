@@ -10,12 +10,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from fabricate.parts.layers import layer_z, skipped_gap, stack_span
 from fabricate.process import Material, ProcessSpec
+
+if TYPE_CHECKING:
+    from fabricate.parts.model import Part
 
 
 @dataclass(frozen=True)
@@ -116,7 +119,7 @@ def pins_and_spacers(pin_joints: Sequence[tuple[str, tuple[str, ...]]], layers: 
 
 def _group(rows: list[dict[str, Any]], key: tuple[str, ...]) -> list[dict[str, Any]]:
     """Merge rows with equal ``key`` fields, summing ``qty`` and collecting ``joints``."""
-    merged: dict[tuple, dict[str, Any]] = {}
+    merged: dict[tuple[Any, ...], dict[str, Any]] = {}
     for row in rows:
         k = tuple(row[f] for f in key)
         if k in merged:
@@ -176,7 +179,7 @@ def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Map
     return rows
 
 
-def part_rows(parts: Sequence[Any], process: ProcessSpec, copies: int = 1) -> list[dict[str, Any]]:
+def part_rows(parts: Sequence[Part], process: ProcessSpec, copies: int = 1) -> list[dict[str, Any]]:
     """One BOM row per printed or cut part: process, material, quantity (all copies), volume and mass.
 
     Mass is the exact volume (profile area x thickness, mm^3) times the profile's density (g/cm^3).

@@ -36,7 +36,7 @@ import math
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
@@ -51,6 +51,10 @@ from fabricate.parts.profiles import circle_hull, fuse_polygons
 from fabricate.parts.spec import PartsSpec
 from fabricate.planar import rotation
 from fabricate.process import ProcessSpec
+
+if TYPE_CHECKING:  # the gears and the design sit above the parts layer
+    from fabricate.gears.pair import GearPair
+    from fabricate.spec import DesignSpec
 
 #: Chord tolerance (mm) of the coarse outlines used only for the layer conflict test.
 CONFLICT_CHORD_MM = 0.05
@@ -170,7 +174,7 @@ def safe_name(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._") or "part"
 
 
-def gear_outline_in_body(mechanism: Mechanism, pair: Any, side: str) -> tuple[str, str, np.ndarray]:
+def gear_outline_in_body(mechanism: Mechanism, pair: GearPair, side: str) -> tuple[str, str, np.ndarray]:
     """A gear outline mapped into the coordinates of the body that carries it.
 
     Parameters
@@ -200,7 +204,7 @@ def gear_outline_in_body(mechanism: Mechanism, pair: Any, side: str) -> tuple[st
     return body, axis, outline @ rotation(beta).T + u_axis
 
 
-def build_parts(design: Any, mechanism: Mechanism, motion: Motion, gear_pairs: Sequence[Any],
+def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_pairs: Sequence[GearPair],
                 hints: Mapping[str, Any] | None = None) -> PartSet:
     """Turn a solved mechanism into parts.
 
@@ -336,7 +340,7 @@ def _add_pads(drawing: _Drawing, mechanism: Mechanism, pads: Mapping[str, Any], 
             drawing.circles[body].append((centre, max(r_pad, radius)))
 
 
-def _add_gears(drawing: _Drawing, mechanism: Mechanism, gear_pairs: Sequence[Any], hub_mm: float,
+def _add_gears(drawing: _Drawing, mechanism: Mechanism, gear_pairs: Sequence[GearPair], hub_mm: float,
                tol: float) -> None:
     """Each gear of each pair, with a hub round its axis, fused to the body that carries it."""
     for pair in gear_pairs:
@@ -373,7 +377,7 @@ def _outlines(drawing: _Drawing, mechanism: Mechanism, motion: Motion, sizes: Si
 
 def _layers(outlines: Mapping[str, BulgePath], holes: Mapping[str, Sequence[Hole]],
             pin_joints: Sequence[tuple[str, tuple[str, ...]]], mechanism: Mechanism, motion: Motion,
-            gear_pairs: Sequence[Any], radius: float, clearance_mm: float) -> dict[str, int]:
+            gear_pairs: Sequence[GearPair], radius: float, clearance_mm: float) -> dict[str, int]:
     """Body name -> layer (see :mod:`fabricate.parts.layers`).
 
     Bodies that come within the clearance of each other anywhere over the motion, or share a pin, get
@@ -402,10 +406,10 @@ def _body_parts(drawing: _Drawing, mechanism: Mechanism, outlines: Mapping[str, 
     for b in mechanism.bodies:
         gears, slots = drawing.gears[b.name], drawing.slots[b.name]
         role = "ground" if b.name == mechanism.ground else ("gear" if gears else ("rod" if slots else "link"))
-        common = dict(name=safe_name(b.name), body=b.name, outline=outlines[b.name],
-                      holes=tuple(drawing.holes[b.name]), thickness_mm=thickness,
-                      z_mm=layer_z(layers[b.name], thickness, gap), layer=layers[b.name],
-                      process=process.name, role=role, gear=",".join(gears))
+        common: dict[str, Any] = dict(name=safe_name(b.name), body=b.name, outline=outlines[b.name],
+                                      holes=tuple(drawing.holes[b.name]), thickness_mm=thickness,
+                                      z_mm=layer_z(layers[b.name], thickness, gap), layer=layers[b.name],
+                                      process=process.name, role=role, gear=",".join(gears))
         parts.append(SlottedPart(**common, slots=tuple(slots)) if slots else Part(**common))
     return parts
 
@@ -516,10 +520,10 @@ def merge_coincident_pins(pin_joints: Sequence[tuple[str, tuple[str, ...]]],
     holes_out: list[tuple[str, str, np.ndarray]] = []
     done: set[tuple[str, str]] = set()
     for name, body, centre in pin_holes:
-        key = (label[find(name)], body)
-        if key not in done:
-            done.add(key)
-            holes_out.append((key[0], body, centre))
+        pin_body = (label[find(name)], body)
+        if pin_body not in done:
+            done.add(pin_body)
+            holes_out.append((pin_body[0], body, centre))
     return [(name, tuple(bodies)) for name, bodies in merged.items()], holes_out
 
 

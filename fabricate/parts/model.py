@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -204,7 +205,7 @@ class Part:
     process: str
     role: str = "link"
     gear: str = ""
-    extra: dict = field(default_factory=dict, compare=False)
+    extra: dict[str, Any] = field(default_factory=dict, compare=False)
 
     def polygons(self, chord_tolerance_mm: float) -> list[np.ndarray]:
         """Outer contour (CCW) then every hole (CW) as polygons, for meshing and booleans."""

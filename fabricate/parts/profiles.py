@@ -155,7 +155,8 @@ def _drop_collinear(ring: np.ndarray, tol: float = 1e-9) -> np.ndarray:
         nxt[:, 0] - prev[:, 0])
     span = np.hypot(nxt[:, 0] - prev[:, 0], nxt[:, 1] - prev[:, 1])
     keep = np.abs(cross) > tol * np.maximum(span, 1e-12)
-    return ring[keep]
+    kept: np.ndarray = ring[keep]
+    return kept
 
 
 def _offset_polygon(path: BulgePath, distance_mm: float) -> BulgePath:

@@ -145,7 +145,8 @@ def _unit_rows(v: np.ndarray) -> np.ndarray:
     good = np.flatnonzero(ok)
     nearest = good[np.clip(np.searchsorted(good, np.arange(len(v))), 0, len(good) - 1)]
     src = np.where(ok, np.arange(len(v)), nearest)
-    return v[src] / norm[src][:, None]
+    unit: np.ndarray = v[src] / norm[src][:, None]
+    return unit
 
 
 def _joint_between(mechanism: Mechanism, a: str, b: str) -> Revolute | None:

@@ -9,6 +9,7 @@ each over the motion.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -19,7 +20,7 @@ from fabricate.errors import GeometryError
 from fabricate.mechanism import Mechanism, Motion, Revolute
 from fabricate.planar import rotation
 from fabricate.strength import models
-from fabricate.strength.section import cut_section, plate_polygon
+from fabricate.strength.section import Section, cut_section, plate_polygon
 from fabricate.strength.statics import Statics
 
 if TYPE_CHECKING:
@@ -69,7 +70,8 @@ class FeatureLoads:
 
 def _on_body_local(force: np.ndarray, pose: np.ndarray) -> np.ndarray:
     """World forces (n, 2) in a body's frame."""
-    return np.einsum("nji,nj->ni", rotation(pose[:, 2]), force)
+    local: np.ndarray = np.einsum("nji,nj->ni", rotation(pose[:, 2]), force)
+    return local
 
 
 def _edge_distances(rings: list[np.ndarray], centre: np.ndarray, radius: float) -> np.ndarray:
@@ -88,7 +90,7 @@ def _edge_distances(rings: list[np.ndarray], centre: np.ndarray, radius: float) 
     return out
 
 
-def _net_section_factors(plate: Any, hole: Any, thickness: float,
+def _net_section_factors(plate: Any, hole: Hole, thickness: float,
                          directions: int = _NET_DIRECTIONS) -> tuple[np.ndarray | None, np.ndarray]:
     """Kt / net area (1/mm²) and Kt of the cut through a pin-loaded hole square to each of ``directions``
     load directions (a load and its opposite share the cut line: half of them are cut).
@@ -112,7 +114,8 @@ def _net_section_factors(plate: Any, hole: Any, thickness: float,
     return factor, kts
 
 
-def _edge_along(values: np.ndarray, directions: np.ndarray, pick: Any = np.minimum) -> np.ndarray:
+def _edge_along(values: np.ndarray, directions: np.ndarray,
+                pick: Callable[[np.ndarray, np.ndarray], np.ndarray] = np.minimum) -> np.ndarray:
     """A per-direction table (``len(values)`` directions evenly round the circle from +x) read at each
     direction (n, 2): of the two measured neighbours, ``pick`` (the least edge distance, the largest stress
     factor), never optimistic."""
@@ -121,7 +124,8 @@ def _edge_along(values: np.ndarray, directions: np.ndarray, pick: Any = np.minim
     pos = ang / (2.0 * math.pi) * count
     k0 = np.floor(pos).astype(int) % count
     k1 = (k0 + 1) % count
-    return pick(values[k0], values[k1])
+    edge: np.ndarray = pick(values[k0], values[k1])
+    return edge
 
 
 def tooth_push_by_axis(gear_pairs: list[GearPair], statics: Statics, motion: Motion) -> dict[str, np.ndarray]:
@@ -206,7 +210,7 @@ def part_findings(part: Part, parts: list[Part], carried: set[str], chord: float
 
 def _hole_findings(part: Part, h: Hole, rings: list[np.ndarray], plate: Any, t: float, share: int,
                    loads_local: list[tuple[np.ndarray, np.ndarray, str]], loaded: FeatureLoads,
-                   material: Any) -> list[Finding]:
+                   material: Material) -> list[Finding]:
     """Bearing, tear-out and the net section across one pin-loaded hole, each at its governing pose."""
     motion, tooth_push = loaded.motion, loaded.tooth_push
     f = sum((lf for lp, lf, at in loads_local if at in _joints_of(h)), np.zeros((len(motion.inputs), 2)))
@@ -252,7 +256,7 @@ def _hole_findings(part: Part, h: Hole, rings: list[np.ndarray], plate: Any, t: 
 
 def _sections_between_holes(part: Part, holes: list[Hole], plate: Any, t: float,
                             loads_local: list[tuple[np.ndarray, np.ndarray, str]],
-                            couples: list[tuple[np.ndarray, str]], material: Any, load_name: str) -> list[Finding]:
+                            couples: list[tuple[np.ndarray, str]], material: Material, load_name: str) -> list[Finding]:
     """Sections at and between every pair of holes: free body on one side of the cut."""
     found = []
     for a_idx in range(len(holes)):
@@ -276,7 +280,9 @@ def _sections_between_holes(part: Part, holes: list[Hole], plate: Any, t: float,
     return found
 
 
-def _section_finding(part, sec, point, u, station, ha, hb, loads_local, couples, material, load_name):
+def _section_finding(part: Part, sec: Section, point: np.ndarray, u: np.ndarray, station: float, ha: Hole, hb: Hole,
+                     loads_local: list[tuple[np.ndarray, np.ndarray, str]], couples: list[tuple[np.ndarray, str]],
+                     material: Material, load_name: str) -> Finding | None:
     """Tension + bending on one cut of a part (``u`` the link axis, the cut square to it)."""
     n = next(iter(lf for _, lf, _ in loads_local)).shape[0] if loads_local else 0
     if n == 0:
@@ -330,7 +336,8 @@ def _tooth_normal_force(pair: GearPair, torque_b: np.ndarray, motion: Motion) ->
     ratio = np.abs(np.asarray(pair.law(xa, 1), dtype=np.float64))
     r_b = pair.center_distance_mm / (1.0 + ratio)
     phi = _pressure_angle(pair)
-    return np.abs(torque_b) / np.maximum(r_b, 1e-9) / math.cos(phi)
+    normal: np.ndarray = np.abs(torque_b) / np.maximum(r_b, 1e-9) / math.cos(phi)
+    return normal
 
 
 def gear_findings(pair: GearPair, torque_b: np.ndarray, mechanism: Mechanism, motion: Motion, parts: list[Part],
@@ -398,4 +405,5 @@ def local_radius(points: np.ndarray, at: np.ndarray) -> np.ndarray:
     # an open curve's end vertices have no neighbour on one side: take their inner neighbour's value
     radius[0], radius[-1] = radius[1], radius[-2]
     nearest = np.argmin(np.sum((p[None, :, :] - at[:, None, :]) ** 2, axis=2), axis=1)
-    return radius[nearest]
+    nearest_radius: np.ndarray = radius[nearest]
+    return nearest_radius

@@ -27,8 +27,12 @@ The materials the stresses are held to belong to the process profile (:class:`fa
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from fabricate.errors import SpecError
+
+if TYPE_CHECKING:
+    from fabricate.table import Table
 
 
 @dataclass(frozen=True)
@@ -53,7 +57,7 @@ class LoadSpec:
                     or self.springs)
 
 
-def parse_load(table) -> LoadSpec:
+def parse_load(table: Table) -> LoadSpec:
     """Read ``[load]`` (``{}`` when absent)."""
     spec = LoadSpec(
         tip_force_N=table.number("tip_force_N", 0.0, min=0.0, max=10000.0),

@@ -321,7 +321,9 @@ class SweepSpec:
         """Every point as ``{field path: value}``, in a fixed order (the grid's last field varies
         fastest; lhs/sobol in the sampler's order)."""
         if self.sampling == "grid":
-            combos = itertools.product(*(f.values for f in self.fields))
+            grid = [f.values for f in self.fields if f.values is not None]
+            assert len(grid) == len(self.fields)  # a grid's every field has its values (parse_values)
+            combos = itertools.product(*grid)
             return [dict(zip((f.path for f in self.fields), combo, strict=True)) for combo in combos]
         unit = unit_samples(self.sampling, len(self.fields), self.samples, self.seed)
         return [{f.path: f.at(float(u[j])) for j, f in enumerate(self.fields)} for u in unit]

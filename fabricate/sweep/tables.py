@@ -67,7 +67,8 @@ def arrow_table(rows: Sequence[Mapping[str, Any]], field_paths: Sequence[str], m
         elif values and all(isinstance(v, int) and not isinstance(v, bool) for v in values):
             arrays[path] = pa.array(values, type=pa.int64())
         elif all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
-            arrays[path] = pa.array([float(v) for v in values], type=pa.float64())
+            # every value is a number here (the test above): the filter only tells the type checker
+            arrays[path] = pa.array([float(v) for v in values if v is not None], type=pa.float64())
         else:
             arrays[path] = pa.array([v if isinstance(v, str) else json.dumps(v) for v in values], type=pa.string())
     arrays["exit_code"] = pa.array([int(r["exit_code"]) for r in ordered], type=pa.int64())

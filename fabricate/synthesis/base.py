@@ -15,8 +15,8 @@ class SynthesisResult:
 
     Attributes
     ----------
-    mechanism : Mechanism or None
-        The selected design as a solvable mechanism (None for a standalone gear pair).
+    mechanism : Mechanism
+        The selected design as a solvable mechanism (a gear pair's is its carrier and two gears).
     report : dict
         JSON-ready ``synthesis`` section of report.json (numbers as floats/lists, angles in degrees
         where the key says ``_deg``).
@@ -29,7 +29,7 @@ class SynthesisResult:
         for the bill of materials). Keys are documented in :mod:`fabricate.parts`.
     """
 
-    mechanism: Mechanism | None
+    mechanism: Mechanism
     report: dict[str, Any]
     figures: Callable[[], dict[str, bytes]] = lambda: {}
     data: Any = None

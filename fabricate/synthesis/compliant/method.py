@@ -4,7 +4,7 @@ section and the parts hints (springs, rods, the drive shared by the fingers)."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -51,7 +51,7 @@ def paper_point(spec: CompliantSpec) -> tuple[ContactPath, Grasp]:
     return path, grasp
 
 
-def _optimum_report(spec: CompliantSpec, result: OptimumResult) -> dict:
+def _optimum_report(spec: CompliantSpec, result: OptimumResult) -> dict[str, Any]:
     g = spec.geometry
     geom = GripperGeometry(g.a1, g.a2, g.a3, g.b, result.c, g.d, g.l1, g.l2, g.r, result.alpha)
     springs = Springs(result.k1, result.k2, result.phi01, result.phi02)

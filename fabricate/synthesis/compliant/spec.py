@@ -49,7 +49,8 @@ def _grid_axis(table: Table, key: str, scale: float, lo: float, hi: float) -> np
     count = int(np.floor((stop - start) / step + 1e-9)) + 1
     if count > MAX_GRID_AXIS:  # checked before the axis is made (a step of 1e-300 would not fit memory)
         raise SpecError(table.field(key), f"{count} grid values, over the bound of {MAX_GRID_AXIS}; use a larger step")
-    return (start + step * np.arange(count)) * scale
+    axis: np.ndarray = (start + step * np.arange(count)) * scale
+    return axis
 
 
 def parse_spec(root: Table) -> CompliantSpec:

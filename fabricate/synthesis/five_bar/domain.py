@@ -53,7 +53,8 @@ class HingeDomain:
 
     @property
     def feasible(self) -> np.ndarray:
-        return self.status == 0
+        ok: np.ndarray = self.status == 0
+        return ok
 
     def rejected_counts(self) -> dict[str, int]:
         return {name: int(np.sum(self.status == k + 1)) for k, (name, _) in enumerate(REJECTIONS)}

@@ -4,7 +4,6 @@ law."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -12,7 +11,7 @@ import numpy as np
 from fabricate.errors import SpecError
 from fabricate.gears.law import FormulaLaw, elliptic_formula, samples_law
 from fabricate.gears.pitch import PitchCurves
-from fabricate.mechanism import Body, Driver, GearCoupling, Mechanism, Revolute
+from fabricate.mechanism import Body, Driver, GearCoupling, Law, Mechanism, Revolute
 from fabricate.synthesis.gear_pair.spec import GearPairSpec
 
 if TYPE_CHECKING:
@@ -21,7 +20,7 @@ if TYPE_CHECKING:
 PAIR_NAME = "pair"
 
 
-def make_law(spec: GearPairSpec) -> tuple[Callable, str]:
+def make_law(spec: GearPairSpec) -> tuple[Law, str]:
     """The coupling law (external pair: negative slope) and a description of it."""
     if spec.family == "elliptic":
         assert spec.eccentricity is not None  # the parser reads it for this family
@@ -34,7 +33,7 @@ def make_law(spec: GearPairSpec) -> tuple[Callable, str]:
     return FormulaLaw(spec.formula, sign=-1.0, path="gear_pair.law"), spec.formula
 
 
-def center_distance(spec: GearPairSpec, design: DesignSpec, law: Callable, lo: float) -> float:
+def center_distance(spec: GearPairSpec, design: DesignSpec, law: Law, lo: float) -> float:
     """Centre distance: given, or from whole teeth of the requested module (closed pairs)."""
     if spec.center_distance_mm is not None:
         return spec.center_distance_mm
@@ -49,7 +48,7 @@ def center_distance(spec: GearPairSpec, design: DesignSpec, law: Callable, lo: f
     return teeth[0] * np.pi * module / perimeter
 
 
-def build_mechanism(name: str, spec: GearPairSpec, law: Callable, a: float) -> Mechanism:
+def build_mechanism(name: str, spec: GearPairSpec, law: Law, a: float) -> Mechanism:
     """The carrier and its two gears at centre distance ``a`` (mm), gear a driven over the working range."""
     lo, hi = (float(np.radians(v)) for v in spec.working_range_deg)
     carrier = Body("carrier", {"OA": (0.0, 0.0), "OB": (a, 0.0)})

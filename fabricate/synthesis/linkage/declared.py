@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from fabricate.mechanism import Mechanism
@@ -94,5 +94,5 @@ class ExactLinkageSpec:
     mechanism as it was, and the parts hints it came with (see :mod:`fabricate.synthesis.linkage.exact`)."""
 
     mechanism: Mechanism
-    hints: dict
+    hints: dict[str, Any]
     tip_point: str | None = None

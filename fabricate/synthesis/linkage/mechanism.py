@@ -12,7 +12,6 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -21,7 +20,7 @@ from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from fabricate.errors import LockupError, SpecError
 from fabricate.gears.law import FormulaLaw, check_ratio, elliptic_formula
-from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Motion, Revolute, Slider
+from fabricate.mechanism import Body, Driver, GearCoupling, Law, LinearLaw, Mechanism, Motion, Revolute, Slider
 
 if TYPE_CHECKING:
     from fabricate.synthesis.linkage.declared import DriverSpec, JointSpec, LinkageGearSpec, LinkageSpec
@@ -29,9 +28,10 @@ if TYPE_CHECKING:
 
 # -- laws ------------------------------------------------------------------------------------------
 
-def sampled_law(x: tuple[float, ...], y: tuple[float, ...], spline: str) -> Callable:
+def sampled_law(x: tuple[float, ...], y: tuple[float, ...], spline: str) -> Law:
     xa, ya = np.asarray(x), np.asarray(y)
-    return PchipInterpolator(xa, ya) if spline == "pchip" else CubicSpline(xa, ya)
+    law: Law = PchipInterpolator(xa, ya) if spline == "pchip" else CubicSpline(xa, ya)
+    return law
 
 
 @dataclass(frozen=True)
@@ -59,7 +59,7 @@ class PeriodicTableLaw:
 
     def __call__(self, x: np.ndarray | float, nu: int = 0) -> np.ndarray | float:
         x = np.asarray(x, dtype=np.float64)
-        out = self._spline(x, nu)
+        out: np.ndarray = self._spline(x, nu)
         if nu == 0:
             out = out + self._slope * x
         elif nu == 1:
@@ -67,7 +67,7 @@ class PeriodicTableLaw:
         return self.sign * out
 
 
-def gear_law(g: LinkageGearSpec, path: str) -> tuple[Callable, str]:
+def gear_law(g: LinkageGearSpec, path: str) -> tuple[Law, str]:
     """The coupling law ``x_b = law(x_a)`` (rad; an external pair: negative slope) and its description."""
     # the parser sets the fields of the law it read (and only those)
     if g.law == "constant":
@@ -91,13 +91,13 @@ def gear_law(g: LinkageGearSpec, path: str) -> tuple[Callable, str]:
 class NegatedLaw:
     """``-law(x)``: a driven angle counted in gear b's own sense as an external pair's coupling law."""
 
-    law: Callable
+    law: Law
 
     def __call__(self, x: np.ndarray | float, nu: int = 0) -> np.ndarray | float:
         return -self.law(np.asarray(x, dtype=np.float64), nu)
 
 
-def _check_gear_law(g: LinkageGearSpec, law: Callable, path: str) -> None:
+def _check_gear_law(g: LinkageGearSpec, law: Law, path: str) -> None:
     """Ratio positive and finite over the working range; a closed law repeats its ratio after a turn."""
     lo, hi = np.radians(g.working_range_deg)
     x = np.linspace(lo, hi, 2049)
@@ -111,7 +111,7 @@ def _check_gear_law(g: LinkageGearSpec, law: Callable, path: str) -> None:
                                            "a periodic law")
 
 
-def _driver_law(d: DriverSpec, joint: JointSpec, at_reference: float) -> Callable:
+def _driver_law(d: DriverSpec, joint: JointSpec, at_reference: float) -> Law:
     """Input to the mechanism's joint coordinate (rad for an angle, mm for a slide).
 
     The template's joint value is 0 at the reference input; ``at_reference`` is the coordinate the

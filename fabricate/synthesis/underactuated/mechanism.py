@@ -28,7 +28,7 @@ def build_mechanism(spec: UnderactuatedSpec, motion: ClosingMotion, name: str) -
     bodies.append(Body("push_link", {"S": (0.0, 0.0), "K": (float(np.hypot(*kvec)), 0.0)}))
     assembly = {"rod": (float(open_pose.S[0]), d.rod_y, 0.0),
                 "push_link": (float(open_pose.S[0]), d.rod_y, float(np.arctan2(kvec[1], kvec[0])))}
-    joints: list = [Slider("rod", "palm", "rod", (1.0, 0.0)), Revolute("S", "rod", "push_link"),
+    joints: list[Revolute | Slider] = [Slider("rod", "palm", "rod", (1.0, 0.0)), Revolute("S", "rod", "push_link"),
                     Revolute("K", "push_link", "rocker1")]
     for i in range(n):
         pts = {f"G{i + 1}": (0.0, 0.0)}
@@ -70,7 +70,7 @@ def build_mechanism(spec: UnderactuatedSpec, motion: ClosingMotion, name: str) -
                      assembly=assembly)
 
 
-def mobility(n: int) -> dict:
+def mobility(n: int) -> dict[str, int]:
     """The chapter's count (eq 2.1): m = 3(n-1)+3 moving links, P_L = 4(n-1)+4 lower pairs."""
     m = 3 * (n - 1) + 3
     pl = 4 * (n - 1) + 4

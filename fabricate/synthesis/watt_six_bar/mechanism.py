@@ -53,7 +53,7 @@ def build_mechanism(name: str, finger: FingerPositions, angles: np.ndarray, d: n
                      input_unit="deg", assembly=assembly)
 
 
-def _load_on_distal(mech: Mechanism, poses: dict[str, np.ndarray], force: float):
+def _load_on_distal(mech: Mechanism, poses: dict[str, np.ndarray], force: float) -> tuple[np.ndarray, np.ndarray]:
     """Midpoint of e-c and the force normal to e->c (turned +90 deg), world, from the distal pose."""
     from fabricate.planar import transform_points
 

@@ -5,7 +5,7 @@ computation on that same mechanism."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,9 +30,10 @@ from fabricate.synthesis.watt_six_bar.statics import JOINTS, SixBarBatch, assemb
 
 if TYPE_CHECKING:
     from fabricate.spec import DesignSpec
+    from fabricate.synthesis.watt_six_bar.burmester import CubicCurve
 
 
-def _reference_report(spec: WattSixBarSpec, finger: FingerPositions, inputs: RegionInputs) -> dict:
+def _reference_report(spec: WattSixBarSpec, finger: FingerPositions, inputs: RegionInputs) -> dict[str, Any]:
     """How a published design (template ``[reference]``) fits these curves and positions."""
     ref = {k: np.asarray(v) for k, v in spec.reference}
     d, e, f, d0 = ref["d"], ref["e"], ref["f"], ref["d0"]
@@ -59,7 +60,7 @@ def _reference_report(spec: WattSixBarSpec, finger: FingerPositions, inputs: Reg
     }
 
 
-def _curve_d(finger: FingerPositions):
+def _curve_d(finger: FingerPositions) -> CubicCurve:
     from fabricate.synthesis.watt_six_bar.burmester import dyad_curve
 
     return dyad_curve(finger.proximal, finger.distal)
@@ -98,7 +99,7 @@ def synthesise_spec(spec: WattSixBarSpec, name: str = "finger_watt_six_bar") -> 
 
 
 def _report(spec: WattSixBarSpec, inputs: RegionInputs, finger: FingerPositions, region: SolutionRegion,
-            refined: RefinedCandidates | None, choice: Choice, mech: Mechanism, theta: np.ndarray) -> dict:
+            refined: RefinedCandidates | None, choice: Choice, mech: Mechanism, theta: np.ndarray) -> dict[str, Any]:
     """The ``synthesis`` section: the choice, its checks through the generic solver, the region's counts."""
     # fingertip through the generic solver: a dense sweep with the positions in it
     dense = np.unique(np.concatenate([np.degrees(theta), np.degrees(inputs.angles[0])]))
@@ -153,7 +154,7 @@ def _report(spec: WattSixBarSpec, inputs: RegionInputs, finger: FingerPositions,
     return report
 
 
-def _region_report(spec: WattSixBarSpec, region: SolutionRegion) -> dict:
+def _region_report(spec: WattSixBarSpec, region: SolutionRegion) -> dict[str, Any]:
     """The solution region's counts: points, defect-free, K within the limit, accepted, by branch pair."""
     one = region.stage_one
     return {
