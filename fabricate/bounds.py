@@ -180,7 +180,8 @@ def check_expression(text: str, path: str) -> None:
     except (RecursionError, MemoryError):  # the parser's own stack: deeper than any bound below
         raise SpecError(path, f"the expression is nested too deeply (at most {MAX_EXPRESSION_DEPTH} levels)") from None
     # the depth by an explicit stack: a recursive walk would overflow on the input it is meant to refuse
-    deepest, stack = 0, [(tree.body, 1)]
+    deepest = 0
+    stack: list[tuple[ast.AST, int]] = [(tree.body, 1)]
     while stack:
         node, depth = stack.pop()
         deepest = max(deepest, depth)

@@ -23,7 +23,7 @@ import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, NoReturn, TextIO
 
 from fabricate import __version__
 from fabricate.errors import FabricateError, SpecError
@@ -181,7 +181,7 @@ QUIET_HELP = "no progress output (the result line and any failures are still pri
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # argparse exits 2 already; keep its message short
+    def error(self, message: str) -> NoReturn:  # argparse exits 2 already; keep its message short
         self.print_usage(sys.stderr)
         self.exit(EXIT_USAGE, f"fabricate: error: {message}\n")
 
@@ -317,13 +317,13 @@ def _build(args: argparse.Namespace) -> int:
 
     design = load_design(args.template, args.process)
     stage = args.command
-    default = None if args.output else _default_output(design.name, Path(design.template), stage)
+    target = args.output or _default_output(design.name, Path(design.template), stage)
     # inputs the build reads: never inside the folder replaced, even with --force
     protect = {Path(design.template): "the template being built"}
     if args.process and args.process not in shipped_profiles():
         protect[Path(args.process)] = "the process profile in use"
     # refuse a bad output folder before the work, and again under the lock when writing
-    out = check_output_dir(args.output or default, force=args.force, stage=stage, protect=protect)
+    out = check_output_dir(target, force=args.force, stage=stage, protect=protect)
     outcome = (run_build if stage == "build" else run_synth)(design, _progress(args.quiet))
     write_output(outcome.files, out, force=args.force, stage=stage, protect=protect,
                  warn=lambda msg: _say(f"fabricate: warning: {msg}"))
@@ -517,7 +517,8 @@ def _stopped(args: argparse.Namespace | None, signum: int) -> str:
 
 def _out_of_memory(args: argparse.Namespace | None) -> tuple[str, int]:
     command = getattr(args, "command", None)
-    if command == "check" and Path(args.target).is_dir():  # the folder's files, not a template, took it
+    # the folder's files, not a template, took it
+    if command == "check" and args is not None and Path(args.target).is_dir():
         return f"fabricate: error: out of memory while checking {args.target} (the folder was not verified)", \
             EXIT_FAILED
     if command == "sweep":

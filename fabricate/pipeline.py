@@ -108,7 +108,7 @@ def _quiet(_: str) -> None:
 def design_section(design: DesignSpec, stage: str) -> dict[str, Any]:
     # the template's file name only: a folder in the report would make its bytes depend on where the
     # build ran (the template itself is embedded as template_text)
-    section = {"name": design.name, "kind": design.kind, "template": Path(design.template).name,
+    section: dict[str, Any] = {"name": design.name, "kind": design.kind, "template": Path(design.template).name,
                "fabricate_version": __version__, "description": design.description,
                "process": design.process.name, "stage": stage}
     if design.process_override is not None:  # --process: check rebuilds with the same profile
@@ -292,6 +292,7 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
         _plots(run, pictures)
     finally:
         pictures.cancel()
+    assert run.given is not None  # set in __post_init__
     return _finish(run.given, run.report, run.files, exit_code=0 if not run.failures else 1,
                    synthesis=run.synthesis, motion=run.motion, partset=run.partset, gear_pairs=run.gear_pairs,
                    checks=run.checks)
@@ -333,6 +334,7 @@ def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
     """The slow outputs, for the forked child: the method's plots, gear pictures, previews, STEP files."""
     from fabricate.export import export_previews, export_step
 
+    assert run.partset is not None  # the parts stage ran
     result, gear_pairs, design, partset, motion = run.synthesis, run.gear_pairs, run.design, run.partset, run.motion
     optional = run.optional
 
@@ -368,6 +370,7 @@ def _export(run: BuildRun, with_step: bool) -> None:
     from fabricate.synthesis.linkage.exact import mechanism_toml
 
     run.enter("exports")
+    assert run.partset is not None  # the parts stage ran
     exported, parts_report = export_all(run.design, run.partset, run.mechanism, run.motion, previews=False,
                                         step=False, with_step=with_step)
     run.files.update(exported)
@@ -385,6 +388,7 @@ def _check(run: BuildRun) -> None:
     from fabricate.checks import run_checks
 
     run.enter("checks")
+    assert run.partset is not None  # the parts stage ran
     run.checks = run_checks(run.design, run.partset, run.mechanism, run.motion, run.gear_pairs)
     run.report["interference"] = run.checks.interference
     run.failures = list(run.checks.failures)
@@ -397,6 +401,7 @@ def _check_strength(run: BuildRun) -> None:
     from fabricate.strength.check import run_strength
 
     run.enter("strength")
+    assert run.partset is not None  # the parts stage ran
     run.strength = run_strength(run.design, run.partset, run.mechanism, run.motion, run.gear_pairs,
                                 run.synthesis.parts)
     run.report["strength"] = run.strength.report()
@@ -408,6 +413,7 @@ def _check_strength(run: BuildRun) -> None:
 def _verdict(run: BuildRun) -> None:
     """report.json's ``checks``: passed is over the checks that ran; those that could not run are listed,
     never passed."""
+    assert run.checks is not None and run.strength is not None  # both checks ran
     not_checked = [dict(entry) for entry in run.checks.not_checked]
     if run.strength.reason is not None:
         not_checked.append({"check": "strength", "reason": run.strength.reason})
@@ -419,6 +425,7 @@ def _plots(run: BuildRun, pictures: Background) -> None:
     from fabricate.strength.plots import strength_plot
 
     run.enter("plots")
+    assert run.checks is not None and run.strength is not None  # both checks ran
     if run.strength.findings:
         run.files["plots/strength.png"] = strength_plot(run.strength, run.mechanism.input_unit)
     for name, data in sorted(run.checks.figures().items()):
@@ -431,7 +438,7 @@ def synthesis_plots(result: SynthesisResult) -> dict[str, bytes]:
     return {f"plots/{name}": data for name, data in sorted(result.figures().items())}
 
 
-def gear_pictures(gear_pairs: list[Any]) -> dict[str, bytes]:
+def gear_pictures(gear_pairs: list[GearPair]) -> dict[str, bytes]:
     """Each gear pair in mesh (PNG, mid-range) and turning (GIF)."""
     if not gear_pairs:
         return {}

@@ -20,12 +20,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fabricate.errors import SpecError
 from fabricate.process import ProcessOverride, ProcessSpec, parse_process, process_override
 from fabricate.table import Table
 from fabricate.templates import find_template, parse_toml, read_text
+
+if TYPE_CHECKING:  # the sections' parsers import this module's neighbours: names for the checker only
+    from fabricate.gears.spec import GearSpec
+    from fabricate.parts.spec import PartsSpec
+    from fabricate.strength.spec import LoadSpec
 
 
 @dataclass(frozen=True)
@@ -121,12 +126,12 @@ class DesignSpec:
     template: Path
     process: ProcessSpec
     checks: ChecksSpec
-    gears: Any
-    parts: Any
-    method: Any
+    gears: GearSpec
+    parts: PartsSpec
+    method: Any  # the kind's own spec; each kind's entry points know its type
     template_text: str = ""
     process_override: ProcessOverride | None = None
-    load: Any = None
+    load: LoadSpec | None = None
 
 
 def load_design(path: str | Path, process: str | ProcessOverride | None = None) -> DesignSpec:

@@ -1,15 +1,30 @@
-"""Shared fixtures: small mechanisms built from first principles (no template, no synthesis)."""
+"""Shared fixtures: small mechanisms built from first principles (no template, no synthesis), the
+process profiles, and every shipped template built once per test process (``shipped_build``).
+
+Markers: ``slow`` (registered in pyproject.toml) marks full builds of shipped templates and other tests of
+several seconds; ``python -m pytest -m "not slow"`` is the day-to-day subset, the whole suite the CI's.
+Hypothesis runs without its wall-clock deadline and "too slow" health check: on a loaded machine those fail
+a correct test (the suite must pass with the cores busy).
+"""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute
+from fabricate.pipeline import BuildOutcome, run_build
 from fabricate.planar import circle_circle_intersection
-from fabricate.spec import ProcessSpec
+from fabricate.process import ProcessSpec
+from fabricate.spec import load_design
+
+# Test modules' own @settings(...) inherit what they do not set from this profile.
+settings.register_profile("fabricate", deadline=None, suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile("fabricate")
 
 
 def make_four_bar(crank: float = 15.0, coupler: float = 40.0, rocker: float = 30.0, ground: float = 40.0,
@@ -59,4 +74,26 @@ def sla_process() -> ProcessSpec:
 def laser_process() -> ProcessSpec:
     return ProcessSpec(name="laser", running_clearance_mm=0.1, hole_compensation_mm=0.0, min_wall_mm=3.0,
                        min_pin_mm=2.0, layer_gap_mm=0.5, thickness_mm=3.0, kerf_mm=0.2, min_feature_mm=0.5,
-                       build_volume_mm=(600.0, 400.0, 3.0), pin_diameter_mm=3.0, chord_tolerance_mm=0.005)
+                       build_volume_mm=(600.0, 400.0, 3.0), pin_diameter_mm=3.0, chord_tolerance_mm=0.005,
+                       technique="cut", layout="sheet")
+
+
+#: ``{template name: outcome}`` of this test process (each pytest-xdist worker has its own).
+_SHIPPED_BUILDS: dict[str, BuildOutcome] = {}
+
+
+@pytest.fixture(scope="session")
+def shipped_build() -> Callable[[str], BuildOutcome]:
+    """``shipped_build(name)``: ``run_build(load_design(name))`` of a shipped template, built once per test
+    process and shared by every test that only reads it.
+
+    The outcome is shared: a test must not change it (copy what it edits). ``run_build`` is the real
+    pipeline's, bound at import, so a module that monkeypatches ``fabricate.pipeline.run_build`` does not
+    change what is cached here.
+    """
+    def get(name: str) -> BuildOutcome:
+        if name not in _SHIPPED_BUILDS:
+            _SHIPPED_BUILDS[name] = run_build(load_design(name))
+        return _SHIPPED_BUILDS[name]
+
+    return get
