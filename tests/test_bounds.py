@@ -17,6 +17,7 @@ from fabricate.cli import main
 from fabricate.errors import SpecError
 from fabricate.spec import design_from_text, load_design
 from fabricate.templates import TEMPLATE_DIR, parse_toml
+from tests.test_linkage import GEARED
 from tests.toml_writer import toml_text
 
 
@@ -154,52 +155,8 @@ def test_gear_pair_poses_times_teeth_over_the_bound_names_sweep_poses(tmp_path: 
 
 # -- issue 23 item 4: gear law expressions, the exact form, the linkage's solver work, --workers -----------
 
-LINKAGE_GEARS = """
-[design]
-name = "geared"
-kind = "linkage"
-
-[gears]
-teeth = [30, 30]
-
-[linkage]
-ground = "frame"
-input_unit = "deg"
-input_range = [0.0, 360.0]
-
-[[linkage.bodies]]
-name = "frame"
-points = { OA = [0.0, 0.0], OB = [40.0, 0.0] }
-
-[[linkage.bodies]]
-name = "gear_a"
-points = { OA = [0.0, 0.0] }
-
-[[linkage.bodies]]
-name = "gear_b"
-points = { OB = [40.0, 0.0] }
-
-[[linkage.joints]]
-name = "OA"
-type = "revolute"
-bodies = ["frame", "gear_a"]
-
-[[linkage.joints]]
-name = "OB"
-type = "revolute"
-bodies = ["frame", "gear_b"]
-
-[[linkage.gears]]
-name = "g"
-carrier = "frame"
-bodies = ["gear_a", "gear_b"]
-axes = ["OA", "OB"]
-law = "expression"
-expression = "EXPRESSION"
-
-[[linkage.drivers]]
-joint = "OA"
-"""
+#: test_linkage's geared pair with an expression law (EXPRESSION is replaced by each test)
+LINKAGE_GEARS = GEARED.replace("LAW", 'law = "expression"\nexpression = "EXPRESSION"')
 
 
 def _padded(length: int) -> str:
