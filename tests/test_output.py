@@ -227,11 +227,11 @@ def _hammer(out: str, tag: str, rounds: int, errors: multiprocessing.Queue) -> N
         errors.put(f"{tag}: {type(exc).__name__}: {exc}")
 
 
-def test_concurrent_writers_are_serialised(tmp_path):
-    out = tmp_path / "out"
+def _run_writers(jobs: list[tuple]) -> None:
+    """Run ``(target, out, tag, rounds)`` writers in forked processes at once; none may report an error."""
     ctx = multiprocessing.get_context("fork")
     errors = ctx.Queue()
-    workers = [ctx.Process(target=_hammer, args=(str(out), tag, 40, errors)) for tag in "abcd"]
+    workers = [ctx.Process(target=target, args=(out, tag, rounds, errors)) for target, out, tag, rounds in jobs]
     for w in workers:
         w.start()
     for w in workers:
@@ -240,6 +240,11 @@ def test_concurrent_writers_are_serialised(tmp_path):
     while not errors.empty():
         found.append(errors.get())
     assert found == [] and all(w.exitcode == 0 for w in workers)
+
+
+def test_concurrent_writers_are_serialised(tmp_path):
+    out = tmp_path / "out"
+    _run_writers([(_hammer, str(out), tag, 40) for tag in "abcd"])
     tree = _tree(out)
     tag = json.loads(tree["report.json"])["tag"]
     assert tree == fake_output(tag)  # one writer's complete output, nothing mixed
@@ -406,18 +411,8 @@ def _hammer_verified(out: str, tag: str, rounds: int, errors: multiprocessing.Qu
 
 
 def test_writers_of_a_and_a_b_both_end_complete(tmp_path):
-    ctx = multiprocessing.get_context("fork")
-    errors = ctx.Queue()
     outs = {"a": str(tmp_path / "a"), "b": str(tmp_path / "a.b")}
-    workers = [ctx.Process(target=_hammer_verified, args=(out, tag, 25, errors)) for tag, out in outs.items()]
-    for w in workers:
-        w.start()
-    for w in workers:
-        w.join(600)
-    found = []
-    while not errors.empty():
-        found.append(errors.get())
-    assert found == [] and all(w.exitcode == 0 for w in workers)
+    _run_writers([(_hammer_verified, out, tag, 25) for tag, out in outs.items()])
     for tag, out in outs.items():
         tree = _tree(Path(out))
         report = json.loads(tree["report.json"])
