@@ -82,7 +82,8 @@ def test_a_mechanism_built_in_code_goes_through_the_same_pipeline():
     import io
 
     import numpy as np
-    from conftest import make_four_bar
+
+    from tests.conftest import make_four_bar
 
     mech = make_four_bar()
     design = fabricate.from_mechanism(mech, tip_point="B", pads={"rocker": {"point": "B", "radius_mm": 3.0}},
@@ -102,11 +103,11 @@ def test_a_geared_mechanism_built_in_code_is_the_mechanism_built():
     """A mechanism with a gear coupling (a spline law) goes over exactly: the design's mechanism sweeps to
     the same poses, bit for bit, as the one built in code."""
     import numpy as np
-    from conftest import make_four_bar
     from scipy.interpolate import CubicSpline
 
     from fabricate.mechanism import Body, GearCoupling, Mechanism, Revolute
     from fabricate.pipeline import synthesise
+    from tests.conftest import make_four_bar
 
     four_bar = make_four_bar()
     # a wheel on the ground turned at -1/2 by a pinion on the crank

@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import make_four_bar
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -25,6 +24,7 @@ import fabricate
 from fabricate.errors import FabricateError, SpecError
 from fabricate.spec import DesignSpec
 from fabricate.templates import TEMPLATE_DIR, read_toml
+from tests.conftest import make_four_bar
 
 
 class _PathLikeBytes:

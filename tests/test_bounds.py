@@ -17,7 +17,7 @@ from fabricate.cli import main
 from fabricate.errors import SpecError
 from fabricate.spec import design_from_text, load_design
 from fabricate.templates import TEMPLATE_DIR, parse_toml
-from tests.test_linkage import GEARED
+from tests.synthesis.linkage.test_linkage import GEARED
 from tests.toml_writer import toml_text
 
 

@@ -272,7 +272,7 @@ def test_velocity_of_off_axis_and_slider_mechanisms():
     """The constraint Jacobian (through velocity = -J^-1 dres/ds) against finite differences of the solved
     poses: a crank-slider (slider joint: projection and fixed-angle rows) and a four-bar whose joint points
     lie off their bodies' x axes (rotation-derivative terms of both coordinates)."""
-    from tests.test_parts import slider_crank
+    from tests.parts.test_build import slider_crank
 
     _velocity_matches_finite_differences(slider_crank())
     base = make_four_bar()

@@ -45,14 +45,14 @@ RESULTS = HERE / "results.json"
 EQUIVALENT = HERE / "equivalent.toml"
 REPORT = ROOT / "tests" / "benchmarks" / "mutation_report.md"
 
-GEARS_TESTS = ["tests/test_gears_properties.py", "tests/test_gears.py", "tests/test_gears_mesh.py",
-               "tests/test_gears_pair.py", "tests/test_gears_teeth.py", "tests/test_gears_free_play.py"]
-CHECK_TESTS = ["tests/test_checks_properties.py", "tests/test_interference.py",
-               "tests/test_checks_interference.py"]
-PARTS_TESTS = ["tests/test_parts_properties.py", "tests/test_parts.py", "tests/test_parts_build.py",
-               "tests/test_parts_mounting.py"]
-# test_export.py builds every template with both processes (minutes per mutant): not in the mutation run
-EXPORT_TESTS = ["tests/test_export_properties.py"]
+GEARS_TESTS = ["tests/gears/test_gears_properties.py", "tests/gears/test_pair.py", "tests/gears/test_gears.py",
+               "tests/gears/test_teeth.py", "tests/gears/test_mesh.py"]
+CHECK_TESTS = ["tests/checks/test_checks_properties.py", "tests/checks/test_interference.py"]
+PARTS_TESTS = ["tests/parts/test_parts_properties.py", "tests/parts/test_build.py",
+               "tests/parts/test_build_mounting.py"]
+# tests/export/test_export.py builds every template with both processes (minutes per mutant): not in the
+# mutation run
+EXPORT_TESTS = ["tests/export/test_export_properties.py"]
 
 #: module key -> (source file, test files that exercise it). The CLI tests are left out on purpose:
 #: they build whole designs (3-8 s each) and would make one module's run take hours.
@@ -64,37 +64,43 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "gears/mesh": ("fabricate/gears/mesh.py", GEARS_TESTS),
     "gears/pair": ("fabricate/gears/pair.py", GEARS_TESTS),
     "gears/checks": ("fabricate/gears/checks.py", GEARS_TESTS),
-    "gears/spec": ("fabricate/gears/spec.py", ["tests/test_gears_spec.py", "tests/test_spec.py"]),
+    "gears/spec": ("fabricate/gears/spec.py", ["tests/gears/test_spec.py", "tests/test_spec.py"]),
     "mechanism": ("fabricate/mechanism.py", ["tests/test_mechanism_properties.py", "tests/test_mechanism.py",
                                             "tests/test_mechanism_solver.py"]),
     "checks/interference": ("fabricate/checks/interference.py", CHECK_TESTS),
     "checks/distance": ("fabricate/checks/distance.py", CHECK_TESTS),
-    # test_checks.py synthesises the five-bar NCG finger (tens of seconds): the property tests drive the check
+    # tests/checks/test_checks.py synthesises the five-bar NCG finger (tens of seconds): the property tests drive
+    # the check
     "checks/gear_mesh": ("fabricate/checks/gear_mesh.py",
-                         ["tests/test_gears_properties.py", "tests/test_checks_gear_mesh.py"]),
+                         ["tests/gears/test_gears_properties.py", "tests/checks/test_gear_mesh.py"]),
     "checks/printability": ("fabricate/checks/printability.py",
-                            ["tests/test_checks_printability.py", "tests/test_checks.py"]),
+                            ["tests/checks/test_printability.py", "tests/checks/test_checks.py"]),
     # run_checks and CheckReport (checks/__init__.py): what gates a build and what report.json says of it
-    "checks/run": ("fabricate/checks/__init__.py", ["tests/test_checks_run.py", "tests/test_checks.py"]),
+    "checks/run": ("fabricate/checks/__init__.py", ["tests/checks/test_checks.py"]),
     "parts/profiles": ("fabricate/parts/profiles.py", PARTS_TESTS),
     "parts/build": ("fabricate/parts/build.py", PARTS_TESTS),
     "parts/features": ("fabricate/parts/features.py", PARTS_TESTS),
     "export/dxf": ("fabricate/export/dxf.py", EXPORT_TESTS),
     "export/stl": ("fabricate/export/stl.py", EXPORT_TESTS),
     "synthesis/kinematic_mapping": ("fabricate/synthesis/five_bar/kinematic_mapping.py",
-                                    ["tests/test_five_bar.py", "tests/test_kinematic_mapping.py"]),
+                                    ["tests/synthesis/five_bar/test_five_bar.py",
+                                     "tests/synthesis/five_bar/test_kinematic_mapping.py"]),
     # the other synthesis methods' numeric kernels: the six-bar's Burmester curves and its vectorised
     # statics, the underactuated finger's kinematics and statics, the compliant gripper's force model
     "synthesis/burmester": ("fabricate/synthesis/watt_six_bar/burmester.py",
-                            ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py",
-                             "tests/test_burmester.py"]),
+                            ["tests/synthesis/watt_six_bar/test_watt_six_bar.py",
+                             "tests/synthesis/watt_six_bar/test_watt_six_bar_paper.py",
+                             "tests/synthesis/watt_six_bar/test_burmester.py"]),
     "synthesis/six_bar_statics": ("fabricate/synthesis/watt_six_bar/statics.py",
-                                  ["tests/test_watt_six_bar.py", "tests/test_watt_six_bar_paper.py",
-                                   "tests/test_six_bar_statics.py"]),
+                                  ["tests/synthesis/watt_six_bar/test_watt_six_bar.py",
+                                   "tests/synthesis/watt_six_bar/test_watt_six_bar_paper.py",
+                                   "tests/synthesis/watt_six_bar/test_statics.py"]),
     "synthesis/underactuated_model": ("fabricate/synthesis/underactuated/model.py",
-                                      ["tests/test_underactuated.py", "tests/test_underactuated_model.py"]),
+                                      ["tests/synthesis/underactuated/test_underactuated.py",
+                                       "tests/synthesis/underactuated/test_model.py"]),
     "synthesis/compliant_model": ("fabricate/synthesis/compliant/model.py",
-                                  ["tests/test_compliant.py", "tests/test_compliant_model.py"]),
+                                  ["tests/synthesis/compliant/test_compliant.py",
+                                   "tests/synthesis/compliant/test_model.py"]),
 }
 
 #: The six hand-made mutants of issue 15 and the tests that must kill them (``--examples`` checks it).
@@ -104,23 +110,23 @@ EXAMPLES = [
      ["tests/test_mechanism_properties.py::test_sweep_through_change_point_is_reported"]),
     ("sector hub radius min -> max", "fabricate/gears/teeth.py",
      "hub = Polygon(circle_points(min(hub_radius_mm,", "hub = Polygon(circle_points(max(hub_radius_mm,",
-     ["tests/test_gears_properties.py::test_sector_hub_is_the_hub_asked_for"]),
+     ["tests/gears/test_gears_properties.py::test_sector_hub_is_the_hub_asked_for"]),
     ("transmission error takes the smaller flank error", "fabricate/gears/mesh.py",
      "te = np.where(np.abs(err_plus) >= np.abs(err_minus), err_plus, err_minus)",
      "te = np.where(np.abs(err_plus) <= np.abs(err_minus), err_plus, err_minus)",
-     ["tests/test_gears_properties.py::test_spur_transmission_error_is_the_larger_flank_error"]),
+     ["tests/gears/test_gears_properties.py::test_spur_transmission_error_is_the_larger_flank_error"]),
     ("clearance verdict slack x10", "fabricate/checks/interference.py",
      "and p.min_clearance_mm < p.required_mm - self.tolerance_mm]",
      "and p.min_clearance_mm < p.required_mm - 10 * self.tolerance_mm]",
-     ["tests/test_checks_properties.py::test_clearance_just_under_the_requirement_fails"]),
+     ["tests/checks/test_checks_properties.py::test_clearance_just_under_the_requirement_fails"]),
     ("slot kerf offset with the wrong sign", "fabricate/export/dxf.py",
      "slots = [offset_path(s, -half)", "slots = [offset_path(s, half)",
-     ["tests/test_export_properties.py::test_cut_path_is_offset_by_half_the_kerf",
-      "tests/test_export.py::test_part_dxf_round_trip[slider_crank-laser]"]),
+     ["tests/export/test_export_properties.py::test_cut_path_is_offset_by_half_the_kerf",
+      "tests/export/test_export.py::test_part_dxf_round_trip[slider_crank-laser]"]),
     ("cut hole diameter not shrunk by the kerf (was read from the model by the old round-trip test)",
      "fabricate/export/dxf.py", "h.diameter_mm - kerf_mm)", "h.diameter_mm)",
-     ["tests/test_export_properties.py::test_cut_path_is_offset_by_half_the_kerf",
-      "tests/test_export.py::test_part_dxf_round_trip[four_bar-laser]"]),
+     ["tests/export/test_export_properties.py::test_cut_path_is_offset_by_half_the_kerf",
+      "tests/export/test_export.py::test_part_dxf_round_trip[four_bar-laser]"]),
 ]
 
 STATUS = {1: "killed", 3: "killed", 0: "survived", 5: "no tests", 33: "no tests", 34: "skipped",

@@ -22,11 +22,9 @@ import numpy as np
 import pytest
 import shapely
 import trimesh
-from conftest import make_four_bar
 from ezdxf import path as dxf_path
 from ezdxf.math import bulge_to_arc
 from PIL import Image
-from test_parts import slider_crank, spur_like, sun_planet_four_bar
 
 from fabricate.export import export_all
 from fabricate.export.dxf import audit_problems, kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
@@ -45,6 +43,8 @@ from fabricate.parts.spec import PartsSpec
 from fabricate.process import ProcessSpec
 from fabricate.spec import load_design
 from fabricate.templates import shipped_templates
+from tests.conftest import make_four_bar
+from tests.parts.test_build import slider_crank, spur_like, sun_planet_four_bar
 
 SLA = ProcessSpec(name="sla", running_clearance_mm=0.25, hole_compensation_mm=0.2, min_wall_mm=0.8,
                   min_pin_mm=1.5, layer_gap_mm=0.3, thickness_mm=3.0, kerf_mm=0.0, min_feature_mm=0.3,
@@ -579,8 +579,8 @@ def test_prusaslicer_reports_manifold_without_repair(name, tmp_path):
 
 ENCODE_IN_CHILD = """
 import hashlib, sys
-sys.path.insert(0, {tests!r})
-from test_export import case
+sys.path.insert(0, {root!r})
+from tests.export.test_export import case
 c = case({name!r})
 for key in sorted(c.files):
     print(key, hashlib.sha256(c.files[key]).hexdigest())
@@ -599,10 +599,10 @@ def test_bytes_do_not_depend_on_the_hash_seed():
     name = "slider_crank-laser"
     here = case(name)
     expected = "".join(f"{k} {hashlib.sha256(here.files[k]).hexdigest()}\n" for k in sorted(here.files))
-    script = ENCODE_IN_CHILD.format(tests=str(Path(__file__).parent), name=name)
+    script = ENCODE_IN_CHILD.format(root=str(Path(__file__).resolve().parents[2]), name=name)
     for seed in ("1", "12345"):
         env = {**os.environ, "PYTHONHASHSEED": seed}
         run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env,
-                             timeout=300, cwd=Path(__file__).parent.parent)
+                             timeout=300, cwd=Path(__file__).resolve().parents[2])
         assert run.returncode == 0, run.stderr
         assert run.stdout == expected

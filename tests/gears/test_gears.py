@@ -20,7 +20,7 @@ from fabricate.kinds import KINDS
 from fabricate.spec import load_design
 from fabricate.templates import TEMPLATE_DIR
 
-DATA = json.loads((Path(__file__).parent / "data" / "gears_expected.json").read_text())
+DATA = json.loads((Path(__file__).resolve().parents[1] / "data" / "gears_expected.json").read_text())
 ELLIPTIC = DATA["elliptic_template"]
 REPORT_KEYS = {"name", "teeth", "module_mm", "method", "center_distance_mm", "transmission_error_deg",
                "backlash_mm", "interference_area_mm2", "undercut", "min_pitch_radius_of_curvature_mm"}

@@ -23,13 +23,13 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import shapely
-from conftest import make_four_bar
-from test_parts import design_for
 
 from fabricate.mechanism import Body, Driver, LinearLaw, Mechanism, Revolute, Slider
 from fabricate.parts.build import Sizes, _add_mounting, build_parts
 from fabricate.parts.spec import PartsSpec
 from fabricate.planar import transform_points
+from tests.conftest import make_four_bar
+from tests.parts.test_build import design_for
 
 CHORD = 0.01  # mm, chord tolerance of the polygons the tests build
 

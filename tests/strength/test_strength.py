@@ -12,14 +12,14 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from conftest import make_four_bar
-from test_parts import slider_crank
 
 from fabricate.cli import main
 from fabricate.strength.check import body_loads, design_loads, solved_loads
 from fabricate.strength.spec import LoadSpec
 from fabricate.strength.statics import BodyTorque, PointForce, solve_statics
 from fabricate.templates import TEMPLATE_DIR
+from tests.conftest import make_four_bar
+from tests.parts.test_build import slider_crank
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -1,6 +1,7 @@
 """Planar kinematic mapping and dyad-family tracing (fabricate.synthesis.five_bar.kinematic_mapping).
 
-Fast and independent of the paper's finger (tests/test_five_bar.py synthesises it in a slow fixture).
+Fast and independent of the paper's finger (tests/synthesis/five_bar/test_five_bar.py synthesises it in a slow
+fixture).
 Expected values come from closed forms written out here (Bottema & Roth's image coordinates, explicit
 rotation matrices, circles through hand-picked points, conics solved by hand), from a dyad built by hand
 (four poses of a body whose moving point ``b`` runs on a circle about ``c``), or from a brute-force scan of

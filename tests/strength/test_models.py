@@ -37,7 +37,7 @@ from fabricate.strength.models import (
 )
 from fabricate.strength.section import Section, cut_section, side_of_cut
 
-DATA = json.loads((Path(__file__).parent / "data" / "strength_examples.json").read_text())
+DATA = json.loads((Path(__file__).resolve().parents[1] / "data" / "strength_examples.json").read_text())
 LBF = DATA["units"]["lbf_N"]
 INCH = DATA["units"]["in_mm"]
 PSI = LBF / INCH ** 2  # MPa per psi

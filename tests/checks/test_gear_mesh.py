@@ -15,9 +15,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from shapely.geometry import Polygon
-from test_gears_properties import fake_motion, sector_pair, spur_pair
 
 from fabricate.checks.gear_mesh import check_gear_mesh
+from tests.gears.test_gears_properties import fake_motion, sector_pair, spur_pair
 
 DESIGN_MM = 0.1  # design backlash of the fake pair; band 0.5..2 x this
 

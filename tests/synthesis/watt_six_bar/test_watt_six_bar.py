@@ -45,7 +45,7 @@ from fabricate.synthesis.watt_six_bar.statics import (
 from fabricate.table import Table
 from fabricate.templates import TEMPLATE_DIR, read_toml
 
-DATA = json.loads((Path(__file__).parent / "data" / "watt_six_bar_paper.json").read_text())
+DATA = json.loads((Path(__file__).resolve().parents[2] / "data" / "watt_six_bar_paper.json").read_text())
 TEMPLATE = TEMPLATE_DIR / "finger_watt_six_bar.toml"
 
 

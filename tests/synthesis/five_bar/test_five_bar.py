@@ -25,7 +25,7 @@ from fabricate.synthesis.five_bar.targets import finger_targets
 from fabricate.table import Table
 from fabricate.templates import TEMPLATE_DIR, read_toml
 
-PAPER = json.loads((Path(__file__).parent / "data" / "five_bar_paper.json").read_text())
+PAPER = json.loads((Path(__file__).resolve().parents[2] / "data" / "five_bar_paper.json").read_text())
 TEMPLATE = TEMPLATE_DIR / "finger_five_bar_ncg.toml"
 
 

@@ -3,7 +3,7 @@
 The shipped linkages against position analyses written here from their published or stated numbers
 (circle intersections and closed forms, no fabricate code), and every bad linkage against its exit code
 and a message that names the joint. The shipped templates' full builds (interference, strength, exports)
-are the parametrised tests of test_cli.py and test_export.py.
+are the parametrised tests of tests/test_cli.py and tests/export/test_export.py.
 """
 
 from __future__ import annotations

@@ -34,8 +34,8 @@ from fabricate.synthesis.compliant.model import (
 )
 from fabricate.table import Table
 
-ROOT = Path(__file__).resolve().parent.parent
-DATA = json.loads((Path(__file__).parent / "data" / "compliant_paper.json").read_text())
+ROOT = Path(__file__).resolve().parents[3]
+DATA = json.loads((Path(__file__).resolve().parents[2] / "data" / "compliant_paper.json").read_text())
 GEOM = GripperGeometry(40, 40, 20, 20, 0.0, 70, 50, 60, 36, np.pi / 3)
 LOAD = Load(85.0, 0.25, 0.27, 0.8)
 PAPER = Springs(0.0, 30.0, 0.0, 1.274)

@@ -42,9 +42,9 @@ from fabricate.synthesis.watt_six_bar.region import (
 )
 from fabricate.table import Table
 from fabricate.templates import TEMPLATE_DIR, read_toml
-from tests.test_watt_six_bar import assert_grid_count
+from tests.synthesis.watt_six_bar.test_watt_six_bar import assert_grid_count
 
-DATA = json.loads((Path(__file__).parent / "data" / "watt_six_bar_paper.json").read_text())
+DATA = json.loads((Path(__file__).resolve().parents[2] / "data" / "watt_six_bar_paper.json").read_text())
 FIT = DATA["table2_rounding_fit"]
 LENGTHS = np.asarray(DATA["phalanx_lengths_mm"], dtype=np.float64)
 PRINTED = np.asarray(DATA["theta_deg"], dtype=np.float64)

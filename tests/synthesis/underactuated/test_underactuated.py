@@ -32,8 +32,8 @@ from fabricate.synthesis.underactuated.model import (
 from fabricate.synthesis.underactuated.settler import Settler, face_clearance, face_geometry
 from fabricate.table import Table
 
-ROOT = Path(__file__).resolve().parent.parent
-DATA = json.loads((Path(__file__).parent / "data" / "underactuated_closing.json").read_text())
+ROOT = Path(__file__).resolve().parents[3]
+DATA = json.loads((Path(__file__).resolve().parents[2] / "data" / "underactuated_closing.json").read_text())
 
 
 def _raw() -> dict:
