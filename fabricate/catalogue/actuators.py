@@ -49,9 +49,9 @@ class Hole:
 
 @dataclass(frozen=True)
 class Spline:
-    """A servo output spline."""
+    """A servo output spline (``teeth`` None where no source gives the count)."""
 
-    teeth: int
+    teeth: int | None
     diameter_mm: float
     length_mm: float
 
@@ -169,9 +169,12 @@ def _servo_body(aft: float, wing: float, fore: float, body_w: float, wing_w: flo
             Box(cx - wing_w / 2, -body_l / 2, top_of_tab - wing, cx + wing_w / 2, body_l / 2, top_of_tab))
 
 
-def _servo_holes(axle_off: float, fore: float, hole_x: float, hole_d: float) -> tuple[Hole, ...]:
-    """The two tab holes, ``hole_x`` either side of the case centre, on the tabs' top face."""
-    return (Hole(-axle_off - hole_x, 0.0, -fore, hole_d), Hole(-axle_off + hole_x, 0.0, -fore, hole_d))
+def _servo_holes(axle_off: float, fore: float, hole_x: float, hole_d: float,
+                 hole_y: float = 0.0) -> tuple[Hole, ...]:
+    """The tab holes, ``hole_x`` either side of the case centre, on the tabs' top face: one per tab on the
+    centre line, or (``hole_y`` > 0) a pair per tab at ``±hole_y`` across it."""
+    ys = (0.0,) if hole_y == 0.0 else (-hole_y, hole_y)
+    return tuple(Hole(-axle_off + sx * hole_x, y, -fore, hole_d) for sx in (-1.0, 1.0) for y in ys)
 
 
 HORN_20T_I = Horn(
@@ -235,6 +238,51 @@ MG90S = Actuator(
              ("stall_torque_nmm", MG90S_DATASHEET), ("no_load_speed", MG90S_DATASHEET),
              ("voltage_v", MG90S_DATASHEET)),
     gaps=(("rated_torque_nmm", "the datasheet gives the stall torque only"),),
+)
+
+# ---------------------------------------------------------------------------------------------------------
+# Standard-size servo (MG996R class)
+# ---------------------------------------------------------------------------------------------------------
+
+MG996R_DATASHEET = ("TowerPro MG996R datasheet, Handsontec EMH-1056 (https://www.handsontec.com/dataspecs/motor_fan/"
+                    "MG996R.pdf), read through a public transcription of its spec lines and page-2 drawing: 'Stall "
+                    "torque: 9.4 kgf·cm (4.8 V), 11 kgf·cm (6 V); Operating speed: 0.17 s/60º (4.8 V), 0.14 s/60º "
+                    "(6 V); Operating voltage: 4.8 V a 7.2 V'; drawing: case 40.3 long, 53.6 over the tabs, 20 wide, "
+                    "36.6 high, 26.6 from the base to the tabs, 47.6 high with the horn")
+#: The MG996R drawing's own envelope (mm), kept to check the body below against it (not used to build it).
+MG996R_DRAWING = {"case_l": 40.3, "over_tabs": 53.6, "case_w": 20.0,  # MG996R_DATASHEET drawing
+                  "case_h": 36.6, "base_to_tabs": 26.6}  # MG996R_DATASHEET drawing
+
+# The drawing does not place the output axis in the case nor dimension the tab holes, so the body and mount
+# are Kartchner's measured standard-size servo (s3003_clone.scad): aft 26.79, wing 4.00, fore 6.43, axle
+# 5.52, body width 40.86, wing width 54.15, axle offset 10.15, axle Ø5.80, body length 20.30, four holes at
+# x ±24.43, y ±4.50, Ø4.42. Every one of its outer dimensions is at or up to 0.62 mm over the MG996R
+# drawing's (40.86 ≥ 40.3, 54.15 ≥ 53.6, 20.30 ≥ 20, 37.22 ≥ 36.6, 26.79 ≥ 26.6), so the interference proof
+# sees a body no smaller than the MG996R (tests/catalogue/test_actuators.py checks it).
+_STD = {"aft": 26.79, "wing": 4.00, "fore": 6.43, "body_w": 40.86, "wing_w": 54.15,  # s3003_clone.scad
+        "axle_off": 10.15, "body_l": 20.30}  # s3003_clone.scad
+MG996R = Actuator(
+    key="mg996r", name="TowerPro MG996R metal-gear standard servo", kind="servo",
+    body=_servo_body(**_STD),
+    mounting_holes=_servo_holes(10.15, 6.43, 24.43, 4.42, 4.50),  # s3003_clone.scad x ±24.43, y ±4.50, Ø4.42
+    spline=Spline(teeth=None, diameter_mm=5.80, length_mm=5.52),  # s3003_clone.scad axle Ø5.80, axle h 5.52
+    horn=None, shaft=None,
+    rated_torque_nmm=None,
+    stall_torque_nmm=9.4 * KGF_CM_NMM,  # MG996R_DATASHEET: stall torque 9.4 kgf·cm (4.8 V)
+    rated_force_n=None, stall_force_n=None,
+    no_load_speed=s_per_60deg_to_deg_s(0.17),  # MG996R_DATASHEET: 0.17 s/60º (4.8 V)
+    voltage_v=4.8,  # MG996R_DATASHEET: 4.8 V, the lower end of 4.8-7.2 V, where the figures above hold
+    stroke_mm=None, closed_length_mm=None,
+    sources=(("body", KARTCHNB_SERVOS.format(file="s3003_clone.scad") + "; cross-checked against the "
+              + MG996R_DATASHEET),
+             ("mounting_holes", KARTCHNB_SERVOS.format(file="s3003_clone.scad") + " (the standard-size servo's "
+              "four tab holes; the MG996R ships with 4 fixing screws, " + MG996R_DATASHEET + ")"),
+             ("spline", KARTCHNB_SERVOS.format(file="s3003_clone.scad") + " (axle diameter and height)"),
+             ("stall_torque_nmm", MG996R_DATASHEET), ("no_load_speed", MG996R_DATASHEET),
+             ("voltage_v", MG996R_DATASHEET)),
+    gaps=(("rated_torque_nmm", "the datasheet gives the stall torque only"),
+          ("horn", "no source dimensions the horns supplied with the MG996R"),
+          ("spline.teeth", "no source states the MG996R spline's tooth count (s3003_clone.scad: 'unknown')")),
 )
 
 # ---------------------------------------------------------------------------------------------------------
@@ -402,9 +450,9 @@ L16 = Actuator(
                              "118 mm closed, is closed_length_mm)")),
 )
 
-#: The catalogue, by key. MG996R-class servos are missing: no source giving their mounting geometry was
-#: found, and the torque figures found disagree (9.4 to 15 kgf·cm) without a primary datasheet.
-CATALOGUE: dict[str, Actuator] = {a.key: a for a in (SG90, MG90S, N20, NEMA17, BYJ48, TENDON, L16)}
+#: The catalogue, by key. Complete (body, mount, interface, rating): sg90, mg90s, mg996r, nema17, 28byj48
+#: (and the tendon, once its force is given); n20 and l16 lack the body and mount their drawings alone give.
+CATALOGUE: dict[str, Actuator] = {a.key: a for a in (SG90, MG90S, MG996R, N20, NEMA17, BYJ48, TENDON, L16)}
 
 
 def actuator(key: str) -> Actuator:

@@ -17,11 +17,24 @@ BENERI_6799
     (http://beneri.com/en/prodotto/din-6799): groove width m and edge margin n, besides d2, d3, s.
 KB3D_SHIMS
     KB-3D retail listings of DIN 988 shim rings (named in the comment of each size).
+DIN988_TEXT
+    DIN 988:1990-03, page 1 (English edition, reproduced at http://m.mydoc123.com/p-662206.html and
+    https://de.scribd.com/document/440217046/DIN-988): the designation "Shim ring DIN 988 - 40 x 50 x 0,5"
+    (inside diameter d1 × outside diameter d2 × thickness h). Its size table (page 2) was not legible in any
+    public reproduction found, so the shim sizes are only those a retail listing names.
+
+Designations
+------------
+Every record carries the ``designation`` a shop names it by (the form each standard's own designation
+example uses, with "×" between dimensions and a decimal point): ``ISO 8734 2 × 20``, ``ISO 7089 3``
+(also ``DIN 125-A 3.2``), ``DIN 988 3 × 6 × 0.5``, ``ISO 4762 M3 × 12``, ``ISO 4032 M3``, ``DIN 6799 1.9``,
+``ISO 2341-B 3 × 16``, ``ISO 1234 0.8 × 5``. :func:`parse_designation` reads each back.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -40,6 +53,16 @@ def _finite_positive(path: str, value: float) -> float:
         raise SpecError(path, f"expected a number, got {value!r}") from None
     if not math.isfinite(v) or v <= 0.0:
         raise SpecError(path, f"expected a positive finite number, got {value!r}")
+    return v
+
+
+def _finite_nonnegative(path: str, value: float) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise SpecError(path, f"expected a number, got {value!r}") from None
+    if not math.isfinite(v) or v < 0.0:
+        raise SpecError(path, f"expected a finite number >= 0, got {value!r}")
     return v
 
 
@@ -154,13 +177,19 @@ def dowel_pin(diameter_mm: float, min_length_mm: float, standard: str = "ISO 873
 
 @dataclass(frozen=True)
 class Washer:
-    """A flat washer or shim ring: bore ``d1``, outside ``d2``, thickness ``h`` (mm)."""
+    """A flat washer or shim ring: bore ``d1``, outside ``d2``, thickness ``h`` (mm).
+
+    ``designation`` is the name a shop orders it by; ``alt_designation`` an equivalent name under another
+    standard (an ISO 7089 washer is also a DIN 125-A one), or None.
+    """
 
     designation: str
     d1_mm: float
     d2_mm: float
     h_mm: float
     source: str
+    standard: str = ""
+    alt_designation: str | None = None
 
 
 #: ISO 7089 normal series (d1 min, d2 max, h nominal), mm. FsData/iso7089def.csv columns d1_min, d2_max, h.
@@ -172,17 +201,22 @@ ISO7089: dict[str, tuple[float, float, float]] = {
     "M4": (4.3, 9.0, 0.8),  # iso7089def.csv "M4",4.3,9.0,0.8
     "M5": (5.3, 10.0, 1.0),  # iso7089def.csv "M5",5.3,10.0,1.0
     "M6": (6.4, 12.0, 1.6),  # iso7089def.csv "M6",6.4,12.0,1.6
+    "M8": (8.4, 16.0, 1.6),  # iso7089def.csv "M8",8.4,16.0,1.6
 }
 ISO7089_SOURCE = (f"ISO 7089 / DIN 125-A: {FASTENERS_WB}, iso7089def.csv (M3..M6 also engineeringhardware.com "
                   "ISO 7089 size table, https://engineeringhardware.com/guide/standard/iso-7089-cad-svg-086-washer/)")
 
 
 def washer(size: str) -> Washer:
-    """The ISO 7089 (DIN 125-A) washer of thread ``size`` (``"M3"``)."""
+    """The ISO 7089 (DIN 125-A) washer of thread ``size`` (``"M3"``).
+
+    Its designation is ISO 7089's, by the nominal thread size (``"ISO 7089 3"``); ``alt_designation`` is
+    DIN 125-A's, by the bore d1 (``"DIN 125-A 3.2"``).
+    """
     if size not in ISO7089:
         raise SpecError("size", f"no ISO 7089 washer for {size!r}; sizes {', '.join(ISO7089)}")
     d1, d2, h = ISO7089[size]
-    return Washer(f"ISO 7089 {size} (DIN 125-A {d1:g})", d1, d2, h, ISO7089_SOURCE)
+    return Washer(f"ISO 7089 {size[1:]}", d1, d2, h, ISO7089_SOURCE, "ISO 7089", f"DIN 125-A {d1:g}")
 
 
 def washer_for_shaft(diameter_mm: float) -> Washer:
@@ -194,6 +228,8 @@ def washer_for_shaft(diameter_mm: float) -> Washer:
     raise SpecError("diameter_mm", f"no ISO 7089 washer in the catalogue clears Ø{d:g} mm")
 
 
+DIN988_NAMING = ("DIN 988:1990-03 p. 1, 'Shim ring DIN 988 - 40 x 50 x 0,5' (d1 x d2 x h), http://m.mydoc123.com/"
+                 "p-662206.html")
 #: DIN 988 shim rings (d1, d2) -> thicknesses h, mm. Only the sizes a retail listing was found for: the
 #: standard's full table (and its thickness series) was not found in a public reproduction.
 DIN988: dict[tuple[float, float], tuple[tuple[float, ...], str]] = {
@@ -224,7 +260,85 @@ def shim_ring(shaft_mm: float, thickness_mm: float) -> Washer:
     if not any(abs(h - t) < 1e-6 for h in thicknesses):
         raise SpecError("thickness_mm", f"no {d1:g} × {d2:g} DIN 988 ring {t:g} mm thick in the catalogue "
                         f"(thicknesses {', '.join(f'{h:g}' for h in thicknesses)})")
-    return Washer(f"DIN 988 {d1:g} × {d2:g} × {t:g}", d1, d2, t, source)
+    return Washer(f"DIN 988 {d1:g} × {d2:g} × {t:g}", d1, d2, t, f"{source}; naming: {DIN988_NAMING}", "DIN 988")
+
+
+def washers_for_shaft(shaft_mm: float) -> tuple[Washer, ...]:
+    """Every catalogued washer or shim that sits on a pin of ``shaft_mm``: the smallest ISO 7089 washer
+    that clears it and each DIN 988 shim ring of that bore (thinnest first)."""
+    d = _finite_positive("shaft_mm", shaft_mm)
+    out: list[Washer] = []
+    try:
+        out.append(washer_for_shaft(d))
+    except SpecError:
+        pass
+    for (d1, _), (thicknesses, _) in DIN988.items():
+        if abs(d1 - d) < 1e-6:
+            out.extend(shim_ring(d1, h) for h in thicknesses)
+    return tuple(sorted(out, key=lambda w: (w.h_mm, w.designation)))
+
+
+#: fill_gap works in these steps (mm): every catalogued thickness is a whole number of them.
+_GAP_STEP = 0.01  # fill_gap's resolution, not a table value (every thickness above is a multiple of it)
+
+
+def fill_gap(shaft_mm: float, gap_mm: float, tol_mm: float) -> tuple[Washer, ...]:
+    """The fewest standard washers and shims on a pin of ``shaft_mm`` that fill an axial gap.
+
+    The stack's thickness ``t`` satisfies ``gap_mm - tol_mm <= t <= gap_mm`` (it never over-fills the
+    gap, so the stack and the pin length stay consistent). Among the stacks with the fewest pieces the
+    thickest is taken. Only the washers :func:`washers_for_shaft` lists are used, each as often as needed.
+
+    Parameters
+    ----------
+    shaft_mm : float
+        Pin diameter.
+    gap_mm : float
+        The axial play to take up (>= 0).
+    tol_mm : float
+        How much of the gap may stay open (>= 0).
+
+    Returns
+    -------
+    tuple of Washer
+        Thickest first; empty when ``gap_mm <= tol_mm``.
+
+    Raises
+    ------
+    SpecError
+        Bad numbers (the parameter's name); no washer for the shaft (``shaft_mm``); no stack within the
+        tolerance (``gap_mm``).
+    """
+    d = _finite_positive("shaft_mm", shaft_mm)
+    gap = _finite_nonnegative("gap_mm", gap_mm)
+    tol = _finite_nonnegative("tol_mm", tol_mm)
+    if gap <= tol + _EPS:
+        return ()
+    items = washers_for_shaft(d)
+    if not items:
+        raise SpecError("shaft_mm", f"no washer or shim in the catalogue fits a Ø{d:g} mm pin")
+    steps = [round(w.h_mm / _GAP_STEP) for w in items]
+    hi = math.floor(gap / _GAP_STEP + 1e-6)
+    lo = max(0, math.ceil((gap - tol) / _GAP_STEP - 1e-6))
+    # fewest pieces to reach each total (unbounded change-making), the last piece remembered
+    inf = hi + 1
+    count = [0] + [inf] * hi
+    last = [-1] * (hi + 1)
+    for total in range(1, hi + 1):
+        for i, st in enumerate(steps):
+            if st <= total and count[total - st] + 1 < count[total]:
+                count[total] = count[total - st] + 1
+                last[total] = i
+    reachable = [t for t in range(lo, hi + 1) if count[t] < inf]
+    if not reachable:
+        raise SpecError("gap_mm", f"no stack of {', '.join(w.designation for w in items)} fills {gap:g} mm "
+                        f"within {tol:g} mm")
+    best = min(reachable, key=lambda t: (count[t], -t))
+    stack: list[Washer] = []
+    while best > 0:
+        stack.append(items[last[best]])
+        best -= steps[last[best]]
+    return tuple(sorted(stack, key=lambda w: -w.h_mm))
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -341,6 +455,48 @@ def screw(size: str, clamp_mm: float, engagement_mm: float, standard: str = "ISO
                     f"the longest {standard} {size} ({row.max_length_mm:g} mm)")
 
 
+@dataclass(frozen=True)
+class Nut:
+    """An ISO 4032 hexagon nut (style 1): pitch ``P``, width across flats ``s``, across corners ``e`` (min)
+    and height ``m`` (max), mm."""
+
+    designation: str
+    size: str
+    pitch_mm: float
+    s_mm: float
+    e_mm: float
+    m_mm: float
+    source: str
+
+
+#: ISO 4032 (P, s nominal, e min, m max), mm. FsData/iso4032def.csv columns P, s_nom, e, m.
+ISO4032: dict[str, tuple[float, float, float, float]] = {
+    "M1.6": (0.35, 3.2, 3.4, 1.3),  # iso4032def.csv "M1.6",0.35,..,e 3.4,m 1.3,..,s 3.2
+    "M2": (0.4, 4.0, 4.4, 1.6),  # iso4032def.csv "M2",0.4,..,e 4.4,m 1.6,..,s 4.0
+    "M2.5": (0.45, 5.0, 5.5, 2.0),  # iso4032def.csv "M2.5",0.45,..,e 5.5,m 2.0,..,s 5.0
+    "M3": (0.5, 5.5, 6.1, 2.4),  # iso4032def.csv "M3",0.5,..,e 6.1,m 2.4,..,s 5.5
+    "M4": (0.7, 7.0, 7.7, 3.2),  # iso4032def.csv "M4",0.7,..,e 7.7,m 3.2,..,s 7.0
+    "M5": (0.8, 8.0, 8.9, 4.7),  # iso4032def.csv "M5",0.8,..,e 8.9,m 4.7,..,s 8.0
+    "M6": (1.0, 10.0, 11.05, 5.2),  # iso4032def.csv "M6",1.0,..,e 11.05,m 5.2,..,s 10.0
+}
+ISO4032_SOURCE = f"ISO 4032: {FASTENERS_WB}, iso4032def.csv (columns P, s_nom, e, m)"
+
+
+def nut(size: str) -> Nut:
+    """The ISO 4032 hexagon nut of thread ``size`` (``"M3"``)."""
+    if size not in ISO4032:
+        raise SpecError("size", f"no ISO 4032 nut {size!r} in the catalogue; sizes {', '.join(ISO4032)}")
+    p, s, e, m = ISO4032[size]
+    return Nut(f"ISO 4032 {size}", size, p, s, e, m, ISO4032_SOURCE)
+
+
+def screw_and_nut(size: str, clamp_mm: float, standard: str = "ISO 4762") -> tuple[Screw, Nut]:
+    """A screw through ``clamp_mm`` of parts into an ISO 4032 nut: the thread engages the nut's full
+    height ``m`` (the shortest standard screw that reaches through the nut)."""
+    n = nut(size)
+    return screw(size, clamp_mm, n.m_mm, standard), n
+
+
 # ---------------------------------------------------------------------------------------------------------
 # Retaining washers (E-clips) DIN 6799
 # ---------------------------------------------------------------------------------------------------------
@@ -384,6 +540,11 @@ DIN6799: dict[float, tuple[float, float, float, float, float, float]] = {
 DIN6799_SOURCE = f"DIN 6799: {BENERI_6799}; cross-checked against {FASTENERS_WB}, din6799def.csv"
 
 
+def _e_clip_row(groove: float) -> RetainingRing:
+    lo, hi, od, s, m, n = DIN6799[groove]
+    return RetainingRing(f"DIN 6799 {groove:g}", lo, hi, groove, m, s, od, n, DIN6799_SOURCE)
+
+
 def e_clip(shaft_mm: float) -> RetainingRing:
     """The DIN 6799 retaining washer for a pin of ``shaft_mm``.
 
@@ -398,9 +559,225 @@ def e_clip(shaft_mm: float) -> RetainingRing:
         No DIN 6799 ring covers ``shaft_mm``.
     """
     d = _finite_positive("shaft_mm", shaft_mm)
-    for groove, (lo, hi, od, s, m, n) in sorted(DIN6799.items()):
+    for groove, (lo, hi, *_) in sorted(DIN6799.items()):
         if lo + _EPS < d <= hi + _EPS:
-            return RetainingRing(f"DIN 6799 – {groove:g}", lo, hi, groove, m, s, od, n, DIN6799_SOURCE)
+            return _e_clip_row(groove)
     raise SpecError("shaft_mm", f"no DIN 6799 retaining washer in the catalogue for a Ø{d:g} mm shaft "
                     f"(shafts over {min(v[0] for v in DIN6799.values()):g} up to "
                     f"{max(v[1] for v in DIN6799.values()):g} mm)")
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Clevis pins ISO 2341 type B and split pins ISO 1234
+# ---------------------------------------------------------------------------------------------------------
+
+#: ISO 2341 rows d -> (head d_k, split-pin hole d_l, chamfer c, head edge e, head height k, hole centre from
+#: the end l_e), mm. FsData/iso2341def.csv columns d, d_k, d_l, c, e, k, l_e (its r, the under-head radius,
+#: is left out); the geometry (head above, the hole l_e from the tip): FsFunctions/FSmakeClevisPin.py.
+ISO2341: dict[float, tuple[float, float, float, float, float, float]] = {
+    3.0: (5.0, 0.8, 1.0, 0.5, 1.0, 1.6),  # iso2341def.csv "3 mm",3,5,0.8,1,0.5,1,1.6
+    4.0: (6.0, 1.0, 1.0, 0.5, 1.0, 2.2),  # iso2341def.csv "4 mm",4,6,1,1,0.5,1,2.2
+    5.0: (8.0, 1.2, 2.0, 1.0, 1.6, 2.9),  # iso2341def.csv "5 mm",5,8,1.2,2,1,1.6,2.9
+    6.0: (10.0, 1.6, 2.0, 1.0, 2.0, 3.2),  # iso2341def.csv "6 mm",6,10,1.6,2,1,2,3.2
+    8.0: (14.0, 2.0, 2.0, 1.0, 3.0, 3.5),  # iso2341def.csv "8 mm",8,14,2,2,1,3,3.5
+    10.0: (18.0, 3.2, 2.0, 1.0, 4.0, 4.5),  # iso2341def.csv "10 mm",10,18,3.2,2,1,4,4.5
+}
+#: ISO 2341 nominal lengths (mm). FsData/iso2341length.csv column "nominal" (to 100 mm).
+ISO2341_LENGTHS_MM: tuple[float, ...] = (
+    6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30, 32, 35, 40, 45, 50,  # iso2341length.csv "nominal"
+    55, 60, 65, 70, 75, 80, 85, 90, 95, 100)  # iso2341length.csv "nominal"
+#: ISO 2341 length range (min, max) per d. FsData/iso2341range.csv.
+ISO2341_RANGE_MM: dict[float, tuple[float, float]] = {
+    3.0: (6, 30),  # iso2341range.csv "3 mm","6","30"
+    4.0: (8, 40),  # iso2341range.csv "4 mm","8","40"
+    5.0: (10, 50),  # iso2341range.csv "5 mm","10","50"
+    6.0: (12, 60),  # iso2341range.csv "6 mm","12","60"
+    8.0: (16, 80),  # iso2341range.csv "8 mm","16","80"
+    10.0: (20, 100),  # iso2341range.csv "10 mm","20","100"
+}
+ISO2341_SOURCE = (f"ISO 2341: {FASTENERS_WB}, iso2341def.csv, iso2341length.csv, iso2341range.csv; geometry "
+                  "FsFunctions/FSmakeClevisPin.py")
+
+#: ISO 1234 rows nominal size (= the hole it fits) -> (leg extension a, length b, eye c, wire width d), mm.
+#: FsData/iso1234def.csv columns a, b, c, d; the shape FsFunctions/FSmakeSplitPin.py.
+ISO1234: dict[float, tuple[float, float, float, float]] = {
+    0.6: (1.2, 2.0, 0.95, 0.45),  # iso1234def.csv "0.6 mm",1.2,2,0.95,0.45
+    0.8: (1.2, 2.4, 1.3, 0.65),  # iso1234def.csv "0.8 mm",1.2,2.4,1.3,0.65
+    1.0: (1.2, 3.0, 1.7, 0.85),  # iso1234def.csv "1 mm",1.2,3,1.7,0.85
+    1.2: (1.875, 3.2, 2.6, 0.95),  # iso1234def.csv "1.2 mm",1.875,3.2,2.6,0.95
+    1.6: (1.875, 4.0, 3.4, 1.35),  # iso1234def.csv "1.6 mm",1.875,4,3.4,1.35
+    2.0: (1.875, 5.0, 4.3, 1.75),  # iso1234def.csv "2 mm",1.875,5,4.3,1.75
+    2.5: (1.875, 5.0, 4.3, 2.2),  # iso1234def.csv "2.5 mm",1.875,5,4.3,2.2
+    3.2: (2.4, 6.4, 5.45, 2.8),  # iso1234def.csv "3.2 mm",2.4,6.4,5.45,2.8
+}
+#: ISO 1234 nominal lengths (mm). FsData/iso1234length.csv column "nominal" (to 50 mm).
+ISO1234_LENGTHS_MM: tuple[float, ...] = (
+    4, 5, 6, 8, 10, 12, 14, 16, 18, 20, 22, 25, 28, 32, 36, 40, 45, 50)  # iso1234length.csv "nominal"
+#: ISO 1234 length range (min, max) per nominal size. FsData/iso1234range.csv.
+ISO1234_RANGE_MM: dict[float, tuple[float, float]] = {
+    0.6: (4, 12),  # iso1234range.csv "0.6 mm","4","12"
+    0.8: (5, 16),  # iso1234range.csv "0.8 mm","5","16"
+    1.0: (6, 20),  # iso1234range.csv "1 mm","6","20"
+    1.2: (8, 25),  # iso1234range.csv "1.2 mm","8","25"
+    1.6: (8, 32),  # iso1234range.csv "1.6 mm","8","32"
+    2.0: (10, 40),  # iso1234range.csv "2 mm","10","40"
+    2.5: (12, 50),  # iso1234range.csv "2.5 mm","12","50"
+    3.2: (14, 63),  # iso1234range.csv "3.2 mm","14","63"
+}
+ISO1234_SOURCE = (f"ISO 1234: {FASTENERS_WB}, iso1234def.csv, iso1234length.csv, iso1234range.csv; shape "
+                  "FsFunctions/FSmakeSplitPin.py")
+
+
+@dataclass(frozen=True)
+class SplitPin:
+    """An ISO 1234 split pin (cotter pin): ``size`` is the nominal size, the diameter of the hole it goes
+    through; ``length_mm`` the shank under the eye; ``wire_d_mm`` the pin's width (d), ``eye_d_mm`` (c)."""
+
+    designation: str
+    size_mm: float
+    length_mm: float
+    wire_d_mm: float
+    eye_d_mm: float
+    leg_extension_mm: float
+    source: str
+
+
+@dataclass(frozen=True)
+class ClevisPin:
+    """An ISO 2341 type B clevis pin (head, and a cross hole for a split pin) with its split pin.
+
+    The head sits on one face of the stack; the cross hole's centre is ``hole_from_end_mm`` from the
+    pin's tip. ``grip_mm = length - hole_from_end - hole_d / 2`` is the longest stack the pin holds with
+    its cross hole entirely outside the stack (the split pin then bears on the far face).
+    ``protrusion_mm`` is what passes the far face of a stack of ``grip_mm`` (the pin's end and the split
+    pin's hole), and ``head_h_mm`` what stands proud of the near face.
+    """
+
+    designation: str
+    d_mm: float
+    length_mm: float
+    head_d_mm: float
+    head_h_mm: float
+    hole_d_mm: float
+    hole_from_end_mm: float
+    split_pin: SplitPin
+    source: str
+
+    @property
+    def grip_mm(self) -> float:
+        return self.length_mm - self.hole_from_end_mm - self.hole_d_mm / 2.0
+
+    @property
+    def protrusion_mm(self) -> float:
+        return self.length_mm - self.grip_mm
+
+
+def split_pin(size_mm: float, min_length_mm: float) -> SplitPin:
+    """The shortest ISO 1234 split pin of nominal ``size_mm`` (its hole) at least ``min_length_mm`` long."""
+    size = _finite_positive("size_mm", size_mm)
+    need = _finite_positive("min_length_mm", min_length_mm)
+    if _key(size) not in ISO1234:
+        raise SpecError("size_mm", f"no ISO 1234 split pin of size {size:g} in the catalogue; sizes "
+                        f"{', '.join(f'{k:g}' for k in ISO1234)}")
+    a, _, c, d = ISO1234[_key(size)]
+    lo, hi = ISO1234_RANGE_MM[_key(size)]
+    for length in ISO1234_LENGTHS_MM:
+        if lo - _EPS <= length <= hi + _EPS and length >= need - _EPS:
+            return SplitPin(f"ISO 1234 {size:g} × {length:g}", size, float(length), d, c, a, ISO1234_SOURCE)
+    raise SpecError("min_length_mm", f"{need:g} mm is longer than the longest ISO 1234 {size:g} split pin "
+                    f"({min(hi, ISO1234_LENGTHS_MM[-1]):g} mm)")
+
+
+def clevis_pin(diameter_mm: float, min_grip_mm: float) -> ClevisPin:
+    """The shortest ISO 2341-B clevis pin of ``diameter_mm`` whose grip covers ``min_grip_mm``, with the
+    ISO 1234 split pin its cross hole takes.
+
+    The split pin is the shortest of its size whose shank spans the pin (length >= d: its legs must
+    pass the far side to be bent back); a longer one is the fitter's choice.
+
+    Parameters
+    ----------
+    diameter_mm : float
+        Pin diameter; ISO 2341 starts at 3 mm.
+    min_grip_mm : float
+        The stack the pin passes, with any washer under the split pin.
+
+    Raises
+    ------
+    SpecError
+        ``diameter_mm`` not in the catalogue; ``min_grip_mm`` beyond the longest pin of the diameter.
+    """
+    d = _finite_positive("diameter_mm", diameter_mm)
+    grip = _finite_positive("min_grip_mm", min_grip_mm)
+    if _key(d) not in ISO2341:
+        raise SpecError("diameter_mm", f"no ISO 2341 clevis pin of Ø{d:g} mm in the catalogue; diameters "
+                        f"{', '.join(f'{k:g}' for k in ISO2341)}")
+    dk, dl, _, _, k, le = ISO2341[_key(d)]
+    lo, hi = ISO2341_RANGE_MM[_key(d)]
+    for length in ISO2341_LENGTHS_MM:
+        if not lo - _EPS <= length <= hi + _EPS:
+            continue
+        if length - le - dl / 2.0 >= grip - _EPS:
+            sp = split_pin(dl, d)
+            return ClevisPin(f"ISO 2341-B {d:g} × {length:g}", d, float(length), dk, k, dl, le, sp,
+                             ISO2341_SOURCE)
+    raise SpecError("min_grip_mm", f"a {grip:g} mm grip is more than the longest ISO 2341 Ø{d:g} pin holds "
+                    f"({hi - le - dl / 2.0:g} mm)")
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Designations read back
+# ---------------------------------------------------------------------------------------------------------
+
+Designated = PinChoice | Washer | Screw | Nut | RetainingRing | ClevisPin | SplitPin
+
+_NUM = r"(\d+(?:\.\d+)?)"
+_X = r"\s*[×x]\s*"
+
+
+def parse_designation(text: str) -> Designated:
+    """The catalogue record a shop designation names (the inverse of every ``designation`` above).
+
+    A screw is named without its joint: it comes back with ``clamp_mm = 0`` and its whole length as
+    ``engagement_mm``. Raises :class:`SpecError` (path ``designation``) for a name the catalogue does
+    not hold.
+    """
+    t = " ".join(str(text).replace(",", ".").split())
+    try:
+        if m := re.fullmatch(rf"(ISO 8734|ISO 2338) {_NUM}{_X}{_NUM}", t):
+            pin = dowel_pin(float(m[2]), float(m[3]), m[1])
+            if abs(pin.length_mm - float(m[3])) < 1e-6:
+                return pin
+        elif m := re.fullmatch(rf"ISO 7089 {_NUM}", t):
+            return washer(f"M{m[1]}")
+        elif m := re.fullmatch(rf"DIN 125-A {_NUM}", t):
+            for size, (d1, _, _) in ISO7089.items():
+                if abs(d1 - float(m[1])) < 1e-6:
+                    return washer(size)
+        elif m := re.fullmatch(rf"DIN 988 {_NUM}{_X}{_NUM}{_X}{_NUM}", t):
+            ring = shim_ring(float(m[1]), float(m[3]))
+            if abs(ring.d2_mm - float(m[2])) < 1e-6:
+                return ring
+        elif m := re.fullmatch(rf"(ISO 4762|ISO 7380) (M{_NUM}){_X}{_NUM}", t):
+            table, lengths, source = SCREW_SERIES[m[1]]
+            row = table.get(m[2])
+            length = float(m[4])
+            if row and length in lengths and row.min_length_mm <= length <= row.max_length_mm:
+                return Screw(t, m[1], m[2], length, 0.0, length, row.head_d_mm, row.head_h_mm,
+                             min(length, row.thread_b_mm), source)
+        elif m := re.fullmatch(r"ISO 4032 (M\d+(?:\.\d+)?)", t):
+            return nut(m[1])
+        elif m := re.fullmatch(rf"DIN 6799 {_NUM}", t):
+            return _e_clip_row(_key(float(m[1])))
+        elif m := re.fullmatch(rf"ISO 2341-B {_NUM}{_X}{_NUM}", t):
+            cp = clevis_pin(float(m[1]), float(m[2]) - ISO2341[_key(float(m[1]))][5]
+                            - ISO2341[_key(float(m[1]))][1] / 2.0)
+            if abs(cp.length_mm - float(m[2])) < 1e-6:
+                return cp
+        elif m := re.fullmatch(rf"ISO 1234 {_NUM}{_X}{_NUM}", t):
+            sp = split_pin(float(m[1]), float(m[2]))
+            if abs(sp.length_mm - float(m[2])) < 1e-6:
+                return sp
+    except (SpecError, KeyError):
+        pass
+    raise SpecError("designation", f"{text!r} names no part in the catalogue")

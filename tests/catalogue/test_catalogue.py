@@ -143,7 +143,7 @@ def test_tendon_takes_its_force_from_the_template_and_unknown_keys_are_refused()
         tendon(-1.0)
     assert err.value.path == "force_n"
     with pytest.raises(SpecError) as err:
-        actuator("mg996r")
+        actuator("mg995")
     assert err.value.path == "actuator"
 
 
@@ -153,7 +153,7 @@ def test_complete_entries_have_body_mount_interface_and_rating():
             assert a.body and a.mounting_holes
             assert a.spline is not None or a.shaft is not None or a.kind == "linear"
             assert (a.stall_torque_nmm or a.rated_torque_nmm or a.stall_force_n or a.rated_force_n)
-    assert {k for k, a in CATALOGUE.items() if a.complete} >= {"sg90", "mg90s", "nema17", "28byj48"}
+    assert {k for k, a in CATALOGUE.items() if a.complete} >= {"sg90", "mg90s", "mg996r", "nema17", "28byj48"}
 
 
 # --- dowel pins ------------------------------------------------------------------------------------------
@@ -232,11 +232,12 @@ def test_washers_and_shims():
     for size, row in hw.ISO7089.items():
         w = hw.washer(size)
         assert (w.d1_mm, w.d2_mm, w.h_mm) == row
-        assert float(size[1:]) < w.d1_mm < w.d2_mm and w.h_mm > 0 and size in w.designation
+        assert float(size[1:]) < w.d1_mm < w.d2_mm and w.h_mm > 0
+        assert w.designation == f"ISO 7089 {size[1:]}" and w.alt_designation == f"DIN 125-A {row[0]:g}"
     assert hw.washer_for_shaft(2.0).d1_mm == 2.2 and hw.washer_for_shaft(2.3).d1_mm == 2.7
-    assert hw.washer_for_shaft(3.0).designation.startswith("ISO 7089 M3")
+    assert hw.washer_for_shaft(3.0).designation == "ISO 7089 3"
     with pytest.raises(SpecError) as err:
-        hw.washer_for_shaft(7.0)
+        hw.washer_for_shaft(8.5)
     assert err.value.path == "diameter_mm"
     with pytest.raises(SpecError) as err:
         hw.washer("M7")
