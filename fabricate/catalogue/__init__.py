@@ -1,5 +1,6 @@
-"""Catalogue of real hardware: actuators (:mod:`.actuators`), standard pins, washers, screws and
-retaining rings (:mod:`.hardware`) and torsion springs sized by the standard formulas (:mod:`.springs`).
+"""Catalogue of real hardware: actuators (:mod:`.actuators`), standard pins, washers and shims, screws
+and nuts, retaining rings, clevis and split pins (:mod:`.hardware`) and torsion springs sized by the
+standard formulas (:mod:`.springs`).
 
 Every number comes from a named public source (datasheet, a standard's table as a maker or a CAD
 library reproduces it, a spring maker's formula), given beside it; a value no source gave is left out
@@ -10,34 +11,54 @@ from __future__ import annotations
 
 from fabricate.catalogue.actuators import CATALOGUE, Actuator, actuator, tendon
 from fabricate.catalogue.hardware import (
+    ClevisPin,
+    Nut,
     PinChoice,
     RetainingRing,
     Screw,
+    SplitPin,
     Washer,
+    clevis_pin,
     dowel_pin,
     e_clip,
+    fill_gap,
+    nut,
+    parse_designation,
     screw,
+    screw_and_nut,
     shim_ring,
+    split_pin,
     washer,
     washer_for_shaft,
+    washers_for_shaft,
 )
 from fabricate.catalogue.springs import TorsionSpring, torsion_spring
 
 __all__ = [
     "CATALOGUE",
     "Actuator",
+    "ClevisPin",
+    "Nut",
     "PinChoice",
     "RetainingRing",
     "Screw",
+    "SplitPin",
     "TorsionSpring",
     "Washer",
     "actuator",
+    "clevis_pin",
     "dowel_pin",
     "e_clip",
+    "fill_gap",
+    "nut",
+    "parse_designation",
     "screw",
+    "screw_and_nut",
     "shim_ring",
+    "split_pin",
     "tendon",
     "torsion_spring",
     "washer",
     "washer_for_shaft",
+    "washers_for_shaft",
 ]
