@@ -28,7 +28,7 @@ Designations
 Every record carries the ``designation`` a shop names it by (the form each standard's own designation
 example uses, with "×" between dimensions and a decimal point): ``ISO 8734 2 × 20``, ``ISO 7089 3``
 (also ``DIN 125-A 3.2``), ``DIN 988 3 × 6 × 0.5``, ``ISO 4762 M3 × 12``, ``ISO 4032 M3``, ``DIN 6799 1.9``,
-``ISO 2341-B 3 × 16``, ``ISO 1234 0.8 × 5``. :func:`parse_designation` reads each back.
+``ISO 2341-B 3 × 16``, ``ISO 1234 0.8 × 5``, ``ISO 8738 3``. :func:`parse_designation` reads each back.
 """
 
 from __future__ import annotations
@@ -263,15 +263,38 @@ def shim_ring(shaft_mm: float, thickness_mm: float) -> Washer:
     return Washer(f"DIN 988 {d1:g} × {d2:g} × {t:g}", d1, d2, t, f"{source}; naming: {DIN988_NAMING}", "DIN 988")
 
 
+#: ISO 8738 plain washers for clevis pins, pin d -> (d1 min, d2 max, h nominal), mm.
+#: FsData/iso8738def.csv columns d1_min, d2_max, h (rows "M3".."M8" are the pin diameters 3..8).
+ISO8738: dict[float, tuple[float, float, float]] = {
+    3.0: (3.0, 6.0, 0.8),  # iso8738def.csv "M3",3,6,0.8
+    4.0: (4.0, 8.0, 0.8),  # iso8738def.csv "M4",4,8,0.8
+    5.0: (5.0, 10.0, 0.8),  # iso8738def.csv "M5",5,10,0.8
+    6.0: (6.0, 12.0, 1.6),  # iso8738def.csv "M6",6,12,1.6
+    8.0: (8.0, 16.0, 2.0),  # iso8738def.csv "M8",8,16,2
+}
+ISO8738_SOURCE = f"ISO 8738: {FASTENERS_WB}, iso8738def.csv (columns d1_min, d2_max, h)"
+
+
+def pin_washer(diameter_mm: float) -> Washer:
+    """The ISO 8738 plain washer for a clevis pin (or any pin) of ``diameter_mm`` (bore = the pin)."""
+    d = _finite_positive("diameter_mm", diameter_mm)
+    if _key(d) not in ISO8738:
+        raise SpecError("diameter_mm", f"no ISO 8738 washer for a Ø{d:g} mm pin in the catalogue; pins "
+                        f"{', '.join(f'{k:g}' for k in ISO8738)}")
+    d1, d2, h = ISO8738[_key(d)]
+    return Washer(f"ISO 8738 {d:g}", d1, d2, h, ISO8738_SOURCE, "ISO 8738")
+
+
 def washers_for_shaft(shaft_mm: float) -> tuple[Washer, ...]:
     """Every catalogued washer or shim that sits on a pin of ``shaft_mm``: the smallest ISO 7089 washer
-    that clears it and each DIN 988 shim ring of that bore (thinnest first)."""
+    that clears it, the ISO 8738 pin washer and each DIN 988 shim ring of that bore (thinnest first)."""
     d = _finite_positive("shaft_mm", shaft_mm)
     out: list[Washer] = []
-    try:
-        out.append(washer_for_shaft(d))
-    except SpecError:
-        pass
+    for pick in (washer_for_shaft, pin_washer):
+        try:
+            out.append(pick(d))
+        except SpecError:
+            pass
     for (d1, _), (thicknesses, _) in DIN988.items():
         if abs(d1 - d) < 1e-6:
             out.extend(shim_ring(d1, h) for h in thicknesses)
@@ -700,7 +723,8 @@ def clevis_pin(diameter_mm: float, min_grip_mm: float) -> ClevisPin:
     diameter_mm : float
         Pin diameter; ISO 2341 starts at 3 mm.
     min_grip_mm : float
-        The stack the pin passes, with any washer under the split pin.
+        The stack the pin passes, with any washer under the split pin (:func:`pin_washer`, ISO 8738, is
+        the one made for it).
 
     Raises
     ------
@@ -754,6 +778,8 @@ def parse_designation(text: str) -> Designated:
             for size, (d1, _, _) in ISO7089.items():
                 if abs(d1 - float(m[1])) < 1e-6:
                     return washer(size)
+        elif m := re.fullmatch(rf"ISO 8738 {_NUM}", t):
+            return pin_washer(float(m[1]))
         elif m := re.fullmatch(rf"DIN 988 {_NUM}{_X}{_NUM}{_X}{_NUM}", t):
             ring = shim_ring(float(m[1]), float(m[3]))
             if abs(ring.d2_mm - float(m[2])) < 1e-6:

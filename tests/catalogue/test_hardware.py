@@ -50,6 +50,7 @@ def _brute_force(items, gap, tol):
 def test_fill_gap_stays_within_the_gap_uses_table_pieces_and_the_fewest(shaft, tol):
     items = hw.washers_for_shaft(shaft)
     assert items and all(w.d1_mm >= shaft for w in items)       # every piece slides over the pin
+    assert {w.standard for w in items} <= {"ISO 7089", "ISO 8738", "DIN 988"}
     for gap in (0.3, 0.6, 1.0, 1.35, 2.0, 2.9, 4.0):
         options = _brute_force(items, gap, tol)
         if gap <= tol:
@@ -161,6 +162,7 @@ def test_every_designation_names_its_record():
                 for clamp in (2.0, 7.0)]
     records += [hw.e_clip(d) for d in (2.0, 2.5, 3.0, 4.0)]
     records += [hw.split_pin(s, 10) for s in hw.ISO1234]
+    records += [hw.pin_washer(d) for d in hw.ISO8738]
     for r in records:
         back = hw.parse_designation(r.designation)
         assert back.designation == r.designation
