@@ -12,6 +12,7 @@ from __future__ import annotations
 from fabricate.catalogue.actuators import CATALOGUE, Actuator, actuator, tendon
 from fabricate.catalogue.hardware import (
     ClevisPin,
+    GroovedPin,
     Nut,
     PinChoice,
     RetainingRing,
@@ -22,6 +23,7 @@ from fabricate.catalogue.hardware import (
     dowel_pin,
     e_clip,
     fill_gap,
+    grooved_pin,
     nut,
     parse_designation,
     pin_washer,
@@ -39,6 +41,7 @@ __all__ = [
     "CATALOGUE",
     "Actuator",
     "ClevisPin",
+    "GroovedPin",
     "Nut",
     "PinChoice",
     "RetainingRing",
@@ -51,6 +54,7 @@ __all__ = [
     "dowel_pin",
     "e_clip",
     "fill_gap",
+    "grooved_pin",
     "nut",
     "parse_designation",
     "pin_washer",

@@ -590,6 +590,39 @@ def e_clip(shaft_mm: float) -> RetainingRing:
                     f"{max(v[1] for v in DIN6799.values()):g} mm)")
 
 
+@dataclass(frozen=True)
+class GroovedPin:
+    """A pin held by DIN 6799 E-clips at both faces of its stack: an unhardened ISO 2338 pin (a groove can
+    be cut into it) of the standard length, the clip, and where the grooves go.
+
+    The stack sits centred on the pin; each groove's near edge is at a face of the stack (the clip bears on
+    it), so the groove centres are ``groove_from_end_mm`` from each end, and each end keeps at least the
+    clip's edge margin ``n`` beyond its groove.
+    """
+
+    pin: PinChoice
+    clip: RetainingRing
+    stack_mm: float
+
+    @property
+    def designation(self) -> str:
+        return self.pin.designation
+
+    @property
+    def groove_from_end_mm(self) -> float:
+        return (self.pin.length_mm - self.stack_mm) / 2.0 - self.clip.groove_w_mm / 2.0
+
+
+def grooved_pin(diameter_mm: float, stack_mm: float) -> GroovedPin:
+    """The shortest ISO 2338 pin of ``diameter_mm`` that takes a DIN 6799 clip at each face of a
+    ``stack_mm`` stack (length >= stack + 2 × the clip's protrusion)."""
+    d = _finite_positive("diameter_mm", diameter_mm)
+    stack = _finite_positive("stack_mm", stack_mm)
+    clip = e_clip(d)
+    pin = dowel_pin(d, stack + 2.0 * clip.protrusion_mm, "ISO 2338")
+    return GroovedPin(pin, clip, stack)
+
+
 # ---------------------------------------------------------------------------------------------------------
 # Clevis pins ISO 2341 type B and split pins ISO 1234
 # ---------------------------------------------------------------------------------------------------------

@@ -153,6 +153,21 @@ def test_clevis_pin_refuses_a_diameter_iso_2341_lacks():
     assert hw.clevis_pin(3, 9.2).designation == "ISO 2341-B 3 × 12"   # 12 - 1.6 - 0.4 = 10 >= 9.2
 
 
+@pytest.mark.parametrize("d", [2.0, 2.5, 3.0, 4.0, 5.0])
+def test_grooved_pin_leaves_room_for_a_clip_at_each_face(d):
+    for stack in (3.0, 7.4, 12.0):
+        g = hw.grooved_pin(d, stack)
+        series = hw.pin_lengths(d, "ISO 2338")
+        need = stack + 2 * (g.clip.groove_w_mm + g.clip.edge_margin_mm)
+        assert g.pin.length_mm in series and g.pin.length_mm >= need
+        assert all(v < need for v in series if v < g.pin.length_mm)        # the shortest that does
+        # groove centre to the end: half the overhang less half a groove; the margin beyond stays >= n
+        over = (g.pin.length_mm - stack) / 2
+        assert g.groove_from_end_mm == pytest.approx(over - g.clip.groove_w_mm / 2)
+        assert g.groove_from_end_mm - g.clip.groove_w_mm / 2 >= g.clip.edge_margin_mm - 1e-9
+        assert g.designation.startswith("ISO 2338 ") and g.clip.groove_d_mm < d
+
+
 # --- designations --------------------------------------------------------------------------------------------
 
 
