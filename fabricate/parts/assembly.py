@@ -1,12 +1,16 @@
-"""How the parts go together: the stack on every pin from end to end, and numbered assembly steps.
+"""How the parts go together: the stack on every pin from end to end, and the numbered assembly guide.
 
 Pure functions of a :class:`~fabricate.parts.build.PartSet`: each pin passes through the parts of the
-bodies it joins, with a spacer (a printed or purchased tube) or a washer between consecutive layers.
-Nothing here draws or writes.
+bodies it joins, with a spacer (a printed or purchased tube) or a washer between consecutive layers, and
+a torsion spring on its extension where the joint has one (:mod:`fabricate.parts.springs`). The guide
+(:func:`assembly_guide`) is a list of steps a person follows; :mod:`fabricate.export.guide` writes it as
+assembly.md and draws a picture per step. Nothing here draws or writes.
 """
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -21,9 +25,9 @@ class StackItem:
     Attributes
     ----------
     item : str
-        Part name, or the spacer / washer's BOM item.
+        Part name, or the spacer / washer's BOM item, or the spring's designation.
     kind : str
-        ``part``, ``spacer`` or ``washer``.
+        ``part``, ``spacer``, ``washer`` or ``spring`` (on the pin's extension beyond the stack).
     z_mm : (float, float)
         Bottom and top along the pin (mm, the assembly's z).
     """
@@ -78,6 +82,9 @@ def pin_stacks(partset: PartSet) -> list[PinStack]:
             size = f"{spacer.inner_diameter_mm:g}/{spacer.outer_diameter_mm:g} x {spacer.length_mm:.2f} mm"
             name = printed_name or f"{kind} {size}"
             items.append(StackItem(name, kind, z))
+        for spring in getattr(partset, "springs", ()) or ():
+            if spring.pin == pin.joint:
+                items.append(StackItem(spring.designation, "spring", (spring.z_mm[0], spring.z_mm[1])))
         items.sort(key=lambda s: (s.z_mm[0], s.z_mm[1], s.item))
         stacks.append(PinStack(pin.joint, float(pin.diameter_mm), float(pin.length_mm), float(pin.z_mm),
                                tuple(items)))
@@ -102,3 +109,345 @@ def stacks_report(stacks: list[PinStack]) -> list[dict[str, Any]]:
     return [{"pin": s.pin, "diameter_mm": s.diameter_mm, "length_mm": round(s.length_mm, 6),
              "z_mm": round(s.z_mm, 6),
              "stack": [{"item": i.item, "kind": i.kind, "z_mm": list(i.z_mm)} for i in s.items]} for s in stacks]
+
+
+# -- the assembly guide (assembly.md): numbered steps a person follows ------------------------------------
+
+#: Hex key across flats (mm) of socket head cap screws ISO 4762 and button head screws ISO 7380, by thread.
+#: ISO 4762 table "s" and ISO 7380-1 table "s" as fastener makers print them (e.g. Würth, Bossard catalogues).
+HEX_KEY_MM = {"ISO 4762": {"M2": 1.5, "M2.5": 2.0, "M3": 2.5, "M4": 3.0, "M5": 4.0, "M6": 5.0},
+              "ISO 7380": {"M3": 2.0, "M4": 2.5, "M5": 3.0, "M6": 4.0}}
+#: Words that mark a BOM row as the drive's (the actuator step takes it).
+DRIVE_WORDS = ("actuator", "servo", "motor", "stepper", "horn", "tendon", "push rod", "lead screw", "lead-screw")
+
+
+@dataclass(frozen=True)
+class MotionCheck:
+    """What the final step of the guide checks: the input range and the tip's path.
+
+    Attributes
+    ----------
+    input_range : (float, float)
+        The driver's range, in ``unit``.
+    unit : str
+        ``deg`` or ``mm``.
+    tip : str
+        The tip point's name ('' when the design has none).
+    tip_start, tip_end : (float, float) or None
+        The tip at the first and the last pose (ground frame, mm).
+    min_clearance_mm : float or None
+        The interference proof's smallest clearance between moving parts.
+    """
+
+    input_range: tuple[float, float]
+    unit: str = "deg"
+    tip: str = ""
+    tip_start: tuple[float, float] | None = None
+    tip_end: tuple[float, float] | None = None
+    min_clearance_mm: float | None = None
+
+
+@dataclass(frozen=True)
+class GuideItem:
+    """Part or hardware fitted in a step: the BOM row's item and how many (per copy, or in all if shared)."""
+
+    item: str
+    kind: str
+    qty: int
+    shared: bool = False
+
+
+@dataclass(frozen=True)
+class GuideStep:
+    """One numbered step of the assembly guide.
+
+    Attributes
+    ----------
+    number : int
+    title : str
+    items : tuple of GuideItem
+        Every BOM unit this step fits (the guide lists each unit of the BOM once per copy).
+    text : tuple of str
+        What to do, in order.
+    tool : str
+    placed : tuple of str
+        Part names in place after this step (for its picture).
+    new : tuple of str
+        Part names this step adds (highlighted in its picture).
+    pins : tuple of str
+        Pins in place after this step; ``new_pins`` those this step adds.
+    springs : tuple of str
+        Spring joints in place after this step; ``new_springs`` those this step adds.
+    """
+
+    number: int
+    title: str
+    items: tuple[GuideItem, ...]
+    text: tuple[str, ...]
+    tool: str
+    placed: tuple[str, ...] = ()
+    new: tuple[str, ...] = ()
+    pins: tuple[str, ...] = ()
+    new_pins: tuple[str, ...] = ()
+    springs: tuple[str, ...] = ()
+    new_springs: tuple[str, ...] = ()
+
+    @property
+    def picture(self) -> str:
+        """Its picture's path in the output folder."""
+        return f"assembly/step_{self.number:02d}.png"
+
+
+def _words(obj: Any, *names: str) -> str:
+    """The first of ``names`` that ``obj`` has as a non-empty attribute (or key), as text."""
+    for name in names:
+        value = obj.get(name) if isinstance(obj, dict) else getattr(obj, name, None)
+        if value:
+            return str(value)
+    return ""
+
+
+def _pin_words(pin: Any) -> str:
+    """A pin as a shop names it (the parts layer's designation where it gives one)."""
+    return _words(pin, "designation") or f"pin Ø{float(pin.diameter_mm):g} × {float(pin.length_mm):.2f} mm"
+
+
+def _retention(pin: Any) -> tuple[str, str]:
+    """How the pin is held (the parts layer's retention scheme where it gives one) and the tool for it."""
+    scheme = getattr(pin, "retention", None)
+    if scheme is None:
+        return "retain the pin: a drop of retaining adhesive where it leaves the outer plates", "pin punch"
+    text = scheme if isinstance(scheme, str) else (_words(scheme, "words", "description", "scheme", "kind")
+                                                  or str(scheme))
+    low = text.lower()
+    if "press" in low:
+        tool = "bench vice or arbor press (press the pin in square), pin punch"
+    elif "clip" in low or "ring" in low:
+        tool = "E-clip pliers or a flat screwdriver to push the clip into its groove"
+    elif "cap" in low or "head" in low:
+        tool = "pin punch; a drop of retaining adhesive for the printed cap"
+    else:
+        tool = "pin punch"
+    return text, tool
+
+
+def _screw_tool(rows: Sequence[dict[str, Any]]) -> str:
+    for row in rows:
+        item = str(row.get("item", ""))
+        for standard, keys in HEX_KEY_MM.items():
+            if standard in item:
+                thread = next((t for t in sorted(keys, key=len, reverse=True) if f"{t} " in item + " "
+                               or f"{t}×" in item or f"{t} ×" in item or f"{t}x" in item), None)
+                if thread:
+                    return f"{keys[thread]:g} mm hex key"
+    return "screwdriver or hex key to suit the screws"
+
+
+def _is_drive(row: dict[str, Any], actuator_words: str) -> bool:
+    text = f"{row.get('item', '')} {row.get('description', '')} {row.get('role', '')}".lower()
+    if row.get("kind") == "actuator" or (actuator_words and actuator_words.lower() in text):
+        return True
+    if "mounting screw for the ground part" in text:
+        return False
+    return any(word in text for word in DRIVE_WORDS)
+
+
+def _actuator_words(actuator: Any) -> str:
+    """The placed actuator's name for people ('' when there is none)."""
+    if actuator is None:
+        return ""
+    entry = next((getattr(actuator, n) for n in ("entry", "actuator", "catalogue") if getattr(actuator, n, None)),
+                 actuator)
+    return _words(entry, "name", "model", "key") or _words(actuator, "name", "model", "key")
+
+
+def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCheck) -> tuple[GuideStep, ...]:
+    """The numbered assembly guide of one part set (pure: no drawing, no files).
+
+    Steps: the ground part with its mounting screws; one step per pin (the bodies reached from those already
+    placed first), each followed by its spring where it carries one; the actuator; the other bought items; for
+    several copies a repeat step and the items shared by all copies; a final check of the motion. Every unit
+    of every BOM row is fitted in exactly one step (per copy; shared rows in all): the quantities the steps
+    list add up to the BOM's.
+    """
+    copies = max(int(partset.copies), 1)
+    rows = [dict(r) for r in partset.bom]
+    by_name = {p.name: p for p in partset.parts}
+    stack_of = {s.pin: s for s in stacks}
+    pins = list(partset.pins)
+    springs = {sp.pin: sp for sp in getattr(partset, "springs", ()) or ()}
+    actuator = getattr(partset, "actuator", None)
+    act_words = _actuator_words(actuator)
+    ground = [p.name for p in partset.parts if p.role == "ground"]
+    ground_bodies = {by_name[n].body for n in ground}
+
+    # the pin order: from what is placed, outwards (ties: the part set's order)
+    order: list[Any] = []
+    reached = set(ground_bodies)
+    left = list(pins)
+    while left:
+        nxt = next((p for p in left if reached & set(p.bodies)), left[0])
+        left.remove(nxt)
+        order.append(nxt)
+        reached |= set(nxt.bodies)
+
+    # which step a part comes in: its body's first pin (the ground first); a printed spacer with its pin
+    part_step: dict[str, str] = {n: "ground" for n in ground}
+    seen_bodies = set(ground_bodies)
+    for pin in order:
+        stack = stack_of.get(pin.joint)
+        for item in stack.items if stack else ():
+            if item.kind == "spacer" and item.item in by_name:
+                part_step.setdefault(item.item, pin.joint)
+        for body in pin.bodies:
+            if body in seen_bodies:
+                continue
+            seen_bodies.add(body)
+            for part in partset.parts:
+                if part.body == body and part.role not in ("spacer", "mount"):
+                    part_step.setdefault(part.name, pin.joint)
+    for part in partset.parts:
+        part_step.setdefault(part.name, "drive" if part.role == "mount" else "ground")
+
+    # every BOM unit to one step: (step key) -> {item: GuideItem}
+    units: dict[str, list[GuideItem]] = {}
+
+    def give(key: str, row: dict[str, Any], qty: int, shared: bool) -> None:
+        if qty > 0:
+            units.setdefault(key, []).append(GuideItem(str(row.get("item")), str(row.get("kind", "")), qty, shared))
+
+    pin_of_joint = {j: p.joint for p in pins for j in p.joint.split("+")} | {p.joint: p.joint for p in pins}
+    for row in rows:
+        qty = int(row.get("qty", 0) or 0)
+        shared = bool(row.get("shared")) or qty % copies != 0
+        per = qty if shared else qty // copies
+        kind = str(row.get("kind", ""))
+        name = str(row.get("item", ""))
+        joints = [pin_of_joint[j] for j in row.get("joints", []) or [] if j in pin_of_joint]
+        if name in by_name and kind not in ("pin", "washer", "spacer", "spring", "screw", "purchased"):
+            give(part_step[name], row, per, shared)
+        elif kind == "spring" and joints:
+            _round_robin(give, [f"spring:{j}" if j in springs else j for j in joints], row, per, shared)
+        elif joints and not _is_drive(row, act_words):
+            _round_robin(give, joints, row, per, shared)
+        elif _is_drive(row, act_words):
+            give("shared drive" if shared else "drive", row, per, shared)
+        elif kind == "screw":
+            give("ground", row, per, shared)
+        else:
+            give("shared" if shared else "purchased", row, per, shared)
+
+    steps: list[GuideStep] = []
+    placed: list[str] = []
+    pins_in: list[str] = []
+    springs_in: list[str] = []
+
+    def add(key: str, title: str, text: Sequence[str], tool: str, new: Sequence[str] = (),
+            new_pins: Sequence[str] = (), new_springs: Sequence[str] = ()) -> None:
+        placed.extend(n for n in new if n not in placed)
+        pins_in.extend(new_pins)
+        springs_in.extend(new_springs)
+        steps.append(GuideStep(len(steps) + 1, title, tuple(units.pop(key, [])), tuple(text), tool,
+                               tuple(placed), tuple(new), tuple(pins_in), tuple(new_pins), tuple(springs_in),
+                               tuple(new_springs)))
+
+    new_ground = [n for n, k in part_step.items() if k == "ground"]
+    screws = [r for r in rows if r.get("kind") == "screw" and not _is_drive(r, act_words)]
+    text = [f"Lay {', '.join(new_ground) or 'the ground part'} flat, the side marked by its layer down."]
+    if screws:
+        text.append("Fix it to the base plate or the test stand with the screws below through its mounting holes; "
+                    "do not tighten fully until the motion check.")
+    add("ground", "The ground part", text, _screw_tool(screws) if screws else "none", new_ground)
+
+    for pin in order:
+        stack = stack_of.get(pin.joint)
+        new = [n for n, k in part_step.items() if k == pin.joint]
+        on = [i for i in (stack.items if stack else ()) if i.kind != "spring"]
+        listing = "; ".join(f"{i.item} ({i.kind}, z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" if i.kind != "part"
+                            else f"{i.item} (z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" for i in on)
+        retention, tool = _retention(pin)
+        spring = springs.get(pin.joint)
+        text = [f"Stack, bottom to top: {listing}.",
+                f"Push the pin {_pin_words(pin)} through the stack from z {float(pin.z_mm):.2f} mm; every part "
+                "but the one that holds the pin must turn freely on it."]
+        if spring is not None:
+            end = "top" if spring.side == "top" else "bottom"
+            text.append(f"Leave the pin's {end} end free: the torsion spring goes on it in the next step.")
+        else:
+            text.append(f"Retention: {retention}.")
+        add(pin.joint, f"Pin {pin.joint}", text, tool, new, new_pins=(pin.joint,))
+        if spring is not None:
+            s = spring.spring
+            upper = 1.0 if spring.hand == "RH" else -1.0
+            far_turn = upper if spring.side == "top" else -upper
+            way = "counter-clockwise" if far_turn > 0 else "clockwise"
+            text = [f"Slide the coil ({spring.hand} wound, Ø{s.wire_d_mm:.2f} mm wire, OD {s.outer_d_mm:.2f} mm) "
+                    f"over the pin's {spring.side} end until it sits on {spring.near_part}.",
+                    f"Hook the near leg's bent end into the anchor hole in {spring.near_part} "
+                    f"(Ø{spring.anchor_hole_mm:.2f} mm, {spring.leg_radii_mm[0]:g} mm from the pin).",
+                    f"Wind the far leg {spring.deflection_deg[0]:.0f}° {way} (seen from above) and drop its end into "
+                    f"the anchor hole in {spring.far_part} ({spring.leg_radii_mm[1]:g} mm from the pin, "
+                    f"{spring.leg_axial_mm[1]:.1f} mm down along the pin).",
+                    f"Retention: {retention}; it also keeps the spring on the pin."]
+            add(f"spring:{pin.joint}", f"Torsion spring at {spring.joint}", text,
+                "long-nose pliers (to wind and place the legs)", new_springs=(spring.joint,))
+
+    drive_parts = [n for n, k in part_step.items() if k == "drive"]
+    if actuator is not None or "drive" in units or drive_parts:
+        words = act_words or "the actuator"
+        text = []
+        if drive_parts:
+            text.append(f"Fit {', '.join(drive_parts)} to the ground part.")
+        driven = _words(actuator, "driven_body", "driven", "body") if actuator is not None else ""
+        mount = _words(actuator, "ground_body", "ground") if actuator is not None else ""
+        text.append(f"Mount {words}{' on ' + mount if mount else ''} with its screws; couple its output to "
+                    f"{driven or 'the driven part'} at the middle of its range before tightening the interface.")
+        drive_screws = [r for r in rows if r.get("kind") == "screw" and _is_drive(r, act_words)]
+        add("drive", "The actuator", text, _screw_tool(drive_screws), drive_parts)
+    if "purchased" in units:
+        add("purchased", "Bought parts of each copy", ["Fit the bought parts below as their descriptions in the "
+                                                       "bill of materials say."], "as the parts need")
+    if copies > 1:
+        last = len(steps)
+        add("repeat", "The other copies", [f"Repeat steps 1–{last} for each of the {copies} copies."], "as above")
+    if "shared drive" in units or "shared" in units:
+        units.setdefault("shared", []).extend(units.pop("shared drive", []))
+        add("shared", "Parts shared by all copies", [f"These are bought once for all {copies} copies: fit them as "
+                                                     "their descriptions in the bill of materials say."],
+            "as the parts need")
+    a, b = check.input_range
+    text = [f"Move the input by hand through its whole range, {a:.4g} to {b:.4g} {check.unit}, slowly, and back."]
+    if check.tip and check.tip_start and check.tip_end:
+        text.append(f"Watch the tip point {check.tip}: it should go from ({check.tip_start[0]:.1f}, "
+                    f"{check.tip_start[1]:.1f}) mm to ({check.tip_end[0]:.1f}, {check.tip_end[1]:.1f}) mm along "
+                    "the path of previews/motion.gif.")
+    text.append("Feel for an even effort: no tight spot, no knock, no part rubbing another" +
+                (f" (the smallest designed clearance between moving parts is {check.min_clearance_mm:.2f} mm)"
+                 if check.min_clearance_mm is not None else "") + ".")
+    if springs:
+        text.append("Let go at the end of the range: the springs must bring it back to the start.")
+    text.append("Then tighten the screws, power the actuator and run the same range.")
+    leftover = [item for key in list(units) for item in units.pop(key)]
+    if leftover:  # a row the rules above did not place: still listed once
+        add("ground", "Other parts", ["Fit these as their descriptions in the bill of materials say."],
+            "as the parts need")
+        steps[-1] = dataclasses.replace(steps[-1], items=tuple(leftover))
+    add("check", "Check the motion", text, "none (by hand), then the actuator's controller")
+    return tuple(steps)
+
+
+def _round_robin(give: Any, keys: Sequence[str], row: dict[str, Any], qty: int, shared: bool) -> None:
+    """Deal a row's units to its pins' steps one at a time, in the row's joint order."""
+    counts = dict.fromkeys(keys, 0)
+    for k in range(qty):
+        counts[keys[k % len(keys)]] += 1
+    for key, n in counts.items():
+        give(key, row, n, shared)
+
+
+def guide_report(steps: Sequence[GuideStep]) -> list[dict[str, Any]]:
+    """JSON-ready steps (report.json's ``assembly.guide``)."""
+    return [{"step": s.number, "title": s.title, "text": list(s.text), "tool": s.tool,
+             "items": [{"item": i.item, "kind": i.kind, "qty": i.qty, "shared": i.shared} for i in s.items],
+             "new_parts": list(s.new), "new_pins": list(s.new_pins), "new_springs": list(s.new_springs),
+             "picture": s.picture} for s in steps]

@@ -1,0 +1,517 @@
+"""Torsion springs placed in their pin's stack: sized over the joint's real angle range, anchored, drawn.
+
+Where a synthesis gives a return spring (:class:`~fabricate.hints.SpringHint`: joint, rate, preload, leg
+length), :func:`place_springs` sizes a music-wire torsion spring with
+:func:`fabricate.catalogue.springs.torsion_spring` over the deflection the motion really asks of it
+(preload plus the joint's travel, with the strength check's sign convention) and places it:
+
+* **On the pin's extension beyond the stack**, seated on the outer face of the end plate of one of the two
+  bodies it joins (the top of the stack where one of them is the top plate, else the bottom). There the
+  layers, spacers and washers of the stack stay as they are (a coil between two plates would push them
+  apart and change every layer above), the pin keeps the coil on the joint's axis, and the pin's
+  retention (clip or head) beyond the coil also keeps the spring on. The pin grows by the coil's wound
+  body length.
+* **Legs hooked into anchor holes in the two bodies.** The near leg runs out radially along the face of
+  the plate it sits on and its end is bent axially into an anchor hole in that plate. The far leg runs out
+  radially at the coil's far end, then axially back along the pin, outside the plates in between, into an
+  anchor hole in the other body's plate. Each anchor is a hole of the leg wire plus the running clearance
+  and the process's compensation, at the leg length from the pin where the plate has the process's wall
+  around it; the far one also where its leg keeps the running clearance from the near plate over the
+  whole motion (:func:`_anchor`). The interference sweep proves the rest (:func:`spring_sweep_items`).
+* **Wound the right way**: a torsion spring must be loaded to wind up (its coil closes); a right-hand coil
+  winds up when its upper end turns counter-clockwise, seen from above, against its lower end.
+
+A spring no wire of the series can make within its allowable stress is still placed (the thickest wire,
+the largest coil: :func:`_overloaded`) and is a strength failure naming it (:func:`spring_failures`).
+Nothing here draws or writes; :mod:`fabricate.parts.build` calls :func:`place_springs`, the strength stage
+:func:`spring_failures` and :func:`springs_report`, the checks :func:`spring_sweep_items`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import shapely
+
+from fabricate.catalogue._units import INCH_MM, KSI_MPA
+from fabricate.catalogue.springs import (
+    ALLOWABLE_FRACTION,
+    ARBOR_RATIO,
+    INDEX_RANGE,
+    MIN_TURNS,
+    MUSIC_WIRE_IN_KSI,
+    TorsionSpring,
+    curvature_factor,
+    music_wire_modulus_mpa,
+    rate_per_deg,
+    torsion_spring,
+)
+from fabricate.errors import SpecError
+from fabricate.mechanism import Mechanism, Motion, Revolute
+from fabricate.parts.model import Hole, Part, circle_polygon
+
+if TYPE_CHECKING:
+    from fabricate.checks.interference import SweepItem
+    from fabricate.parts.bom import Pin
+    from fabricate.process import ProcessSpec
+
+#: Poses (at most) over which an anchor's leg is kept clear of the other plate while placing it (the
+#: interference sweep then checks every pose).
+ANCHOR_POSES = 90
+#: Angular step (degrees) of the anchor search round the pin.
+ANCHOR_STEP_DEG = 2.0
+#: Radial step (mm) by which an anchor moves in from the leg length when no place fits there.
+ANCHOR_RADIAL_STEP_MM = 0.5
+
+
+@dataclass(frozen=True)
+class PlacedSpring:
+    """A torsion spring on its pin, with its anchors.
+
+    Attributes
+    ----------
+    joint : str
+        The spring's joint (a revolute of the mechanism).
+    pin : str
+        The pin it sits on (``joint`` itself, or a compound pin such as ``G1+G1r``).
+    spring : TorsionSpring
+        Wire, coil, turns, rate, stress and allowable (the catalogue's record).
+    near_body, far_body : str
+        The body whose end plate the coil sits on, and the other body of the joint.
+    near_part, far_part : str
+        The parts of those bodies the anchors are in.
+    side : str
+        ``"top"`` (the coil above the stack) or ``"bottom"``.
+    pin_body : str
+        The body the pin is fixed in (the coil is drawn on it: a coil is round, it reads the same in both).
+    centre : (2,) array
+        The pin's axis in ``pin_body`` coordinates, mm.
+    z_mm : (float, float)
+        The coil's span along the pin, wound up (mm, the assembly's z).
+    near_anchor, far_anchor : (2,) arrays
+        Anchor hole centres in the near and far bodies' coordinates, mm.
+    near_axis, far_axis : (2,) arrays
+        The pin's axis in the near and far bodies' coordinates, mm.
+    leg_radii_mm : (float, float)
+        Near and far anchor distance from the pin axis (the legs' radial lengths), mm.
+    leg_axial_mm : (float, float)
+        Near and far legs' axial runs from the coil's end into their anchor holes, mm.
+    anchor_hole_mm : float
+        Anchor hole diameter (wire, running clearance, process compensation).
+    deflection_deg : (float, float)
+        Least and largest deflection from free over the motion (the first pose is at the preload).
+    hand : str
+        ``"LH"`` or ``"RH"``: the coil's winding, so that the motion winds it up.
+    free_angle_deg : float
+        Angle between the legs when free, from the near leg to the far leg, counter-clockwise seen from
+        above (+z), degrees in [0, 360).
+    within_series : bool
+        False when no wire of the series meets the stress: :attr:`spring` is then the thickest wire's
+        largest coil, over its allowable.
+    note : str
+        What it is for (the synthesis' words).
+    """
+
+    joint: str
+    pin: str
+    spring: TorsionSpring
+    near_body: str
+    far_body: str
+    near_part: str
+    far_part: str
+    side: str
+    pin_body: str
+    centre: np.ndarray
+    z_mm: tuple[float, float]
+    near_anchor: np.ndarray
+    far_anchor: np.ndarray
+    near_axis: np.ndarray
+    far_axis: np.ndarray
+    leg_radii_mm: tuple[float, float]
+    leg_axial_mm: tuple[float, float]
+    anchor_hole_mm: float
+    deflection_deg: tuple[float, float]
+    hand: str
+    free_angle_deg: float
+    within_series: bool
+    note: str = ""
+
+    @property
+    def anchor_joint(self) -> str:
+        """The anchor holes' name on both parts (``spring_<joint>``)."""
+        return f"spring_{self.joint}"
+
+    @property
+    def passed(self) -> bool:
+        """Whether the wire's bending stress at the largest deflection is within its allowable."""
+        return self.within_series and self.spring.stress_mpa <= self.spring.allowable_mpa * (1.0 + 1e-9)
+
+    @property
+    def designation(self) -> str:
+        """The spring as a spring maker is asked for it (the BOM's item)."""
+        s = self.spring
+        near, far = self.leg_radii_mm
+        return (f"torsion spring, music wire Ø{s.wire_d_mm:.2f}, D {s.mean_d_mm:.2f}, {s.active_turns:.2f} turns, "
+                f"legs {near:.1f}/{far:.1f} mm, {self.hand}")
+
+    def description(self) -> str:
+        """The rest a spring maker needs, in words (the BOM's description)."""
+        s = self.spring
+        near, far = self.leg_axial_mm
+        return (f"{s.material} Ø{s.wire_d_mm:.3f} mm ({s.wire_d_in:.3f} in), OD {s.outer_d_mm:.2f} mm, close wound, "
+                f"leg ends bent axially {near:.1f}/{far:.1f} mm, free leg angle {self.free_angle_deg:.0f}°, "
+                f"{s.rate_nmm_per_deg:.4g} N·mm/°, wound {self.deflection_deg[0]:.1f}° at assembly; "
+                f"{self.note}".rstrip("; "))
+
+
+def _get(hint: Any, name: str, default: Any = None) -> Any:
+    """A hint's field, from a :class:`~fabricate.hints.SpringHint` or a plain mapping."""
+    if isinstance(hint, Mapping):
+        return hint.get(name, default)
+    return getattr(hint, name, default)
+
+
+def spring_deflections(mechanism: Mechanism, motion: Motion, joint: Revolute, preload_deg: float
+                       ) -> tuple[np.ndarray, float]:
+    """Deflection from free (degrees) at every pose, and the sense (+1/-1) in which body_b turns against
+    body_a to wind it up: the strength check's convention (a return spring resists the motion)."""
+    rel = np.degrees(motion.relative_angle(joint.body_b, joint.body_a))
+    sense = 1.0 if rel[-1] >= rel[0] else -1.0
+    return preload_deg + sense * (rel - rel[0]), sense
+
+
+def _overloaded(rate: float, work_deg: float, preload_nmm: float, legs: tuple[float, float],
+                pin_mm: float) -> TorsionSpring:
+    """The spring of the thickest wire of the series and its largest coil (least stress) when no wire
+    meets the stress: the same formulas as :func:`~fabricate.catalogue.springs.torsion_spring`, stress over
+    the allowable (reported as a failure, never shipped as passing)."""
+    d_in, sut_ksi = MUSIC_WIRE_IN_KSI[-1]
+    d = d_in * INCH_MM
+    e = music_wire_modulus_mpa(d_in)
+    sut = sut_ksi * KSI_MPA
+    theta = preload_nmm / rate + work_deg
+    a = e * d**4 / (10.8 * rate * 360.0)          # D·N fixed by the rate
+    mean_d = max(min(INDEX_RANGE[1] * d, a / MIN_TURNS), d + pin_mm / ARBOR_RATIO)
+    turns = a / mean_d
+    wound = theta / 360.0
+    m_max = rate * theta
+    kb = curvature_factor(mean_d / d)
+    return TorsionSpring(
+        material="music wire", wire_d_mm=d, wire_d_in=d_in, mean_d_mm=mean_d, active_turns=turns,
+        leg_lengths_mm=legs, rate_nmm_per_deg=rate_per_deg(e, d, mean_d, turns), preload_nmm=preload_nmm,
+        preload_angle_deg=preload_nmm / rate, max_deflection_deg=theta, max_torque_nmm=m_max,
+        inner_d_wound_mm=mean_d * turns / (turns + wound) - d, pin_diameter_mm=pin_mm,
+        body_length_free_mm=d * (turns + 1.0), body_length_wound_mm=d * (turns + 1.0 + wound),
+        index=mean_d / d, curvature_factor=kb, stress_mpa=kb * 32.0 * m_max / (math.pi * d**3),
+        allowable_mpa=ALLOWABLE_FRACTION * sut, tensile_min_mpa=sut, modulus_mpa=e, sources=())
+
+
+def _part_of(parts: Sequence[Part], body: str, joint: str) -> Part:
+    """The part of ``body`` with the hole of pin ``joint``."""
+    for part in parts:
+        if part.body == body and part.role != "spacer" and any(h.joint == joint for h in part.holes):
+            return part
+    raise SpecError("springs", f"no part of body {body!r} holds pin {joint!r}")
+
+
+def _material(part: Part, tol: float) -> Any:
+    rings = part.polygons(tol)
+    return shapely.Polygon(rings[0], [r for r in rings[1:]]).buffer(0)
+
+
+def _to_frame(points: np.ndarray, pose_from: np.ndarray, pose_to: np.ndarray) -> np.ndarray:
+    """Points (k, 2) of a body at poses ``pose_from`` (n, 3) in the frame of a body at ``pose_to``: (n, k, 2)."""
+    cf, sf = np.cos(pose_from[:, 2]), np.sin(pose_from[:, 2])
+    wx = pose_from[:, None, 0] + cf[:, None] * points[None, :, 0] - sf[:, None] * points[None, :, 1]
+    wy = pose_from[:, None, 1] + sf[:, None] * points[None, :, 0] + cf[:, None] * points[None, :, 1]
+    dx, dy = wx - pose_to[:, None, 0], wy - pose_to[:, None, 1]
+    ct, st = np.cos(pose_to[:, 2])[:, None], np.sin(pose_to[:, 2])[:, None]
+    return np.stack([ct * dx + st * dy, -st * dx + ct * dy], axis=-1)
+
+
+def _anchor(material: Any, axis: np.ndarray, radius_max: float, radius_min: float, keep_in: float,
+            clear_of: tuple[Any, np.ndarray, np.ndarray, float] | None = None) -> tuple[np.ndarray, float]:
+    """An anchor hole centre round ``axis`` in a plate: the largest radius from ``radius_max`` down to
+    ``radius_min`` with a place ``keep_in`` inside the plate's material (its wall round the hole), at the
+    angle of most margin.
+
+    ``clear_of`` = (other plate's material, this body's poses, the other's poses, gap): the leg must also
+    stay ``gap`` outside the other plate at every pose (the far leg passing the near plate).
+    """
+    inner = material.buffer(-keep_in)
+    angles = np.radians(np.arange(0.0, 360.0, ANCHOR_STEP_DEG))
+    radius = radius_max
+    while radius >= radius_min - 1e-9:
+        pts = axis + radius * np.column_stack([np.cos(angles), np.sin(angles)])
+        inside = shapely.contains_xy(inner, pts[:, 0], pts[:, 1])
+        if inside.any():
+            margin = np.where(inside, shapely.distance(inner.boundary, shapely.points(pts)), -np.inf)
+            if clear_of is not None:
+                other, own_poses, other_poses, gap = clear_of
+                seen = _to_frame(pts, own_poses, other_poses)            # (n, k, 2)
+                dist = shapely.distance(other, shapely.points(seen.reshape(-1, 2))).reshape(seen.shape[:2])
+                spare = dist.min(axis=0) - gap
+                margin = np.where(spare >= 0.0, np.minimum(margin, spare), -np.inf)
+            best = int(np.argmax(margin))
+            if math.isfinite(float(margin[best])):
+                return pts[best], radius
+        radius -= ANCHOR_RADIAL_STEP_MM
+    raise SpecError("springs", "no place for a leg anchor")
+
+
+def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, parts: Sequence[Part],
+                  pins: Sequence[Pin], process: ProcessSpec) -> tuple[tuple[PlacedSpring, ...], list[Part], list[Pin]]:
+    """Size and place every spring of the hints; the parts get their anchor holes, the pins their extension.
+
+    Parameters
+    ----------
+    hints : sequence of SpringHint (or mappings with its fields)
+        A rate of 0 means no spring there (the compliant optimum may set k1 = 0).
+    mechanism, motion
+        The joint's angle range over the motion sets the deflection.
+    parts, pins
+        The body parts (anchor holes are added to copies) and the pins (the spring's pin is lengthened by the
+        coil's wound body).
+    process : ProcessSpec
+        Running clearance, hole compensation and minimum wall of the anchor holes; chord tolerance.
+
+    Returns
+    -------
+    (springs, parts, pins)
+
+    Raises
+    ------
+    GeometryError
+        A spring at a joint that is not a revolute of a pin, or a plate with no room for its anchor.
+    """
+    from fabricate.errors import GeometryError
+
+    placed: list[PlacedSpring] = []
+    parts = list(parts)
+    pins = list(pins)
+    tol = process.chord_tolerance_mm
+    for hint in hints:
+        rate = float(_get(hint, "rate_Nmm_per_deg", 0.0) or 0.0)
+        name = str(_get(hint, "joint", ""))
+        if rate <= 0.0:
+            continue  # no spring there
+        joint = next((j for j in mechanism.joints if j.name == name), None)
+        k = next((i for i, p in enumerate(pins) if name in p.joint.split("+")), None)
+        if not isinstance(joint, Revolute) or k is None:
+            raise GeometryError(f"spring at {name!r}: not a revolute joint with a pin")
+        pin = pins[k]
+        preload = float(_get(hint, "preload_deg", 0.0) or 0.0)
+        legs_hint = _get(hint, "legs_mm")
+        deflection, sense = spring_deflections(mechanism, motion, joint, preload)
+        work = max(float(deflection.max()) - preload, 1e-6)
+        try:
+            parts_by = {b: _part_of(parts, b, pin.joint) for b in (joint.body_a, joint.body_b)}
+        except SpecError as exc:
+            raise GeometryError(f"spring at {name}: {exc}") from None
+        top = {b: p.z_mm + p.thickness_mm for b, p in parts_by.items()}
+        z_top = pin.z_mm + pin.length_mm
+        at_top = [b for b in parts_by if abs(top[b] - z_top) < 1e-6]
+        at_bottom = [b for b, p in parts_by.items() if abs(p.z_mm - pin.z_mm) < 1e-6]
+        side = "top" if at_top or not at_bottom else "bottom"
+        near = (at_top or at_bottom or [joint.body_b])[0]
+        far = joint.body_a if near == joint.body_b else joint.body_b
+        near_part, far_part = parts_by[near], parts_by[far]
+        pin_mm = float(pin.diameter_mm)
+        legs_default = float(legs_hint) if legs_hint else 2.5 * (pin_mm + 2.0)
+        legs = (legs_default, legs_default)
+        try:
+            spring = torsion_spring(rate, work, rate * preload, legs, pin_mm)
+            within = True
+        except SpecError:
+            spring = _overloaded(rate, work, rate * preload, legs, pin_mm)
+            within = False
+        length = spring.body_length_wound_mm
+        if side == "top":
+            z = (z_top, z_top + length)
+            pins[k] = replace(pin, length_mm=pin.length_mm + length)
+        else:
+            z = (pin.z_mm - length, pin.z_mm)
+            pins[k] = replace(pin, length_mm=pin.length_mm + length, z_mm=pin.z_mm - length)
+        # anchors: the leg wire plus the running fit and the compensation, with the process's wall round it
+        hole = spring.wire_d_mm + 2.0 * process.running_clearance_mm + process.hole_compensation_mm
+        keep = 0.5 * hole + process.min_wall_mm
+        r_min = 0.5 * spring.outer_d_mm + spring.wire_d_mm + process.running_clearance_mm
+        axis = {b: next(h.centre for h in parts_by[b].holes if h.joint == pin.joint) for b in parts_by}
+        pick = np.unique(np.linspace(0, len(motion.inputs) - 1, min(ANCHOR_POSES, len(motion.inputs)))
+                         .round().astype(int))
+        near_material, far_material = _material(near_part, tol), _material(far_part, tol)
+        try:
+            near_at, near_r = _anchor(near_material, np.asarray(axis[near], dtype=np.float64), legs[0],
+                                      r_min, keep)
+            gap = 0.5 * spring.wire_d_mm + process.running_clearance_mm + tol
+            far_at, far_r = _anchor(far_material, np.asarray(axis[far], dtype=np.float64), legs[1], r_min, keep,
+                                    (near_material, motion.pose(far)[pick], motion.pose(near)[pick], gap))
+        except SpecError:
+            raise GeometryError(f"spring at {name}: no place for its leg anchors in {near_part.name} and "
+                                f"{far_part.name} within {legs[0]:g} mm of the pin; give longer legs or wider "
+                                "plates") from None
+        # the nominal (finished) size apart from the process's compensation, where the hole records it
+        nominal = ({"nominal_diameter_mm": hole - process.hole_compensation_mm}
+                   if "nominal_diameter_mm" in getattr(Hole, "__dataclass_fields__", {}) else {})
+        anchor = Hole(f"spring_{name}", near_at, hole, 0.0, **nominal)
+        far_hole = Hole(f"spring_{name}", far_at, hole, 0.0, **nominal)
+        for part, extra in ((near_part, anchor), (far_part, far_hole)):
+            idx = parts.index(part)
+            parts[idx] = replace(parts[idx], holes=tuple(parts[idx].holes) + (extra,))
+        # axial runs: the near leg's end into its plate (half its thickness); the far leg from the coil's far
+        # end back past the coil and the plates between, to the middle of the far plate
+        mid_far = far_part.z_mm + 0.5 * far_part.thickness_mm
+        far_end = z[1] if side == "top" else z[0]
+        axial = (0.5 * near_part.thickness_mm, abs(far_end - mid_far))
+        # which end is up: winding up = the upper leg turning counter-clockwise (seen from above) against the
+        # lower one for a right-hand coil; the far body turns against the near one by sense (body_b vs body_a)
+        far_turn = sense if far == joint.body_b else -sense
+        upper_turn = far_turn if side == "top" else -far_turn
+        hand = "RH" if upper_turn > 0 else "LH"
+        # leg angle (near to far, in the near frame) at the first pose, less the preload the way it winds
+        p0_near, p0_far = motion.pose(near)[0], motion.pose(far)[0]
+        far_in_near = _to_frame(np.asarray([far_at, axis[far]]), p0_far[None, :], p0_near[None, :])[0]
+        v_far = far_in_near[0] - far_in_near[1]
+        v_near = near_at - axis[near]
+        assembled = math.degrees(math.atan2(v_far[1], v_far[0]) - math.atan2(v_near[1], v_near[0]))
+        free = (assembled - far_turn * float(deflection[0])) % 360.0
+        placed.append(PlacedSpring(
+            joint=name, pin=pin.joint, spring=spring, near_body=near, far_body=far, near_part=near_part.name,
+            far_part=far_part.name, side=side, pin_body=pin.bodies[0],
+            centre=np.asarray(axis[pin.bodies[0]] if pin.bodies[0] in axis else
+                              next(h.centre for p in parts if p.body == pin.bodies[0] for h in p.holes
+                                   if h.joint == pin.joint), dtype=np.float64),
+            z_mm=(round(z[0], 6), round(z[1], 6)), near_anchor=np.asarray(near_at), far_anchor=np.asarray(far_at),
+            near_axis=np.asarray(axis[near], dtype=np.float64), far_axis=np.asarray(axis[far], dtype=np.float64),
+            leg_radii_mm=(round(float(near_r), 3), round(float(far_r), 3)),
+            leg_axial_mm=(round(axial[0], 3), round(axial[1], 3)), anchor_hole_mm=hole,
+            deflection_deg=(float(deflection.min()), float(deflection.max())), hand=hand, free_angle_deg=free,
+            within_series=within, note=str(_get(hint, "note", "") or "")))
+    return tuple(placed), parts, pins
+
+
+def spring_bom_rows(springs: Sequence[PlacedSpring], copies: int = 1) -> list[dict[str, Any]]:
+    """One BOM row per spring designation (quantity over all copies), in the BOM's row shape."""
+    rows: dict[str, dict[str, Any]] = {}
+    for sp in springs:
+        row = rows.get(sp.designation)
+        if row is not None:
+            row["qty"] += copies
+            row["joints"] = sorted(set(row["joints"]) | {sp.joint})
+            continue
+        s = sp.spring
+        rows[sp.designation] = {
+            "item": sp.designation, "kind": "spring", "qty": copies, "joints": [sp.joint],
+            "wire_d_mm": round(s.wire_d_mm, 4), "mean_d_mm": round(s.mean_d_mm, 4),
+            "active_turns": round(s.active_turns, 4), "legs_mm": [sp.leg_radii_mm[0], sp.leg_radii_mm[1]],
+            "hand": sp.hand, "rate_Nmm_per_deg": round(s.rate_nmm_per_deg, 6),
+            "preload_deg": round(sp.deflection_deg[0], 4), "description": sp.description()}
+    return list(rows.values())
+
+
+def with_spring_rows(bom: Sequence[Mapping[str, Any]], springs: Sequence[PlacedSpring],
+                     copies: int = 1) -> list[dict[str, Any]]:
+    """The BOM with its rate-only spring rows replaced by the placed springs' designations (in place of the
+    first such row, so the row order stays)."""
+    out: list[dict[str, Any]] = []
+    done = False
+    for row in bom:
+        if row.get("kind") == "spring":
+            if not done:
+                out += spring_bom_rows(springs, copies)
+                done = True
+            continue
+        out.append(dict(row))
+    if not done:
+        out += spring_bom_rows(springs, copies)
+    return out
+
+
+def springs_report(springs: Sequence[PlacedSpring]) -> list[dict[str, Any]]:
+    """JSON-ready springs (report.json's ``springs``)."""
+    out = []
+    for sp in springs:
+        s = sp.spring
+        out.append({
+            "joint": sp.joint, "pin": sp.pin, "designation": sp.designation, "hand": sp.hand,
+            "material": s.material, "wire_d_mm": s.wire_d_mm, "mean_d_mm": s.mean_d_mm, "outer_d_mm": s.outer_d_mm,
+            "active_turns": s.active_turns, "legs_mm": list(sp.leg_radii_mm), "leg_axial_mm": list(sp.leg_axial_mm),
+            "free_angle_deg": sp.free_angle_deg, "rate_Nmm_per_deg": s.rate_nmm_per_deg,
+            "deflection_deg": list(sp.deflection_deg), "max_torque_Nmm": s.max_torque_nmm,
+            "body_length_mm": s.body_length_wound_mm, "z_mm": list(sp.z_mm), "side": sp.side,
+            "near": {"part": sp.near_part, "anchor": [float(v) for v in sp.near_anchor]},
+            "far": {"part": sp.far_part, "anchor": [float(v) for v in sp.far_anchor]},
+            "anchor_hole_mm": sp.anchor_hole_mm, "stress_MPa": s.stress_mpa, "allowable_MPa": s.allowable_mpa,
+            "passed": sp.passed})
+    return out
+
+
+def spring_failures(springs: Sequence[PlacedSpring]) -> list[str]:
+    """One line per spring whose wire is stressed beyond its allowable (a strength failure)."""
+    out = []
+    for sp in springs:
+        if sp.passed:
+            continue
+        s = sp.spring
+        why = "" if sp.within_series else " (no music wire of the series up to Ø3.18 mm holds it)"
+        out.append(f"spring at {sp.joint} ({sp.designation}): wire stress {s.stress_mpa:.0f} MPa over its allowable "
+                   f"{s.allowable_mpa:.0f} MPa at {sp.deflection_deg[1]:.1f}° deflection{why}")
+    return out
+
+
+def spring_sweep_items(springs: Sequence[PlacedSpring], chord_tolerance_mm: float) -> list[SweepItem]:
+    """The springs as solids of the interference sweep.
+
+    Each spring is four prisms: its coil (a ring from the wound inside to the free outside diameter over the
+    wound body length) on the pin's body; the near leg's radial run along the face it sits on, on the near
+    body; the far leg's radial run at the coil's far end and its axial run back to the far plate, on the far
+    body. The coil's end bears on the plate it sits on (kind ``spacer``: touching is its job, an overlap is
+    not); the legs share the anchor name with the coil (they are its wire: they touch it, never overlap).
+    """
+    from fabricate.checks.interference import SweepItem
+
+    items: list[SweepItem] = []
+    tol = chord_tolerance_mm
+    for sp in springs:
+        s = sp.spring
+        anchor = sp.anchor_joint
+        ring = (circle_polygon(sp.centre, s.outer_d_mm, tol),
+                circle_polygon(sp.centre, max(s.inner_d_wound_mm, s.pin_diameter_mm + 1e-3), tol, clockwise=True))
+        items.append(SweepItem(f"spring_{sp.joint}", sp.pin_body, "spacer", ring, sp.z_mm[0], sp.z_mm[1],
+                               frozenset([sp.pin, anchor]), "", sp))
+        d = s.wire_d_mm
+        near_z = (sp.z_mm[0], sp.z_mm[0] + d) if sp.side == "top" else (sp.z_mm[1] - d, sp.z_mm[1])
+        far_z = (sp.z_mm[1] - d, sp.z_mm[1]) if sp.side == "top" else (sp.z_mm[0], sp.z_mm[0] + d)
+        r0 = 0.5 * s.outer_d_mm
+        items.append(SweepItem(f"spring_{sp.joint}_leg_near", sp.near_body, "spring",
+                               (_leg(sp.near_axis, sp.near_anchor, r0, d, tol),), near_z[0], near_z[1],
+                               frozenset([anchor]), "", sp))
+        items.append(SweepItem(f"spring_{sp.joint}_leg_far", sp.far_body, "spring",
+                               (_leg(sp.far_axis, sp.far_anchor, r0, d, tol),), far_z[0], far_z[1],
+                               frozenset([anchor]), "", sp))
+        if sp.side == "top":
+            run = (sp.z_mm[1] - sp.leg_axial_mm[1], sp.z_mm[1] - d)
+        else:
+            run = (sp.z_mm[0] + d, sp.z_mm[0] + sp.leg_axial_mm[1])
+        items.append(SweepItem(f"spring_{sp.joint}_leg_far_axial", sp.far_body, "spring",
+                               (circle_polygon(sp.far_anchor, d, tol),), run[0], run[1], frozenset([anchor]), "", sp))
+    return items
+
+
+def _leg(axis: np.ndarray, anchor: np.ndarray, r0: float, d: float, tol: float) -> np.ndarray:
+    """A leg's radial run in plan: a stadium of the wire's width from the coil's outside to the anchor."""
+    direction = np.asarray(anchor, dtype=np.float64) - axis
+    length = float(np.hypot(*direction))
+    u = direction / length
+    start = axis + u * r0
+    n = np.array([-u[1], u[0]])
+    half = 0.5 * d
+    arc = max(4, int(math.ceil(math.pi / (2.0 * math.acos(max(-1.0, 1.0 - tol / max(half, tol)))))))
+    ang = np.linspace(-0.5 * math.pi, 0.5 * math.pi, arc + 1)
+    end_cap = anchor + half * (np.outer(np.cos(ang), u) + np.outer(np.sin(ang), n))
+    start_cap = start + half * (np.outer(np.cos(ang + math.pi), u) + np.outer(np.sin(ang + math.pi), n))
+    return np.vstack([end_cap, start_cap])
