@@ -6,8 +6,9 @@ Public entry points: :func:`build_gear_pairs` (one pair per gear coupling of a m
 
 from __future__ import annotations
 
-from fabricate.gears.mesh import MeshResult, mesh_check
-from fabricate.gears.pair import GearPair, build_gear_pairs, make_gear_pair
+from fabricate.gears.build import build_gear_pairs, make_gear_pair
+from fabricate.gears.mesh import mesh_check
+from fabricate.gears.pair import GearPair, MeshResult
 from fabricate.gears.spec import GearSpec, parse_gear_spec
 
 __all__ = ["GearPair", "GearSpec", "MeshResult", "build_gear_pairs", "make_gear_pair", "mesh_check",

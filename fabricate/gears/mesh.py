@@ -24,75 +24,20 @@ Backlash is the circumferential free play at the pitch curve, ``(free_plus + fre
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
 
-if TYPE_CHECKING:  # fabricate.gears.pair builds on this module
-    from fabricate.gears.pair import GearPair
+from fabricate.gears.pair import GearPair, MeshResult
+
+if TYPE_CHECKING:
     from fabricate.mechanism import Law
 
 #: Driving flank pairs whose gap is within this of the smallest count as touching together (rad).
 CONTACT_TOLERANCE_RAD = 2e-6
 
 
-@dataclass(frozen=True)
-class MeshResult:
-    """Mesh check over ``n`` steps. Angles rad, lengths mm, areas mm^2.
-
-    Attributes
-    ----------
-    x_a : (n,) array
-        Driving angles.
-    free_plus, free_minus : (n,) array
-        Free rotation of gear b towards / away from gear a's driving flanks (negative: interference).
-    backlash_mm : (n,) array
-        Circumferential backlash at the pitch curve.
-    transmission_error : (n,) array
-        Driven angle at contact minus the law minus the designed backlash lag, on whichever flank
-        deviates more (signed).
-    contact_lag : (n,) array
-        Driven angle at contact (a driving forward) minus the law, ``= free_plus``.
-    interference_area_mm2 : (n,) array
-        Overlap area of the two outlines.
-    teeth_in_contact : (n,) int array
-        Driving flank pairs touching at once (conjugate flanks touch together; the mean over a
-        cycle is the measured contact ratio); 0 at steps where no driving flank pair is in mesh.
-    """
-
-    x_a: np.ndarray
-    free_plus: np.ndarray
-    free_minus: np.ndarray
-    backlash_mm: np.ndarray
-    transmission_error: np.ndarray
-    contact_lag: np.ndarray
-    interference_area_mm2: np.ndarray
-    teeth_in_contact: np.ndarray | None = None
-
-    @property
-    def steps(self) -> int:
-        return len(self.x_a)
-
-    def summary(self) -> dict[str, Any]:
-        """JSON-ready numbers (degrees where the key says so)."""
-        ok = np.isfinite(self.backlash_mm)
-        return {
-            "steps": int(self.steps),
-            "interference_area_mm2": float(np.max(self.interference_area_mm2)),
-            "backlash_mm": [float(np.min(self.backlash_mm[ok])), float(np.max(self.backlash_mm[ok]))]
-            if np.any(ok) else [None, None],
-            "transmission_error_deg": float(np.degrees(np.max(np.abs(self.transmission_error[ok]))))
-            if np.any(ok) else None,
-            "contact_lag_deg": [float(np.degrees(np.min(self.contact_lag[ok]))),
-                                float(np.degrees(np.max(self.contact_lag[ok])))] if np.any(ok) else [None, None],
-            "steps_without_contact_pair": int(np.count_nonzero(~ok)),
-            "teeth_in_contact": [int(self.teeth_in_contact.min()), int(self.teeth_in_contact.max())]
-            if self.teeth_in_contact is not None else None,
-            "contact_ratio_measured": float(np.mean(self.teeth_in_contact))
-            if self.teeth_in_contact is not None else None,
-        }
 
 
 def _pad_flanks(flanks: dict[int, np.ndarray]) -> tuple[np.ndarray, np.ndarray, int]:

@@ -63,6 +63,7 @@ MODULES: dict[str, tuple[str, list[str]]] = {
     "gears/teeth": ("fabricate/gears/teeth.py", GEARS_TESTS),
     "gears/mesh": ("fabricate/gears/mesh.py", GEARS_TESTS),
     "gears/pair": ("fabricate/gears/pair.py", GEARS_TESTS),
+    "gears/build": ("fabricate/gears/build.py", GEARS_TESTS),
     "gears/checks": ("fabricate/gears/checks.py", GEARS_TESTS),
     "gears/spec": ("fabricate/gears/spec.py", ["tests/gears/test_spec.py", "tests/test_spec.py"]),
     "mechanism": ("fabricate/mechanism.py", ["tests/test_mechanism_properties.py", "tests/test_mechanism.py",

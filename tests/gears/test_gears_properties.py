@@ -719,7 +719,7 @@ def test_osculating_frames_of_a_circle_are_the_circle(radius):
 def test_mesh_summary_of_given_arrays():
     """The summary of hand-made arrays: ranges over the steps with a contact pair, NaN steps counted, the
     TE the largest magnitude in degrees, the measured contact ratio the mean teeth in contact."""
-    from fabricate.gears.mesh import MeshResult
+    from fabricate.gears.pair import MeshResult
 
     nan = np.nan
     r = MeshResult(x_a=np.array([0.0, 0.1, 0.2, 0.3]), free_plus=np.array([0.01, nan, 0.02, 0.015]),

@@ -34,8 +34,8 @@ from shapely.geometry import LineString, Polygon
 
 from fabricate.errors import SpecError
 from fabricate.gears import GearSpec, build_gear_pairs, make_gear_pair
+from fabricate.gears.build import _deviation_um
 from fabricate.gears.law import FormulaLaw, elliptic_law
-from fabricate.gears.pair import _deviation_um
 from fabricate.gears.pitch import PitchCurves
 from fabricate.gears.spec import parse_gear_spec
 from fabricate.mechanism import Body, Driver, GearCoupling, Mechanism, Revolute
