@@ -20,6 +20,23 @@ Modules downstream never test a process by its name; they read what it can do:
 plus the numbers every process has: ``min_feature_mm``, ``min_wall_mm``, ``min_pin_mm``, the fits
 (``running_clearance_mm``, ``hole_compensation_mm``, ``kerf_mm``) and ``min_text_mm``.
 
+Fits and retention
+------------------
+Every pin runs in the holes of all but (at most) one of the parts it joins. How it is kept in is the
+profile's ``retention`` (:data:`RETENTIONS`):
+
+``"press"``  pressed into the hole of the part that holds it (its first body), whose NOMINAL hole is the pin
+             less ``press_fit_interference_mm`` (diametral); it runs in the others.
+``"clip"``   runs in every part; it sticks out at both ends far enough for a DIN 6799 retaining washer in a
+             groove (an ISO 2338 pin, which can be grooved).
+``"cap"``    runs in every part; a collar of the process's own stock (printed, or cut from the sheet) is
+             bonded onto each end.
+
+``press_fit_interference_mm`` is the profile's value, else the part material's (``[materials.X]``): a
+material that does not take a press fit (cast acrylic crazes under a lasting hoop stress) has none, and
+``retention = "press"`` with it is a SpecError. Fit sizes are NOMINAL (what to measure on the finished part);
+``hole_compensation_mm`` is added to the modelled (CAD) hole separately (:mod:`fabricate.parts.retention`).
+
 A profile that leaves a capability out (a ``--process`` file written before the field existed) takes it from
 the shipped profile of its ``method``; a profile with a method of its own must state both.
 """
@@ -40,6 +57,11 @@ DEFAULT_PROFILE = "sla"
 #: How a process shapes a part, and how it lays the parts out (see the module docstring).
 TECHNIQUES = ("additive", "cut")
 LAYOUTS = ("plate", "sheet")
+#: How a joint's pin is kept in (see the module docstring).
+RETENTIONS = ("press", "clip", "cap")
+#: Largest diametral press-fit interference (mm): beyond ~0.5 mm a pin of any catalogued size splits a
+#: printed or cut boss (hoop strain interference / pin of 10 % and more).
+MAX_INTERFERENCE_MM = 0.5
 #: A process name (``method``; a shipped profile's file is ``process_<name>.toml``).
 _PROCESS_NAME = re.compile(r"[a-z][a-z0-9_-]{0,39}")
 
@@ -64,6 +86,9 @@ class Material:
     modulus_MPa, poisson : float
         Elastic constants (Hertz contact).
     density_g_cm3 : float
+    press_fit_interference_mm : float or None
+        Diametral interference (mm) a pin pressed into a hole of this material takes; None when the
+        material does not take a press fit (the profile says why beside the material).
     """
 
     key: str
@@ -75,6 +100,7 @@ class Material:
     modulus_MPa: float
     poisson: float
     density_g_cm3: float
+    press_fit_interference_mm: float | None = None
 
 
 def parse_materials(table: Table) -> dict[str, Material]:
@@ -94,6 +120,9 @@ def parse_materials(table: Table) -> dict[str, Material]:
             modulus_MPa=t.number("modulus_MPa", positive=True, max=1e7),
             poisson=t.number("poisson", min=0.0, max=0.5),
             density_g_cm3=t.number("density_g_cm3", positive=True, max=25.0),
+            press_fit_interference_mm=(t.number("press_fit_interference_mm", positive=True,
+                                                max=MAX_INTERFERENCE_MM)
+                                       if t.has("press_fit_interference_mm") else None),
         )
         t.finish()
     return out
@@ -150,6 +179,11 @@ class ProcessSpec:
         The profile's ``[materials]``: key -> :class:`Material`.
     pin_material : str
         Key of the dowel pins' material.
+    retention : str
+        How every pin is kept in: ``"press"``, ``"clip"`` or ``"cap"`` (see the module docstring).
+    press_fit_interference_mm : float
+        Diametral interference of a press-fit hole (nominal hole = pin - interference); 0 when the process
+        does not press-fit (``retention`` is then not ``"press"``).
     """
 
     name: str
@@ -174,6 +208,8 @@ class ProcessSpec:
     engrave_colour: str = "#0000ff"
     materials: Mapping[str, Material] = field(default_factory=dict, compare=False)
     pin_material: str = ""
+    retention: str = "press"  # the default profile's (process_sla.toml)
+    press_fit_interference_mm: float = 0.05
 
     def part_material(self) -> Material | None:
         """The :class:`Material` of the parts (None if the profile has none)."""
@@ -281,22 +317,47 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
         engrave_colour=_colour(t, "engrave_colour", "#0000ff"),
         materials=materials,
         pin_material=pin_material,
+        retention=_capability(t, "retention", name, RETENTIONS, fallback="clip"),
+        press_fit_interference_mm=_interference(t, materials.get(material), name, material),
     )
     t.finish()
+    if spec.retention == "press" and spec.press_fit_interference_mm <= 0.0:
+        why = (f"{materials[material].name} takes no press fit (the profile gives it no press_fit_interference_mm)"
+               if material in materials else "the profile gives no press_fit_interference_mm")
+        raise SpecError(t.field("retention"), f'"press" needs a press-fit interference: {why}; use "clip" or "cap", '
+                                              "or set press_fit_interference_mm")
     if spec.pin_diameter_mm < spec.min_pin_mm:
         raise SpecError(t.field("pin_diameter_mm"),
                         f"pin {spec.pin_diameter_mm:g} mm is below the process minimum {spec.min_pin_mm:g} mm")
     return spec
 
 
-def _capability(t: Table, key: str, name: str, choices: tuple[str, ...]) -> str:
+def _capability(t: Table, key: str, name: str, choices: tuple[str, ...], fallback: str | None = None) -> str:
     """A capability field: the profile's value; if it has none, the shipped profile's of the same ``method``
-    (``process_<name>.toml``: a ``--process`` file older than the field); else it is required."""
+    (``process_<name>.toml``: a ``--process`` file older than the field); else ``fallback``, or it is
+    required when there is none."""
     if not t.has(key) and name in shipped_profiles():
         default = read_toml(TEMPLATE_DIR / f"process_{name}.toml").get(key)
         if isinstance(default, str) and default in choices:
             return t.string(key, default, choices=choices)
+    if fallback is not None:
+        return t.string(key, fallback, choices=choices)
     return t.string(key, choices=choices)
+
+
+def _interference(t: Table, material: Material | None, name: str, key: str) -> float:
+    """``press_fit_interference_mm``: the profile's (0 allowed: no press fits), else the part material's, else
+    (a ``--process`` file older than the field) the shipped profile's of the same ``method`` for that material,
+    else 0."""
+    default = material.press_fit_interference_mm if material is not None else None
+    if default is None and name in shipped_profiles():
+        shipped = read_toml(TEMPLATE_DIR / f"process_{name}.toml")
+        row = shipped.get("materials", {}).get(key, {})
+        value = row.get("press_fit_interference_mm") if isinstance(row, dict) else None
+        if isinstance(value, (int, float)) and material is not None and material.name == row.get("name"):
+            default = float(value)
+    return t.number("press_fit_interference_mm", default if default is not None else 0.0, min=0.0,
+                    max=MAX_INTERFERENCE_MM)
 
 
 def _colour(t: Table, key: str, default: str) -> str:

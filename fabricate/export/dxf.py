@@ -3,8 +3,13 @@
 Every document is R2010 in millimetres ($INSUNITS = 4, $MEASUREMENT = 1). Cut geometry goes on layer
 ``CUT`` (red): each outline is one closed LWPOLYLINE whose arcs are bulges, each hole a CIRCLE, each slot
 a closed LWPOLYLINE. Labels go on ``ENGRAVE`` (blue). The laser kerf is applied to the cut path only:
-outlines are offset out by kerf / 2 and holes in by kerf / 2 (a hole's CIRCLE is its finished diameter
+outlines are offset out by kerf / 2 and holes in by kerf / 2 (a hole's CIRCLE is its modelled diameter
 minus the kerf), so the finished part has the modelled size.
+
+A part's drawing (``drawings/NAME.dxf``, :attr:`DxfStyle.hole_labels`) also labels every hole on layer
+``HOLES`` (never in a cut file): the NOMINAL hole and its fit, what the finished part should measure, and
+apart from it the CAD (modelled) size with the process's compensation, e.g. ``Ø1.95 press (CAD Ø2.15 incl.
++0.2 sla compensation)``. The labels stand in a column right of the part, each with a leader to its hole.
 
 Documents are written with ezdxf's fixed metadata (dates, GUIDs) so equal inputs give equal bytes.
 """
@@ -14,7 +19,7 @@ from __future__ import annotations
 import contextlib
 import io
 from collections import OrderedDict
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -25,7 +30,7 @@ from ezdxf import units
 from shapely.ops import polylabel
 
 from fabricate.export.layout import Placement, shelf_pack
-from fabricate.parts.model import BulgePath, Part
+from fabricate.parts.model import BulgePath, Hole, Part
 from fabricate.parts.profiles import offset_path
 from fabricate.planar import transform_points
 
@@ -38,7 +43,7 @@ MIN_DRAWING_TEXT_MM = 2.5
 DIMSTYLE = "FABRICATE"
 
 #: ACI colours: red for cutting, blue for engraving, grey for the sheet border, others for CAD drawings.
-LAYERS = {"CUT": 1, "ENGRAVE": 5, "SHEET": 8, "LINKS": 7, "JOINTS": 3, "DIMENSIONS": 2, "LABELS": 4}
+LAYERS = {"CUT": 1, "ENGRAVE": 5, "SHEET": 8, "LINKS": 7, "JOINTS": 3, "DIMENSIONS": 2, "LABELS": 4, "HOLES": 3}
 
 
 @contextlib.contextmanager
@@ -128,11 +133,15 @@ class DxfStyle:
     chord_tolerance_mm : float
     min_text_mm : float
         Labels that would be smaller are left out (0 keeps every label).
+    hole_labels : bool
+        Label every hole on layer ``HOLES`` with its nominal size, fit and compensation (drawings only: a
+        cutter would engrave them).
     """
 
     arcs: str = "bulge"
     chord_tolerance_mm: float = 0.005
     min_text_mm: float = 0.0
+    hole_labels: bool = False
 
 
 EXACT = DxfStyle()
@@ -165,6 +174,8 @@ def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None =
     for centre, diameter in holes:
         c = place(centre[None, :])[0]
         msp.add_circle((float(c[0]), float(c[1])), float(diameter) / 2.0, dxfattribs={"layer": "CUT"})
+    if style.hole_labels:
+        _hole_labels(msp, part, place)
     label = label if label is not None else part.name
     spot, height = _label_spot(part, label)
     if height < style.min_text_mm:  # the process cannot engrave it legibly
@@ -174,9 +185,35 @@ def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None =
     text.set_placement((float(spot[0]), float(spot[1])), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
 
 
+def hole_label(part: Part, hole: Hole) -> str:
+    """A hole's label: nominal size and fit, then the CAD size and the compensation (see the module docstring)."""
+    from fabricate.parts.retention import hole_label as label
+
+    return label(hole.fit, hole.nominal_mm, hole.diameter_mm, part.process)
+
+
+def _hole_labels(msp: Any, part: Part, place: Callable[[np.ndarray], np.ndarray]) -> None:
+    """Label every hole on layer HOLES: a column of texts right of the part, a leader line to each hole."""
+    if not part.holes:
+        return
+    height = MIN_DRAWING_TEXT_MM
+    outline = place(part.outline.polygon(0.05))
+    x_text = float(outline[:, 0].max()) + 2.0 * height
+    centres = [place(np.asarray(h.centre, dtype=np.float64)[None, :])[0] for h in part.holes]
+    order = sorted(range(len(part.holes)), key=lambda k: (-float(centres[k][1]), float(centres[k][0])))
+    top = max(float(outline[:, 1].max()), max(float(c[1]) for c in centres))
+    for row, k in enumerate(order):
+        hole, c = part.holes[k], centres[k]
+        y = top - row * 1.6 * height
+        edge = (float(c[0]) + 0.5 * hole.diameter_mm, float(c[1]))
+        msp.add_line(edge, (x_text - 0.5 * height, y), dxfattribs={"layer": "HOLES"})
+        text = msp.add_text(f"{hole.joint}: {hole_label(part, hole)}", height=height, dxfattribs={"layer": "HOLES"})
+        text.set_placement((x_text, y), align=ezdxf.enums.TextEntityAlignment.MIDDLE_LEFT)
+
+
 def part_dxf(part: Part, kerf_mm: float, style: DxfStyle = EXACT) -> bytes:
-    """DXF of one part in its own (body) coordinates."""
-    doc = new_document()
+    """DXF of one part in its own (body) coordinates (with the layer ``HOLES`` when the style labels holes)."""
+    doc = new_document(("CUT", "ENGRAVE", "HOLES") if style.hole_labels else ("CUT", "ENGRAVE"))
     add_part(doc.modelspace(), part, kerf_mm, style=style)
     return document_bytes(doc)
 

@@ -7,7 +7,9 @@ coloured by operation: pure red ``#ff0000`` cuts, pure blue ``#0000ff`` engraves
 LightBurn's layer palette and Glowforge's colour-to-step mapping; a process profile may set others).
 Outlines are ``path`` elements whose arcs are SVG elliptical arcs with equal radii, holes are ``circle``
 elements, labels ``text`` on the engrave colour. Cut order: holes and slots before the outline, so a part
-is cut free last. Encoders return bytes; nothing here writes files.
+is cut free last. Each hole's ``circle`` carries a ``title`` (shown by Inkscape, ignored by the cutter): its
+nominal size and fit, the CAD size with the process's compensation, and the cut path's diameter (the
+drawing's hole label, see :mod:`fabricate.export.dxf`). Encoders return bytes; nothing here writes files.
 """
 
 from __future__ import annotations
@@ -65,9 +67,10 @@ class _Canvas:
         parts.append("Z")
         return f'<path d="{" ".join(parts)}" {_stroke(colour)}/>'
 
-    def circle(self, centre: np.ndarray, diameter: float, colour: str) -> str:
-        return (f'<circle cx="{_num(float(centre[0]))}" cy="{_num(self.height - float(centre[1]))}" '
-                f'r="{_num(diameter / 2.0)}" {_stroke(colour)}/>')
+    def circle(self, centre: np.ndarray, diameter: float, colour: str, title: str = "") -> str:
+        head = (f'<circle cx="{_num(float(centre[0]))}" cy="{_num(self.height - float(centre[1]))}" '
+                f'r="{_num(diameter / 2.0)}" {_stroke(colour)}')
+        return f"{head}><title>{escape(title)}</title></circle>" if title else f"{head}/>"
 
     def text(self, spot: np.ndarray, height: float, label: str, colour: str) -> str:
         return (f'<text x="{_num(float(spot[0]))}" y="{_num(self.height - float(spot[1]))}" '
@@ -89,7 +92,7 @@ def _stroke(colour: str) -> str:
 
 def _part_elements(canvas: _Canvas, part: Part, kerf_mm: float, placement: Placement | None,
                    label: str | None, min_text_mm: float, colours: tuple[str, str]) -> list[str]:
-    from fabricate.export.dxf import _label_spot, cut_geometry
+    from fabricate.export.dxf import _label_spot, cut_geometry, hole_label
 
     outline, holes, slots = cut_geometry(part, kerf_mm)
 
@@ -102,7 +105,9 @@ def _part_elements(canvas: _Canvas, part: Part, kerf_mm: float, placement: Place
 
     cut, engrave = colours
     elements = [f'<g id={quoteattr(part.name)}>']
-    elements += [canvas.circle(place(centre[None, :])[0], diameter, cut) for centre, diameter in holes]
+    elements += [canvas.circle(place(centre[None, :])[0], diameter, cut,
+                               f"{hole.joint}: {hole_label(part, hole)}; cut path Ø{_num(diameter)}")
+                 for hole, (centre, diameter) in zip(part.holes, holes, strict=True)]
     elements += [canvas.path(placed(slot), cut) for slot in slots]
     elements.append(canvas.path(placed(outline), cut))
     text = part.name if label is None else label

@@ -147,9 +147,19 @@ def circle_polygon(centre: np.ndarray, diameter: float, chord_tolerance_mm: floa
         [np.cos(angles), np.sin(angles)])
 
 
+#: How a hole fits what goes through it: a pin that turns in it (``running``), a pin pressed into it
+#: (``press``), a screw that passes it (``clearance``).
+HOLE_FITS = ("running", "press", "clearance")
+
+
 @dataclass(frozen=True)
 class Hole:
     """A round hole through a part.
+
+    Two sizes are kept apart: the NOMINAL diameter is the fit's (pin + 2 × running clearance, pin − press
+    interference, screw + 2 × clearance): what the finished part should measure. The MODELLED diameter
+    (``diameter_mm``, the CAD, STL and DXF size) is the nominal plus the process's hole compensation (SLA
+    prints holes undersize, so the model's hole is larger).
 
     Attributes
     ----------
@@ -158,15 +168,31 @@ class Hole:
     centre : (2,) array
         Centre in part (body) coordinates, mm.
     diameter_mm : float
-        Diameter as modelled (nominal pin plus clearance and process compensation).
+        Diameter as modelled (nominal plus the process compensation).
     pin_diameter_mm : float
         Nominal diameter of the pin it takes (0 for mounting holes with no pin).
+    fit : str
+        One of :data:`HOLE_FITS`.
+    nominal_diameter_mm : float
+        The fit's diameter, to measure on the finished part; 0 means "as modelled" (no compensation known).
     """
 
     joint: str
     centre: np.ndarray
     diameter_mm: float
     pin_diameter_mm: float = 0.0
+    fit: str = "running"
+    nominal_diameter_mm: float = 0.0
+
+    @property
+    def nominal_mm(self) -> float:
+        """The nominal (finished) diameter: what to measure on the made part."""
+        return self.nominal_diameter_mm if self.nominal_diameter_mm > 0.0 else self.diameter_mm
+
+    @property
+    def compensation_mm(self) -> float:
+        """What the process adds to the nominal diameter in the model (modelled − nominal)."""
+        return self.diameter_mm - self.nominal_mm
 
 
 @dataclass(frozen=True)
