@@ -124,6 +124,7 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
         out.append("")
     for note in report.get("notes", []):
         out += [f"Note: {note}", ""]
+    out += _contents(report)
     mech = report.get("mechanism", {})
     if mech.get("joints"):
         out += ["## Mechanism (first pose)", ""]
@@ -155,27 +156,68 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
                         ", ".join(f"{h['joint']}: {h['diameter_mm']:.3f}" for h in p.get("holes", [])),
                         p.get("stl"), p.get("dxf")] for p in parts]) + [""]
     assembly = report.get("assembly", {})
-    if assembly.get("steps"):
-        out += ["## Assembly", "", "Each pin's stack from bottom to top (also in `assembly.csv`):", ""]
-        out += list(assembly["steps"]) + [""]
+    if assembly.get("steps") or assembly.get("guide"):
+        out += ["## Assembly", ""]
+        if assembly.get("guide"):
+            out += [f"Follow [assembly.md](assembly.md): {len(assembly['guide'])} numbered steps, each with its "
+                    "picture, parts, hardware, retention and tool, ending with a check of the motion.", ""]
+        if assembly.get("steps"):
+            out += ["Each pin's stack from bottom to top (also in `assembly.csv`):", ""]
+            out += list(assembly["steps"]) + [""]
     bom = report.get("bom", [])
     if bom:
         out += ["## Bill of materials", ""]
         keys = list(dict.fromkeys(k for row in bom for k in row))
         out += _table(keys, [[row.get(k, "") for k in keys] for row in bom]) + [""]
-    inter = report.get("interference", {})
-    if inter:
-        out += interference_markdown(inter)
     strength = report.get("strength", {})
     if strength:
         out += strength_markdown(strength)
+    if report.get("springs"):
+        out += springs_markdown(report["springs"])
+    if report.get("drive"):
+        from fabricate.drive.check import drive_markdown
+
+        out += drive_markdown(report["drive"])
+    # the step pictures belong to assembly.md, not here
+    images = [path for path in images if not path.startswith("assembly/")]
     if images:
         out += ["## Pictures", ""]
         out += [f"![{path}]({path})" for path in images] + [""]
     files = report.get("files", [])
     if files:
         out += ["## Files", ""] + [f"- `{f}`" for f in files] + [""]
+    # the pair-by-pair table is long (86 rows for the gripper): an appendix, after everything people read first
+    inter = report.get("interference", {})
+    if inter:
+        out += ["---", "", "Appendix.", ""] + interference_markdown(inter)
     return "\n".join(out)
+
+
+def _contents(report: Mapping[str, Any]) -> list[str]:
+    """The lines under the verdict: where the assembly guide is, and the interference proof in one line (its
+    table is the appendix at the end)."""
+    out = []
+    if (report.get("assembly") or {}).get("guide"):
+        out.append("Assembly guide: [assembly.md](assembly.md) (numbered steps with pictures).")
+    inter = report.get("interference") or {}
+    if inter and inter.get("passed") is not None:
+        out.append(f"Interference: {inter.get('pairs_checked')} pairs over {inter.get('poses')} poses, "
+                   f"{len(inter.get('collisions', []))} collisions, smallest clearance between moving parts "
+                   f"{_fmt(inter.get('min_clearance_mm'))} mm; every pair in the appendix at the end.")
+    return out + [""] if out else []
+
+
+def springs_markdown(springs: Sequence[Mapping[str, Any]]) -> list[str]:
+    """report.md's springs paragraph: each torsion spring as specified, its wire stress against the allowable."""
+    out = ["## Springs", "",
+           "Torsion springs (music wire), sized from the synthesis' rate and preload over the joint's travel, on "
+           "their pin's extension beyond the stack, legs hooked into anchor holes; bending stress at the largest "
+           "deflection against the wire's allowable (0.65 × its minimum tensile strength):", ""]
+    out += _table(["joint", "spring", "deflection °", "max torque N·mm", "stress MPa", "allowable MPa", "verdict"],
+                  [[s.get("joint"), s.get("designation"), s.get("deflection_deg"), s.get("max_torque_Nmm"),
+                    s.get("stress_MPa"), s.get("allowable_MPa"), "passes" if s.get("passed") else "FAILS"]
+                   for s in springs])
+    return out + [""]
 
 
 #: How each kind of contact in the interference sweep is judged, in the words report.md uses.

@@ -298,14 +298,14 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
         stack = stack_of.get(pin.joint)
         for item in stack.items if stack else ():
             if item.kind == "spacer" and item.item in by_name:
-                part_step.setdefault(item.item, pin.joint)
+                part_step.setdefault(item.item, f"pin:{pin.joint}")
         for body in pin.bodies:
             if body in seen_bodies:
                 continue
             seen_bodies.add(body)
             for part in partset.parts:
                 if part.body == body and part.role not in ("spacer", "mount"):
-                    part_step.setdefault(part.name, pin.joint)
+                    part_step.setdefault(part.name, f"pin:{pin.joint}")
     for part in partset.parts:
         part_step.setdefault(part.name, "drive" if part.role == "mount" else "ground")
 
@@ -316,6 +316,7 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
         if qty > 0:
             units.setdefault(key, []).append(GuideItem(str(row.get("item")), str(row.get("kind", "")), qty, shared))
 
+    # step keys: "ground", "pin:<pin>", "spring:<pin>", "drive", "purchased", "shared drive", "shared", "check"
     pin_of_joint = {j: p.joint for p in pins for j in p.joint.split("+")} | {p.joint: p.joint for p in pins}
     for row in rows:
         qty = int(row.get("qty", 0) or 0)
@@ -327,9 +328,9 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
         if name in by_name and kind not in ("pin", "washer", "spacer", "spring", "screw", "purchased"):
             give(part_step[name], row, per, shared)
         elif kind == "spring" and joints:
-            _round_robin(give, [f"spring:{j}" if j in springs else j for j in joints], row, per, shared)
+            _round_robin(give, [f"spring:{j}" if j in springs else f"pin:{j}" for j in joints], row, per, shared)
         elif joints and not _is_drive(row, act_words):
-            _round_robin(give, joints, row, per, shared)
+            _round_robin(give, [f"pin:{j}" for j in joints], row, per, shared)
         elif _is_drive(row, act_words):
             give("shared drive" if shared else "drive", row, per, shared)
         elif kind == "screw":
@@ -361,21 +362,21 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
 
     for pin in order:
         stack = stack_of.get(pin.joint)
-        new = [n for n, k in part_step.items() if k == pin.joint]
+        new = [n for n, k in part_step.items() if k == f"pin:{pin.joint}"]
         on = [i for i in (stack.items if stack else ()) if i.kind != "spring"]
         listing = "; ".join(f"{i.item} ({i.kind}, z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" if i.kind != "part"
                             else f"{i.item} (z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" for i in on)
         retention, tool = _retention(pin)
         spring = springs.get(pin.joint)
         text = [f"Stack, bottom to top: {listing}.",
-                f"Push the pin {_pin_words(pin)} through the stack from z {float(pin.z_mm):.2f} mm; every part "
+                f"Push {_pin_words(pin)} through the stack from z {float(pin.z_mm):.2f} mm; every part "
                 "but the one that holds the pin must turn freely on it."]
         if spring is not None:
             end = "top" if spring.side == "top" else "bottom"
             text.append(f"Leave the pin's {end} end free: the torsion spring goes on it in the next step.")
         else:
             text.append(f"Retention: {retention}.")
-        add(pin.joint, f"Pin {pin.joint}", text, tool, new, new_pins=(pin.joint,))
+        add(f"pin:{pin.joint}", f"Pin {pin.joint}", text, tool, new, new_pins=(pin.joint,))
         if spring is not None:
             s = spring.spring
             upper = 1.0 if spring.hand == "RH" else -1.0

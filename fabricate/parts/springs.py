@@ -263,6 +263,13 @@ def _anchor(material: Any, axis: np.ndarray, radius_max: float, radius_min: floa
     raise SpecError("springs", "no place for a leg anchor")
 
 
+def _towards(material: Any, axis: np.ndarray, radius: float) -> np.ndarray:
+    """The point ``radius`` from ``axis`` towards the plate's centroid (any direction for a round plate)."""
+    direction = np.array([material.centroid.x, material.centroid.y]) - axis
+    norm = float(np.hypot(*direction))
+    return axis + radius * (direction / norm if norm > 1e-9 else np.array([1.0, 0.0]))
+
+
 def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, parts: Sequence[Part],
                   pins: Sequence[Pin], process: ProcessSpec) -> tuple[tuple[PlacedSpring, ...], list[Part], list[Pin]]:
     """Size and place every spring of the hints; the parts get their anchor holes, the pins their extension.
@@ -351,9 +358,15 @@ def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, pa
             far_at, far_r = _anchor(far_material, np.asarray(axis[far], dtype=np.float64), legs[1], r_min, keep,
                                     (near_material, motion.pose(far)[pick], motion.pose(near)[pick], gap))
         except SpecError:
-            raise GeometryError(f"spring at {name}: no place for its leg anchors in {near_part.name} and "
-                                f"{far_part.name} within {legs[0]:g} mm of the pin; give longer legs or wider "
-                                "plates") from None
+            if within:
+                raise GeometryError(f"spring at {name}: no place for its leg anchors in {near_part.name} and "
+                                    f"{far_part.name} within {legs[0]:g} mm of the pin; give longer legs or wider "
+                                    "plates") from None
+            # a spring over its allowable fails the strength check by name; its anchors only stand in: out
+            # from the pin towards each plate's middle, clear of the oversized coil
+            near_r = far_r = max(legs[0], r_min)
+            near_at = _towards(near_material, np.asarray(axis[near], dtype=np.float64), near_r)
+            far_at = _towards(far_material, np.asarray(axis[far], dtype=np.float64), far_r)
         # the nominal (finished) size apart from the process's compensation, where the hole records it
         nominal = ({"nominal_diameter_mm": hole - process.hole_compensation_mm}
                    if "nominal_diameter_mm" in getattr(Hole, "__dataclass_fields__", {}) else {})

@@ -1,0 +1,187 @@
+"""The assembly guide: assembly.md and a picture per step (``assembly/step_NN.png``).
+
+Encoders only: :func:`guide_markdown` returns the text, :func:`guide_pictures` PNG bytes (the pipeline
+writes them). The steps come from :func:`fabricate.parts.assembly.assembly_guide`.
+
+Each picture shows the assembly after its step at the first pose in an oblique view from above: every
+plate a prism (its top face true to the plan, the height drawn up and to the right), the parts placed
+before in grey and the step's new parts, pins and springs in orange, drawn bottom to top (painter's order).
+All pictures of a guide share one frame, so they line up when paged through.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from fabricate.parts.assembly import GuideStep
+
+if TYPE_CHECKING:
+    from fabricate.mechanism import Motion
+    from fabricate.parts.build import PartSet
+
+#: Picture size (inches at :data:`DPI`): 360 × 270 px.
+SIZE_IN = (3.6, 2.7)
+DPI = 100
+#: Oblique projection: a point at height z is drawn shifted by z × this in plan (x, y).
+OBLIQUE = np.array([0.35, 0.5])
+#: Colours: placed before (top face, sides), new in this step (top, sides), edges, pins, springs.
+OLD = ("#d3d7db", "#a0a6ad")
+NEW = ("#f5a04a", "#c4701f")
+EDGE = "#3a3a3a"
+PIN, NEW_PIN = "#555555", "#d9480f"
+SPRING, NEW_SPRING = "#5f6b76", "#d9480f"
+
+
+def guide_markdown(steps: Sequence[GuideStep], name: str, copies: int = 1) -> str:
+    """assembly.md: the numbered steps, each with its picture, the parts and hardware it fits, what to do
+    and the tool.
+
+    The "Parts and hardware" lines read ``- N × `item` (kind)``, N per copy (``shared`` items: in all); over
+    the whole guide they add up to the bill of materials.
+    """
+    tools = list(dict.fromkeys(s.tool for s in steps if s.tool and s.tool not in ("none", "as above")))
+    per = (f"Quantities are for one copy: the design has {copies} identical copies (the BOM's quantities are "
+           "for all of them); items marked shared are bought once for all copies." if copies > 1 else
+           "Quantities are for the whole design.")
+    out = [f"# Assembly: {name}", "",
+           "Follow the steps in order. Each picture shows the assembly after its step at the first pose, seen "
+           "from above; the step's new parts are orange. Every part and every piece of hardware of the bill of "
+           "materials (`bom.csv`) is fitted in exactly one step.", "", per, "",
+           "Tools: " + "; ".join(tools) + ".", ""]
+    for step in steps:
+        out += [f"## Step {step.number}. {step.title}", "", f"![step {step.number}]({step.picture})", ""]
+        if step.items:
+            out += ["Parts and hardware:", ""]
+            out += [f"- {i.qty} × `{i.item}` ({i.kind}{', shared' if i.shared else ''})" for i in step.items]
+            out.append("")
+        out += [f"{k}. {line}" for k, line in enumerate(step.text, start=1)]
+        out += ["", f"Tool: {step.tool}.", ""]
+    return "\n".join(out)
+
+
+def _world(points: np.ndarray, pose: np.ndarray) -> np.ndarray:
+    c, s = np.cos(pose[2]), np.sin(pose[2])
+    return np.column_stack([pose[0] + c * points[:, 0] - s * points[:, 1],
+                            pose[1] + s * points[:, 0] + c * points[:, 1]])
+
+
+def _prism(rings: list[np.ndarray], z0: float, z1: float) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray]]:
+    """Projected side quads (k, 4, 2) of the outer ring and the top face's rings of a prism."""
+    outer = rings[0]
+    lo, hi = outer + z0 * OBLIQUE, outer + z1 * OBLIQUE
+    nxt = np.roll(np.arange(len(outer)), -1)
+    quads = np.stack([lo, lo[nxt], hi[nxt], hi], axis=1)
+    return quads, [r + z1 * OBLIQUE for r in rings], [outer + z0 * OBLIQUE]
+
+
+def _face_path(rings: list[np.ndarray]) -> Any:
+    from matplotlib.path import Path
+
+    verts, codes = [], []
+    for ring in rings:
+        verts += [*ring.tolist(), ring[0].tolist()]
+        codes += [Path.MOVETO] + [Path.LINETO] * (len(ring) - 1) + [Path.CLOSEPOLY]
+    return Path(np.asarray(verts), codes)
+
+
+def guide_pictures(partset: PartSet, motion: Motion, steps: Sequence[GuideStep]) -> dict[str, bytes]:
+    """One PNG per step (``assembly/step_NN.png``): the parts, pins and springs in place after it."""
+    from matplotlib.collections import PolyCollection
+    from matplotlib.patches import PathPatch
+
+    from fabricate.plotting import figure, png_bytes
+
+    poses = {name: motion.pose(name)[0] for name in motion.body_names}
+    # coarse outlines: a picture of 360 px needs no finer than a few hundredths of the assembly's size
+    span = max((float(np.ptp(p.outline.vertices, axis=0).max()) for p in partset.parts), default=10.0)
+    tol = max(0.02, span / 300.0)
+    solids: dict[str, tuple[float, np.ndarray, list[np.ndarray]]] = {}
+    corners = []
+    for part in partset.parts:
+        pose = poses.get(part.body, np.zeros(3))
+        rings = [_world(r, pose) for r in part.polygons(tol)]
+        quads, top, _ = _prism(rings, part.z_mm, part.z_mm + part.thickness_mm)
+        solids[part.name] = (part.z_mm + part.thickness_mm, quads, top)
+        corners.append(quads.reshape(-1, 2))
+    pins = {}
+    for pin in partset.pins:
+        hole = next((h for p in partset.parts if p.body == pin.bodies[0] for h in p.holes if h.joint == pin.joint),
+                    None)
+        if hole is None:
+            continue
+        centre = _world(np.asarray([hole.centre], dtype=np.float64), poses.get(pin.bodies[0], np.zeros(3)))[0]
+        seg = np.array([centre + pin.z_mm * OBLIQUE, centre + (pin.z_mm + pin.length_mm) * OBLIQUE])
+        pins[pin.joint] = (pin.z_mm + pin.length_mm, seg)
+        corners.append(seg)
+    springs = {}
+    angles = np.linspace(0.0, 2.0 * np.pi, 40)
+    circle = np.column_stack([np.cos(angles), np.sin(angles)])
+    for sp in getattr(partset, "springs", ()) or ():
+        centre = _world(sp.centre[None, :], poses.get(sp.pin_body, np.zeros(3)))[0]
+        r = 0.5 * sp.spring.outer_d_mm
+        turns = max(2, min(8, int(round(sp.spring.active_turns))))
+        coils = [centre + r * circle + z * OBLIQUE for z in np.linspace(sp.z_mm[0], sp.z_mm[1], turns)]
+        near = _world(sp.near_anchor[None, :], poses.get(sp.near_body, np.zeros(3)))[0]
+        far = _world(sp.far_anchor[None, :], poses.get(sp.far_body, np.zeros(3)))[0]
+        z_near = sp.z_mm[0] if sp.side == "top" else sp.z_mm[1]
+        z_far = sp.z_mm[1] if sp.side == "top" else sp.z_mm[0]
+        far_down = z_far - sp.leg_axial_mm[1] if sp.side == "top" else z_far + sp.leg_axial_mm[1]
+        legs = [np.array([centre + z_near * OBLIQUE, near + z_near * OBLIQUE]),
+                np.array([centre + z_far * OBLIQUE, far + z_far * OBLIQUE, far + far_down * OBLIQUE])]
+        springs[sp.joint] = (sp.z_mm[1], coils, legs)
+        corners += coils
+    allpts = np.concatenate(corners) if corners else np.zeros((1, 2))
+    lo, hi = allpts.min(axis=0), allpts.max(axis=0)
+    pad = 0.04 * float(max(hi - lo)) + 1.0
+    files = {}
+    for step in steps:
+        fig = figure(SIZE_IN, DPI)
+        ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
+        ax.set_axis_off()
+        ax.set_aspect("equal")
+        ax.set_xlim(lo[0] - pad, hi[0] + pad)
+        ax.set_ylim(lo[1] - pad, hi[1] + pad)
+        # painter's order: whatever ends lower is drawn first
+        layers: list[tuple[float, int, str, str]] = [(solids[n][0], 0, "part", n) for n in step.placed if n in solids]
+        layers += [(pins[j][0], 1, "pin", j) for j in step.pins if j in pins]
+        layers += [(springs[j][0], 2, "spring", j) for j in step.springs if j in springs]
+        for _, _, kind, name in sorted(layers):
+            if kind == "part":
+                _, quads, top = solids[name]
+                face, side = NEW if name in step.new else OLD
+                ax.add_collection(PolyCollection(list(quads), facecolors=side, edgecolors=side, linewidths=0.3))
+                ax.add_patch(PathPatch(_face_path(top), facecolor=face, edgecolor=EDGE, linewidth=0.4))
+            elif kind == "pin":
+                seg = pins[name][1]
+                ax.plot(seg[:, 0], seg[:, 1], color=NEW_PIN if name in step.new_pins else PIN, linewidth=1.6,
+                        solid_capstyle="round")
+            else:
+                _, coils, legs = springs[name]
+                colour = NEW_SPRING if name in step.new_springs else SPRING
+                for ring in coils:
+                    ax.plot(ring[:, 0], ring[:, 1], color=colour, linewidth=0.8)
+                for leg in legs:
+                    ax.plot(leg[:, 0], leg[:, 1], color=colour, linewidth=0.8)
+        ax.text(0.02, 0.97, f"step {step.number}", transform=ax.transAxes, fontsize=8, va="top", color=EDGE)
+        files[step.picture] = png_bytes(fig)
+    return files
+
+
+def motion_check(partset: PartSet, motion: Motion, min_clearance_mm: float | None = None) -> Any:
+    """The final step's :class:`~fabricate.parts.assembly.MotionCheck` from a part set and its motion: the
+    input range and the tip point's first and last positions (the hints' tip point, where given)."""
+    from fabricate.parts.assembly import MotionCheck
+
+    mechanism = motion.mechanism
+    hints = partset.hints
+    tip = (hints.get("tip_point") if isinstance(hints, dict) else getattr(hints, "tip_point", None)) or ""
+    start = end = None
+    if tip and tip in mechanism.point_names():
+        path = motion.point(tip)
+        start, end = (float(path[0, 0]), float(path[0, 1])), (float(path[-1, 0]), float(path[-1, 1]))
+    a, b = mechanism.input_range
+    return MotionCheck((float(a), float(b)), mechanism.input_unit, tip if start else "", start, end,
+                       min_clearance_mm)

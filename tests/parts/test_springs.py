@@ -1,0 +1,155 @@
+"""Torsion springs in their pin's stack (``fabricate/parts/springs.py``).
+
+The rate and the stress are recomputed here from the chosen wire, coil and turns with the textbook
+formulas and constants written out again (not the catalogue's functions); the anchors are measured on
+the parts' outlines and over the motion with shapely; the shipped springs are read from real builds.
+"""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+import shapely
+
+from fabricate.hints import SpringHint
+from fabricate.parts.build import build_parts
+from fabricate.parts.spec import PartsSpec
+from fabricate.parts.springs import place_springs, spring_bom_rows, spring_failures, with_spring_rows
+from tests.conftest import make_four_bar
+
+#: Music wire A228 modulus by diameter (Shigley 9th ed. Table 10-5), written out again: d < 0.032 in
+#: 203.4 GPa, 0.033-0.063 in 200 GPa, above 196.5 GPa.
+INCH = 25.4
+
+
+def modulus(d_mm: float) -> float:
+    d_in = d_mm / INCH
+    return 203_400.0 if d_in <= 0.0325 else (200_000.0 if d_in <= 0.0635 else 196_500.0)
+
+
+def rate_from(d: float, mean_d: float, turns: float) -> float:
+    """k = E d^4 / (10.8 D N) per turn, in N·mm per degree."""
+    return modulus(d) * d**4 / (10.8 * mean_d * turns) / 360.0
+
+
+def stress_from(d: float, mean_d: float, torque: float) -> float:
+    """sigma = K_B 32 M / (pi d^3), K_B = (4C^2 - C - 1) / (4C (C - 1))."""
+    c = mean_d / d
+    return (4 * c * c - c - 1) / (4 * c * (c - 1)) * 32.0 * torque / (math.pi * d**3)
+
+
+def four_bar_parts(sla_process):
+    mech = make_four_bar()
+    motion = mech.sweep(41)
+    design = SimpleNamespace(name="t", process=sla_process, parts=PartsSpec(),
+                             gears=SimpleNamespace(hub_diameter_mm=None))
+    return mech, motion, build_parts(design, mech, motion, [])
+
+
+def test_spring_rate_stress_and_place_recomputed(sla_process):
+    mech, motion, partset = four_bar_parts(sla_process)
+    hint = SpringHint("B", rate_Nmm_per_deg=0.2, preload_deg=10.0, legs_mm=12.0, note="return")
+    springs, parts, pins = place_springs([hint], mech, motion, partset.parts, partset.pins, sla_process)
+    (sp,) = springs
+    s = sp.spring
+    # the rate the wire, coil and turns give is the rate asked for (the turns are not rounded)
+    assert rate_from(s.wire_d_mm, s.mean_d_mm, s.active_turns) == pytest.approx(0.2, rel=1e-9)
+    # the deflection over the motion: preload plus the joint's travel (coupler against rocker)
+    rel = np.degrees(motion.relative_angle("rocker", "coupler"))
+    travel = abs(rel - rel[0]).max()
+    assert sp.deflection_deg[1] == pytest.approx(10.0 + travel, rel=1e-9)
+    assert stress_from(s.wire_d_mm, s.mean_d_mm, 0.2 * (10.0 + travel)) == pytest.approx(s.stress_mpa, rel=1e-9)
+    assert s.stress_mpa <= s.allowable_mpa and sp.passed and not spring_failures(springs)
+    # wound up, the coil still clears its pin (the catalogue's 10 % arbor clearance)
+    assert s.inner_d_wound_mm >= s.pin_diameter_mm / 0.9 - 1e-9
+    # the pin grows by the coil's wound body, which sits on the stack's end face
+    old = next(p for p in partset.pins if p.joint == "B")
+    new = next(p for p in pins if p.joint == "B")
+    assert new.length_mm == pytest.approx(old.length_mm + s.body_length_wound_mm, rel=1e-12)
+    stack_top, stack_bottom = old.z_mm + old.length_mm, old.z_mm
+    assert sp.z_mm == pytest.approx((stack_top, stack_top + s.body_length_wound_mm)) if sp.side == "top" else \
+        sp.z_mm == pytest.approx((stack_bottom - s.body_length_wound_mm, stack_bottom))
+    # one anchor hole in each body's plate, a leg's length from the pin, with the process's wall round it
+    for body, anchor in ((sp.near_body, sp.near_anchor), (sp.far_body, sp.far_anchor)):
+        part = next(p for p in parts if p.body == body and p.role != "spacer")
+        axis = next(h.centre for h in part.holes if h.joint == "B")
+        hole = next(h for h in part.holes if h.joint == "spring_B")
+        assert np.allclose(hole.centre, anchor)
+        assert math.hypot(*(hole.centre - axis)) == pytest.approx(12.0, abs=1e-9)
+        assert hole.diameter_mm == pytest.approx(s.wire_d_mm + 2 * sla_process.running_clearance_mm
+                                                 + sla_process.hole_compensation_mm)
+        rings = part.polygons(0.01)
+        material = shapely.Polygon(rings[0], [r for r in rings[1:] if not np.allclose(r.mean(axis=0), anchor)])
+        disc = shapely.Point(*anchor).buffer(hole.diameter_mm / 2 + sla_process.min_wall_mm - 0.02)
+        assert material.contains(disc)
+    # the far leg runs past the near plate: it keeps the running clearance from it at every pose
+    near = next(p for p in parts if p.body == sp.near_body and p.role != "spacer")
+    rings = near.polygons(0.01)
+    near_poly = shapely.Polygon(rings[0], rings[1:])
+    for i in range(len(motion.inputs)):
+        pf, pn = motion.pose(sp.far_body)[i], motion.pose(sp.near_body)[i]
+        c, s_ = math.cos(pf[2]), math.sin(pf[2])
+        world = pf[:2] + np.array([c * sp.far_anchor[0] - s_ * sp.far_anchor[1],
+                                   s_ * sp.far_anchor[0] + c * sp.far_anchor[1]])
+        d = world - pn[:2]
+        c, s_ = math.cos(pn[2]), math.sin(pn[2])
+        local = np.array([c * d[0] + s_ * d[1], -s_ * d[0] + c * d[1]])
+        gap = near_poly.distance(shapely.Point(*local)) - 0.5 * s.wire_d_mm
+        assert gap >= sla_process.running_clearance_mm - 0.02
+    # the BOM row names it as a spring maker is asked for it, and replaces the rate-only row
+    (row,) = spring_bom_rows(springs, copies=2)
+    assert row["qty"] == 2 and row["item"] == sp.designation and row["joints"] == ["B"]
+    assert f"Ø{s.wire_d_mm:.2f}" in row["item"] and f"{s.active_turns:.2f} turns" in row["item"]
+    assert row["item"].endswith(sp.hand) and sp.hand in ("LH", "RH")
+    bom = with_spring_rows([{"item": "x", "kind": "pin", "qty": 2}, {"item": "torsion spring at B", "kind": "spring",
+                                                                      "qty": 2}], springs, copies=2)
+    assert [r["item"] for r in bom] == ["x", sp.designation]
+
+
+def test_a_spring_no_wire_can_make_is_a_failure_naming_it(sla_process):
+    mech, motion, partset = four_bar_parts(sla_process)
+    hint = SpringHint("B", rate_Nmm_per_deg=40.0, preload_deg=180.0, legs_mm=12.0)
+    springs, _, _ = place_springs([hint], mech, motion, partset.parts, partset.pins, sla_process)
+    (sp,) = springs
+    assert not sp.passed and sp.spring.stress_mpa > sp.spring.allowable_mpa
+    (failure,) = spring_failures(springs)
+    assert failure.startswith("spring at B") and "over its allowable" in failure
+    # the stand-in is still the rate asked for, from the thickest wire
+    assert rate_from(sp.spring.wire_d_mm, sp.spring.mean_d_mm, sp.spring.active_turns) == pytest.approx(40.0,
+                                                                                                          rel=1e-9)
+
+
+def test_no_spring_where_the_rate_is_zero(sla_process):
+    mech, motion, partset = four_bar_parts(sla_process)
+    springs, parts, pins = place_springs([SpringHint("B", 0.0)], mech, motion, partset.parts, partset.pins,
+                                         sla_process)
+    assert springs == () and list(pins) == list(partset.pins) and list(parts) == list(partset.parts)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["gripper_compliant", "finger_underactuated"])
+def test_shipped_springs_within_allowable_and_in_their_pin_stack(shipped_build, name):
+    outcome = shipped_build(name)
+    springs = outcome.report["springs"]
+    hinted = [s for s in outcome.partset.hints.springs if s.rate_Nmm_per_deg > 0]
+    assert len(springs) == len(hinted) > 0
+    bom = {r["item"]: r for r in outcome.report["bom"] if r["kind"] == "spring"}
+    stacks = {s["pin"]: s for s in outcome.report["assembly"]["pins"]}
+    for spring in springs:
+        assert spring["stress_MPa"] <= spring["allowable_MPa"] and spring["passed"]
+        assert stress_from(spring["wire_d_mm"], spring["mean_d_mm"], spring["max_torque_Nmm"]) == pytest.approx(
+            spring["stress_MPa"], rel=1e-9)
+        rate = next(h.rate_Nmm_per_deg for h in hinted if h.joint == spring["joint"])
+        assert rate_from(spring["wire_d_mm"], spring["mean_d_mm"], spring["active_turns"]) == pytest.approx(
+            rate, rel=1e-9)
+        assert spring["designation"] in bom
+        stack = stacks[spring["pin"]]
+        items = [i for i in stack["stack"] if i["kind"] == "spring"]
+        assert [i["item"] for i in items] == [spring["designation"]]
+        # on the pin, within its length
+        z0, z1 = items[0]["z_mm"]
+        assert stack["z_mm"] - 1e-9 <= z0 < z1 <= stack["z_mm"] + stack["length_mm"] + 1e-9
+    assert not [f for f in outcome.report["checks"]["failures"] if f.startswith("spring at")]
