@@ -702,7 +702,8 @@ def _schema_only(value, node=None):
 def _sweep_metrics():
     """Every metric a shipped sweep or the README reads, and the default ones, by name (``{template: {}}``
     collects the values read)."""
-    from fabricate.sweep.spec import default_metrics, load_sweep, parse_metric
+    from fabricate.sweep.paths import parse_metric
+    from fabricate.sweep.spec import default_metrics, load_sweep
 
     names = set(default_metrics("build"))
     for spec in (TEMPLATE_DIR / "sweeps").glob("*.toml"):

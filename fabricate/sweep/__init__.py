@@ -13,7 +13,8 @@ builds.
 
 from __future__ import annotations
 
-from fabricate.sweep.spec import Field, Metric, SweepSpec, load_sweep, sweep_from_tables
+from fabricate.sweep.paths import Metric
+from fabricate.sweep.spec import Field, SweepSpec, load_sweep, sweep_from_tables
 
 __all__ = ["Field", "Metric", "SweepSpec", "load_sweep", "run_sweep", "sweep_from_tables"]
 

@@ -15,7 +15,7 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from fabricate.sweep.spec import Metric
+from fabricate.sweep.paths import Metric
 
 #: Exit codes of a row, as the CLI's: 0 passes, 1 fails a check, 2 invalid or infeasible, 3 internal error.
 EXIT_OK, EXIT_FAILED, EXIT_INVALID, EXIT_INTERNAL = 0, 1, 2, 3
@@ -24,7 +24,7 @@ EXIT_OK, EXIT_FAILED, EXIT_INVALID, EXIT_INTERNAL = 0, 1, 2, 3
 def point_text(base: Mapping[str, Any], fields: Sequence[tuple[str, Sequence[str | int]]],
                values: Mapping[str, Any]) -> str:
     """A point's template as TOML text: the base tables with the point's values set."""
-    from fabricate.sweep.spec import set_path
+    from fabricate.sweep.paths import set_path
     from fabricate.tomlwrite import dumps
 
     data = copy.deepcopy(dict(base))

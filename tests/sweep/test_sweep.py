@@ -24,14 +24,8 @@ import numpy as np
 import pytest
 
 from fabricate.errors import SpecError
-from fabricate.sweep.spec import (
-    get_path,
-    parse_metric,
-    parse_path,
-    set_path,
-    sweep_from_tables,
-    unit_samples,
-)
+from fabricate.sweep.paths import get_path, parse_metric, parse_path, set_path
+from fabricate.sweep.spec import sweep_from_tables, unit_samples
 from fabricate.sweep.task import run_point
 
 pytest.importorskip("distributed")
@@ -417,7 +411,8 @@ def test_cli_sweep_never_writes_into_a_foreign_folder(tmp_path, capsys):
 
 def _earlier_sweep(tmp_path: Path) -> tuple[Path, Path, object]:
     """A spec file and the folder of an earlier run of it (its sweep.json, no rows yet)."""
-    from fabricate.sweep.runner import SWEEP_JSON, _json, _marker
+    from fabricate.sweep.folder import SWEEP_JSON, sweep_record
+    from fabricate.sweep.runner import _json
     from fabricate.tomlwrite import dumps
 
     tables = gear_tables(eccentricities=(0.1, 0.2), modules=(1.0,))
@@ -426,13 +421,13 @@ def _earlier_sweep(tmp_path: Path) -> tuple[Path, Path, object]:
     spec = sweep_from_tables(tables, tmp_path)
     out = tmp_path / "out"
     out.mkdir()
-    (out / SWEEP_JSON).write_bytes(_json(_marker(spec, {"points": 2, "done": 0, "complete": False})))
+    (out / SWEEP_JSON).write_bytes(_json(sweep_record(spec, {"points": 2, "done": 0, "complete": False})))
     return spec_file, out, spec
 
 
 def test_a_symlinked_journal_is_refused_and_never_written_through(tmp_path, capsys):
     from fabricate.cli import main
-    from fabricate.sweep.runner import Journal, read_journal
+    from fabricate.sweep.folder import Journal, read_journal
 
     spec_file, out, spec = _earlier_sweep(tmp_path)
     target = tmp_path / "thesis.txt"
