@@ -18,7 +18,10 @@ pair's closest pose (searching just beyond the planar value) and the boolean int
 each colliding pair's worst pose. The kernel's numbers are the ones reported (the smaller of the two
 for a clearance); the planar engine chooses where to ask.
 
-Pairs of one body are rigid (no relative motion) and are not swept. Joined pairs (two parts on one
+Pairs of one body are rigid (no relative motion) and are not swept, but for an actuator's body (and its
+mount's standoffs) against the parts of the body it is fixed to: those are "fixed" (may touch, must not
+overlap; one pose settles them). An actuator's output and horn screws are fastened to the part they
+drive (rigid with it); the output on the actuator's own body is "bearing". Joined pairs (two parts on one
 pin, a pin in the hole of a part of another body) are swept like any other: their clearances are the
 layer gap and the radial pin clearance, and they must meet the minimum like every moving pair. Gear
 parts meshing with each other (same ``gear`` name, different bodies) run with the backlash, far below
@@ -53,6 +56,10 @@ DEFAULT_SEARCH_MM = 2.0
 TOUCH_MM = 1e-9
 #: Colliding poses at which the overlap volume is computed before refining around the worst.
 OVERLAP_SAMPLES = 24
+#: Relations whose solids may touch (only an overlap fails): gears in mesh (the backlash is the gear mesh
+#: check's), spacers on their faces, an actuator's output in its own bearing, an actuator or standoff fixed
+#: to a body's parts.
+TOUCHING = ("meshing", "bearing", "fixed")
 
 
 @dataclass(frozen=True)
@@ -79,11 +86,13 @@ class PinSolid:
 
 @dataclass(frozen=True)
 class SweepItem:
-    """One solid of the sweep in its body's frame: a part or a pin."""
+    """One solid of the sweep in its body's frame: a part, a pin, a spacer or an actuator's solid."""
 
     name: str
     body: str
-    kind: str                       # "part", "pin" or "spacer" (a tube or washer on a pin)
+    # "part", "pin", "spacer" (a tube or washer on a pin) or "actuator" (an actuator's body, output, screw
+    # head or mount standoff, :func:`fabricate.drive.parts.sweep_items`; its source's ``role`` says which)
+    kind: str
     rings: tuple[np.ndarray, ...]   # outer CCW then holes CW, mm, body frame
     z0: float
     z1: float
@@ -104,7 +113,9 @@ class PairResult:
     relation : str
         ``"moving"``, ``"joined"`` (share a pin), ``"pin"`` (a pin in another body's hole),
         ``"bearing"`` (a spacer against a part of its joint, or anything flush with a spacer's end
-        face: may touch, must not overlap) or
+        face, or an actuator's output on its body: may touch, must not overlap),
+        ``"fixed"`` (an actuator's body or a mount standoff against a part of the body it is fixed to:
+        may touch, must not overlap) or
         ``"meshing"`` (gear parts in mesh).
     z_gap_mm : float
         Gap between the z ranges (negative: the overlap thickness).
@@ -192,7 +203,7 @@ class InterferenceResult:
     @property
     def min_clearance_mm(self) -> float:
         """Smallest clearance over all pairs that must keep the process clearance (mm)."""
-        values = [p.min_clearance_mm for p in self.pairs if p.relation not in ("meshing", "bearing")]
+        values = [p.min_clearance_mm for p in self.pairs if p.relation not in TOUCHING]
         return float(min(values)) if values else math.inf
 
     def failures(self) -> list[str]:
@@ -359,7 +370,17 @@ def spacer_items(spacers: Sequence[Spacer], parts: Sequence[Part], chord_toleran
 
 def _relation(a: SweepItem, b: SweepItem) -> str:
     if a.body == b.body:
+        # an actuator's body (or a standoff of its mount) is fixed to a body's parts, not part of them: it
+        # may bear on them, it must not cut into them; its output and the horn screws are fastened to the
+        # part they drive, and an actuator's own solids are one purchased piece
+        fixed = [_is_fixed_actuator(it) for it in (a, b)]
+        if any(fixed) and "actuator" in (a.kind, b.kind) and not (a.kind == b.kind == "actuator"):
+            return "fixed"
         return "rigid"
+    roles = {getattr(it.source, "role", "") for it in (a, b)}
+    if a.kind == b.kind == "actuator" and roles == {"output", "body"}:
+        # the output turns in the actuator's own bearing, on its face: touching is its job
+        return "bearing"
     if a.kind == "part" and b.kind == "part" and a.gear and a.gear == b.gear:
         return "meshing"
     if a.joints & b.joints:
@@ -373,6 +394,12 @@ def _relation(a: SweepItem, b: SweepItem) -> str:
     if (_is_spacer(a) or _is_spacer(b)) and abs(z_gap) < 1e-9:
         return "bearing"
     return "moving"
+
+
+def _is_fixed_actuator(item: SweepItem) -> bool:
+    """An actuator solid fixed to its body's parts rather than fastened into them (body, standoff, screw
+    head on the mount): see :data:`fabricate.drive.parts.DRIVEN_ROLES` for the others."""
+    return item.kind == "actuator" and getattr(item.source, "role", "") not in ("output", "screw")
 
 
 def _is_spacer(item: SweepItem) -> bool:
@@ -391,7 +418,7 @@ def _outline(item: SweepItem) -> Outline:
 def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance_mm: float,
                        min_clearance_mm: float, pins: Sequence[PinSolid | Pin] | None = None,
                        spacers: Sequence[Spacer] = (), search_length_mm: float | None = None,
-                       use_kernel: bool = True) -> InterferenceResult:
+                       use_kernel: bool = True, extra: Sequence[SweepItem] = ()) -> InterferenceResult:
     """Check every pair of parts and pins for collision and clearance at every pose of ``motion``.
 
     Parameters
@@ -411,6 +438,8 @@ def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
         Planar distances up to this are resolved exactly (default max(2 mm, 4 × the minimum)).
     use_kernel : bool
         Confirm with manifold3d (``min_gap`` / intersection volume) at the deciding poses.
+    extra : sequence of SweepItem
+        Further solids (an actuator's, :func:`fabricate.drive.parts.sweep_items`), swept like the rest.
 
     Returns
     -------
@@ -424,7 +453,7 @@ def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
     pins = pins_from_holes(parts) if pins is None else pins_from_parts_layer(pins, parts)
     search = float(search_length_mm or max(DEFAULT_SEARCH_MM, 4.0 * min_clearance_mm))
     items = (part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
-             + spacer_items(spacers, parts, chord_tolerance_mm))
+             + spacer_items(spacers, parts, chord_tolerance_mm) + list(extra))
     outlines: dict[str, Outline] = {}
     solids: dict[str, object] = {}
     poses = {name: motion.pose(name) for name in motion.body_names}
@@ -440,7 +469,7 @@ def sweep_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
             for it in (a, b):
                 if it.name not in outlines:
                     outlines[it.name] = _outline(it)
-            required = 0.0 if relation in ("meshing", "bearing") else float(min_clearance_mm)
+            required = 0.0 if relation in TOUCHING else float(min_clearance_mm)
             results.append(_sweep_pair(a, b, outlines[a.name], outlines[b.name], poses[a.body], poses[b.body],
                                        relation, required, search, solids if use_kernel else None,
                                        chord_tolerance_mm))
@@ -465,8 +494,14 @@ def _sweep_pair(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, pose_a: np
     planar = np.maximum(lower, search)
     exact = np.zeros(n, dtype=bool)
     near = np.nonzero(lower < search)[0]
-    shortcut = _shortcut(a, b, oa, ob, rel, lower, z_gap, required, tol, search)
-    if shortcut is not None:
+    shortcut = None if a.body == b.body else _shortcut(a, b, oa, ob, rel, lower, z_gap, required, tol, search)
+    if a.body == b.body:  # fixed to one body: one pose is every pose
+        value = float(planar_clearance(oa, ob, RelativePoses(rel.q[:1]), search)[0])
+        resolved = math.isfinite(value) or value < 0
+        planar[:] = value if resolved else search
+        exact[:] = resolved
+        near = near[:0]
+    elif shortcut is not None:
         k, value = shortcut
         if value > 0.0:  # a pin in its hole: the same clearance at every pose
             planar[:] = value
@@ -589,8 +624,8 @@ def _posed_pair(a: SweepItem, b: SweepItem, pose_a: np.ndarray, pose_b: np.ndarr
 
 
 def naive_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance_mm: float,
-                       pins: Sequence[PinSolid | Pin] | None = None,
-                       spacers: Sequence[Spacer] = ()) -> dict[tuple[str, str], np.ndarray]:
+                       pins: Sequence[PinSolid | Pin] | None = None, spacers: Sequence[Spacer] = (),
+                       extra: Sequence[SweepItem] = ()) -> dict[tuple[str, str], np.ndarray]:
     """Reference: the boolean intersection of every non-rigid pair at every pose (manifold3d only).
 
     Returns
@@ -601,7 +636,7 @@ def naive_interference(parts: Sequence[Part], motion: Motion, *, chord_tolerance
     """
     pins = pins_from_holes(parts) if pins is None else pins_from_parts_layer(pins, parts)
     items = (part_items(parts, chord_tolerance_mm) + pin_items(pins, chord_tolerance_mm)
-             + spacer_items(spacers, parts, chord_tolerance_mm))
+             + spacer_items(spacers, parts, chord_tolerance_mm) + list(extra))
     cache: dict[str, object] = {}
     poses = {name: motion.pose(name) for name in motion.body_names}
     out = {}
