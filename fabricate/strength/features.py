@@ -19,7 +19,7 @@ import shapely
 from fabricate.errors import GeometryError
 from fabricate.mechanism import Mechanism, Motion, Revolute
 from fabricate.planar import rotation
-from fabricate.strength import models
+from fabricate.strength import gear_teeth, models
 from fabricate.strength.section import Section, cut_section, plate_polygon
 from fabricate.strength.statics import Statics
 
@@ -369,8 +369,8 @@ def gear_findings(pair: GearPair, torque_b: np.ndarray, mechanism: Mechanism, mo
     for gear, rho in (("a", rho_a), ("b", rho_b)):
         with np.errstate(divide="ignore", invalid="ignore"):
             teeth = np.where(np.isfinite(rho) & (rho > 0), 2.0 * rho / pair.module, np.inf)
-        y = np.asarray(models.lewis_form_factor(teeth), dtype=np.float64)
-        sigma = np.asarray(models.lewis_bending_stress(ft, pair.module, face, y), dtype=np.float64)
+        y = np.asarray(gear_teeth.lewis_form_factor(teeth), dtype=np.float64)
+        sigma = np.asarray(gear_teeth.lewis_bending_stress(ft, pair.module, face, y), dtype=np.float64)
         i = int(np.argmax(sigma))
         body = pair.body_a if gear == "a" else pair.body_b
         name = next((p.name for p in parts if p.body == body and p.gear == pair.name), body)
@@ -380,9 +380,9 @@ def gear_findings(pair: GearPair, torque_b: np.ndarray, mechanism: Mechanism, mo
                                        sigma))
     fn = ft / math.cos(phi)
     flat = 1e9  # a straight pitch stretch: a flat flank for Hertz
-    r1, r2 = models.involute_contact_radii(np.where(np.isfinite(rho_a), rho_a, flat),
+    r1, r2 = gear_teeth.involute_contact_radii(np.where(np.isfinite(rho_a), rho_a, flat),
                                            np.where(np.isfinite(rho_b), rho_b, flat), phi)
-    hertz = np.asarray(models.hertz_line_contact_stress(fn, face, r1, r2, material.modulus_MPa, material.poisson,
+    hertz = np.asarray(gear_teeth.hertz_line_contact_stress(fn, face, r1, r2, material.modulus_MPa, material.poisson,
                                                         material.modulus_MPa, material.poisson), dtype=np.float64)
     i = int(np.argmax(hertz))
     name = next((p.name for p in parts if p.gear == pair.name), pair.name)

@@ -1,4 +1,5 @@
-"""Closed-form strength models for pin-jointed plate links, their pins, gear teeth and torsion springs.
+"""Closed-form strength models for pin-jointed plate links, their pins and torsion springs (gear teeth:
+:mod:`fabricate.strength.gear_teeth`), and the argument checks they share.
 
 Every function is a textbook formula with its assumptions and reference in its docstring; the tests
 check each against a published worked example (``tests/data/strength_examples.json``).
@@ -27,26 +28,26 @@ if TYPE_CHECKING:
 ArrayLike = float | np.ndarray
 
 
-def _out(x: np.ndarray) -> ArrayLike:
+def scalar_or_array(x: np.ndarray) -> ArrayLike:
     """A float for a 0-d result, the array otherwise."""
     return float(x) if np.ndim(x) == 0 else x
 
 
-def _positive(name: str, value: ArrayLike) -> np.ndarray:
+def positive(name: str, value: ArrayLike) -> np.ndarray:
     v = np.asarray(value, dtype=np.float64)
     if not np.all(np.isfinite(v) & (v > 0.0)):
         raise ValueError(f"{name} must be finite and positive, got {value}")
     return v
 
 
-def _non_negative(name: str, value: ArrayLike) -> np.ndarray:
+def non_negative(name: str, value: ArrayLike) -> np.ndarray:
     v = np.asarray(value, dtype=np.float64)
     if not np.all(np.isfinite(v) & (v >= 0.0)):
         raise ValueError(f"{name} must be finite and non-negative, got {value}")
     return v
 
 
-def _magnitude(name: str, value: ArrayLike) -> np.ndarray:
+def magnitude(name: str, value: ArrayLike) -> np.ndarray:
     v = np.asarray(value, dtype=np.float64)
     if not np.all(np.isfinite(v)):
         raise ValueError(f"{name} must be finite, got {value}")
@@ -81,9 +82,9 @@ def pin_shear_stress(force_N: ArrayLike, pin_diameter_mm: ArrayLike, shear_plane
     """
     if int(shear_planes) != shear_planes or shear_planes < 1:
         raise ValueError(f"shear_planes must be a positive integer, got {shear_planes}")
-    f = _magnitude("force_N", force_N)
-    d = _positive("pin_diameter_mm", pin_diameter_mm)
-    return _out(f / (shear_planes * math.pi * d ** 2 / 4.0))
+    f = magnitude("force_N", force_N)
+    d = positive("pin_diameter_mm", pin_diameter_mm)
+    return scalar_or_array(f / (shear_planes * math.pi * d ** 2 / 4.0))
 
 
 def pin_bending_moment_double_shear(force_N: ArrayLike, inner_thickness_mm: ArrayLike,
@@ -114,11 +115,11 @@ def pin_bending_moment_double_shear(force_N: ArrayLike, inner_thickness_mm: Arra
     float or array
         Largest pin bending moment (N·mm).
     """
-    f = _magnitude("force_N", force_N)
-    b = _positive("inner_thickness_mm", inner_thickness_mm)
-    a = _positive("outer_thickness_mm", outer_thickness_mm)
-    g = _non_negative("gap_mm", gap_mm)
-    return _out(f / 2.0 * (a / 2.0 + g + b / 4.0))
+    f = magnitude("force_N", force_N)
+    b = positive("inner_thickness_mm", inner_thickness_mm)
+    a = positive("outer_thickness_mm", outer_thickness_mm)
+    g = non_negative("gap_mm", gap_mm)
+    return scalar_or_array(f / 2.0 * (a / 2.0 + g + b / 4.0))
 
 
 def pin_bending_moment_single_shear(force_N: ArrayLike, thickness_a_mm: ArrayLike,
@@ -154,11 +155,11 @@ def pin_bending_moment_single_shear(force_N: ArrayLike, thickness_a_mm: ArrayLik
     float or array
         Pin bending moment (N·mm).
     """
-    f = _magnitude("force_N", force_N)
-    ta = _positive("thickness_a_mm", thickness_a_mm)
-    tb = _positive("thickness_b_mm", thickness_b_mm)
-    g = _non_negative("gap_mm", gap_mm)
-    return _out(f * (np.maximum(ta, tb) / 2.0 + g))
+    f = magnitude("force_N", force_N)
+    ta = positive("thickness_a_mm", thickness_a_mm)
+    tb = positive("thickness_b_mm", thickness_b_mm)
+    g = non_negative("gap_mm", gap_mm)
+    return scalar_or_array(f * (np.maximum(ta, tb) / 2.0 + g))
 
 
 def pin_bending_stress(moment_Nmm: ArrayLike, pin_diameter_mm: ArrayLike) -> ArrayLike:
@@ -176,9 +177,9 @@ def pin_bending_stress(moment_Nmm: ArrayLike, pin_diameter_mm: ArrayLike) -> Arr
     float or array
         Largest bending stress at the pin surface (MPa).
     """
-    m = _magnitude("moment_Nmm", moment_Nmm)
-    d = _positive("pin_diameter_mm", pin_diameter_mm)
-    return _out(32.0 * m / (math.pi * d ** 3))
+    m = magnitude("moment_Nmm", moment_Nmm)
+    d = positive("pin_diameter_mm", pin_diameter_mm)
+    return scalar_or_array(32.0 * m / (math.pi * d ** 3))
 
 
 # -- plates at a pin hole ------------------------------------------------------------------------------
@@ -204,10 +205,10 @@ def bearing_stress(force_N: ArrayLike, pin_diameter_mm: ArrayLike, thickness_mm:
     float or array
         Bearing stress (MPa).
     """
-    f = _magnitude("force_N", force_N)
-    d = _positive("pin_diameter_mm", pin_diameter_mm)
-    t = _positive("thickness_mm", thickness_mm)
-    return _out(f / (d * t))
+    f = magnitude("force_N", force_N)
+    d = positive("pin_diameter_mm", pin_diameter_mm)
+    t = positive("thickness_mm", thickness_mm)
+    return scalar_or_array(f / (d * t))
 
 
 def tearout_stress(force_N: ArrayLike, edge_distance_mm: ArrayLike, hole_diameter_mm: ArrayLike,
@@ -240,15 +241,15 @@ def tearout_stress(force_N: ArrayLike, edge_distance_mm: ArrayLike, hole_diamete
     GeometryError
         The hole reaches the edge (``e <= D/2``).
     """
-    f = _magnitude("force_N", force_N)
-    e = _positive("edge_distance_mm", edge_distance_mm)
-    dh = _positive("hole_diameter_mm", hole_diameter_mm)
-    t = _positive("thickness_mm", thickness_mm)
+    f = magnitude("force_N", force_N)
+    e = positive("edge_distance_mm", edge_distance_mm)
+    dh = positive("hole_diameter_mm", hole_diameter_mm)
+    t = positive("thickness_mm", thickness_mm)
     ligament = e - dh / 2.0
     if np.any(ligament <= 0.0):
         raise GeometryError(f"hole of diameter {hole_diameter_mm} mm breaks the edge {edge_distance_mm} mm "
                             f"from its centre: no material to shear out")
-    return _out(f / (2.0 * t * ligament))
+    return scalar_or_array(f / (2.0 * t * ligament))
 
 
 #: Peterson's open-hole fit falls up to 1.4 % short of converged finite elements for large holes
@@ -332,8 +333,8 @@ def hole_stress_concentration(hole_diameter_mm: float, width_mm: float, pin_load
     ValueError
         Non-positive width, negative diameter, or a pin-loaded hole of zero diameter.
     """
-    w = float(_positive("width_mm", width_mm))
-    d = float(_non_negative("hole_diameter_mm", hole_diameter_mm))
+    w = float(positive("width_mm", width_mm))
+    d = float(non_negative("hole_diameter_mm", hole_diameter_mm))
     if d >= w:
         raise GeometryError(f"hole of diameter {d} mm does not fit in a {w} mm wide section")
     ratio = d / w
@@ -382,178 +383,11 @@ def net_section_stress(axial_N: ArrayLike, moment_Nmm: ArrayLike, section: Secti
     """
     if not (math.isfinite(kt) and kt >= 1.0):
         raise ValueError(f"stress concentration factor must be >= 1, got {kt}")
-    n = _magnitude("axial_N", axial_N)
-    m = _magnitude("moment_Nmm", moment_Nmm)
+    n = magnitude("axial_N", axial_N)
+    m = magnitude("moment_Nmm", moment_Nmm)
     if section.area_mm2 <= 0.0 or section.inertia_mm4 <= 0.0:
         raise GeometryError("section has no material")
-    return _out(kt * (n / section.area_mm2 + m * section.extreme_fibre_mm / section.inertia_mm4))
-
-
-# -- gear teeth ---------------------------------------------------------------------------------------
-
-#: Lewis form factor Y for 20 deg full-depth involute teeth, diametral-pitch/module based (Y = y * pi):
-#: Shigley's *Mechanical Engineering Design* (Budynas & Nisbett, 9th/10th ed.) Table 14-2; the rack is
-#: the limit of infinitely many teeth.
-LEWIS_TABLE_TEETH = np.array([12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 24, 26, 28, 30, 34, 38, 43, 50,
-                              60, 75, 100, 150, 300, 400], dtype=np.float64)
-LEWIS_TABLE_Y = np.array([0.245, 0.261, 0.277, 0.290, 0.296, 0.303, 0.309, 0.314, 0.322, 0.328, 0.331,
-                          0.337, 0.346, 0.353, 0.359, 0.371, 0.384, 0.397, 0.409, 0.422, 0.435, 0.447,
-                          0.460, 0.472, 0.480])
-LEWIS_RACK_Y = 0.485
-
-
-def lewis_form_factor(teeth: ArrayLike) -> ArrayLike:
-    """Lewis form factor Y of a 20 deg full-depth involute tooth (module based, ``sigma = F / (b m Y)``).
-
-    Interpolated in ``1/N`` (the table follows ``Y ~ a - b/N`` closely) between the entries of
-    Shigley's Table 14-2 (12 teeth 0.245 ... 400 teeth 0.480) and the rack (0.485 at ``1/N = 0``), so
-    the tabulated values are returned exactly.
-
-    ``teeth`` may be non-integer: for a non-circular gear use the equivalent tooth count ``2 rho / m`` of
-    the local pitch-curve curvature radius ``rho``. A concave pitch segment (negative ``rho``, negative
-    teeth) or a straight one (``inf``) gets the rack value: its tooth roots are at least as wide as a
-    rack's, so this is conservative. Below 12 teeth, outside the table, Y falls with the square of N
-    (``0.245 (N/12)^2``): conservative against the 0.226 (11) and 0.201 (10 teeth) of extended tables
-    and zero for a vanishing radius.
-
-    Parameters
-    ----------
-    teeth : float or array
-        (Equivalent) number of teeth; non-zero; ``inf`` or negative for a rack / concave segment.
-
-    Returns
-    -------
-    float or array
-        Y (dimensionless).
-    """
-    n = np.asarray(teeth, dtype=np.float64)
-    if np.any(np.isnan(n) | (n == 0.0)):
-        raise ValueError(f"teeth must be non-zero (inf or negative for a rack), got {teeth}")
-    rack = ~np.isfinite(n) | (n < 0.0)
-    safe = np.where(rack, 1e9, n)
-    u = 1.0 / safe
-    # np.interp needs ascending abscissae: 1/N runs from 0 (rack) up to 1/12.
-    y = np.interp(u, np.concatenate([[0.0], 1.0 / LEWIS_TABLE_TEETH[::-1]]),
-                  np.concatenate([[LEWIS_RACK_Y], LEWIS_TABLE_Y[::-1]]))
-    small = safe < LEWIS_TABLE_TEETH[0]
-    y = np.where(small, LEWIS_TABLE_Y[0] * (safe / LEWIS_TABLE_TEETH[0]) ** 2, y)
-    y = np.where(rack, LEWIS_RACK_Y, y)
-    return _out(y)
-
-
-def lewis_bending_stress(tangential_force_N: ArrayLike, module_mm: ArrayLike, face_width_mm: ArrayLike,
-                         form_factor: ArrayLike) -> ArrayLike:
-    """Lewis bending stress at a tooth root: ``sigma = F_t / (b m Y)``.
-
-    The tooth is a cantilever of uniform strength (a parabola inscribed in the tooth) loaded at the tip
-    by the whole tangential load, one tooth pair in contact, root fillet stress concentration not
-    included (W. Lewis 1892; Shigley ch. 14 in SI form with ``P = 25.4 / m``). No velocity factor: the
-    mechanisms here are quasi-static; multiply the force by ``Kv`` for running gears.
-
-    Parameters
-    ----------
-    tangential_force_N : float or array
-        Transmitted load tangent to the pitch curve (N).
-    module_mm : float or array
-        Module (mm).
-    face_width_mm : float or array
-        Face width, the gear thickness (mm).
-    form_factor : float or array
-        Lewis Y (:func:`lewis_form_factor`).
-
-    Returns
-    -------
-    float or array
-        Root bending stress (MPa).
-    """
-    f = _magnitude("tangential_force_N", tangential_force_N)
-    m = _positive("module_mm", module_mm)
-    b = _positive("face_width_mm", face_width_mm)
-    y = _positive("form_factor", form_factor)
-    return _out(f / (b * m * y))
-
-
-def hertz_line_contact_stress(normal_force_N: ArrayLike, face_width_mm: ArrayLike, radius1_mm: ArrayLike,
-                              radius2_mm: ArrayLike, e1_MPa: float, nu1: float, e2_MPa: float,
-                              nu2: float) -> ArrayLike:
-    """Maximum Hertz pressure between two parallel cylinders (line contact).
-
-    ::
-
-        p_max = sqrt( F (1/rho1 + 1/rho2) / (pi b ((1 - nu1^2)/E1 + (1 - nu2^2)/E2)) )
-
-    Elastic, frictionless, the contact half-width small against the radii, load uniform along the face
-    width ``b`` (Hertz 1881; Shigley's cylinder-contact equations with ``d = 2 rho``; for spur gears at
-    the pitch point Shigley Eq. 14-14 with ``F = W_t / cos(phi)``). A concave surface has a negative
-    radius (it must be larger in magnitude than the convex one); a flat has ``inf``.
-
-    Parameters
-    ----------
-    normal_force_N : float or array
-        Force normal to the contact (N).
-    face_width_mm : float or array
-        Contact length along the cylinders (mm).
-    radius1_mm, radius2_mm : float or array
-        Radii of curvature at the contact (mm); negative for concave, ``inf`` for flat.
-    e1_MPa, e2_MPa : float
-        Young's moduli (MPa).
-    nu1, nu2 : float
-        Poisson's ratios.
-
-    Returns
-    -------
-    float or array
-        Maximum contact pressure (MPa), the largest compressive stress.
-
-    Raises
-    ------
-    GeometryError
-        The surfaces are conformal or inverted (``1/rho1 + 1/rho2 <= 0``, e.g. two flats or a convex
-        cylinder in a smaller concave one): no Hertz line contact.
-    """
-    f = _magnitude("normal_force_N", normal_force_N)
-    b = _positive("face_width_mm", face_width_mm)
-    r1 = np.asarray(radius1_mm, dtype=np.float64)
-    r2 = np.asarray(radius2_mm, dtype=np.float64)
-    if np.any(np.isnan(r1) | np.isnan(r2) | (r1 == 0.0) | (r2 == 0.0)):
-        raise ValueError(f"radii of curvature must be non-zero (inf for flat), got {radius1_mm}, {radius2_mm}")
-    curvature = 1.0 / r1 + 1.0 / r2
-    if np.any(curvature <= 0.0):
-        raise GeometryError(f"radii {radius1_mm}, {radius2_mm} mm are conformal or inverted: no line contact")
-    for name, e, nu in (("1", e1_MPa, nu1), ("2", e2_MPa, nu2)):
-        if not (math.isfinite(e) and e > 0.0 and -1.0 < nu < 0.5):
-            raise ValueError(f"material {name}: need E > 0 and -1 < nu < 0.5, got E={e}, nu={nu}")
-    compliance = (1.0 - nu1 ** 2) / e1_MPa + (1.0 - nu2 ** 2) / e2_MPa
-    return _out(np.sqrt(f * curvature / (math.pi * b * compliance)))
-
-
-def involute_contact_radii(pitch_radius1: ArrayLike, pitch_radius2: ArrayLike,
-                           pressure_angle: float) -> tuple[ArrayLike, ArrayLike]:
-    """Radii of curvature of two involute flanks touching at the pitch point: ``rho_i = r_i sin(phi)``.
-
-    The involute's radius of curvature is the length of its generating line from the base circle, which
-    at the pitch point is ``r sin(phi)`` (Shigley Eq. 14-12). For the equivalent gears of a non-circular
-    pair pass the local pitch-curve curvature radii (negative for a concave segment, ``inf`` for a
-    straight one); the signs carry through.
-
-    Parameters
-    ----------
-    pitch_radius1, pitch_radius2 : float or array
-        Pitch radii, or local pitch-curve curvature radii (mm).
-    pressure_angle : float
-        Pressure angle (rad), in (0, pi/2).
-
-    Returns
-    -------
-    (float or array, float or array)
-        ``(rho1, rho2)`` in mm.
-    """
-    if not 0.0 < pressure_angle < math.pi / 2.0:
-        raise ValueError(f"pressure angle must be in (0, pi/2) rad, got {pressure_angle}")
-    s = math.sin(pressure_angle)
-    r1 = np.asarray(pitch_radius1, dtype=np.float64)
-    r2 = np.asarray(pitch_radius2, dtype=np.float64)
-    return _out(r1 * s), _out(r2 * s)
+    return scalar_or_array(kt * (n / section.area_mm2 + m * section.extreme_fibre_mm / section.inertia_mm4))
 
 
 # -- springs, margins --------------------------------------------------------------------------------
@@ -580,13 +414,13 @@ def torsion_spring_stress(torque_Nmm: ArrayLike, wire_diameter_mm: ArrayLike, co
     float or array
         Inner-fibre bending stress (MPa).
     """
-    m = _magnitude("torque_Nmm", torque_Nmm)
-    d = _positive("wire_diameter_mm", wire_diameter_mm)
+    m = magnitude("torque_Nmm", torque_Nmm)
+    d = positive("wire_diameter_mm", wire_diameter_mm)
     c = np.asarray(coil_index, dtype=np.float64)
     if not np.all(np.isfinite(c) & (c > 1.0)):
         raise ValueError(f"spring index D/d must exceed 1, got {coil_index}")
     ki = (4.0 * c ** 2 - c - 1.0) / (4.0 * c * (c - 1.0))
-    return _out(ki * 32.0 * m / (math.pi * d ** 3))
+    return scalar_or_array(ki * 32.0 * m / (math.pi * d ** 3))
 
 
 def safety_factor(allowable_MPa: ArrayLike, stress_MPa: ArrayLike) -> ArrayLike:
@@ -604,7 +438,7 @@ def safety_factor(allowable_MPa: ArrayLike, stress_MPa: ArrayLike) -> ArrayLike:
     float or array
         Safety factor (dimensionless).
     """
-    a = _positive("allowable_MPa", allowable_MPa)
-    s = _magnitude("stress_MPa", stress_MPa)
+    a = positive("allowable_MPa", allowable_MPa)
+    s = magnitude("stress_MPa", stress_MPa)
     with np.errstate(divide="ignore"):
-        return _out(np.where(s == 0.0, np.inf, a / np.where(s == 0.0, 1.0, s)))
+        return scalar_or_array(np.where(s == 0.0, np.inf, a / np.where(s == 0.0, 1.0, s)))

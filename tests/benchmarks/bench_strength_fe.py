@@ -32,7 +32,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository: tests/ helpers
 
 from fabricate.strength.models import OPEN_HOLE_MARGIN, hole_stress_concentration  # noqa: E402
-from tests.test_strength_models import blocks_mesh, plate_hole_peak_von_mises  # noqa: E402
+from tests.strength.test_models import blocks_mesh, plate_hole_peak_von_mises  # noqa: E402
 
 MODULUS, POISSON = 2800.0, 0.35
 

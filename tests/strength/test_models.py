@@ -18,14 +18,16 @@ from hypothesis import strategies as st
 
 from fabricate.errors import GeometryError
 from fabricate.parts.model import BulgePath, Hole, Part
-from fabricate.strength.models import (
-    PIN_CLEARANCE_FACTOR,
-    bearing_stress,
+from fabricate.strength.gear_teeth import (
     hertz_line_contact_stress,
-    hole_stress_concentration,
     involute_contact_radii,
     lewis_bending_stress,
     lewis_form_factor,
+)
+from fabricate.strength.models import (
+    PIN_CLEARANCE_FACTOR,
+    bearing_stress,
+    hole_stress_concentration,
     net_section_stress,
     pin_bending_moment_double_shear,
     pin_bending_moment_single_shear,
