@@ -28,6 +28,7 @@ from fabricate.tomlwrite import dumps
 
 NO_MATERIALS = "no materials in the profile"
 NO_LOAD = "no [load] in the template"
+DRIVE_NO_LOAD = "no [load] in the template: the input effort is zero (friction and inertia are not modelled)"
 
 #: Crank O-A 15 mm, coupler A-B to (40, 30), rocker D-B 30 mm, ground O-D 40 mm: a Grashof crank-rocker.
 FOUR_BAR: dict[str, Any] = {
@@ -35,6 +36,7 @@ FOUR_BAR: dict[str, Any] = {
     "process": {"profile": "sla", "pin_diameter_mm": 3.0},
     "checks": {"sweep_poses": 24},
     "load": {"torque_Nmm": 50.0, "torque_body": "rocker"},
+    "actuator": {"model": "nema17"},  # a full-turn crank: the drive check runs where the load does
     "linkage": {
         "ground": "frame", "input_unit": "deg", "input_range": [0.0, 360.0],
         "bodies": [{"name": "frame", "points": {"O": [0.0, 0.0], "D": [40.0, 0.0]}},
@@ -120,8 +122,10 @@ def test_template_without_load_is_not_checked_and_writes_no_infinite_factor(tmp_
     strength = report["strength"]
     assert strength["passed"] is None and strength["reason"] == NO_LOAD
     assert strength["parts"] == [] and strength["loads"] == []
-    assert report["checks"]["not_checked"] == [{"check": "strength", "reason": NO_LOAD}]
-    assert stdout.splitlines()[0] == f"four_bar_nc: checks passed (strength not checked: {NO_LOAD}) -> {out}"
+    assert report["checks"]["not_checked"] == [{"check": "strength", "reason": NO_LOAD},
+                                               {"check": "drive", "reason": DRIVE_NO_LOAD}]
+    assert stdout.splitlines()[0] == (f"four_bar_nc: checks passed (strength not checked: {NO_LOAD}; drive not "
+                                      f"checked: {DRIVE_NO_LOAD}) -> {out}")
     assert f"fabricate: note: strength not checked: {NO_LOAD}" in stderr.splitlines()
     md = (out / "report.md").read_text(encoding="utf-8")
     strength_md = _section(md, "Strength")
@@ -136,7 +140,7 @@ def test_synth_never_says_checks_passed(tmp_path, capsys):
     assert "checks passed" not in stdout + stderr
     report = _strict_json(out / "report.json")
     assert {e["check"] for e in report["checks"]["not_checked"]} == {"interference", "gear mesh", "printability",
-                                                                     "strength"}
+                                                                     "strength", "drive"}
     md = (out / "report.md").read_text(encoding="utf-8")
     assert "## Checks: none run" in md and "PASSED" not in md
 
@@ -206,6 +210,7 @@ def test_report_json_writes_null_for_infinite_values():
 def test_the_api_names_what_was_not_checked() -> None:
     """``Build.not_checked`` says what ``passed`` does not cover (issue 23 item 5)."""
     unloaded = fabricate.build(fabricate.load(_tables(load=False)))
-    assert unloaded.passed and unloaded.not_checked == ["strength not checked: " + NO_LOAD]
+    assert unloaded.passed and unloaded.not_checked == ["strength not checked: " + NO_LOAD,
+                                                        "drive not checked: " + DRIVE_NO_LOAD]
     loaded = fabricate.build(fabricate.load(_tables(load=True)))
     assert loaded.passed and loaded.not_checked == []

@@ -185,7 +185,7 @@ def test_every_text_field_takes_hostile_text_without_a_bug(tmp_path, capsys):
         else:
             ran.append(_dotted(path))
     # load.torque_body names a body: a build checks it against the mechanism's (synth has no load)
-    assert ran == ["design.description", "load.torque_body", "load.source"]
+    assert ran == ["design.description", "load.torque_body", "load.source", "actuator.source"]
 
 
 @pytest.mark.parametrize(("template", "path", "value", "needle"), [
