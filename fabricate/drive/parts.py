@@ -128,6 +128,9 @@ class PlacedActuator:
     direction : (2,) array
         Slide driver: the slide axis (unit) in the ground body's coordinates; angle driver: the direction the
         actuator's body points in (away from what moves).
+    angle : float
+        Angle driver: the catalogue frame's x axis turned by this (rad) about the axis in the ground body's
+        frame (:class:`fabricate.drive.geometry.Placement`); 0 for a slide driver.
     z_face : float
         Stack z of the actuator's output face (servo top, motor face), mm; for a slide driver the mid-plane
         of the slider part.
@@ -158,6 +161,7 @@ class PlacedActuator:
     ground_body: str
     axis: np.ndarray
     direction: np.ndarray
+    angle: float
     z_face: float
     flip: bool
     removed_pin: str
@@ -569,7 +573,8 @@ class _Rotary:
         record = PlacedActuator(
             model=entry.key, name=entry.name, kind=entry.kind, driver=self.index, driver_kind="angle",
             joint=self.joint, driven_body=self.driven, ground_body=self.ground, axis=np.asarray(c_g, dtype=float),
-            direction=away, z_face=float(z_face), flip=flip, removed_pin=pin.joint, interface=tuple(interface),
+            direction=away, angle=float(angle), z_face=float(z_face), flip=flip, removed_pin=pin.joint,
+            interface=tuple(interface),
             mount_part=mount.name, fasteners=tuple(fasteners), standoffs=tuple(standoffs), solids=tuple(solids),
             notes=tuple(self.notes))
         return dataclasses.replace(ps, parts=tuple(parts), pins=pins, spacers=spacers, bom=bom,
@@ -702,7 +707,7 @@ def _attach_rod_end(design: Any, mechanism: Mechanism, motion: Motion, ps: PartS
     warnings = tuple(ps.warnings) + tuple(w for w in overlapping_cuts([new_rod]) if w not in ps.warnings)
     record = PlacedActuator(
         model=entry.key, name=entry.name, kind=entry.kind, driver=index, driver_kind="slide", joint=slider.name,
-        driven_body=slider.body_b, ground_body=slider.body_a, axis=at_ground, direction=axis_a,
+        driven_body=slider.body_b, ground_body=slider.body_a, axis=at_ground, direction=axis_a, angle=0.0,
         z_face=float(rod.z_mm + 0.5 * rod.thickness_mm), flip=False, removed_pin="", interface=("actuator_rod_end",),
         mount_part="", fasteners=(), standoffs=(), solids=(),
         notes=(f"the {what} acts along the slide axis on a Ø{pin_mm:g} mm pin in the rod-end hole",))
