@@ -185,3 +185,15 @@ def motion_check(partset: PartSet, motion: Motion, min_clearance_mm: float | Non
     a, b = mechanism.input_range
     return MotionCheck((float(a), float(b)), mechanism.input_unit, tip if start else "", start, end,
                        min_clearance_mm)
+
+
+def guide_steps(partset: PartSet, motion: Motion, min_clearance_mm: float | None = None) -> tuple[GuideStep, ...]:
+    """The guide of a part set: its pin stacks, then :func:`~fabricate.parts.assembly.assembly_guide`."""
+    from fabricate.parts.assembly import assembly_guide, pin_stacks
+
+    return assembly_guide(partset, pin_stacks(partset), motion_check(partset, motion, min_clearance_mm))
+
+
+def guide_picture_files(partset: PartSet, motion: Motion) -> dict[str, bytes]:
+    """Every step's picture (the pipeline's background job: the steps are the same as assembly.md's)."""
+    return guide_pictures(partset, motion, guide_steps(partset, motion))

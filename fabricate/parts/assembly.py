@@ -49,7 +49,8 @@ class PinStack:
 
 
 def _joints(pin_name: str) -> set[str]:
-    return set(pin_name.split("+"))
+    # a compound pin's holes carry its whole name ("G1+G1r"); its joints are the parts of the name
+    return set(pin_name.split("+")) | {pin_name}
 
 
 def pin_stacks(partset: PartSet) -> list[PinStack]:
@@ -304,10 +305,10 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
                 continue
             seen_bodies.add(body)
             for part in partset.parts:
-                if part.body == body and part.role not in ("spacer", "mount"):
+                if part.body == body and part.role not in ("spacer", "mount", "standoff"):
                     part_step.setdefault(part.name, f"pin:{pin.joint}")
     for part in partset.parts:
-        part_step.setdefault(part.name, "drive" if part.role == "mount" else "ground")
+        part_step.setdefault(part.name, "drive" if part.role in ("mount", "standoff") else "ground")
 
     # every BOM unit to one step: (step key) -> {item: GuideItem}
     units: dict[str, list[GuideItem]] = {}
