@@ -98,7 +98,8 @@ def from_mechanism(mechanism: Mechanism, *, process: str = "sla", tip_point: str
     tip_point : str, optional
         The output point (a point name of a body).
     pads : Mapping, optional
-        Fingertip pads, ``{body: {"point": name, "radius_mm": r}}``.
+        Fingertip pads, ``{body: {"point": name, "radius_mm": r}}`` (the fields of
+        :class:`~fabricate.hints.PadHint`).
     tables : Mapping, optional
         More template tables: ``{"load": {...}, "parts": {...}, "checks": {...}}``.
 
@@ -109,7 +110,8 @@ def from_mechanism(mechanism: Mechanism, *, process: str = "sla", tip_point: str
         argument has the wrong type (naming it), or the written template is invalid (naming the field).
     """
     from fabricate.mechanism import Mechanism
-    from fabricate.synthesis.linkage.exact import exact_linkage
+    from fabricate.synthesis.linkage.exact import exact_linkage, read_hints
+    from fabricate.table import Table
 
     if not isinstance(mechanism, Mechanism):
         raise SpecError("mechanism", f"expected a fabricate.mechanism.Mechanism, got {type_name(mechanism)}")
@@ -131,11 +133,12 @@ def from_mechanism(mechanism: Mechanism, *, process: str = "sla", tip_point: str
                                 "process": {"profile": process}}
     for key, value in (tables or {}).items():
         template[key] = dict(value) if key != "process" else {**template["process"], **value}
-    hints: dict[str, Any] = {}
+    raw_hints: dict[str, Any] = {}
     if tip_point:
-        hints["tip_point"] = tip_point
+        raw_hints["tip_point"] = tip_point
     if pads:
-        hints["pads"] = {body: dict(pad) for body, pad in pads.items()}
+        raw_hints["pads"] = pads
+    hints = read_hints(Table(raw_hints))  # a bad pad names its argument: "pads.<body>.radius_mm"
     try:
         linkage, exact = exact_linkage(mechanism, hints)
     except SpecError:

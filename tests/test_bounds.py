@@ -15,6 +15,7 @@ import pytest
 from fabricate import bounds
 from fabricate.cli import main
 from fabricate.errors import SpecError
+from fabricate.hints import PartHints
 from fabricate.spec import design_from_text, load_design
 from fabricate.templates import TEMPLATE_DIR, parse_toml
 from tests.synthesis.linkage.test_linkage import GEARED
@@ -225,13 +226,13 @@ def exact_text() -> str:
     from fabricate.synthesis.linkage.mechanism import build_mechanism
 
     design = load_design(TEMPLATE_DIR / "linkage_stephenson.toml")
-    return mechanism_toml(design, build_mechanism(design.name, design.method), {"copies": 1}).decode("utf-8")
+    return mechanism_toml(design, build_mechanism(design.name, design.method), PartHints(copies=1)).decode("utf-8")
 
 
 def test_exact_form_copies_at_the_bound_validate_and_past_it_are_refused(exact_text: str) -> None:
     assert "copies = 1\n" in exact_text
     design = design_from_text(exact_text.replace("copies = 1\n", f"copies = {bounds.MAX_COPIES}\n"), "m.toml")
-    assert design.method.hints["copies"] == bounds.MAX_COPIES
+    assert design.method.hints.copies == bounds.MAX_COPIES
     for bad in (bounds.MAX_COPIES + 1, 2000, 0, 2.5, "true"):
         with pytest.raises(SpecError) as info:
             design_from_text(exact_text.replace("copies = 1\n", f"copies = {bad}\n"), "m.toml")
@@ -402,7 +403,7 @@ def test_the_exact_form_of_the_largest_tables_is_a_valid_template() -> None:
         return t
 
     design = design_from_text(dumps(tables(MAX_LINKAGE_TABLE)), "largest_table.toml")
-    text = mechanism_toml(design, build_mechanism(design.name, design.method), {"tip_point": "B"})
+    text = mechanism_toml(design, build_mechanism(design.name, design.method), PartHints(tip_point="B"))
     assert len(text) <= MAX_TEMPLATE_BYTES
     rebuilt = design_from_text(text.decode("utf-8"), "mechanism.toml")
     assert rebuilt.kind == "linkage"

@@ -19,6 +19,7 @@ import shapely.ops
 
 from fabricate.cli import main
 from fabricate.errors import SpecError
+from fabricate.hints import PartHints
 from fabricate.process import ProcessOverride, parse_process, process_override
 from fabricate.spec import design_from_text, load_design
 from fabricate.table import Table
@@ -212,6 +213,6 @@ def test_what_is_made_follows_the_capabilities_not_the_name(four_bar, laser_proc
 
     thick_cut = dataclasses.replace(laser_process, name="router", thickness_mm=5.0)
     thick_printed = dataclasses.replace(thick_cut, technique="additive", layout="plate")
-    hole = derive_sizes(thick_cut, PartsSpec(), {}).hole_mm
-    assert derive_sizes(thick_cut, PartsSpec(), {}).boss_radius_mm == pytest.approx(hole / 2 + 5.0)
-    assert derive_sizes(thick_printed, PartsSpec(), {}).boss_radius_mm == pytest.approx(hole / 2 + 3.0)
+    hole = derive_sizes(thick_cut, PartsSpec(), PartHints()).hole_mm
+    assert derive_sizes(thick_cut, PartsSpec(), PartHints()).boss_radius_mm == pytest.approx(hole / 2 + 5.0)
+    assert derive_sizes(thick_printed, PartsSpec(), PartHints()).boss_radius_mm == pytest.approx(hole / 2 + 3.0)

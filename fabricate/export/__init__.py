@@ -326,7 +326,7 @@ def export_previews(design: DesignSpec, partset: PartSet, motion: Motion) -> dic
 
     parts = list(partset.parts)
     spec = design.parts
-    tip = partset.hints.get("tip_point") if hasattr(partset, "hints") else None
+    tip = partset.hints.tip_point
     return {"previews/assembly.png": assembly_png(parts, motion, spec.preview_poses, tip, title=design.name),
             "previews/exploded.png": exploded_png(parts, motion.poses_at(0), pin_stacks(partset), title=design.name),
             "previews/motion.gif": motion_gif(parts, motion, spec.gif_frames)}

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from fabricate.hints import PartHints
 from fabricate.parts.layers import layer_z, skipped_gap, stack_span
 from fabricate.process import Material, ProcessSpec
 
@@ -130,7 +131,7 @@ def _group(rows: list[dict[str, Any]], key: tuple[str, ...]) -> list[dict[str, A
     return list(merged.values())
 
 
-def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Mapping[str, Any],
+def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: PartHints,
                       process: ProcessSpec, copies: int = 1, mounting: int = 0,
                       mounting_mm: float = 3.0) -> list[dict[str, Any]]:
     """Bill of materials rows (JSON-ready), quantities multiplied by ``copies``.
@@ -158,24 +159,19 @@ def bill_of_materials(pins: Sequence[Pin], spacers: Sequence[Spacer], hints: Map
     if mounting:
         rows.append({"item": f"screw M{mounting_mm:g}", "kind": "screw", "qty": mounting * copies,
                      "joints": [], "description": "mounting screw for the ground part"})
-    for spring in hints.get("springs", ()) or ():
-        rate = spring.get("rate_Nmm_per_deg")
-        if isinstance(rate, (int, float)) and rate <= 0.0:
+    for spring in hints.springs:
+        if spring.rate_Nmm_per_deg <= 0.0:
             continue  # a zero rate means no spring there (the compliant optimum has k1 = 0)
-        rows.append({"item": f"torsion spring at {spring.get('joint', '?')}", "kind": "spring",
-                     "qty": copies, "joints": [str(spring.get("joint", ""))],
-                     "rate_Nmm_per_deg": spring.get("rate_Nmm_per_deg"),
-                     "preload_deg": spring.get("preload_deg"), "legs_mm": spring.get("legs_mm"),
-                     "description": str(spring.get("note", ""))})
-    for item in hints.get("purchased", ()) or ():
-        rows.append({"item": str(item.get("item", "item")), "kind": "purchased",
-                     "qty": int(item.get("qty", 1)) * copies, "joints": [],
-                     "description": str(item.get("note", ""))})
+        rows.append({"item": f"torsion spring at {spring.joint}", "kind": "spring",
+                     "qty": copies, "joints": [spring.joint], "rate_Nmm_per_deg": spring.rate_Nmm_per_deg,
+                     "preload_deg": spring.preload_deg, "legs_mm": spring.legs_mm, "description": spring.note})
+    for item in hints.purchased:
+        rows.append({"item": item.item, "kind": "purchased", "qty": item.qty * copies, "joints": [],
+                     "description": item.note})
     # items shared by all copies (one drive for a three-finger gripper) are not multiplied
-    for item in hints.get("purchased_shared", ()) or ():
-        rows.append({"item": str(item.get("item", "item")), "kind": "purchased",
-                     "qty": int(item.get("qty", 1)), "joints": [],
-                     "description": str(item.get("note", "")), "shared": True})
+    for item in hints.purchased_shared:
+        rows.append({"item": item.item, "kind": "purchased", "qty": item.qty, "joints": [],
+                     "description": item.note, "shared": True})
     return rows
 
 

@@ -42,6 +42,7 @@ import numpy as np
 import shapely
 
 from fabricate.errors import GeometryError, SpecError
+from fabricate.hints import PadHint, PartHints
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
 from fabricate.parts.bom import Pin, Spacer, bill_of_materials, part_rows, pins_and_spacers
 from fabricate.parts.features import pad_segment, slider_guides
@@ -103,7 +104,7 @@ class PartSet:
         Polygonisation tolerance for meshes.
     copies : int
         Identical copies of the mechanism (BOM quantities already multiplied).
-    hints : Mapping
+    hints : PartHints
         The synthesis hints used.
     warnings : tuple of str
         Geometry the mechanism forces but nobody can make: holes that run into each other (their
@@ -121,7 +122,7 @@ class PartSet:
     layer_gap_mm: float
     kerf_mm: float
     copies: int = 1
-    hints: Mapping[str, Any] = field(default_factory=dict)
+    hints: PartHints = field(default_factory=PartHints)
     warnings: tuple[str, ...] = ()
 
     def part(self, name: str) -> Part:
@@ -147,7 +148,7 @@ class Sizes:
     hub_mm: float
 
 
-def derive_sizes(process: ProcessSpec, parts: PartsSpec, hints: Mapping[str, Any],
+def derive_sizes(process: ProcessSpec, parts: PartsSpec, hints: PartHints,
                  gear_hub_mm: float | None = None) -> Sizes:
     """Hole and boss sizes from the process and the ``[parts]`` table.
 
@@ -160,7 +161,7 @@ def derive_sizes(process: ProcessSpec, parts: PartsSpec, hints: Mapping[str, Any
     if process.technique == "cut":
         wall = max(wall, process.thickness_mm)  # a web cut from sheet stock is at least the stock thick
     radius = hole / 2.0 + wall
-    width = parts.link_width_mm if parts.link_width_mm is not None else hints.get("link_width_mm")
+    width = parts.link_width_mm if parts.link_width_mm is not None else hints.link_width_mm
     if width is not None:
         radius = max(radius, 0.5 * float(width))
     mount = parts.mounting_hole_mm + 2.0 * process.running_clearance_mm + process.hole_compensation_mm
@@ -205,7 +206,7 @@ def gear_outline_in_body(mechanism: Mechanism, pair: GearPair, side: str) -> tup
 
 
 def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_pairs: Sequence[GearPair],
-                hints: Mapping[str, Any] | None = None) -> PartSet:
+                hints: PartHints | None = None) -> PartSet:
     """Turn a solved mechanism into parts.
 
     Parameters
@@ -217,8 +218,8 @@ def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_p
         A sweep of the mechanism (layers are chosen over this motion).
     gear_pairs : sequence of GearPair
         Built gears; each gear is fused to the body that carries it.
-    hints : Mapping, optional
-        ``SynthesisResult.parts`` (pads, springs, purchased, copies, link_width_mm).
+    hints : PartHints, optional
+        ``SynthesisResult.parts`` (pads, springs, purchased items, copies, link width).
 
     Returns
     -------
@@ -229,7 +230,7 @@ def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_p
     GeometryError
         When a hint names a point a body does not have, or a gear does not join its body.
     """
-    hints = dict(hints or {})
+    hints = hints if hints is not None else PartHints()
     process: ProcessSpec = design.process
     parts_spec: PartsSpec = design.parts
     gear_hub = getattr(getattr(design, "gears", None), "hub_diameter_mm", None)
@@ -238,7 +239,7 @@ def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_p
 
     drawing = _Drawing.start(mechanism, sizes.boss_radius_mm)
     pin_joints = _add_joints(drawing, mechanism, motion, sizes, process)
-    _add_pads(drawing, mechanism, dict(hints.get("pads", {})), parts_spec, sizes.boss_radius_mm, tol)
+    _add_pads(drawing, mechanism, hints.pads or {}, parts_spec, sizes.boss_radius_mm, tol)
     _add_gears(drawing, mechanism, gear_pairs, sizes.hub_mm, tol)
     outlines = _outlines(drawing, mechanism, motion, sizes, parts_spec, process)
     layers = _layers(outlines, drawing.holes, pin_joints, mechanism, motion, gear_pairs, sizes.boss_radius_mm,
@@ -254,7 +255,7 @@ def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_p
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
         raise GeometryError(f"part names collide after sanitising: {sorted(names)}")
-    copies = int(hints.get("copies", 1) or 1)
+    copies = hints.copies or 1
     mounting = sum(1 for h in drawing.holes[mechanism.ground] if h.joint.startswith("mount_"))
     bom = part_rows(parts, process, copies) + bill_of_materials(pins, spacers, hints, process, copies,
                                                                  mounting=mounting,
@@ -318,7 +319,7 @@ def _add_joints(drawing: _Drawing, mechanism: Mechanism, motion: Motion, sizes: 
     return pin_joints
 
 
-def _add_pads(drawing: _Drawing, mechanism: Mechanism, pads: Mapping[str, Any], parts_spec: PartsSpec,
+def _add_pads(drawing: _Drawing, mechanism: Mechanism, pads: Mapping[str, PadHint], parts_spec: PartsSpec,
               radius: float, tol: float) -> None:
     """Fingertip pads (the ``pads`` hint): a circle round the pad's point, or on a curved face the circular
     segment between two named points on the circle."""
@@ -326,12 +327,12 @@ def _add_pads(drawing: _Drawing, mechanism: Mechanism, pads: Mapping[str, Any], 
         if body not in drawing.circles:
             raise GeometryError(f"pad hint names unknown body {body!r}")
         points = mechanism.body(body).points
-        if pad.get("point") not in points:
-            raise GeometryError(f"pad hint: body {body!r} has no point {pad.get('point')!r}")
-        r_pad = parts_spec.pad_radius_mm or float(pad.get("radius_mm", radius))
-        centre = mechanism.body(body).point(pad["point"])
-        if "arc" in pad:
-            ends = [mechanism.body(body).point(name) for name in pad["arc"]]
+        if pad.point not in points:
+            raise GeometryError(f"pad hint: body {body!r} has no point {pad.point!r}")
+        r_pad = parts_spec.pad_radius_mm or (pad.radius_mm if pad.radius_mm is not None else radius)
+        centre = mechanism.body(body).point(pad.point)
+        if pad.arc is not None:
+            ends = [mechanism.body(body).point(name) for name in pad.arc]
             drawing.circles[body] += [(ends[0], radius), (ends[1], radius)]
             segment = pad_segment(centre, ends[0], ends[1], tol)
             if len(segment) >= 3:  # an arc within the chord tolerance of its chord adds nothing to the hull

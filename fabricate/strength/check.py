@@ -26,7 +26,6 @@ an infinite, meaningless "pass").
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -47,6 +46,7 @@ from fabricate.strength.statics import BodyTorque, DriverEffort, PointForce, Sta
 
 if TYPE_CHECKING:
     from fabricate.gears.pair import GearPair
+    from fabricate.hints import PartHints
     from fabricate.parts.build import PartSet
     from fabricate.spec import DesignSpec
     from fabricate.strength.spec import LoadSpec
@@ -156,7 +156,7 @@ def _joint_between(mechanism: Mechanism, a: str, b: str) -> Revolute | None:
     return None
 
 
-def design_loads(design: DesignSpec, mechanism: Mechanism, motion: Motion, hints: Mapping[str, Any]) -> Loads:
+def design_loads(design: DesignSpec, mechanism: Mechanism, motion: Motion, hints: PartHints) -> Loads:
     """The template's ``[load]`` and the synthesis' springs as loads over the motion."""
     load = design.load
     assert load is not None  # load_design reads [load] always (its defaults when the table is absent)
@@ -193,14 +193,14 @@ def design_loads(design: DesignSpec, mechanism: Mechanism, motion: Motion, hints
     return Loads(tuple(forces), tuple(torques), tuple(efforts), tuple(said), reaction)
 
 
-def _tip_load(load: LoadSpec, mechanism: Mechanism, motion: Motion, hints: Mapping[str, Any],
+def _tip_load(load: LoadSpec, mechanism: Mechanism, motion: Motion, hints: PartHints,
               actuated: bool) -> tuple[PointForce, str]:
     """The tip force, or with a known actuator effort the object's reaction at the tip (a unit direction per
     pose; the statics solve its magnitude), and its words."""
-    point = load.tip_point or hints.get("tip_point")
+    point = load.tip_point or hints.tip_point
     if not point or point not in mechanism.point_names():
         raise GeometryError(f"strength: load.tip_point {point!r} is not a named point of the mechanism")
-    owners = [b for b, pad in (hints.get("pads") or {}).items() if pad.get("point") == point]
+    owners = [b for b, pad in (hints.pads or {}).items() if pad.point == point]
     body = owners[0] if owners else mechanism.point_owner(point)
     path = motion.point(point, body)
     if load.object_centre:
@@ -227,21 +227,21 @@ def _tip_load(load: LoadSpec, mechanism: Mechanism, motion: Motion, hints: Mappi
 
 
 def _spring_torques(mechanism: Mechanism, motion: Motion,
-                    hints: Mapping[str, Any]) -> list[tuple[BodyTorque, str]]:
+                    hints: PartHints) -> list[tuple[BodyTorque, str]]:
     """The synthesis' return springs (a rate above 0 at a revolute joint) as torques, with their words."""
     out = []
-    for spring in hints.get("springs", ()) or ():
-        rate = float(spring.get("rate_Nmm_per_deg") or 0.0)
-        joint = next((j for j in mechanism.joints if j.name == spring.get("joint")), None)
+    for spring in hints.springs:
+        rate = spring.rate_Nmm_per_deg
+        joint = next((j for j in mechanism.joints if j.name == spring.joint), None)
         if rate <= 0.0 or not isinstance(joint, Revolute):
             continue
         rel = np.degrees(motion.relative_angle(joint.body_b, joint.body_a))
         sense = 1.0 if rel[-1] >= rel[0] else -1.0
-        deflection = float(spring.get("preload_deg") or 0.0) + sense * (rel - rel[0])
+        deflection = spring.preload_deg + sense * (rel - rel[0])
         # a return spring resists the closing: the torque on body_b is against its relative turn
         out.append((BodyTorque(joint.body_b, joint.body_a, -sense * rate * np.maximum(deflection, 0.0),
                                joint=joint.name),
-                    f"spring at {joint.name}, {rate:g} N·mm/° from {float(spring.get('preload_deg') or 0):g}° "
+                    f"spring at {joint.name}, {rate:g} N·mm/° from {spring.preload_deg:g}° "
                     f"preload (up to {rate * float(np.max(deflection)):.0f} N·mm)"))
     return out
 
@@ -337,7 +337,7 @@ def body_loads(mechanism: Mechanism, motion: Motion, statics: Statics, loads: Lo
 
 def run_strength(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motion: Motion,
                  gear_pairs: list[GearPair],
-                 hints: Mapping[str, Any]) -> StrengthResult:
+                 hints: PartHints) -> StrengthResult:
     """Every part and pin at the design load over ``motion``; see the module docstring."""
     required = float(design.checks.min_safety_factor)
     material = design.process.part_material()
@@ -353,7 +353,7 @@ def run_strength(design: DesignSpec, partset: PartSet, mechanism: Mechanism, mot
         # (every force, torque and effort of [load] is 0 then, and no spring of the synthesis acts)
         result.reason = NO_LOAD
         return result
-    if any(float(sp.get("rate_Nmm_per_deg") or 0.0) > 0.0 for sp in hints.get("springs", ()) or ()):
+    if any(sp.rate_Nmm_per_deg > 0.0 for sp in hints.springs):
         # the springs are bought parts (BOM rows with rate, preload, legs): their wire stress is the maker's
         # rating; what the check covers is the torque they put on the printed parts
         result.notes.append("springs are bought torsion springs (bom.csv): choose one rated for the torque "

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +22,7 @@ from fabricate.strength.check import run_strength
 
 if TYPE_CHECKING:
     from fabricate.gears.pair import GearPair
+    from fabricate.hints import PartHints
     from fabricate.parts.build import PartSet
     from fabricate.spec import DesignSpec
 
@@ -43,7 +44,7 @@ def _coarse(motion: Motion, stride: int) -> Motion:
 
 
 def size_link_width(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_pairs: list[GearPair],
-                    hints: Mapping[str, Any], build: Callable[[DesignSpec], PartSet], stride: int = 4
+                    hints: PartHints, build: Callable[[DesignSpec], PartSet], stride: int = 4
                     ) -> tuple[float, list[tuple[float, float]]]:
     """Smallest link width (mm, a multiple of :data:`RESOLUTION_MM`) whose links and holes keep
     ``design.checks.min_safety_factor``; :data:`MAX_AUTO_WIDTH_MM` if none does.

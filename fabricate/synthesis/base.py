@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from fabricate.hints import PartHints
 from fabricate.mechanism import Mechanism
 
 
@@ -24,13 +25,13 @@ class SynthesisResult:
         Returns ``{file name: PNG bytes}``; called by the pipeline only (plots are slow and optional).
     data : object
         Method-specific results (curves, regions, candidates) for tests and plots.
-    parts : Mapping
-        Method-specific hints for the parts layer (e.g. which body carries the fingertip pad, springs
-        for the bill of materials). Keys are documented in :mod:`fabricate.parts`.
+    parts : PartHints
+        The method's hints for the parts layer (e.g. which body carries the fingertip pad, springs for the
+        bill of materials); see :mod:`fabricate.hints`.
     """
 
     mechanism: Mechanism
     report: dict[str, Any]
     figures: Callable[[], dict[str, bytes]] = lambda: {}
     data: Any = None
-    parts: Mapping[str, Any] = field(default_factory=dict)
+    parts: PartHints = field(default_factory=PartHints)

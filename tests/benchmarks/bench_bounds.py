@@ -265,6 +265,7 @@ def worst_exact(copies: int = bounds.MAX_COPIES) -> str:
     The driver's table is halved until the file fits :data:`fabricate.templates.MAX_TEMPLATE_BYTES` (a guard: at
     the bound of 4000 samples in all the table writes 0.44 MB of PCHIP coefficients and fits as it is).
     """
+    from fabricate.hints import PadHint, PartHints
     from fabricate.spec import design_from_text
     from fabricate.synthesis.linkage.exact import mechanism_toml
     from fabricate.synthesis.linkage.mechanism import build_mechanism
@@ -274,8 +275,8 @@ def worst_exact(copies: int = bounds.MAX_COPIES) -> str:
     while True:
         design = design_from_text(toml_text(linkage_poses(table)), "worst_linkage.toml")
         mechanism = build_mechanism(design.name, design.method)
-        hints = {"copies": copies, "tip_point": "A",
-                 "pads": {p.body: {"point": p.point, "radius_mm": p.radius_mm} for p in design.method.pads}}
+        hints = PartHints(copies=copies, tip_point="A",
+                          pads={p.body: PadHint(p.point, p.radius_mm) for p in design.method.pads})
         text = mechanism_toml(design, mechanism, hints)
         if len(text) <= MAX_TEMPLATE_BYTES:
             return text.decode("utf-8")

@@ -37,6 +37,7 @@ from fabricate.export.stl import (
     plate_stl,
     validate_stl,
 )
+from fabricate.hints import PadHint, PartHints
 from fabricate.kinds import KINDS
 from fabricate.parts.build import build_parts
 from fabricate.parts.spec import PartsSpec
@@ -82,13 +83,13 @@ def case(name: str) -> SimpleNamespace:
     """Design, mechanism, motion, part set and exported files of one case (built once per session)."""
     mech_name, process_name = name.rsplit("-", 1)
     process = PROCESSES[process_name]
-    hints: dict = {}
+    hints = PartHints()
     gear_pairs: list = []
     if mech_name in TEMPLATES:
         base, result, gear_pairs = _synthesised(mech_name)
         design = dataclasses.replace(base, process=dataclasses.replace(
             process, chord_tolerance_mm=base.process.chord_tolerance_mm))
-        mechanism, hints = result.mechanism, dict(result.parts)
+        mechanism, hints = result.mechanism, result.parts
         motion = mechanism.sweep(design.checks.sweep_poses + 1)
     else:
         design = SimpleNamespace(name=mech_name, process=process, parts=PartsSpec(gif_frames=8),
@@ -103,7 +104,7 @@ def case(name: str) -> SimpleNamespace:
             gear_pairs = [SimpleNamespace(name="sun_planet", body_a="ground", body_b="coupler", axis_a="O",
                                           axis_b="A", outline_a=spur_like(9.0, 12, 0.4),
                                           outline_b=spur_like(6.0, 8, 0.4))]
-            hints = {"pads": {"rocker": {"point": "B", "radius_mm": 4.0}}}
+            hints = PartHints(pads={"rocker": PadHint("B", 4.0)})
     partset = build_parts(design, mechanism, motion, gear_pairs, hints)
     files, entries = export_all(design, partset, mechanism, motion)
     return SimpleNamespace(design=design, process=process, mechanism=mechanism, motion=motion,

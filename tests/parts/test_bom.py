@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import shapely
 
+from fabricate.hints import PartHints
 from fabricate.parts.bom import Spacer, bill_of_materials
 from fabricate.pipeline import run_build
 from fabricate.spec import load_design
@@ -49,7 +50,7 @@ def test_every_part_is_in_the_bom_with_its_mass(gripper, five_bar_laser):
 @pytest.mark.slow
 def test_springs_only_where_the_rate_is_above_zero(gripper):
     springs = [r for r in gripper.report["bom"] if r["kind"] == "spring"]
-    rates = {s["joint"]: s["rate_Nmm_per_deg"] for s in gripper.partset.hints["springs"]}
+    rates = {s.joint: s.rate_Nmm_per_deg for s in gripper.partset.hints.springs}
     assert min(rates.values()) == 0.0 < max(rates.values())  # the optimum's k1 = 0: no spring at that hinge
     assert {s["joints"][0] for s in springs} == {j for j, k in rates.items() if k > 0}
     assert all(s["rate_Nmm_per_deg"] > 0 and s["qty"] == 3 for s in springs)
@@ -133,6 +134,6 @@ def test_spacers_are_printed_by_an_additive_process_and_bought_for_a_cut_one(sla
     for process, kinds in ((sla_process, {"washer"}), (laser_process, {"spacer", "washer"}),
                            (dataclasses.replace(sla_process, name="laser"), {"washer"}),
                            (dataclasses.replace(laser_process, name="sla"), {"spacer", "washer"})):
-        rows = bill_of_materials([], [tube, washer], {}, process, copies=2)
+        rows = bill_of_materials([], [tube, washer], PartHints(), process, copies=2)
         assert {r["kind"] for r in rows} == kinds, process.name
         assert all(r["qty"] == 2 for r in rows)

@@ -25,6 +25,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fabricate.errors import GeometryError, SpecError
+from fabricate.hints import PadHint, PartHints, PurchasedItem, SpringHint
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
 from fabricate.parts.build import (
     CONFLICT_CHORD_MM,
@@ -181,10 +182,10 @@ def test_gear_hub_from_the_gears_table(four_bar, sla_process):
     disc = shapely.Point(0.0, 0.0).buffer(7.0 - 0.01, 256)  # A is the coupler's origin
     design = design_for(sla_process)
     design.gears = SimpleNamespace(hub_diameter_mm=14.0)
-    hubbed = build_parts(design, mech, motion, [pair], {}).part("coupler")
+    hubbed = build_parts(design, mech, motion, [pair]).part("coupler")
     assert shapely.Polygon(hubbed.outline.polygon(0.005)).contains(disc)
     bare = SimpleNamespace(name="bare", process=sla_process, parts=PartsSpec())
-    plain = build_parts(bare, mech, motion, [pair], {}).part("coupler")
+    plain = build_parts(bare, mech, motion, [pair]).part("coupler")
     assert not shapely.Polygon(plain.outline.polygon(0.005)).contains(disc)
     assert plain.gear == hubbed.gear == "sun_planet"
     assert hubbed.role == "gear"  # a moving body carrying a gear is a gear part
@@ -193,7 +194,7 @@ def test_gear_hub_from_the_gears_table(four_bar, sla_process):
 def test_part_lookup_names_the_missing_part(four_bar, sla_process):
     """``PartSet.part`` finds a part by its name, and an unknown name raises a KeyError carrying that name
     (what a user scripting against the part set reads)."""
-    partset = build_parts(design_for(sla_process), four_bar, four_bar.sweep(11), [], {})
+    partset = build_parts(design_for(sla_process), four_bar, four_bar.sweep(11), [])
     assert partset.part("rocker").body == "rocker"
     with pytest.raises(KeyError, match="no_such_part"):
         partset.part("no_such_part")
@@ -249,7 +250,7 @@ def test_slider_guide_pins_and_slot(sla_process, tail_side):
     """
     mech = tilted_slider(tail_side)
     motion = mech.sweep(33)
-    partset = build_parts(design_for(sla_process), mech, motion, [], {})
+    partset = build_parts(design_for(sla_process), mech, motion, [])
     hole_mm = 2.0 + 2 * 0.25 + 0.2
     boss = hole_mm / 2 + max(0.8, 2.0 / 2)
     spacing = 2 * boss + 2 * 0.8
@@ -320,7 +321,7 @@ def test_a_slot_that_would_cut_into_a_rod_point_is_refused(sla_process):
     slider, the rod and the point (the user has to move one of them)."""
     mech = tilted_slider(0.0, across=2.0)
     with pytest.raises(GeometryError, match=r"slider G: the guide slot in 'rod' runs into its point 'T'"):
-        build_parts(design_for(sla_process), mech, mech.sweep(9), [], {})
+        build_parts(design_for(sla_process), mech, mech.sweep(9), [])
 
 
 # -- a curved fingertip pad and a gear on one body --------------------------------------------------
@@ -341,7 +342,7 @@ def test_curved_pad_and_gear_fuse_into_one_plate(four_bar, sla_process):
     planet = spur_like(6.0, 8, 0.4)
     pair = SimpleNamespace(name="sun_planet", body_a="ground", body_b="coupler", axis_a="O", axis_b="A",
                            outline_a=spur_like(9.0, 12, 0.4), outline_b=planet)
-    hints = {"pads": {"coupler": {"point": "C", "arc": ["B", "E"]}}}
+    hints = PartHints(pads={"coupler": PadHint("C", arc=("B", "E"))})
     coupler = build_parts(design_for(sla_process), mech, motion, [pair], hints).part("coupler")
     boss = (2.0 + 2 * 0.25 + 0.2) / 2 + 1.0
     points = [(0.0, 0.0), (40.0, 0.0), (40.0, 36.0), (76.0, 36.0)]
@@ -361,7 +362,7 @@ def coupler_with_arc_pad(four_bar: Mechanism, process, pts: dict) -> Part:
     bodies = tuple(Body("coupler", {**b.points, **pts}) if b.name == "coupler" else b for b in four_bar.bodies)
     mech = Mechanism(name="arc_pad", bodies=bodies, ground=four_bar.ground, joints=four_bar.joints, gears=(),
                      drivers=four_bar.drivers, input_range=four_bar.input_range, assembly=four_bar.assembly)
-    hints = {"pads": {"coupler": {"point": "C", "arc": ["E1", "E2"]}}}
+    hints = PartHints(pads={"coupler": PadHint("C", arc=("E1", "E2"))})
     return build_parts(design_for(process), mech, mech.sweep(7), [], hints).part("coupler")
 
 
@@ -424,12 +425,12 @@ def test_printed_spacer_roles_heights_and_bill_of_materials(sla_process):
     mech = make_four_bar(12.0, 25.0, 20.0, 25.0)
     motion = mech.sweep(61)
     design = design_for(sla_process, PartsSpec(link_width_mm=10.0, mounting_hole_mm=2.5))
-    partset = build_parts(design, mech, motion, [], {"copies": 2})
+    partset = build_parts(design, mech, motion, [], PartHints(copies=2))
     layers = partset.layers
     # what the exporters read from the part set: the process and its plate, gap, kerf and chord tolerance
     assert (partset.process, partset.thickness_mm, partset.layer_gap_mm, partset.kerf_mm) == ("sla", t, g, 0.0)
     assert partset.chord_tolerance_mm == 0.005
-    assert (partset.copies, dict(partset.hints), partset.warnings) == (2, {"copies": 2}, ())
+    assert (partset.copies, partset.hints, partset.warnings) == (2, PartHints(copies=2), ())
     for part in partset.body_parts():
         assert part.z_mm == pytest.approx(layers[part.body] * (t + g), abs=1e-12)
         assert part.process == "sla"
@@ -464,7 +465,7 @@ def test_printed_spacer_roles_heights_and_bill_of_materials(sla_process):
     assert not [r for r in bom if r["kind"] == "spacer"]
     neighbours = sum(abs(layers[j.body_a] - layers[j.body_b]) == 1 for j in mech.joints)
     assert sum(r["qty"] for r in bom if r["kind"] == "washer") == 2 * neighbours
-    single = build_parts(design, mech, motion, [], {"copies": None})
+    single = build_parts(design, mech, motion, [], PartHints(copies=None))
     assert single.copies == 1 and all(r["qty"] == 1 for r in single.bom if r["kind"] == "printed part")
 
 
@@ -477,7 +478,7 @@ def test_gaps_thinner_than_a_plate_stay_washers(sla_process):
 
     mech = make_four_bar(12.0, 25.0, 20.0, 25.0)
     process = dataclasses.replace(sla_process, layer_gap_mm=2.0)
-    partset = build_parts(design_for(process, PartsSpec(link_width_mm=10.0)), mech, mech.sweep(61), [], {})
+    partset = build_parts(design_for(process, PartsSpec(link_width_mm=10.0)), mech, mech.sweep(61), [])
     t, layers = process.thickness_mm, partset.layers
     skips = {j.name: abs(layers[j.body_a] - layers[j.body_b]) for j in mech.joints}
     printed = {p.name: p.thickness_mm for p in partset.parts if p.role == "spacer"}
@@ -500,7 +501,7 @@ def test_overlapping_holes_are_refused_wherever_the_body_frame_sits(sla_process)
                      assembly={**base.assembly, "crank": (7.5 * math.cos(th), 7.5 * math.sin(th), th)})
     fat = dataclasses.replace(sla_process, pin_diameter_mm=15.0)
     with pytest.raises(SpecError, match=r"process.pin_diameter_mm: 15 mm pins: holes O and A of part crank"):
-        build_parts(design_for(fat), mech, mech.sweep(11), [], {})
+        build_parts(design_for(fat), mech, mech.sweep(11), [])
 
 
 # -- distances, guide side, overlapping cuts ------------------------------------------------------
@@ -808,7 +809,7 @@ def test_layering_sees_bodies_and_spacers_within_the_running_clearance(sla_proce
     width = 24.76
     plates = [c.buffer(width / 2, 128).distance(r.buffer(width / 2, 128)) for c, r in zip(crank, rocker, strict=True)]
     assert min(plates) == pytest.approx(0.24, abs=1e-3)
-    partset = build_parts(design_for(sla_process, PartsSpec(link_width_mm=width)), mech, motion, [], {})
+    partset = build_parts(design_for(sla_process, PartsSpec(link_width_mm=width)), mech, motion, [])
     assert "rocker" in seen["conflict_graph"]["crank"]
     assert partset.layers["crank"] != partset.layers["rocker"]
 
@@ -871,7 +872,7 @@ def test_spacer_check_gets_each_compound_pin_in_its_own_body_frame(sla_process, 
         return real(outlines, world_poses, pins, *args)
 
     monkeypatch.setattr(build, "pin_crossings", spy)
-    build_parts(design_for(sla_process), mech, motion, [], {})
+    build_parts(design_for(sla_process), mech, motion, [])
     pairs = {(a, b) for _, a, b in seen}
     assert {("ground", "crank"), ("ground", "flap"), ("crank", "flap")} <= pairs
     world_pin = {frozenset(("ground", "crank")): motion.point("O", "ground"),
@@ -898,7 +899,7 @@ def test_printed_spacers_on_one_compound_pin_are_numbered_bottom_up(sla_process,
     forced = {"ground": 0, "coupler": 1, "crank": 2, "rocker": 3, "flap": 4}
     monkeypatch.setattr(build, "order_layers", lambda layers, crossings: dict(forced))
     mech = flapped_four_bar()
-    partset = build_parts(design_for(sla_process), mech, mech.sweep(13), [], {})
+    partset = build_parts(design_for(sla_process), mech, mech.sweep(13), [])
     assert partset.layers == forced
     spacers = {p.name: (p.z_mm, p.thickness_mm) for p in partset.parts if p.role == "spacer"}
     assert spacers == {"spacer_O_Or_1": pytest.approx((3.0, 3.6)), "spacer_O_Or_2": pytest.approx((9.6, 3.6)),
@@ -951,7 +952,7 @@ def test_a_body_within_the_running_clearance_of_a_spacer_is_kept_off_its_layers(
     monkeypatch.setattr(build, "pin_crossings", spy)
     mech = stop_arm(gap)
     motion = mech.sweep(73)
-    partset = build_parts(design_for(sla_process), mech, motion, [], {})
+    partset = build_parts(design_for(sla_process), mech, motion, [])
     pose = motion.pose("arm")
     assert np.ptp(pose, axis=0) == pytest.approx([0.0, 0.0, 0.0], abs=1e-12)
     plate = shapely.Polygon(world(pose[0], partset.part("arm").outline.polygon(0.001)))
@@ -992,7 +993,7 @@ def test_a_guide_pin_in_the_guiding_rods_own_slot_is_a_warning_of_the_part_set(s
     naming rod 1 and the hole. At h = 10 it is 3.7 mm away: no warning. (The build's own refusal only looks
     at rod points, and S2 itself is h mm from the line.)"""
     mech = stacked_rods(height)
-    partset = build_parts(design_for(sla_process), mech, mech.sweep(11), [], {})
+    partset = build_parts(design_for(sla_process), mech, mech.sweep(11), [])
     rod1 = partset.part("rod1")
     holes = {h.joint: h.centre for h in rod1.holes}
     np.testing.assert_allclose(holes["S2_guide"], [-5.0, height - 6.3], atol=1e-12)
@@ -1107,17 +1108,17 @@ def test_fuse_polygons_is_union_outline():
 # -- sizes ------------------------------------------------------------------------------------
 
 def test_hole_and_boss_sizes(sla_process, laser_process):
-    sla = derive_sizes(sla_process, PartsSpec(), {})
+    sla = derive_sizes(sla_process, PartsSpec(), PartHints())
     expected = DATA["sizes"]
     assert sla.hole_mm == pytest.approx(expected["sla_hole_mm"], abs=1e-9)  # 2 + 2*0.25 + 0.2
     assert sla.boss_radius_mm == pytest.approx(expected["sla_boss_radius_mm"], abs=1e-9)
-    laser = derive_sizes(laser_process, PartsSpec(), {})
+    laser = derive_sizes(laser_process, PartsSpec(), PartHints())
     assert laser.hole_mm == pytest.approx(expected["laser_hole_mm"], abs=1e-9)  # 3 + 2*0.1
     # minimum web >= sheet thickness on the laser
     assert laser.boss_radius_mm - laser.hole_mm / 2 >= laser_process.thickness_mm - 1e-12
-    wide = derive_sizes(sla_process, PartsSpec(link_width_mm=12.0), {})
+    wide = derive_sizes(sla_process, PartsSpec(link_width_mm=12.0), PartHints())
     assert wide.boss_radius_mm == pytest.approx(6.0)
-    hinted = derive_sizes(sla_process, PartsSpec(), {"link_width_mm": 10.0})
+    hinted = derive_sizes(sla_process, PartsSpec(), PartHints(link_width_mm=10.0))
     assert hinted.boss_radius_mm == pytest.approx(5.0)
 
 
@@ -1127,8 +1128,8 @@ def test_hole_and_boss_sizes(sla_process, laser_process):
 def test_four_bar_parts(four_bar, process_name, request):
     process = request.getfixturevalue(process_name)
     motion = four_bar.sweep(181)
-    partset = build_parts(design_for(process), four_bar, motion, [], {})
-    sizes = derive_sizes(process, PartsSpec(), {})
+    partset = build_parts(design_for(process), four_bar, motion, [])
+    sizes = derive_sizes(process, PartsSpec(), PartHints())
     by_body = {p.body: p for p in partset.body_parts()}
     assert set(by_body) == set(four_bar.body_names)
     for joint in four_bar.joints:
@@ -1152,7 +1153,7 @@ def test_four_bar_parts(four_bar, process_name, request):
 def test_layers_keep_bodies_apart_over_the_motion(four_bar, sla_process):
     """Independent check: bodies in one layer never come within the clearance at any of 361 poses."""
     motion = four_bar.sweep(361)
-    partset = build_parts(design_for(sla_process), four_bar, motion, [], {})
+    partset = build_parts(design_for(sla_process), four_bar, motion, [])
     parts = partset.body_parts()
     for i, a in enumerate(parts):
         for b in parts[i + 1:]:
@@ -1175,7 +1176,7 @@ def test_assign_layers_merges_gears_and_colours_greedily():
 
 
 def test_pins_and_spacers_fill_the_stack(four_bar, sla_process):
-    partset = build_parts(design_for(sla_process), four_bar, four_bar.sweep(121), [], {})
+    partset = build_parts(design_for(sla_process), four_bar, four_bar.sweep(121), [])
     t, g = sla_process.thickness_mm, sla_process.layer_gap_mm
     for pin in partset.pins:
         lo, hi = pin.layers
@@ -1193,10 +1194,9 @@ def test_pins_and_spacers_fill_the_stack(four_bar, sla_process):
 
 
 def test_bom_copies_springs_and_purchased(four_bar, sla_process):
-    hints = {"copies": 3, "springs": [{"joint": "A", "rate_Nmm_per_deg": 30.0, "preload_deg": 5.0,
-                                       "legs_mm": 10.0, "note": "torsion"}],
-             "purchased": [{"item": "micro servo", "qty": 1, "note": "driver"}],
-             "purchased_shared": [{"item": "base plate", "qty": 1, "note": "holds all copies"}]}
+    hints = PartHints(copies=3, springs=(SpringHint("A", 30.0, 5.0, 10.0, "torsion"),),
+                      purchased=(PurchasedItem("micro servo", 1, "driver"),),
+                      purchased_shared=(PurchasedItem("base plate", 1, "holds all copies"),))
     partset = build_parts(design_for(sla_process), four_bar, four_bar.sweep(61), [], hints)
     pins = sum(row["qty"] for row in partset.bom if row["kind"] == "pin")
     assert pins == 3 * len(four_bar.joints)
@@ -1207,16 +1207,16 @@ def test_bom_copies_springs_and_purchased(four_bar, sla_process):
 
 
 def test_pad_hint_adds_fingertip(four_bar, sla_process):
-    plain = build_parts(design_for(sla_process), four_bar, four_bar.sweep(61), [], {})
+    plain = build_parts(design_for(sla_process), four_bar, four_bar.sweep(61), [], PartHints())
     padded = build_parts(design_for(sla_process), four_bar, four_bar.sweep(61), [],
-                         {"pads": {"coupler": {"point": "B", "radius_mm": 6.0}}})
+                         PartHints(pads={"coupler": PadHint("B", 6.0)}))
     outline = shapely.Polygon(padded.part("coupler").outline.polygon(0.001))
     disc = shapely.Point(40.0, 0.0).buffer(6.0 - 1e-3, 256)
     assert outline.contains(disc)
     assert padded.part("coupler").area_mm2() > plain.part("coupler").area_mm2()
     with pytest.raises(GeometryError, match="no point"):
         build_parts(design_for(sla_process), four_bar, four_bar.sweep(11), [],
-                    {"pads": {"coupler": {"point": "Z", "radius_mm": 6.0}}})
+                    PartHints(pads={"coupler": PadHint("Z", 6.0)}))
 
 
 # -- gears fused to bodies ----------------------------------------------------------------------
@@ -1262,7 +1262,7 @@ def test_gears_fused_with_hub_share_a_layer(four_bar, sla_process):
     motion = four_bar.sweep(91)
     pair = SimpleNamespace(name="sun_planet", body_a="ground", body_b="coupler", axis_a="O", axis_b="A",
                            outline_a=spur_like(9.0, 12, 0.4), outline_b=spur_like(6.0, 8, 0.4))
-    partset = build_parts(design_for(sla_process), mech, motion, [pair], {})
+    partset = build_parts(design_for(sla_process), mech, motion, [pair])
     assert partset.layers["ground"] == partset.layers["coupler"]
     ground, coupler = partset.part("ground"), partset.part("coupler")
     assert ground.gear == "sun_planet" and coupler.gear == "sun_planet"
@@ -1303,7 +1303,7 @@ def slider_crank() -> Mechanism:
 def test_slider_rod_gets_a_guide_slot(sla_process):
     mech = slider_crank()
     motion = mech.sweep(41)
-    partset = build_parts(design_for(sla_process), mech, motion, [], {})
+    partset = build_parts(design_for(sla_process), mech, motion, [])
     rod = partset.part("rod")
     assert rod.role == "rod" and len(rod.slots) == 1
     ground = partset.part("ground")
@@ -1323,8 +1323,8 @@ def test_slider_rod_gets_a_guide_slot(sla_process):
 
 
 def test_same_input_same_parts(four_bar, sla_process):
-    a = build_parts(design_for(sla_process), four_bar, four_bar.sweep(61), [], {})
-    b = build_parts(design_for(sla_process), four_bar, four_bar.sweep(61), [], {})
+    a = build_parts(design_for(sla_process), four_bar, four_bar.sweep(61), [])
+    b = build_parts(design_for(sla_process), four_bar, four_bar.sweep(61), [])
     assert [p.name for p in a.parts] == [p.name for p in b.parts]
     for p, q in zip(a.parts, b.parts, strict=True):
         np.testing.assert_array_equal(p.outline.vertices, q.outline.vertices)
@@ -1337,8 +1337,8 @@ def test_no_body_sweeps_over_a_spacer_between_its_layers(four_bar, sla_process):
     (The plain colouring of this four-bar puts the coupler, which sweeps over pin O, between the layers
     of the ground and the crank; the layer ordering must move it out.)"""
     motion = four_bar.sweep(181)
-    partset = build_parts(design_for(sla_process), four_bar, motion, [], {})
-    sizes = derive_sizes(sla_process, PartsSpec(), {})
+    partset = build_parts(design_for(sla_process), four_bar, motion, [])
+    sizes = derive_sizes(sla_process, PartsSpec(), PartHints())
     for pin in partset.pins:
         a, b = pin.bodies
         lo, hi = pin.layers
@@ -1368,8 +1368,8 @@ def test_mounting_screws_clear_everything_that_moves(four_bar, sla_process):
     """Independent check at every pose: each mounting boss (screw head) keeps the clearance from every
     moving part."""
     motion = four_bar.sweep(181)
-    partset = build_parts(design_for(sla_process), four_bar, motion, [], {})
-    sizes = derive_sizes(sla_process, PartsSpec(), {})
+    partset = build_parts(design_for(sla_process), four_bar, motion, [])
+    sizes = derive_sizes(sla_process, PartsSpec(), PartHints())
     mounts = [h for h in partset.part("ground").holes if h.joint.startswith("mount_")]
     assert len(mounts) == 2
     for hole in mounts:
@@ -1415,12 +1415,12 @@ def test_overlapping_holes_name_the_pin_and_the_largest_that_fits(four_bar, sla_
 
     fat = dataclasses.replace(sla_process, pin_diameter_mm=15.0)
     with pytest.raises(SpecError, match=r"process.pin_diameter_mm: 15 mm pins: holes O and A of part crank") as info:
-        build_parts(design_for(fat), four_bar, four_bar.sweep(11), [], {})
+        build_parts(design_for(fat), four_bar, four_bar.sweep(11), [])
     largest = float(re.search(r"at most ([\d.]+) mm", str(info.value)).group(1))
     # closed form: centre distance 15 - wall - 2 x clearance - compensation
     assert largest == pytest.approx(15.0 - 0.8 - 2 * 0.25 - 0.2, abs=0.01)
     fits = build_parts(design_for(dataclasses.replace(sla_process, pin_diameter_mm=largest)), four_bar,
-                       four_bar.sweep(11), [], {})
+                       four_bar.sweep(11), [])
     crank = fits.part("crank")
     (o, a) = crank.holes[:2]
     assert np.hypot(*(o.centre - a.centre)) - 0.5 * (o.diameter_mm + a.diameter_mm) >= 0.8 - 1e-9

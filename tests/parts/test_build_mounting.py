@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 import shapely
 
+from fabricate.hints import PadHint, PartHints
 from fabricate.mechanism import Body, Driver, LinearLaw, Mechanism, Revolute, Slider
 from fabricate.parts.build import Sizes, _add_mounting, build_parts
 from fabricate.parts.spec import PartsSpec
@@ -140,7 +141,7 @@ def test_mounting_hole_count_size_and_names(four_bar, sla_process, count):
     (closed form, 1e-12 mm) and taking no pin; the joint holes are untouched."""
     motion = four_bar.sweep(61)
     partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=count, mounting_hole_mm=2.5)),
-                          four_bar, motion, [], {})
+                          four_bar, motion, [])
     mount_hole, _, _ = sla_sizes(sla_process, screw_mm=2.5)
     holes = mounts(partset)
     assert [h.joint for h in holes] == [f"mount_{k + 1}" for k in range(count)]
@@ -157,7 +158,7 @@ def test_no_mounting_holes_leaves_the_ground_a_plain_link(four_bar, sla_process)
     """With ``mounting_holes = 0`` the ground bar O-D is just the rounded slot of its two joint bosses:
     area 2 r L + pi r^2 - 2 pi (hole/2)^2 (closed form, relative 1e-9)."""
     motion = four_bar.sweep(61)
-    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=0)), four_bar, motion, [], {})
+    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=0)), four_bar, motion, [])
     _, _, r = sla_sizes(sla_process)
     hole = sla_process.pin_diameter_mm + 2 * sla_process.running_clearance_mm + sla_process.hole_compensation_mm
     ground = partset.part("ground")
@@ -179,7 +180,7 @@ def test_swing_row_sits_just_outside_the_ground_bosses(sla_process):
     _, r_mount, r_boss = sla_sizes(sla_process)
     pitch = 2.0 * r_mount + 2.0
     for count in (1, 2, 4):
-        partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=count)), mech, motion, [], {})
+        partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=count)), mech, motion, [])
         got = np.array([h.centre for h in mounts(partset)])
         want = np.column_stack([(np.arange(count) - 0.5 * (count - 1)) * pitch,
                                 np.full(count, -(r_boss + r_mount + 1.0))])
@@ -200,7 +201,7 @@ def test_row_moves_out_past_a_pad_fused_to_the_ground(sla_process):
     motion = mech.sweep(31)
     _, r_mount, r_boss = sla_sizes(sla_process)
     assert 10.0 + r_boss < 20.0  # the pad, not a boss, is the ground's furthest reach
-    hints = {"pads": {"ground": {"point": "O", "arc": ["P1", "P2"]}}}
+    hints = PartHints(pads={"ground": PadHint("O", arc=("P1", "P2"))})
     partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=2)), mech, motion, [], hints)
     got = np.array([h.centre for h in mounts(partset)])
     pitch = 2.0 * r_mount + 2.0
@@ -221,7 +222,7 @@ def test_row_is_straight_even_centred_and_numbered_across_the_far_side(sla_proce
     across d. Tolerance 1e-9 mm (the direction is an average over the sweep, rounding only)."""
     mech = make()
     motion = mech.sweep(61)
-    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=count)), mech, motion, [], {})
+    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=count)), mech, motion, [])
     _, r_mount, r_boss = sla_sizes(sla_process)
     d = away_direction(mech, motion)
     side = np.array([-d[1], d[0]])
@@ -245,7 +246,7 @@ def test_four_bar_screw_heads_clear_everything_that_moves(four_bar, sla_process,
     outlines and the poses), every mounting boss keeps at least the running clearance: distance from the
     hole centre >= mount boss r + clearance (no tolerance: the parts keep 0.5 mm margin for this)."""
     motion = four_bar.sweep(181)
-    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=count)), four_bar, motion, [], {})
+    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=count)), four_bar, motion, [])
     _, r_mount, _ = sla_sizes(sla_process)
     centres = np.array([h.centre for h in mounts(partset)])
     gaps = shapely.distance(shapely.points(centres), moving_region(partset, motion))
@@ -267,7 +268,7 @@ def test_wide_swing_pushes_the_row_out_to_the_first_step_that_clears(sla_process
     the margin allows -- the row is pushed out no further than needed."""
     mech = swing_mechanism(-60.0, 240.0)
     motion = mech.sweep(181)
-    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=count)), mech, motion, [], {})
+    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=count)), mech, motion, [])
     _, r_mount, r_boss = sla_sizes(sla_process)
     need = r_mount + sla_process.running_clearance_mm
     xs = (np.arange(count) - 0.5 * (count - 1)) * (2.0 * r_mount + 2.0)
@@ -290,7 +291,7 @@ def test_ground_outline_encloses_every_mounting_boss(four_bar, sla_process):
     to the outline's boundary is at least the mount boss radius (= hole / 2 + wall), less the chord
     tolerance; so the screw keeps the process wall all round."""
     motion = four_bar.sweep(61)
-    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=3)), four_bar, motion, [], {})
+    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=3)), four_bar, motion, [])
     mount_hole, r_mount, _ = sla_sizes(sla_process)
     outline = shapely.Polygon(partset.part("ground").outline.polygon(CHORD))
     assert outline.is_valid
@@ -314,7 +315,7 @@ def test_a_bare_ground_plate_gets_its_row_below(sla_process, points):
     mech = Mechanism(name="plate", bodies=(Body("ground", points),), ground="ground", joints=(), gears=(),
                      drivers=(), input_range=(0.0, 1.0))
     motion = mech.sweep(3)
-    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=3)), mech, motion, [], {})
+    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=3)), mech, motion, [])
     _, r_mount, r_boss = sla_sizes(sla_process)
     ys = [y for _, y in points.values()] or [0.0]
     xs = [x for x, _ in points.values()] or [0.0]
@@ -333,7 +334,7 @@ def test_a_lever_turning_right_round_the_ground_centre_puts_the_row_on_minus_y(s
     every pose of the lever; 1e-9 mm, the row before misses by 0.25 mm), x centred on O."""
     mech = swing_mechanism(0.0, 360.0)
     motion = mech.sweep(np.arange(12) * 30.0)
-    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=2)), mech, motion, [], {})
+    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=2)), mech, motion, [])
     _, r_mount, r_boss = sla_sizes(sla_process)
     xs = np.array([-0.5, 0.5]) * (2.0 * r_mount + 2.0)
     tips = np.array([transform_points(pose, np.array([20.0, 0.0])) for pose in motion.pose("lever")])
@@ -350,7 +351,7 @@ def test_a_ground_half_a_millimetre_off_centre_takes_the_row_on_that_side(sla_pr
     22.35 mm out) leaves more than the clearance there."""
     mech = swing_mechanism(0.0, 360.0, {"L": (-20.0, 0.0), "O": (0.0, 0.0), "R": (21.5, 0.0)})
     motion = mech.sweep(np.arange(12) * 30.0)
-    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=2)), mech, motion, [], {})
+    partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=2)), mech, motion, [])
     _, r_mount, r_boss = sla_sizes(sla_process)
     x = 21.5 + r_boss + r_mount + 1.0
     half = 0.5 * (2.0 * r_mount + 2.0)
@@ -366,7 +367,7 @@ def test_when_nothing_within_reach_clears_the_row_stops_at_the_end_of_the_search
     mech = swing_mechanism(0.0, 360.0, length=450.0)
     motion = mech.sweep(91)
     partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=1, link_width_mm=100.0)), mech,
-                          motion, [], {})
+                          motion, [])
     _, r_mount, _ = sla_sizes(sla_process)
     d = away_direction(mech, motion)
     own = np.array([[-20.0, 0.0], [0.0, 0.0], [20.0, 0.0]])

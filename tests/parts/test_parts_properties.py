@@ -13,6 +13,7 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from fabricate.hints import PartHints
 from fabricate.parts.build import derive_sizes
 from fabricate.parts.model import BulgePath
 from fabricate.parts.profiles import circle_hull, circle_path, fuse_polygons, offset_path
@@ -28,7 +29,7 @@ def test_sizes_closed_forms(sla_process, laser_process):
         wall = max(process.min_wall_mm, 0.5 * pin)
         if process.name == "laser":
             wall = max(wall, process.thickness_mm)
-        s = derive_sizes(process, PartsSpec(mounting_hole_mm=4.0), {})
+        s = derive_sizes(process, PartsSpec(mounting_hole_mm=4.0), PartHints())
         assert s.pin_mm == pin
         assert s.hole_mm == pytest.approx(pin + 2 * c + comp, abs=1e-12)
         assert s.boss_radius_mm == pytest.approx((pin + 2 * c + comp) / 2 + wall, abs=1e-12)
@@ -36,13 +37,13 @@ def test_sizes_closed_forms(sla_process, laser_process):
         assert s.mount_boss_radius_mm == pytest.approx((4.0 + 2 * c + comp) / 2 + wall, abs=1e-12)
         assert s.hub_mm == pytest.approx(max(2 * s.boss_radius_mm, s.hole_mm + 2 * process.min_wall_mm), abs=1e-12)
         # an explicit boss wall and hub win (the hub still at least hole + 2 min walls)
-        t = derive_sizes(process, PartsSpec(boss_wall_mm=5.0, hub_diameter_mm=30.0), {})
+        t = derive_sizes(process, PartsSpec(boss_wall_mm=5.0, hub_diameter_mm=30.0), PartHints())
         wall_t = max(5.0, process.thickness_mm) if process.name == "laser" else 5.0
         assert t.boss_radius_mm == pytest.approx(s.hole_mm / 2 + wall_t, abs=1e-12)
         assert t.hub_mm == pytest.approx(30.0, abs=1e-12)
-        tiny = derive_sizes(process, PartsSpec(hub_diameter_mm=0.5), {})
+        tiny = derive_sizes(process, PartsSpec(hub_diameter_mm=0.5), PartHints())
         assert tiny.hub_mm == pytest.approx(s.hole_mm + 2 * process.min_wall_mm, abs=1e-12)
-        geared = derive_sizes(process, PartsSpec(), {}, gear_hub_mm=25.0)
+        geared = derive_sizes(process, PartsSpec(), PartHints(), gear_hub_mm=25.0)
         assert geared.hub_mm == pytest.approx(25.0, abs=1e-12)
 
 

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from fabricate.cli import main
+from fabricate.hints import PadHint, PartHints, SpringHint
 from fabricate.strength.check import body_loads, design_loads, solved_loads
 from fabricate.strength.spec import LoadSpec
 from fabricate.strength.statics import BodyTorque, PointForce, solve_statics
@@ -69,7 +70,7 @@ def test_actuator_effort_is_held_by_the_object_at_the_tip():
     mech = make_four_bar()
     s = np.linspace(60.0, 160.0, 51)
     motion = mech.sweep(s)
-    hints = {"tip_point": "B", "pads": {"rocker": {"point": "B"}}}
+    hints = PartHints(tip_point="B", pads={"rocker": PadHint("B")})
     loads = design_loads(_design(input_torque_Nmm=80.0), mech, motion, hints)
     assert loads.reaction is not None and not loads.forces
     st = solve_statics(mech, motion, loads.forces, loads.torques, loads.efforts, loads.reaction)
@@ -93,8 +94,7 @@ def _design(**load) -> SimpleNamespace:
 def test_tip_force_opposes_the_tip_motion_and_springs_follow_their_rate():
     mech = make_four_bar()
     motion = mech.sweep(np.linspace(60.0, 200.0, 61))
-    hints = {"tip_point": "B", "pads": {"rocker": {"point": "B"}},
-             "springs": [{"joint": "D", "rate_Nmm_per_deg": 2.0, "preload_deg": 10.0}]}
+    hints = PartHints(tip_point="B", pads={"rocker": PadHint("B")}, springs=(SpringHint("D", 2.0, 10.0),))
     loads = design_loads(_design(tip_force_N=7.0), mech, motion, hints)
     (tip,) = loads.forces
     path = motion.point("B", "rocker")
@@ -119,8 +119,7 @@ def test_every_body_is_in_equilibrium_under_all_its_loads(load):
     side."""
     mech = make_four_bar()
     motion = mech.sweep(49)
-    hints = {"tip_point": "B", "pads": {"rocker": {"point": "B"}},
-             "springs": [{"joint": "A", "rate_Nmm_per_deg": 3.0, "preload_deg": 20.0}]}
+    hints = PartHints(tip_point="B", pads={"rocker": PadHint("B")}, springs=(SpringHint("A", 3.0, 20.0),))
     loads = design_loads(_design(**load), mech, motion, hints)
     st = solve_statics(mech, motion, loads.forces, loads.torques, loads.efforts, loads.reaction)
     if loads.reaction is not None:
@@ -259,7 +258,7 @@ def test_auto_link_width_is_the_smallest_width_that_passes():
 
     mech = make_four_bar()
     motion = mech.sweep(121)
-    hints = {"tip_point": "B", "pads": {"rocker": {"point": "B"}}}
+    hints = PartHints(tip_point="B", pads={"rocker": PadHint("B")})
     design = _four_bar_design("auto", 25.0)
 
     def build(d):
@@ -338,7 +337,7 @@ def test_zero_load_and_no_materials_are_not_checked_never_passed():
 
     mech = make_four_bar()
     motion = mech.sweep(25)
-    hints = {"tip_point": "B", "pads": {"rocker": {"point": "B"}}}
+    hints = PartHints(tip_point="B", pads={"rocker": PadHint("B")})
     loaded = _four_bar_design(None, 25.0)
     partset = build_parts(loaded, mech, motion, [], hints)
     control = run_strength(loaded, partset, mech, motion, [], hints)

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from fabricate.errors import SynthesisError
+from fabricate.hints import PadHint, PartHints, PurchasedItem, SpringHint
 from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.compliant.closing import closing_motion
 from fabricate.synthesis.compliant.grid_search import OptimumResult, optimise
@@ -32,11 +33,11 @@ if TYPE_CHECKING:
 #: Drive parts shared by all fingers (paper Fig 1): two lead-screw steppers move the tip and root
 #: drive plates along two guide posts.
 DRIVE_PARTS = (
-    {"item": "stepper motor with lead screw", "qty": 2, "note": "tip drive (1) and root drive (2), Fig 1"},
-    {"item": "guide post", "qty": 2, "note": "joins the motor plate and the finger-base plate (4)"},
-    {"item": "linear bearing", "qty": 4, "note": "each guide post through both drive plates (5)"},
-    {"item": "lead-screw nut", "qty": 2, "note": "one per drive plate (8)"},
-    {"item": "lead-screw support bearing", "qty": 2, "note": "in the finger-base plate (12)"},
+    PurchasedItem("stepper motor with lead screw", 2, "tip drive (1) and root drive (2), Fig 1"),
+    PurchasedItem("guide post", 2, "joins the motor plate and the finger-base plate (4)"),
+    PurchasedItem("linear bearing", 4, "each guide post through both drive plates (5)"),
+    PurchasedItem("lead-screw nut", 2, "one per drive plate (8)"),
+    PurchasedItem("lead-screw support bearing", 2, "in the finger-base plate (12)"),
 )
 
 
@@ -100,7 +101,7 @@ def synthesise(design: DesignSpec) -> SynthesisResult:
         "grasp_force_curve": {"stroke_mm": strokes[::10].tolist(), "F_static_N": f_static[::10].tolist(),
                               "F_hover_N": f_hover[::10].tolist()},
         "fingers": spec.fingers,
-        "drive_parts": [dict(item) for item in DRIVE_PARTS],
+        "drive_parts": [{"item": p.item, "qty": p.qty, "note": p.note} for p in DRIVE_PARTS],
     }
     optimum = None
     if spec.grid is not None:
@@ -108,27 +109,23 @@ def synthesise(design: DesignSpec) -> SynthesisResult:
                            hinge_margin=spec.min_hinge)
         report["optimum"] = _optimum_report(spec, optimum)
     g = spec.geometry
-    parts = {
-        "springs": [
-            {"joint": "C", "rate_Nmm_per_deg": spec.springs.k1, "preload_deg": float(np.degrees(spec.springs.phi01)),
-             "legs_mm": spec.spring_legs, "note": "small torsion spring, tip hinge (k1)"},
-            {"joint": "B", "rate_Nmm_per_deg": spec.springs.k2, "preload_deg": float(np.degrees(spec.springs.phi02)),
-             "legs_mm": spec.spring_legs, "note": "large torsion spring, middle hinge (k2)"},
-        ],
-        # the fingertip arc of radius r runs from its tangent point on the phalanx to the tip
-        "pads": {"tip": {"point": "pad", "radius_mm": g.r, "arc": ["pad_start", "tip"]}},
-        # per finger (the BOM layer multiplies these by "copies")
-        "purchased": [
-            {"item": "tip drive rod, 4 mm steel, threaded end", "qty": 1, "note": "pushes the two-force rod"},
-            {"item": "root push rod, 4 mm steel, threaded end", "qty": 1, "note": "sets the root angle alpha"},
-            {"item": "adjusting knob", "qty": 1, "note": "sets the tip spring preload"},
-        ],
+    parts = PartHints(
+        springs=(SpringHint("C", spec.springs.k1, float(np.degrees(spec.springs.phi01)), spec.spring_legs,
+                            "small torsion spring, tip hinge (k1)"),
+                 SpringHint("B", spec.springs.k2, float(np.degrees(spec.springs.phi02)), spec.spring_legs,
+                            "large torsion spring, middle hinge (k2)")),
+        # per finger (the BOM layer multiplies these by the copies)
+        purchased=(PurchasedItem("tip drive rod, 4 mm steel, threaded end", 1, "pushes the two-force rod"),
+                   PurchasedItem("root push rod, 4 mm steel, threaded end", 1, "sets the root angle alpha"),
+                   PurchasedItem("adjusting knob", 1, "sets the tip spring preload")),
         # once per gripper, shared by the fingers: listed apart so they are not multiplied
-        "purchased_shared": list(DRIVE_PARTS),
-        "copies": spec.fingers,
-        "copy_angle_deg": 360.0 / spec.fingers,
-        "tip_point": "tip",
-    }
+        purchased_shared=DRIVE_PARTS,
+        copies=spec.fingers,
+        copy_angle_deg=360.0 / spec.fingers,
+        tip_point="tip",
+        # the fingertip arc of radius r runs from its tangent point on the phalanx to the tip
+        pads={"tip": PadHint("pad", g.r, ("pad_start", "tip"))},
+    )
 
     def figures() -> dict[str, bytes]:
         from fabricate.synthesis.compliant.plots import compliant_figures

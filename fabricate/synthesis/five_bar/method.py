@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from fabricate.errors import LockupError, SynthesisError
+from fabricate.hints import PadHint, PartHints
 from fabricate.mechanism import Mechanism, Motion
 from fabricate.planar import rotation
 from fabricate.synthesis.base import SynthesisResult
@@ -147,5 +148,5 @@ def synthesise(design: DesignSpec) -> SynthesisResult:
 
         return five_bar_figures(data)
 
-    parts = {"pads": {DISTAL: {"point": "P", "radius_mm": spec.pad_radius_mm}}, "tip_point": "P"}
+    parts = PartHints(tip_point="P", pads={DISTAL: PadHint("P", spec.pad_radius_mm)})
     return SynthesisResult(mechanism=mech, report=build_report(data), figures=figures, data=data, parts=parts)

@@ -51,4 +51,4 @@ def synthesise(design: DesignSpec) -> SynthesisResult:
         return gear_pair_figures(law, (lo, hi), a)
 
     return SynthesisResult(mechanism=mech, report=report, figures=figures,
-                           data={"law": law, "center_distance_mm": a}, parts={})
+                           data={"law": law, "center_distance_mm": a})

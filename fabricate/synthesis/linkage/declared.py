@@ -4,9 +4,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from fabricate.hints import PartHints
     from fabricate.mechanism import Mechanism
 
 
@@ -94,5 +95,5 @@ class ExactLinkageSpec:
     mechanism as it was, and the parts hints it came with (see :mod:`fabricate.synthesis.linkage.exact`)."""
 
     mechanism: Mechanism
-    hints: dict[str, Any]
+    hints: PartHints
     tip_point: str | None = None

@@ -12,7 +12,8 @@ its rebuild is close, not identical.
 
 Edit it by hand (move a point, change a law) and ``fabricate build mechanism.toml`` builds the edit. The
 reader holds it to the declared linkage's bounds (bodies, joints, gears, drivers, points per body) and to
-its own: ``hints.copies`` at most :data:`~fabricate.bounds.MAX_COPIES`, a law's points at most
+its own: ``hints.copies`` at most :data:`~fabricate.bounds.MAX_COPIES` (the hints are
+:class:`~fabricate.hints.PartHints`'s fields, read by :func:`read_hints`), a law's points at most
 :data:`~fabricate.bounds.MAX_EXACT_LAW_POINTS` and pieces of at most
 :data:`~fabricate.bounds.MAX_EXACT_LAW_ORDER` coefficients.
 """
@@ -36,10 +37,12 @@ from fabricate.bounds import (
     MAX_LINKAGE_POINTS,
 )
 from fabricate.errors import SpecError
+from fabricate.hints import PadHint, PartHints, PurchasedItem, SpringHint
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
 
 if TYPE_CHECKING:
     from fabricate.spec import DesignSpec
+    from fabricate.table import Table
 
 #: Samples of a law written approximately (a law of a kind this file cannot write exactly).
 SAMPLED_LAW_POINTS = 2001
@@ -77,7 +80,7 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def exact_linkage(mechanism: Mechanism, hints: Mapping[str, Any]) -> tuple[dict[str, Any], bool]:
+def exact_linkage(mechanism: Mechanism, hints: PartHints) -> tuple[dict[str, Any], bool]:
     """The ``[linkage]`` table of the exact form, and whether every law in it is exact."""
     exact = True
     lo, hi = (float(v) for v in mechanism.input_range)
@@ -110,7 +113,7 @@ def exact_linkage(mechanism: Mechanism, hints: Mapping[str, Any]) -> tuple[dict[
     table: dict[str, Any] = {
         "exact": True, "ground": mechanism.ground, "input_unit": mechanism.input_unit, "input_range": [lo, hi],
         "assembly": {name: [float(v) for v in pose] for name, pose in mechanism.assembly.items()},
-        "hints": _plain(dict(hints)),
+        "hints": _plain(hints.as_table()),
         "bodies": bodies, "joints": joints, "drivers": drivers,
     }
     if gears:
@@ -118,7 +121,7 @@ def exact_linkage(mechanism: Mechanism, hints: Mapping[str, Any]) -> tuple[dict[
     return table, exact
 
 
-def mechanism_toml(design: DesignSpec, mechanism: Mechanism, hints: Mapping[str, Any]) -> bytes:
+def mechanism_toml(design: DesignSpec, mechanism: Mechanism, hints: PartHints) -> bytes:
     """``mechanism.toml`` of a build: see the module docstring."""
     from fabricate.templates import parse_toml
     from fabricate.tomlwrite import dumps
@@ -179,20 +182,61 @@ def _law_points(table: Any, key: str) -> np.ndarray:
     return table.array(key, shape=(None,), min_rows=2, min=-1e6, max=1e6)
 
 
-def _hints(t: Any) -> dict[str, Any]:
-    """The parts hints, with the counts that drive the parts' cost checked (``copies``)."""
-    raw = t.raw("hints", {})
-    if not isinstance(raw, Mapping):
-        raise SpecError(t.field("hints"), "expected a table")
-    hints = dict(raw)
-    copies = hints.get("copies", 1)
-    if isinstance(copies, bool) or not isinstance(copies, int) or not 1 <= copies <= MAX_COPIES:
-        raise SpecError(f"{t.field('hints')}.copies", f"expected a whole number of copies from 1 to {MAX_COPIES} "
-                                                      f"(every copy of every part is laid out), got {copies!r}")
-    return hints
+def read_hints(h: Table) -> PartHints:
+    """The parts hints of a ``[linkage.hints]`` table (:class:`~fabricate.hints.PartHints`'s fields, every one
+    optional), with the counts that drive the parts' cost checked: ``copies`` at most
+    :data:`~fabricate.bounds.MAX_COPIES`, a pad per body and a spring per joint at most."""
+    copies = h.raw("copies", None)
+    if copies is not None and (isinstance(copies, bool) or not isinstance(copies, int)
+                               or not 1 <= copies <= MAX_COPIES):
+        raise SpecError(h.field("copies"), f"expected a whole number of copies from 1 to {MAX_COPIES} "
+                                           f"(every copy of every part is laid out), got {copies!r}")
+    spring_tables = h.tables("springs", [])
+    if len(spring_tables) > MAX_LINKAGE_JOINTS:
+        raise SpecError(h.field("springs"), f"at most {MAX_LINKAGE_JOINTS} springs (one a joint)")
+    springs = tuple(_spring(s) for s in spring_tables)
+    purchased = tuple(_purchased(p) for p in h.tables("purchased", []))
+    shared = tuple(_purchased(p) for p in h.tables("purchased_shared", []))
+    angle = h.number("copy_angle_deg", None, min=-360.0, max=360.0)
+    tip = h.string("tip_point", None)
+    width = h.number("link_width_mm", None, positive=True, max=500.0)
+    pads = None
+    if h.has("pads"):
+        pad_table = h.table("pads")
+        if len(pad_table.data) > MAX_LINKAGE_BODIES:
+            raise SpecError(h.field("pads"), f"at most {MAX_LINKAGE_BODIES} pads (one a body)")
+        pads = {str(body): _pad(pad_table.table(body)) for body in list(pad_table.data)}
+        pad_table.finish()
+    h.finish()
+    return PartHints(springs=springs, purchased=purchased, purchased_shared=shared, copies=copies,
+                     copy_angle_deg=angle, tip_point=tip, link_width_mm=width, pads=pads)
 
 
-def parse_exact(t: Any, name: str) -> tuple[Mechanism, dict[str, Any], str | None]:
+def _spring(s: Table) -> SpringHint:
+    spring = SpringHint(s.string("joint"), s.number("rate_Nmm_per_deg", min=0.0, max=1e6),
+                        s.number("preload_deg", 0.0, min=-3600.0, max=3600.0),
+                        s.number("legs_mm", None, positive=True, max=1e4), s.string("note", ""))
+    s.finish()
+    return spring
+
+
+def _purchased(p: Table) -> PurchasedItem:
+    item = PurchasedItem(p.string("item"), p.integer("qty", 1, min=1, max=1_000_000), p.string("note", ""))
+    p.finish()
+    return item
+
+
+def _pad(p: Table) -> PadHint:
+    arc = p.strings("arc", None)
+    if arc is not None and len(arc) != 2:
+        raise SpecError(p.field("arc"), f"expected the two points the pad's arc runs between, got {len(arc)}")
+    pad = PadHint(p.string("point"), p.number("radius_mm", None, positive=True, max=1e4),
+                  (arc[0], arc[1]) if arc is not None else None)
+    p.finish()
+    return pad
+
+
+def parse_exact(t: Table, name: str) -> tuple[Mechanism, PartHints, str | None]:
     """The mechanism and the parts hints of an exact ``[linkage]`` table (``t`` after ``exact``)."""
 
     unit = t.string("input_unit", choices=("deg", "mm"))
@@ -252,9 +296,9 @@ def parse_exact(t: Any, name: str) -> tuple[Mechanism, dict[str, Any], str | Non
     assembly_t = t.table("assembly", {})
     assembly = {k: tuple(assembly_t.array(k, shape=(3,), min=-1e5, max=1e5).tolist()) for k in list(assembly_t.data)}
     assembly_t.finish()
-    hints = _hints(t)
+    hints = read_hints(t.table("hints", {}))
     t.finish()
     mech = Mechanism(name=name, bodies=tuple(bodies), ground=ground, joints=tuple(joints), gears=tuple(gears),
                      drivers=tuple(drivers), input_range=(float(rng[0]), float(rng[1])), input_unit=unit,
                      assembly=assembly)
-    return mech, hints, hints.get("tip_point")
+    return mech, hints, hints.tip_point

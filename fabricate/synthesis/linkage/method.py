@@ -11,6 +11,7 @@ import numpy as np
 
 from fabricate.bounds import blas_threads
 from fabricate.errors import LockupError, SpecError
+from fabricate.hints import PadHint, PartHints
 from fabricate.mechanism import Mechanism, Motion
 from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.linkage.declared import ExactLinkageSpec, LinkageSpec
@@ -59,9 +60,7 @@ def synthesise(design: DesignSpec) -> SynthesisResult:
 
         return gear_law_figures(mech)
 
-    parts: dict[str, Any] = {"pads": {p.body: {"point": p.point, "radius_mm": p.radius_mm} for p in spec.pads}}
-    if spec.tip_point is not None:
-        parts["tip_point"] = spec.tip_point
+    parts = PartHints(tip_point=spec.tip_point, pads={p.body: PadHint(p.point, p.radius_mm) for p in spec.pads})
     return SynthesisResult(mechanism=mech, report=report, figures=figures, data={"spec": spec}, parts=parts)
 
 
@@ -71,7 +70,7 @@ def _exact_form(spec: ExactLinkageSpec, sweep_poses: int) -> SynthesisResult:
               "degrees_of_freedom": spec.mechanism.degrees_of_freedom(), "tip_point": spec.tip_point}
     with blas_threads(), contextlib.suppress(LockupError):
         spec.mechanism.sweep(sweep_poses)  # solved here with one BLAS thread; the pipeline's sweep is cached
-    return SynthesisResult(mechanism=spec.mechanism, report=report, parts=dict(spec.hints))
+    return SynthesisResult(mechanism=spec.mechanism, report=report, parts=spec.hints)
 
 
 def _report(spec: LinkageSpec, mech: Mechanism, motion: Motion | None) -> dict[str, Any]:

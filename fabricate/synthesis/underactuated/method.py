@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from fabricate.errors import SynthesisError
+from fabricate.hints import PadHint, PartHints, PurchasedItem, SpringHint
 from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.underactuated.closing import closing_motion, final_contact_forces
 from fabricate.synthesis.underactuated.mechanism import build_mechanism, mobility
@@ -53,16 +54,16 @@ def synthesise(design: DesignSpec) -> SynthesisResult:
             "distal_rate_rad_per_mm_final": distal_rate(d, pose_end),
         },
     }
-    springs = [{"joint": f"G{i + 1}", "rate_Nmm_per_deg": float(spec.spring_rates[i] * np.pi / 180.0),
-                "preload_deg": float(np.degrees(spec.spring_preloads[i])), "legs_mm": spec.spring_legs,
-                "note": "return spring, opens the joint against its stop"} for i in range(d.n)]
-    parts = {
-        "springs": springs,
-        "purchased": [{"item": f"linear actuator, stroke >= {spec.stroke:.0f} mm, force >= "
-                               f"{spec.push_force:.0f} N", "qty": 1, "note": "drives the push rod"}],
-        "tip_point": "tip",
-        "pads": {f"phalanx{d.n}": {"point": "tip", "radius_mm": 0.5 * d.thickness}},
-    }
+    springs = tuple(SpringHint(f"G{i + 1}", float(spec.spring_rates[i] * np.pi / 180.0),
+                               float(np.degrees(spec.spring_preloads[i])), spec.spring_legs,
+                               "return spring, opens the joint against its stop") for i in range(d.n))
+    parts = PartHints(
+        springs=springs,
+        purchased=(PurchasedItem(f"linear actuator, stroke >= {spec.stroke:.0f} mm, force >= {spec.push_force:.0f} N",
+                                 1, "drives the push rod"),),
+        tip_point="tip",
+        pads={f"phalanx{d.n}": PadHint("tip", float(0.5 * d.thickness))},
+    )
 
     def figures() -> dict[str, bytes]:
         from fabricate.synthesis.underactuated.plots import closing_figures

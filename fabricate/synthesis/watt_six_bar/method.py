@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from fabricate.errors import SynthesisError
+from fabricate.hints import PadHint, PartHints
 from fabricate.mechanism import Mechanism
 from fabricate.synthesis.base import SynthesisResult
 from fabricate.synthesis.watt_six_bar.burmester import distance_to_curve
@@ -94,7 +95,7 @@ def synthesise_spec(spec: WattSixBarSpec, name: str = "finger_watt_six_bar") -> 
         return plots.all_figures(spec, finger, region, refined, choice)
 
     data = {"region": region, "refined": refined, "choice": choice, "finger": finger, "inputs": inputs}
-    parts = {"pads": {"distal": {"point": "c", "radius_mm": spec.tip_pad_radius_mm}}, "tip_point": "c"}
+    parts = PartHints(tip_point="c", pads={"distal": PadHint("c", spec.tip_pad_radius_mm)})
     return SynthesisResult(mechanism=mech, report=report, figures=figures, data=data, parts=parts)
 
 

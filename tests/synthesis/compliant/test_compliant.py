@@ -213,8 +213,8 @@ def test_mechanism_sweeps_the_closing_motion():
     assert np.allclose(-sweep.relative_angle("tip", "middle"), motion.phi1, atol=1e-6)
     assert np.allclose(-sweep.relative_angle("middle", "root"), motion.phi2, atol=1e-6)
     assert res.report["paper_optimum"]["F_n2_N"] == pytest.approx(3.7809, abs=1e-3)
-    assert res.parts["copies"] == 3 and res.parts["pads"]["tip"]["radius_mm"] == 36.0
-    assert {s["joint"] for s in res.parts["springs"]} == {"B", "C"}
+    assert res.parts.copies == 3 and res.parts.pads is not None and res.parts.pads["tip"].radius_mm == 36.0
+    assert {s.joint for s in res.parts.springs} == {"B", "C"}
     pngs = res.figures()
     assert set(pngs) == {"grasp_force.png", "closing.png"}
     assert all(v[:8] == b"\x89PNG\r\n\x1a\n" for v in pngs.values())

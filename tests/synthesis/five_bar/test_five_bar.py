@@ -262,7 +262,7 @@ def test_mechanism_names_and_gear_convention(paper_result):
     motion = paper_result.data.motion
     x_a = motion.relative_angle("ground", "proximal")
     assert lo - 1e-9 <= x_a.min() and x_a.max() <= hi + 1e-9
-    assert paper_result.parts["tip_point"] == "P" and "distal" in paper_result.parts["pads"]
+    assert paper_result.parts.tip_point == "P" and "distal" in (paper_result.parts.pads or {})
 
 
 def _io_equation_tip(result, psi_deg: np.ndarray) -> np.ndarray:

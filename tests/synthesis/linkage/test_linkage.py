@@ -18,6 +18,7 @@ import pytest
 
 from fabricate.cli import main
 from fabricate.errors import LockupError, SpecError
+from fabricate.hints import PartHints
 from fabricate.pipeline import synthesise
 from fabricate.spec import design_from_text, load_design
 from fabricate.templates import TEMPLATE_DIR
@@ -528,7 +529,7 @@ def test_exact_form_synthesis_solves_the_sweep_the_pipeline_asks_for() -> None:
     from fabricate.synthesis.linkage.mechanism import build_mechanism
 
     design = load_design(TEMPLATE_DIR / "linkage_stephenson.toml")
-    text = mechanism_toml(design, build_mechanism(design.name, design.method), {}).decode("utf-8")
+    text = mechanism_toml(design, build_mechanism(design.name, design.method), PartHints()).decode("utf-8")
     exact = design_from_text(text, "mechanism.toml")
     mech = synthesise(exact).mechanism
     inputs = np.linspace(*mech.input_range, exact.checks.sweep_poses)

@@ -289,7 +289,7 @@ def test_paper_template_builds_a_finger_that_passes_the_positions(paper_result):
     motion = mech.sweep(361)
     tips = motion.point("c")[[0, 90, 225, 360]]
     assert np.max(np.hypot(*(tips - res.data["finger"].c).T)) <= 0.5
-    assert res.parts["tip_point"] == "c" and res.parts["pads"]["distal"]["point"] == "c"
+    assert res.parts.tip_point == "c" and res.parts.pads is not None and res.parts.pads["distal"].point == "c"
     json.dumps(rep)  # JSON-ready
 
 
