@@ -8,9 +8,10 @@ from fabricate.catalogue.actuators import CATALOGUE
 from fabricate.cli import main
 from fabricate.drive.spec import ActuatorSpec, catalogue_keys, parse_actuator
 from fabricate.errors import SpecError
-from fabricate.spec import design_from_text
+from fabricate.spec import design_from_text, load_design
 from fabricate.table import Table
-from fabricate.templates import TEMPLATE_DIR
+from fabricate.templates import TEMPLATE_DIR, parse_toml, shipped_templates
+from fabricate.tomlwrite import dumps
 
 
 def _parse(data: dict) -> ActuatorSpec | None:
@@ -69,21 +70,31 @@ def test_an_incomplete_catalogue_entry_is_refused_with_its_gaps() -> None:
     assert err.value.path == "actuator.model" and "incomplete" in str(err.value)
 
 
-def _with_actuator(table: str) -> str:
-    return (TEMPLATE_DIR / "finger_watt_six_bar.toml").read_text(encoding="utf-8").split("[actuator]")[0] + table
+def _with_actuator(actuator: dict) -> str:
+    """The six-bar finger's template with ``[actuator]`` replaced."""
+    data = parse_toml((TEMPLATE_DIR / "finger_watt_six_bar.toml").read_text(encoding="utf-8"), "t")
+    data["actuator"] = actuator
+    return dumps(data)
 
 
 def test_the_design_carries_its_actuator() -> None:
-    design = design_from_text(_with_actuator('\n[actuator]\nmodel = "mg90s"\nmargin = 2.5\n'), "x.toml")
+    design = design_from_text(_with_actuator({"model": "mg90s", "margin": 2.5}), "x.toml")
     assert design.actuator == ActuatorSpec(model="mg90s", margin=2.5)
 
 
 def test_a_bad_actuator_exits_2_naming_the_field_and_writes_nothing(tmp_path, capsys) -> None:
     path = tmp_path / "bad.toml"
-    path.write_text(_with_actuator('\n[actuator]\nmodel = "sg90"\nmargin = 0.5\n'), encoding="utf-8")
+    path.write_text(_with_actuator({"model": "sg90", "margin": 0.5}), encoding="utf-8")
     out = tmp_path / "out"
     code = main(["build", str(path), "-o", str(out)])
     captured = capsys.readouterr()
     assert code == 2
     assert "actuator.margin" in captured.err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("template", [p.stem for p in shipped_templates()])
+def test_every_shipped_template_names_a_catalogue_actuator(template: str) -> None:
+    spec = load_design(template).actuator
+    assert spec is not None and spec.model in catalogue_keys() and spec.margin >= 1.5
+    assert spec.source  # why this actuator, for people
