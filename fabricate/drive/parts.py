@@ -683,7 +683,7 @@ def _attach_rod_end(design: Any, mechanism: Mechanism, motion: Motion, ps: PartS
     best: tuple[float, np.ndarray] | None = None
     for sign in (1.0, -1.0):
         u = sign * axis_b
-        extent = float(np.max((material - line) @ u))
+        extent = float(np.max((material - line) @ u)) + (tol if cuts else 0.0)  # chords lie inside the arcs
         centre = line + u * (max(extent, 0.0) + wall + 0.5 * (hole_nominal + comp))
         score = min((float(np.hypot(*(centre - o))) for o in others), default=math.inf)
         if best is None or score > best[0] + 1e-9:
