@@ -578,7 +578,7 @@ class _Rotary:
             mount_part=mount.name, fasteners=tuple(fasteners), standoffs=tuple(standoffs), solids=tuple(solids),
             notes=tuple(self.notes))
         return dataclasses.replace(ps, parts=tuple(parts), pins=pins, spacers=spacers, bom=bom,
-                                   warnings=warnings, actuator=record)  # type: ignore[call-arg]
+                                   warnings=warnings, actuator=record)
 
     def _mount(self, place: geo.Placement, ground: Part, flip: bool
                ) -> tuple[Part, list[Fastener], list[Standoff], list[Part], list[geo.Solid]]:
@@ -711,4 +711,4 @@ def _attach_rod_end(design: Any, mechanism: Mechanism, motion: Motion, ps: PartS
         z_face=float(rod.z_mm + 0.5 * rod.thickness_mm), flip=False, removed_pin="", interface=("actuator_rod_end",),
         mount_part="", fasteners=(), standoffs=(), solids=(),
         notes=(f"the {what} acts along the slide axis on a Ø{pin_mm:g} mm pin in the rod-end hole",))
-    return dataclasses.replace(ps, parts=parts, bom=bom, warnings=warnings, actuator=record)  # type: ignore[call-arg]
+    return dataclasses.replace(ps, parts=parts, bom=bom, warnings=warnings, actuator=record)
