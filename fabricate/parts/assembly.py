@@ -27,7 +27,7 @@ class StackItem:
     item : str
         Part name, or the spacer / washer's BOM item, or the spring's designation.
     kind : str
-        ``part``, ``spacer``, ``washer`` or ``spring`` (on the pin's extension beyond the stack).
+        ``part``, ``spacer``, ``washer``, ``clip`` (a retainer on the pin's end) or ``spring`` (beyond the stack).
     z_mm : (float, float)
         Bottom and top along the pin (mm, the assembly's z).
     """
@@ -67,6 +67,8 @@ def pin_stacks(partset: PartSet) -> list[PinStack]:
         for part in partset.parts:
             if part.role == "spacer" or part.body not in pin.bodies:
                 continue
+            if part.role == "arbor" and not any(h.joint == f"arbor_{pin.joint}" for h in part.holes):
+                continue  # a spring's arbor on another pin of the same plate
             # a pin through a body passes its hole, or rides in its slot (a slider's guide)
             on_hole = any(h.joint in joints for h in part.holes)
             name = part.name if on_hole or not getattr(part, "slots", ()) else f"{part.name} (in its slot)"
@@ -76,12 +78,15 @@ def pin_stacks(partset: PartSet) -> list[PinStack]:
         for spacer in partset.spacers:
             if spacer.joint != pin.joint:
                 continue
-            kind = "washer" if spacer.washer else "spacer"
+            # the retention's kind where it gives one (a clip on the pin's end), else washer or spacer tube
+            kind = {"clip": "clip", "washer": "washer"}.get(getattr(spacer, "kind", ""),
+                                                            "washer" if spacer.washer else "spacer")
             z = (round(spacer.z_mm, 6), round(spacer.z_mm + spacer.length_mm, 6))
-            # a spacer printed with the parts goes by its part name; a bought one by its size
+            # a spacer printed with the parts goes by its part name; a bought one by its standard designation,
+            # else its size
             printed_name = printed.get(z[0]) if not spacer.washer else None
             size = f"{spacer.inner_diameter_mm:g}/{spacer.outer_diameter_mm:g} x {spacer.length_mm:.2f} mm"
-            name = printed_name or f"{kind} {size}"
+            name = printed_name or getattr(spacer, "designation", "") or f"{kind} {size}"
             items.append(StackItem(name, kind, z))
         for spring in getattr(partset, "springs", ()) or ():
             if spring.pin == pin.joint:
@@ -214,22 +219,26 @@ def _pin_words(pin: Any) -> str:
 
 
 def _retention(pin: Any) -> tuple[str, str]:
-    """How the pin is held (the parts layer's retention scheme where it gives one) and the tool for it."""
-    scheme = getattr(pin, "retention", None)
-    if scheme is None:
-        return "retain the pin: a drop of retaining adhesive where it leaves the outer plates", "pin punch"
-    text = scheme if isinstance(scheme, str) else (_words(scheme, "words", "description", "scheme", "kind")
-                                                  or str(scheme))
-    low = text.lower()
-    if "press" in low:
-        tool = "bench vice or arbor press (press the pin in square), pin punch"
-    elif "clip" in low or "ring" in low:
-        tool = "E-clip pliers or a flat screwdriver to push the clip into its groove"
-    elif "cap" in low or "head" in low:
-        tool = "pin punch; a drop of retaining adhesive for the printed cap"
-    else:
-        tool = "pin punch"
-    return text, tool
+    """How the pin is held (the parts layer's retention: ``press``, ``clip`` or ``cap``) and the tool for it."""
+    scheme = str(getattr(pin, "retention", "") or "")
+    ends = getattr(pin, "end_items", ((), ()))
+    on_ends = "; ".join(f"{where}: {' + '.join(items)}" for where, items in zip(("bottom", "top"), ends, strict=False)
+                        if items)
+    if scheme == "press":
+        short = min(getattr(pin, "protrusion_mm", (0.0, 0.0))) < 0.0
+        text = (f"press the pin into {getattr(pin, 'holder', '') or 'the part that holds it'} "
+                f"({float(getattr(pin, 'engagement_mm', 0.0)):.3g} mm engaged{', short of its face' if short else ''})"
+                "; it runs free in the other parts")
+        return text, "bench vice or arbor press (press the pin in square, supporting the part round the hole)"
+    if scheme == "clip":
+        grooves = ", ".join(f"{g:.2f}" for g in getattr(pin, "grooves_mm", ()))
+        text = (f"the pin runs in every part; clips in its grooves ({grooves} mm from its bottom end)"
+                + (f", on its ends {on_ends}" if on_ends else ""))
+        return text, "E-clip pliers or a flat screwdriver (to push each clip into its groove)"
+    if scheme == "cap":
+        return ("the pin runs in every part; bond its printed end caps onto both ends with retaining adhesive",
+                "retaining adhesive, pin punch")
+    return "retain the pin: a drop of retaining adhesive where it leaves the outer plates", "pin punch"
 
 
 def _screw_tool(rows: Sequence[dict[str, Any]]) -> str:
@@ -305,9 +314,16 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
                 continue
             seen_bodies.add(body)
             for part in partset.parts:
-                if part.body == body and part.role not in ("spacer", "mount", "standoff"):
+                if part.body == body and part.role not in ("spacer", "mount", "standoff", "arbor", "cap"):
                     part_step.setdefault(part.name, f"pin:{pin.joint}")
+    for sp in springs.values():
+        if sp.arbor:
+            part_step[sp.arbor] = f"spring:{sp.pin}"  # the coil's arbor goes on with the coil
     for part in partset.parts:
+        if part.role == "cap":  # a pin's bonded end cap, with its pin
+            joint = next((h.joint for h in part.holes if h.joint in stack_of), "")
+            if joint:
+                part_step.setdefault(part.name, f"pin:{joint}")
         part_step.setdefault(part.name, "drive" if part.role in ("mount", "standoff") else "ground")
 
     # every BOM unit to one step: (step key) -> {item: GuideItem}
@@ -383,16 +399,21 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
             upper = 1.0 if spring.hand == "RH" else -1.0
             far_turn = upper if spring.side == "top" else -upper
             way = "counter-clockwise" if far_turn > 0 else "clockwise"
+            seat = (f"the arbor {spring.arbor} (bond it to {spring.near_part}'s face round the pin's {spring.side} "
+                    "end first, with retaining adhesive)" if spring.arbor else f"the pin's {spring.side} end")
             text = [f"Slide the coil ({spring.hand} wound, Ø{s.wire_d_mm:.2f} mm wire, OD {s.outer_d_mm:.2f} mm) "
-                    f"over the pin's {spring.side} end until it sits on {spring.near_part}.",
+                    f"over {seat} until it sits on {spring.near_part}.",
                     f"Hook the near leg's bent end into the anchor hole in {spring.near_part} "
                     f"(Ø{spring.anchor_hole_mm:.2f} mm, {spring.leg_radii_mm[0]:g} mm from the pin).",
                     f"Wind the far leg {spring.deflection_deg[0]:.0f}° {way} (seen from above) and drop its end into "
                     f"the anchor hole in {spring.far_part} ({spring.leg_radii_mm[1]:g} mm from the pin, "
                     f"{spring.leg_axial_mm[1]:.1f} mm down along the pin).",
-                    f"Retention: {retention}; it also keeps the spring on the pin."]
+                    f"Retention: {retention}; " + ("the clip beyond the coil also keeps the spring on the pin."
+                                                   if "clip" in retention.lower() and not spring.arbor else
+                                                   "the legs' ends in their anchor holes keep the coil in place.")]
             add(f"spring:{pin.joint}", f"Torsion spring at {spring.joint}", text,
-                "long-nose pliers (to wind and place the legs)", new_springs=(spring.joint,))
+                "long-nose pliers (to wind and place the legs)",
+                [n for n, k in part_step.items() if k == f"spring:{pin.joint}"], new_springs=(spring.joint,))
 
     drive_parts = [n for n, k in part_step.items() if k == "drive"]
     if actuator is not None or "drive" in units or drive_parts:

@@ -6,11 +6,14 @@ length), :func:`place_springs` sizes a music-wire torsion spring with
 (preload plus the joint's travel, with the strength check's sign convention) and places it:
 
 * **On the pin's extension beyond the stack**, seated on the outer face of the end plate of one of the two
-  bodies it joins (the top of the stack where one of them is the top plate, else the bottom). There the
-  layers, spacers and washers of the stack stay as they are (a coil between two plates would push them
+  bodies it joins (the end away from a pressed pin's holder first, so its press fit stays as it is). There
+  the layers, spacers and washers of the stack stay as they are (a coil between two plates would push them
   apart and change every layer above), the pin keeps the coil on the joint's axis, and the pin's
-  retention (clip or head) beyond the coil also keeps the spring on. The pin grows by the coil's wound
-  body length.
+  retention beyond the coil (a clip) also keeps the spring on. The pin grows by the coil's wound body
+  length, as long as the lengthened pin is still a standard one its retention fits (:func:`_seat` asks
+  the retention's own plan). Where it is not (a long coil on a thin pin: the gripper's 27 mm coil on its
+  Ø3 pin, whose standard lengths end at 30 mm), the coil rides instead on a printed arbor tube bonded to
+  that plate's face round the pin's end, as large as the coil's wound inside diameter allows.
 * **Legs hooked into anchor holes in the two bodies.** The near leg runs out radially along the face of
   the plate it sits on and its end is bent axially into an anchor hole in that plate. The far leg runs out
   radially at the coil's far end, then axially back along the pin, outside the plates in between, into an
@@ -114,6 +117,9 @@ class PlacedSpring:
         largest coil, over its allowable.
     note : str
         What it is for (the synthesis' words).
+    arbor : str
+        The printed arbor part the coil rides on where the pin cannot be lengthened to carry it ('': the
+        pin's extension carries it).
     """
 
     joint: str
@@ -139,6 +145,7 @@ class PlacedSpring:
     free_angle_deg: float
     within_series: bool
     note: str = ""
+    arbor: str = ""
 
     @property
     def anchor_joint(self) -> str:
@@ -270,8 +277,75 @@ def _towards(material: Any, axis: np.ndarray, radius: float) -> np.ndarray:
     return axis + radius * (direction / norm if norm > 1e-9 else np.array([1.0, 0.0]))
 
 
+def _ends(pin: Pin, parts_by: Mapping[str, Part], process: ProcessSpec) -> list[tuple[str, str]]:
+    """The stack's ends whose outer plate is one of the spring's two bodies, as ``(side, body)``: the end
+    away from a pressed pin's holder first (there the pin's press fit is left as it is)."""
+    z0, z1 = float(pin.z_mm), float(pin.z_mm) + float(pin.length_mm)
+    ends = [("top", b) for b, p in parts_by.items() if abs(p.z_mm + p.thickness_mm - z1) < 1e-6]
+    ends += [("bottom", b) for b, p in parts_by.items() if abs(p.z_mm - z0) < 1e-6]
+    press = process.retention == "press"
+    ends.sort(key=lambda e: press and e[1] == pin.bodies[0])  # a stable sort
+    return ends
+
+
+def _on_pin(pin: Pin, parts: Sequence[Part], ends: Sequence[tuple[str, str]], length: float,
+            process: ProcessSpec, ground: str) -> tuple[str, str] | None:
+    """The first end where the pin lengthened by ``length`` is still a standard pin its retention fits (the
+    retention's own plan, :func:`~fabricate.parts.retention.plan_pin`, is asked); None: no end."""
+    from fabricate.parts.retention import plan_pin
+
+    z0, z1 = float(pin.z_mm), float(pin.z_mm) + float(pin.length_mm)
+    press = process.retention == "press"
+    holder = pin.bodies[0]
+    first = next((p for p in parts if p.body == holder and p.role != "spacer"
+                  and any(h.joint == pin.joint for h in p.holes)), None)
+    for side, body in ends:
+        stack = (z0, z1 + length) if side == "top" else (z0 - length, z1)
+        try:
+            plan_pin(pin.joint, process, stack, holder if press and first is not None else "",
+                     (first.z_mm, first.z_mm + first.thickness_mm) if first is not None else None, holder == ground)
+        except SpecError:
+            continue
+        return side, body
+    return None
+
+
+def _arbor_mm(pin: Pin, process: ProcessSpec) -> float:
+    """The least arbor tube: the pin's running hole with the process's wall round it."""
+    from fabricate.parts.retention import hole_size
+
+    return hole_size(process, float(pin.diameter_mm), "running").modelled_mm + 2.0 * process.min_wall_mm
+
+
+def _sized(rate: float, work: float, preload: float, legs: tuple[float, float],
+           arbor: float) -> tuple[TorsionSpring, bool]:
+    """The catalogue's spring on an arbor of ``arbor`` mm, or the over-stressed stand-in (and False)."""
+    try:
+        return torsion_spring(rate, work, rate * preload, legs, arbor), True
+    except SpecError:
+        return _overloaded(rate, work, rate * preload, legs, arbor), False
+
+
+def _arbor_part(name: str, near: Part, joint: str, diameter: float, z: tuple[float, float],
+                process: ProcessSpec) -> Part:
+    """A printed (or cut) tube the coil rides on, bonded to the near plate's outer face, its bore the pin's
+    running hole."""
+    from fabricate.parts.profiles import circle_hull
+    from fabricate.parts.retention import hole_size
+
+    centre = np.asarray(next(h.centre for h in near.holes if h.joint == joint), dtype=np.float64)
+    bore = next(h for h in near.holes if h.joint == joint)
+    size = hole_size(process, bore.pin_diameter_mm or float(process.pin_diameter_mm), "running")
+    # its bore is named apart from the pin's holes: the pin does not reach into it (a pin's stack, its
+    # bending span and its retention stay those of the plates)
+    return Part(name=name, body=near.body, outline=circle_hull(centre[None, :], np.array([0.5 * diameter])),
+                holes=(Hole(f"arbor_{joint}", centre, size.modelled_mm, 0.0, "running", size.nominal_mm),),
+                thickness_mm=z[1] - z[0], z_mm=z[0], layer=near.layer, process=process.name, role="arbor")
+
+
 def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, parts: Sequence[Part],
-                  pins: Sequence[Pin], process: ProcessSpec) -> tuple[tuple[PlacedSpring, ...], list[Part], list[Pin]]:
+                  pins: Sequence[Pin], process: ProcessSpec,
+                  ground: str = "") -> tuple[tuple[PlacedSpring, ...], list[Part], list[Pin]]:
     """Size and place every spring of the hints; the parts get their anchor holes, the pins their extension.
 
     Parameters
@@ -284,7 +358,10 @@ def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, pa
         The body parts (anchor holes are added to copies) and the pins (the spring's pin is lengthened by the
         coil's wound body).
     process : ProcessSpec
-        Running clearance, hole compensation and minimum wall of the anchor holes; chord tolerance.
+        Running clearance, hole compensation and minimum wall of the anchor holes; chord tolerance; the
+        retention whose standard pins must still carry a lengthened pin.
+    ground : str
+        The ground body (a pressed pin's holder there leaves its mounting face flush).
 
     Returns
     -------
@@ -319,29 +396,37 @@ def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, pa
             parts_by = {b: _part_of(parts, b, pin.joint) for b in (joint.body_a, joint.body_b)}
         except SpecError as exc:
             raise GeometryError(f"spring at {name}: {exc}") from None
-        top = {b: p.z_mm + p.thickness_mm for b, p in parts_by.items()}
-        z_top = pin.z_mm + pin.length_mm
-        at_top = [b for b in parts_by if abs(top[b] - z_top) < 1e-6]
-        at_bottom = [b for b, p in parts_by.items() if abs(p.z_mm - pin.z_mm) < 1e-6]
-        side = "top" if at_top or not at_bottom else "bottom"
-        near = (at_top or at_bottom or [joint.body_b])[0]
-        far = joint.body_a if near == joint.body_b else joint.body_b
-        near_part, far_part = parts_by[near], parts_by[far]
         pin_mm = float(pin.diameter_mm)
         legs_default = float(legs_hint) if legs_hint else 2.5 * (pin_mm + 2.0)
         legs = (legs_default, legs_default)
-        try:
-            spring = torsion_spring(rate, work, rate * preload, legs, pin_mm)
-            within = True
-        except SpecError:
-            spring = _overloaded(rate, work, rate * preload, legs, pin_mm)
-            within = False
+        ends = _ends(pin, parts_by, process)
+        spring, within = _sized(rate, work, preload, legs, pin_mm)
+        seat = _on_pin(pin, parts, ends, spring.body_length_wound_mm, process, ground)
+        arbor_od = 0.0
+        if seat is None and ends:
+            # the coil cannot ride on the pin's extension: on a printed arbor round the pin's end, the coil
+            # sized to clear the arbor as the catalogue clears a pin
+            arbor_min = _arbor_mm(pin, process)
+            spring, within = _sized(rate, work, preload, legs, arbor_min)
+            arbor_od = max(arbor_min, math.floor(ARBOR_RATIO * spring.inner_d_wound_mm * 10.0 + 1e-9) / 10.0)
+            seat = ends[0]
+        if seat is None:
+            raise GeometryError(f"spring at {name}: no end of pin {pin.joint}'s stack is one of the joint's plates "
+                                "to seat the coil on")
+        side, near = seat
+        far = joint.body_a if near == joint.body_b else joint.body_b
+        near_part, far_part = parts_by[near], parts_by[far]
         length = spring.body_length_wound_mm
-        if side == "top":
-            z = (z_top, z_top + length)
+        z_top = pin.z_mm + pin.length_mm
+        z = (z_top, z_top + length) if side == "top" else (pin.z_mm - length, pin.z_mm)
+        arbor = ""
+        if arbor_od:
+            # the coil rides on a printed arbor bonded to the near plate's outer face (the pin is not lengthened)
+            arbor = f"spring_arbor_{name}"
+            parts.append(_arbor_part(arbor, near_part, pin.joint, arbor_od, z, process))
+        elif side == "top":
             pins[k] = replace(pin, length_mm=pin.length_mm + length)
         else:
-            z = (pin.z_mm - length, pin.z_mm)
             pins[k] = replace(pin, length_mm=pin.length_mm + length, z_mm=pin.z_mm - length)
         # anchors: the leg wire plus the running fit and the compensation, with the process's wall round it
         hole = spring.wire_d_mm + 2.0 * process.running_clearance_mm + process.hole_compensation_mm
@@ -367,11 +452,10 @@ def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, pa
             near_r = far_r = max(legs[0], r_min)
             near_at = _towards(near_material, np.asarray(axis[near], dtype=np.float64), near_r)
             far_at = _towards(far_material, np.asarray(axis[far], dtype=np.float64), far_r)
-        # the nominal (finished) size apart from the process's compensation, where the hole records it
-        nominal = ({"nominal_diameter_mm": hole - process.hole_compensation_mm}
-                   if "nominal_diameter_mm" in getattr(Hole, "__dataclass_fields__", {}) else {})
-        anchor = Hole(f"spring_{name}", near_at, hole, 0.0, **nominal)
-        far_hole = Hole(f"spring_{name}", far_at, hole, 0.0, **nominal)
+        # a running fit for the leg's end: the nominal (finished) size apart from the process's compensation
+        nominal = hole - process.hole_compensation_mm
+        anchor = Hole(f"spring_{name}", near_at, hole, 0.0, "running", nominal)
+        far_hole = Hole(f"spring_{name}", far_at, hole, 0.0, "running", nominal)
         for part, extra in ((near_part, anchor), (far_part, far_hole)):
             idx = parts.index(part)
             parts[idx] = replace(parts[idx], holes=tuple(parts[idx].holes) + (extra,))
@@ -403,7 +487,7 @@ def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, pa
             leg_radii_mm=(round(float(near_r), 3), round(float(far_r), 3)),
             leg_axial_mm=(round(axial[0], 3), round(axial[1], 3)), anchor_hole_mm=hole,
             deflection_deg=(float(deflection.min()), float(deflection.max())), hand=hand, free_angle_deg=free,
-            within_series=within, note=str(_get(hint, "note", "") or "")))
+            within_series=within, note=str(_get(hint, "note", "") or ""), arbor=arbor))
     return tuple(placed), parts, pins
 
 
@@ -494,8 +578,10 @@ def spring_sweep_items(springs: Sequence[PlacedSpring], chord_tolerance_mm: floa
         anchor = sp.anchor_joint
         ring = (circle_polygon(sp.centre, s.outer_d_mm, tol),
                 circle_polygon(sp.centre, max(s.inner_d_wound_mm, s.pin_diameter_mm + 1e-3), tol, clockwise=True))
+        # the coil bears on the plate it sits on, on its arbor and on its own legs: touching, never overlapping
+        seats = [sp.pin, anchor] + ([f"arbor_{sp.pin}"] if sp.arbor else [])
         items.append(SweepItem(f"spring_{sp.joint}", sp.pin_body, "spacer", ring, sp.z_mm[0], sp.z_mm[1],
-                               frozenset([sp.pin, anchor]), "", sp))
+                               frozenset(seats), "", sp))
         d = s.wire_d_mm
         near_z = (sp.z_mm[0], sp.z_mm[0] + d) if sp.side == "top" else (sp.z_mm[1] - d, sp.z_mm[1])
         far_z = (sp.z_mm[1] - d, sp.z_mm[1]) if sp.side == "top" else (sp.z_mm[0], sp.z_mm[0] + d)
@@ -520,7 +606,7 @@ def _leg(axis: np.ndarray, anchor: np.ndarray, r0: float, d: float, tol: float) 
     direction = np.asarray(anchor, dtype=np.float64) - axis
     length = float(np.hypot(*direction))
     u = direction / length
-    start = axis + u * r0
+    start = axis + u * (r0 + 0.5 * d)  # its round start touches the coil's outside
     n = np.array([-u[1], u[0]])
     half = 0.5 * d
     arc = max(4, int(math.ceil(math.pi / (2.0 * math.acos(max(-1.0, 1.0 - tol / max(half, tol)))))))

@@ -54,8 +54,7 @@ def orange(png: bytes) -> int:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", sorted(t.removesuffix(".toml") for t in shipped_templates()
-                                        if not t.startswith("process_")))
+@pytest.mark.parametrize("name", [p.stem for p in shipped_templates()])
 def test_guide_lists_every_bom_unit_once_per_copy_with_its_pictures(shipped_build, name):
     outcome = shipped_build(name)
     md = outcome.files["assembly.md"].decode()
@@ -90,3 +89,38 @@ def test_report_md_puts_the_interference_table_last(shipped_build):
     assert md.index("[assembly.md](assembly.md)") < md.index("## Mechanism")
     assert md.index("## Strength") < md.index("## Files") < md.index("## Interference")
     assert "| a | b | contact |" in md[md.index("## Interference"):]
+
+
+def test_guide_of_a_four_bar_fits_every_unit_once_and_draws_each_step(sla_process):
+    """Fast: a four-bar in two copies with a spring and a shared motor, built by the parts layer alone."""
+    from types import SimpleNamespace
+
+    from fabricate.export.guide import guide_markdown, guide_pictures, guide_steps
+    from fabricate.hints import PartHints, PurchasedItem, SpringHint
+    from fabricate.parts.build import build_parts
+    from fabricate.parts.spec import PartsSpec
+    from tests.conftest import make_four_bar
+
+    mech = make_four_bar()
+    motion = mech.sweep(41)
+    design = SimpleNamespace(name="t", process=sla_process, parts=PartsSpec(),
+                             gears=SimpleNamespace(hub_diameter_mm=None))
+    hints = PartHints(copies=2, springs=(SpringHint("B", 0.2, 10.0, 12.0),),
+                      purchased_shared=(PurchasedItem("drive motor", 1, "turns the crank"),))
+    partset = build_parts(design, mech, motion, [], hints)
+    steps = guide_steps(partset, motion)
+    md = guide_markdown(steps, "t", partset.copies)
+    assert listed(md) == expected(partset.bom, 2)
+    assert ("drive motor", True) in listed(md)
+    titles = [s.title for s in steps]
+    assert titles[0] == "The ground part" and titles[-1] == "Check the motion"
+    # the spring's step comes right after its pin's
+    assert titles.index("Torsion spring at B") == titles.index("Pin B") + 1
+    assert "Repeat steps 1–" in md
+    pictures = guide_pictures(partset, motion, steps)
+    assert sorted(pictures) == [s.picture for s in steps]
+    spring_step = steps[titles.index("Torsion spring at B")]
+    assert orange(pictures[spring_step.picture]) > 0  # the new spring is highlighted
+    for before, after in zip(steps, steps[1:], strict=False):
+        if after.new:
+            assert drawn(pictures[after.picture]) > drawn(pictures[before.picture])
