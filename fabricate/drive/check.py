@@ -255,6 +255,12 @@ def run_drive(design: DesignSpec, mechanism: Mechanism, motion: Motion, hints: A
         volts = f" at {actuator.voltage_v:g} V" if actuator.voltage_v is not None else ""
         result.notes.append(f"the catalogue gives no rated (continuous) value: the stall or holding value{volts} is "
                             "used, so the margin is all the reserve there is")
+    load = design.load
+    if load is not None and spec.driver == 0 and (load.input_force_N or load.input_torque_Nmm):
+        push = load.input_force_N if driver.kind == "slide" else load.input_torque_Nmm
+        result.notes.append(f"the design load is the actuator's own effort ([load] {push:g} {unit}): the check says "
+                            "the actuator gives it with the margin; limit the drive to it (more overloads the parts "
+                            "the strength check holds to it)")
     statics = input_statics(design, mechanism, motion, hints, strength)
     if statics is None:
         result.reason = NO_LOAD
