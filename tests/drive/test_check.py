@@ -271,3 +271,4 @@ def test_every_shipped_template_is_driven_by_its_actuator(template: str, shipped
     assert drive["peak_effort"] <= drive["allowed"] and drive["least_margin"] >= drive["margin"]
     assert not any(f.startswith("drive:") for f in outcome.failures)
     assert "plots/drive.png" in outcome.files
+    assert "## Drive" in outcome.files["report.md"].decode("utf-8")
