@@ -34,7 +34,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
+import shapely.ops
 
+from fabricate.catalogue.actuators import Shaft
 from fabricate.catalogue.hardware import ISO4762, ISO7089, screw
 from fabricate.drive import geometry as geo
 from fabricate.errors import SpecError
@@ -325,6 +327,8 @@ class _Rotary:
         self.comp = float(self.process.hole_compensation_mm)
         self.wall = float(self.process.min_wall_mm)
         self.notes: list[str] = []
+        self.new_ground_holes: list[Hole] = []
+        self.ground_arms: list[np.ndarray] = []
 
     # the pin the output replaces
     def _pin(self) -> Any:
@@ -343,12 +347,10 @@ class _Rotary:
         stack (``inf`` when the shaft then does not reach half way into the driven part)."""
         entry, t = self.entry, float(self.process.thickness_mm)
         z_d, t_d = float(driven.z_mm), float(driven.thickness_mm)
-        if entry.kind == "servo":
+        if entry.horn is not None:
             seat1 = geo.horn_seat_z(entry)[1]
             return z_d + t_d + seat1 if flip else z_d - seat1
-        shaft = entry.shaft
-        if shaft is None:
-            raise SpecError("actuator.model", f"{entry.key!r} has no output shaft in the catalogue")
+        shaft = self._shaft()
         plate0 = geo.mount_plate_z(entry)
         top = max(geo.output_base_z(entry), plate0 + t)
         tapped = [h.thread for h in entry.mounting_holes or () if h.thread in ISO4762]
@@ -365,25 +367,38 @@ class _Rotary:
             short = z_face + shaft.length_mm < z_d + 0.5 * t_d - 1e-9
         return math.inf if short else z_face
 
+    def _shaft(self) -> Shaft:
+        """The output the driven part sits on without a horn: the motor's shaft, or a servo's spline (round:
+        the part is pressed on it)."""
+        entry = self.entry
+        if entry.shaft is not None:
+            return entry.shaft
+        if entry.spline is not None:
+            return Shaft(entry.spline.diameter_mm, entry.spline.length_mm, 0, None, None)
+        raise SpecError("actuator.model", f"{entry.key!r} has no output shaft or spline in the catalogue")
+
     def _conflicts(self, flip: bool, driven: Part, z_face: float) -> float:
         """How badly the actuator on this side meets the other parts: 1 for a static part it passes through
-        (the ground, which gets a clearance hole), 10 for each moving part that comes within the actuator's
-        reach of the axis in the z range between the driven part and the actuator's far end."""
+        (the ground, which gets a clearance hole), 10 for each moving part that comes within reach of the
+        axis: the output's (horn or shaft) between the driven part and the output face, the body's beyond."""
         if not math.isfinite(z_face):
             return math.inf
         entry = self.entry
         corners = [np.hypot(x, y) for b in entry.body or () for x in (b.x0, b.x1) for y in (b.y0, b.y1)]
-        reach = max([*corners, *(geo.horn_reach(entry.horn) for _ in [0] if entry.horn is not None)], default=0.0)
+        out_reach = geo.horn_reach(entry.horn) if entry.horn is not None else 0.5 * self._shaft().diameter_mm
         depth = min([b.z0 for b in entry.body or ()], default=0.0)
-        span = geo.Placement(np.zeros(2), 0.0, flip, z_face).z_range(depth, 0.0)
-        lo, hi = (span[0], driven.z_mm) if not flip else (driven.z_mm + driven.thickness_mm, span[1])
+        near = (driven.z_mm + driven.thickness_mm, z_face) if flip else (z_face, driven.z_mm)
+        far = geo.Placement(np.zeros(2), 0.0, flip, z_face).z_range(depth, 0.0)
+        spans = [(near, out_reach), (far, max(corners, default=0.0))]
         picks = np.unique(np.linspace(0, len(self.motion.inputs) - 1, min(60, len(self.motion.inputs)))
                           .round().astype(int))
         axis = shapely.Point(*self.mechanism.body(self.driven).point(self.joint))
         pose_d = self.motion.pose(self.driven)[picks]
         cost = 0.0
         for part in self.ps.parts:
-            if part.body == self.driven or part.z_mm >= hi - 1e-9 or part.z_mm + part.thickness_mm <= lo + 1e-9:
+            z0, z1 = part.z_mm, part.z_mm + part.thickness_mm
+            reach = max([r for (lo, hi), r in spans if z0 < hi - 1e-9 and z1 > lo + 1e-9], default=None)
+            if part.body == self.driven or reach is None:
                 continue
             if part.body == self.ground:
                 cost += 1.0
@@ -397,6 +412,138 @@ class _Rotary:
                     cost += 10.0
                     break
         return cost
+
+    def _orient(self, angle: float, centre: np.ndarray, ground: Part, flip: bool, z_face: float) -> float:
+        """The turn nearest ``angle`` (10 degree steps) at which the standoffs on the ground's mounting holes
+        keep clear of the actuator's body between its mount plate and the ground part."""
+        entry = self.entry
+        mounting = [h for h in ground.holes if h.joint.startswith("mount_")]
+        if not mounting or not entry.body:
+            return angle
+        pz = geo.mount_plate_z(entry)
+        # the ground part's near face in the entry's z: the standoffs run from the plate up to it
+        faces = [(g - z_face) if not flip else (z_face - g) for g in (ground.z_mm, ground.z_mm + ground.thickness_mm)]
+        near = min(faces)
+        boxes = [b for b in entry.body if b.z1 > pz + 1e-9 and b.z0 < near - 1e-9]
+        rects = [geo.rectangle(b.x0 - self.c, b.y0 - self.c, b.x1 + self.c, b.y1 + self.c) for b in boxes]
+        discs = [(np.asarray(h.centre, dtype=float), 0.5 * h.diameter_mm + max(self.wall, 0.25 * h.diameter_mm))
+                 for h in mounting]
+        for k in sorted(range(-18, 19), key=lambda k: (abs(k), k)):
+            turn = angle + math.radians(10.0 * k)
+            place = geo.Placement(centre, turn, flip, z_face)
+            shapes = [shapely.Polygon(geo.placed_ring(r, place)) for r in rects]
+            if all(shape.distance(shapely.Point(c)) >= r for shape in shapes for c, r in discs):
+                return turn
+        return angle
+
+    def _standoff_sites(self, place: geo.Placement, ground: Part, lo: float, hi: float) -> list[Hole]:
+        """Where the standoffs stand on the ground part (holes of the ground): its mounting holes that keep
+        clear of the actuator (body, output) and of every part moving between the plate and the ground; else
+        two new holes (``standoff_1``, ``standoff_2``), as far apart as the ground part's free material allows;
+        none if it has none."""
+        from fabricate.parts.build import swept_region
+
+        entry, c = self.entry, self.c
+        nominal = float(self.design.parts.mounting_hole_mm) + 2.0 * c
+        hole_d = nominal + self.comp
+        outer = hole_d + 2.0 * max(self.wall, 0.25 * hole_d)
+        forbidden = []
+        for b in entry.body or ():
+            z0, z1 = place.z_range(b.z0, b.z1)
+            if z0 < hi - 1e-9 and z1 > lo + 1e-9:
+                forbidden.append(shapely.Polygon(geo.placed_ring(geo.rectangle(b.x0, b.y0, b.x1, b.y1), place)))
+        out_reach = geo.horn_reach(entry.horn) if entry.horn is not None else 0.5 * self._shaft().diameter_mm
+        forbidden.append(shapely.Point(*place.centre).buffer(out_reach, 64))
+        t = float(self.process.thickness_mm)
+        for mh in entry.mounting_holes or ():  # the plate's own screws: their holes and heads
+            f = geo.fastening(entry, mh, t, c, self.comp)
+            head = ISO4762[f.size].head_d_mm if f.tapped else 0.0
+            radius = max(0.5 * f.plate_hole_mm + self.wall, 0.5 * head)
+            forbidden.append(shapely.Point(*place.plan(np.array([mh.x, mh.y]))).buffer(radius, 32))
+        if self.ground == self.mechanism.ground:
+            moving = {p.body: p.outline for p in self.ps.parts if p.body != self.ground
+                      and p.z_mm < hi - 1e-9 and p.z_mm + p.thickness_mm > lo + 1e-9}
+            if moving:
+                forbidden.append(swept_region(moving, self.motion))
+        keep_out = shapely.union_all(forbidden).buffer(0.5 * outer + c)
+        existing = [h for h in ground.holes if h.joint.startswith("mount_")]
+        clear = [h for h in existing if not keep_out.contains(shapely.Point(h.centre))
+                 and keep_out.distance(shapely.Point(h.centre)) > 0.0]
+        if len(clear) >= min(2, len(existing)) and clear:
+            return clear
+        # new sites on the ground part's own material, clear of its holes
+        inset = max(0.5 * outer, 0.5 * hole_d + self.wall)
+        region = shapely.Polygon(ground.outline.polygon(0.05)).buffer(-inset)
+        for h in ground.holes:
+            region = region.difference(shapely.Point(h.centre).buffer(0.5 * (h.diameter_mm + hole_d) + self.wall))
+        region = region.difference(keep_out)
+        if region.is_empty or region.area < 1e-6:
+            return self._standoff_arms(place, ground, keep_out, nominal, hole_d, outer) or clear
+        xs, ys = np.meshgrid(*(np.arange(a, b + 0.25, 0.25) for a, b in
+                               zip(region.bounds[:2], region.bounds[2:], strict=True)))
+        pts = np.column_stack([xs.ravel(), ys.ravel()])
+        pts = pts[shapely.contains_xy(region, pts[:, 0], pts[:, 1])]
+        if len(pts) == 0:
+            pts = np.array(region.representative_point().coords)
+        if len(pts) == 1:
+            picks = pts
+        else:
+            gaps = np.hypot(*(pts[:, None, :] - pts[None, :, :]).transpose(2, 0, 1)) if len(pts) < 1500 else None
+            if gaps is None:  # a coarse pair: the points farthest along the region's long direction
+                u = pts - pts.mean(axis=0)
+                axis = np.linalg.svd(u, full_matrices=False)[2][0]
+                picks = pts[[int(np.argmin(u @ axis)), int(np.argmax(u @ axis))]]
+            else:
+                i, j = np.unravel_index(int(np.argmax(gaps)), gaps.shape)
+                picks = pts[[i, j]] if gaps[i, j] >= outer + self.wall else pts[[i]]
+        self.new_ground_holes = [_hole(f"actuator_standoff_{k + 1}", p, nominal, self.comp, fit="clearance")
+                                 for k, p in enumerate(picks)]
+        return list(self.new_ground_holes)
+
+    def _standoff_arms(self, place: geo.Placement, ground: Part, keep_out: Any, nominal: float, hole_d: float,
+                       outer: float) -> list[Hole]:
+        """Two standoff sites off the ground part, each on an arm the ground part grows to reach it (in its own
+        layer, clear of what moves there): the sites nearest the ground part that clear ``keep_out``, at least
+        three standoffs apart. Sets :attr:`ground_arms`; [] when no site is found."""
+        from fabricate.parts.build import swept_region
+
+        if self.ground != self.mechanism.ground:
+            return []
+        body = shapely.Polygon(ground.outline.polygon(0.05))
+        g0, g1 = ground.z_mm, ground.z_mm + ground.thickness_mm
+        same_layer = {p.body: p.outline for p in self.ps.parts if p.body != self.ground
+                      and p.z_mm < g1 - 1e-9 and p.z_mm + p.thickness_mm > g0 + 1e-9}
+        swept = swept_region(same_layer, self.motion).buffer(self.c + 0.5) if same_layer else shapely.Polygon()
+        boss = max(0.5 * outer, 0.5 * hole_d + self.wall)
+        reach = max([math.hypot(x, y) for b in self.entry.body or () for x in (b.x0, b.x1) for y in (b.y0, b.y1)],
+                    default=20.0) + 4.0 * outer
+        xs, ys = np.meshgrid(*(np.arange(-reach, reach + 1.0, 1.0),) * 2)
+        pts = np.column_stack([xs.ravel(), ys.ravel()]) + np.asarray(place.centre, dtype=float)
+        pts = pts[~shapely.contains_xy(keep_out, pts[:, 0], pts[:, 1])]
+        pts = pts[shapely.distance(keep_out, shapely.points(pts)) > 0.0]
+        order = np.argsort(shapely.distance(body, shapely.points(pts)))
+        sites: list[np.ndarray] = []
+        arms: list[np.ndarray] = []
+        for k in order:
+            p = pts[k]
+            if any(float(np.hypot(*(p - q))) < 3.0 * outer for q in sites):
+                continue
+            near = np.array(shapely.ops.nearest_points(body, shapely.Point(p))[0].coords[0])
+            arm = circle_hull(np.array([near, p]), np.array([boss, boss])) if np.hypot(*(p - near)) > 1e-6 \
+                else circle_hull(p[None, :], boss)
+            ring = arm.polygon(0.05)
+            if not swept.is_empty and shapely.Polygon(ring).intersects(swept):
+                continue
+            sites.append(p)
+            arms.append(ring)
+            if len(sites) == 2:
+                break
+        if len(sites) < 2:
+            return []
+        self.ground_arms = arms
+        self.new_ground_holes = [_hole(f"actuator_standoff_{k + 1}", p, nominal, self.comp, fit="clearance")
+                                 for k, p in enumerate(sites)]
+        return list(self.new_ground_holes)
 
     def _away(self, centre: np.ndarray) -> np.ndarray:
         """Unit direction, in the ground body's frame, from what moves to the axis."""
@@ -451,6 +598,7 @@ class _Rotary:
             ex = ex * np.array([1.0, -1.0])
         # the body's centre (off the axis for a servo or a 28BYJ-48) points away from what moves
         angle = math.atan2(away[1], away[0]) - (math.atan2(ex[1], ex[0]) if float(np.hypot(*ex)) > 1e-6 else 0.0)
+        angle = self._orient(angle, c_g, ground, flip, z_face)
         alpha = self._arm_angle()
         interface: list[str] = []
         solids: list[geo.Solid] = []
@@ -459,7 +607,7 @@ class _Rotary:
         holes = [h for h in driven.holes if h.joint != pin.joint]
         t_d = float(driven.thickness_mm)
         pad_circles: list[tuple[np.ndarray, float]] = []
-        if entry.kind == "servo":
+        if entry.horn is not None:
             horn, spline = entry.horn, entry.spline
             assert horn is not None and spline is not None  # a servo entry has both (catalogue)
             seat0, seat1 = geo.horn_seat_z(entry)
@@ -508,20 +656,24 @@ class _Rotary:
                        (arm0 - horn_screw.head_h_mm, arm0, 2.0 * heads)]
             default_clear = bore
         else:
-            shaft = entry.shaft
-            if shaft is None:
-                raise SpecError("actuator.model", f"{entry.key!r} has no output shaft in the catalogue")
+            shaft = self._shaft()
             base = geo.output_base_z(entry)
             flats = geo.shaft_flats(shaft)
             radial = self.c + 0.5 * self.comp if flats else 0.5 * self.comp
-            if not flats:
+            if entry.shaft is None:  # a servo's spline, no horn catalogued: the part is pressed on the spline
+                press = float(getattr(self.process, "press_fit_interference_mm", 0.0) or 0.0)
+                radial = 0.5 * (self.comp - press)
+                self.notes.append(f"no horn in the catalogue: press the driven part onto the servo's Ø"
+                                  f"{shaft.diameter_mm:g} mm spline (bore Ø{shaft.diameter_mm - press:g} mm "
+                                  "nominal, the teeth cut their way) and fix it with the servo's centre screw")
+            elif not flats:
                 self.notes.append(f"the Ø{shaft.diameter_mm:g} mm shaft is round (no flat in the catalogue): "
                                   "the bore is a slip fit; secure the part with adhesive or a clamp")
             slots.append(geo.shaft_bore(shaft, c_d, alpha, radial))
-            interface.append("actuator_shaft_bore")
+            interface.append("actuator_shaft_bore" if entry.shaft is not None else "actuator_spline_bore")
             pad_circles.append((c_d, 0.5 * shaft.diameter_mm + radial + self.wall))
             place_d = geo.Placement(c_d, alpha, flip, z_face)
-            solids.append(geo.Solid("actuator_shaft", "output",
+            solids.append(geo.Solid("actuator_shaft" if entry.shaft is not None else "actuator_spline", "output",
                                     (geo.circle_ring(c_d, shaft.diameter_mm, self.tol),),
                                     *place_d.z_range(base, shaft.length_mm)))
             passing = [(base, shaft.length_mm, shaft.diameter_mm)]
@@ -544,7 +696,11 @@ class _Rotary:
         fasteners += mount_fasteners
         solids += mount_solids
         ground_pad = circle_hull(np.asarray(c_g, dtype=float)[None, :], 0.5 * (clear + self.comp) + self.wall)
-        new_ground = _with(ground, outline=_fuse(ground.outline, ground_pad, self.tol), holes=tuple(ground_holes))
+        ground_holes += self.new_ground_holes
+        outline = _fuse(ground.outline, ground_pad, self.tol)
+        if self.ground_arms:
+            outline = fuse_polygons(outline, list(self.ground_arms), self.tol)
+        new_ground = _with(ground, outline=outline, holes=tuple(ground_holes))
         # the pin's spacers go with it (printed spacer parts too)
         removed = {p.name for p in ps.parts if p.role == "spacer" and any(h.joint == pin.joint for h in p.holes)}
         parts = []
@@ -617,10 +773,10 @@ class _Rotary:
         circles.append((np.asarray(place.centre, dtype=float), self.wall))
         standoffs: list[Standoff] = []
         standoff_parts: list[Part] = []
-        mounting = [h for h in ground.holes if h.joint.startswith("mount_")]
         g0, g1 = float(ground.z_mm), float(ground.z_mm + ground.thickness_mm)
         lo, hi = (g1, z0) if flip else (z1, g0)
-        if mounting and hi - lo > 1e-6:
+        mounting = self._standoff_sites(place, ground, lo, hi) if hi - lo > 1e-6 else []
+        if mounting:
             size = _screw_size(float(self.design.parts.mounting_hole_mm))
             d = float(size.lstrip("M"))
             printed = process.technique == "additive"
@@ -631,16 +787,18 @@ class _Rotary:
                 st = Standoff(h.joint, np.asarray(h.centre, dtype=float), inner, outer, hi - lo, lo, printed)
                 standoffs.append(st)
                 pilot = geo.PILOT_FRACTION * d
-                holes.append(_hole(f"actuator_{h.joint}", st.centre, pilot, self.comp, fit="tapped"))
+                name = h.joint.removeprefix("actuator_")
+                holes.append(_hole(f"actuator_{name}", st.centre, pilot, self.comp, fit="tapped"))
                 circles.append((st.centre, max(0.5 * outer, 0.5 * (pilot + self.comp) + self.wall)))
                 ring = circle_hull(st.centre[None, :], 0.5 * outer)
                 if printed:
-                    standoff_parts.append(Part(name=safe_name(f"standoff_{h.joint}"), body=self.ground, outline=ring,
+                    standoff_parts.append(Part(name=safe_name(name if name.startswith("standoff") else
+                                                              f"standoff_{name}"), body=self.ground, outline=ring,
                                                holes=(_hole(h.joint, st.centre, inner - self.comp, self.comp),),
                                                thickness_mm=st.length_mm, z_mm=st.z_mm, layer=ground.layer,
                                                process=process.name, role="standoff"))
                 else:
-                    solids.append(geo.Solid(f"standoff_{h.joint}", "standoff",
+                    solids.append(geo.Solid(name if name.startswith("standoff") else f"standoff_{name}", "standoff",
                                             (geo.circle_ring(st.centre, outer, tol),
                                              geo.circle_ring(st.centre, inner, tol)[::-1]), st.z_mm,
                                             st.z_mm + st.length_mm))
@@ -648,9 +806,9 @@ class _Rotary:
             fix = geo.screw_into(size, float(ground.thickness_mm) + (hi - lo), t)
             fasteners.append(Fastener(fix.designation, count, "mount plate to the ground part through the standoffs "
                                       "(taps into the plate)", fix.clamp_mm, fix.engagement_mm))
-        elif not mounting:
-            self.notes.append("the ground part has no mounting holes ([parts] mounting_holes = 0): fix the mount "
-                              "plate to the same base as the ground part")
+        else:
+            self.notes.append("no place on the ground part for the mount's standoffs: fix the mount plate to the "
+                              "same base as the ground part")
         outline = circle_hull(np.array([c for c, _ in circles]), np.array([r for _, r in circles]))
         layers = [p.layer for p in self.ps.parts]
         plate = SlottedPart(name=MOUNT_PART, body=self.ground, outline=outline, holes=tuple(holes), thickness_mm=t,
