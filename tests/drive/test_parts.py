@@ -218,3 +218,26 @@ def test_an_actuator_that_does_not_suit_the_driver_is_a_spec_error(sla_process):
         driven(sla_process, "sg90", mech=slider_crank(), poses=11)
     with pytest.raises(SpecError, match="actuator.driver"):
         driven(sla_process, "sg90", poses=11, driver=3)
+
+
+def test_without_mounting_holes_the_ground_takes_new_standoff_holes(sla_process):
+    mech = make_four_bar()
+    motion = mech.sweep(37)
+    bare = build_parts(SimpleNamespace(**{**vars(design(sla_process, None)), "parts": PartsSpec(mounting_holes=0)}),
+                       mech, motion, [])
+    d = SimpleNamespace(**{**vars(design(sla_process, "mg996r")), "parts": PartsSpec(mounting_holes=0)})
+    ps = attach_actuator(d, mech, motion, bare)
+    ground, mount = ps.part("ground"), ps.part(MOUNT_PART)
+    new = holes(ground, "actuator_standoff")
+    assert len(new) == 2 and len(ps.actuator.standoffs) == 2
+    assert {st.hole for st in ps.actuator.standoffs} == {h.joint for h in new}
+    outline = shapely.Polygon(ground.outline.polygon(0.001))
+    for h in new:
+        # in the ground's material with a wall round the hole, and under a pilot hole of the plate
+        assert outline.exterior.distance(shapely.Point(h.centre)) >= h.diameter_mm / 2 + sla_process.min_wall_mm - 0.01
+        assert outline.contains(shapely.Point(h.centre))
+        assert any(np.allclose(p.centre, h.centre) for p in holes(mount, "actuator_standoff"))
+    # the standoffs keep clear of the servo's case (the sweep's "fixed" pairs) and of what moves
+    result = sweep(ps, motion)
+    assert result.passed, result.failures()
+    assert any(p.relation == "fixed" and "standoff" in p.a + p.b for p in result.pairs)
