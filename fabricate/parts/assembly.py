@@ -380,7 +380,8 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
     for pin in order:
         stack = stack_of.get(pin.joint)
         new = [n for n, k in part_step.items() if k == f"pin:{pin.joint}"]
-        on = [i for i in (stack.items if stack else ()) if i.kind != "spring"]
+        arbors = {sp.arbor for sp in springs.values()}
+        on = [i for i in (stack.items if stack else ()) if i.kind != "spring" and i.item not in arbors]
         listing = "; ".join(f"{i.item} ({i.kind}, z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" if i.kind != "part"
                             else f"{i.item} (z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" for i in on)
         retention, tool = _retention(pin)
@@ -406,8 +407,8 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
                     f"Hook the near leg's bent end into the anchor hole in {spring.near_part} "
                     f"(Ø{spring.anchor_hole_mm:.2f} mm, {spring.leg_radii_mm[0]:g} mm from the pin).",
                     f"Wind the far leg {spring.deflection_deg[0]:.0f}° {way} (seen from above) and drop its end into "
-                    f"the anchor hole in {spring.far_part} ({spring.leg_radii_mm[1]:g} mm from the pin, "
-                    f"{spring.leg_axial_mm[1]:.1f} mm down along the pin).",
+                    f"the anchor hole in {spring.far_part} ({spring.leg_radii_mm[1]:g} mm from the pin; the leg's "
+                    f"end runs {spring.leg_axial_mm[1]:.1f} mm along the pin to it).",
                     f"Retention: {retention}; " + ("the clip beyond the coil also keeps the spring on the pin."
                                                    if "clip" in retention.lower() and not spring.arbor else
                                                    "the legs' ends in their anchor holes keep the coil in place.")]
