@@ -19,9 +19,10 @@ def clearance_png(result: InterferenceResult, max_pairs: int = MAX_PAIRS) -> byt
     Deterministic bytes (no timestamps in the metadata).
     """
     plt = pyplot()
-    # the plot's line is the running clearance: spacers bearing on their joint touch by design and gear
-    # teeth are held to their backlash, so both are named in a note instead of drawn under the line
-    own_limits = ("bearing", "meshing")
+    # the plot's line is the running clearance: spacers bearing on their joint (and an actuator fixed to its
+    # body's parts) touch by design and gear teeth are held to their backlash, so they are named in a note
+    # instead of drawn under the line
+    own_limits = ("bearing", "meshing", "fixed")
     shown = [p for p in result.pairs if p.relation not in own_limits]
     pairs = sorted(shown, key=lambda p: (p.min_clearance_mm, p.a, p.b))[:max_pairs]
     fig, ax = plt.subplots(figsize=(10.0, 4.5), dpi=100)
@@ -39,7 +40,8 @@ def clearance_png(result: InterferenceResult, max_pairs: int = MAX_PAIRS) -> byt
     ax.axhline(result.min_clearance_required_mm, color="red", ls="--", lw=1.0,
                label=f"running clearance required {result.min_clearance_required_mm:g} mm")
     notes = []
-    for relation, held_to in (("meshing", "backlash band (gear mesh check)"), ("bearing", "no overlap")):
+    for relation, held_to in (("meshing", "backlash band (gear mesh check)"), ("bearing", "no overlap"),
+                              ("fixed", "no overlap")):
         group = [p for p in result.pairs if p.relation == relation]
         if group:
             worst = min(p.min_clearance_mm for p in group)
