@@ -165,7 +165,7 @@ def guide_pictures(partset: PartSet, motion: Motion, steps: Sequence[GuideStep])
                     ax.plot(ring[:, 0], ring[:, 1], color=colour, linewidth=0.8)
                 for leg in legs:
                     ax.plot(leg[:, 0], leg[:, 1], color=colour, linewidth=0.8)
-        ax.text(0.02, 0.97, f"step {step.number}", transform=ax.transAxes, fontsize=8, va="top", color=EDGE)
+        fig.text(0.02, 0.97, f"step {step.number}", fontsize=8, va="top", color=EDGE)
         files[step.picture] = png_bytes(fig)
     return files
 
