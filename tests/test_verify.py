@@ -460,7 +460,7 @@ def test_a_3mf_with_another_compression_method_is_not_inflated(copy, capsys):
 def test_an_image_declaring_too_many_pixels_is_not_decoded(copy, capsys):
     from PIL import Image
 
-    from fabricate.verify import IMAGE_MAX_PIXELS
+    from fabricate.verify_files import IMAGE_MAX_PIXELS
 
     side = int(IMAGE_MAX_PIXELS**0.5) + 1
     buffer = io.BytesIO()

@@ -59,7 +59,7 @@ def _fast_and_bounded(monkeypatch):
     blocking the suite."""
     import fabricate.export.step as step
     import fabricate.pipeline as pipeline
-    import fabricate.verify as verify
+    import fabricate.verify_files as verify_files
 
     monkeypatch.setattr(step, "step_available", lambda: False)
 
@@ -72,7 +72,7 @@ def _fast_and_bounded(monkeypatch):
         return _REBUILDS[key]
 
     monkeypatch.setattr(pipeline, "run_build", cached_build)
-    real_content = verify.content_problems
+    real_content = verify_files.content_problems
 
     def cached_content(rel, data, expected):
         key = (rel, hashlib.sha256(data).hexdigest(), repr(expected))
@@ -80,7 +80,7 @@ def _fast_and_bounded(monkeypatch):
             _VERDICTS[key] = real_content(rel, data, expected)
         return list(_VERDICTS[key])
 
-    monkeypatch.setattr(verify, "content_problems", cached_content)
+    monkeypatch.setattr(verify_files, "content_problems", cached_content)
 
     def hung(_signum, _frame):
         raise TimeoutError("check blocked for 120 s (a FIFO or device opened?)")
