@@ -54,8 +54,8 @@ def load(template: str | Path | Mapping[str, Any], process: str | Path | None = 
         On the first invalid field, naming it; an argument of the wrong type names the argument
         (``template``, ``process``) or, inside a dict, the value's path.
     """
+    from fabricate.design import design_from_text, load_design
     from fabricate.process import process_override
-    from fabricate.spec import design_from_text, load_design
 
     if process is not None:
         process = str(path_argument(process, "process", '"sla", "laser" or a process profile file'))
@@ -210,8 +210,8 @@ def build(design: DesignSpec | str | Path | Mapping[str, Any], process: str | Pa
                                       f"a design it returned, or a Mechanism; got {type_name(design)}")
         design, process = load(design, process), None
     if process is not None:
+        from fabricate.design import design_from_text
         from fabricate.process import process_override
-        from fabricate.spec import design_from_text
 
         override = process_override(str(path_argument(process, "process", '"sla", "laser" or a process profile file')))
         design = design_from_text(design.template_text, design.template, override)

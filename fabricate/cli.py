@@ -310,10 +310,10 @@ def _default_output(name: str, template: Path, stage: str) -> Path:
 
 
 def _build(args: argparse.Namespace) -> int:
+    from fabricate.design import load_design
     from fabricate.output import check_output_dir, write_output
     from fabricate.pipeline import run_build, run_synth
     from fabricate.process import shipped_profiles
-    from fabricate.spec import load_design
 
     design = load_design(args.template, args.process)
     stage = args.command
@@ -333,8 +333,8 @@ def _build(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
+    from fabricate.design import load_design
     from fabricate.pipeline import run_build
-    from fabricate.spec import load_design
     from fabricate.templates import find_template, path_kind
 
     target = Path(args.target)
@@ -473,7 +473,7 @@ def _list() -> int:
 
 
 def _init(args: argparse.Namespace) -> int:
-    from fabricate.spec import design_from_text
+    from fabricate.design import design_from_text
     from fabricate.templates import find_template, read_text
 
     name = args.name[:-5] if args.name.endswith(".toml") else args.name

@@ -11,8 +11,8 @@ Generic sections
 ``[process]``  profile (a shipped ``templates/process_<profile>.toml``: ``"sla"``, ``"laser"``...) and any
                field of that profile to override (:mod:`fabricate.process`).
 ``[checks]``   sweep_poses, min_clearance_mm, min_safety_factor.
-``[gears]``, ``[parts]``, ``[load]``  read by :mod:`fabricate.gears.spec`, :mod:`fabricate.parts.spec`,
-               :mod:`fabricate.strength.spec`.
+``[gears]``, ``[parts]``, ``[load]``, ``[actuator]``  read by :mod:`fabricate.gears.spec`,
+               :mod:`fabricate.parts.spec`, :mod:`fabricate.strength.spec`, :mod:`fabricate.drive.spec`.
 Every other top-level table belongs to the kind's parser.
 """
 
@@ -23,11 +23,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from fabricate.errors import SpecError
-from fabricate.process import ProcessOverride, ProcessSpec, parse_process, process_override
+from fabricate.process import ProcessOverride, ProcessSpec
 from fabricate.table import Table
-from fabricate.templates import find_template, parse_toml, read_text
 
 if TYPE_CHECKING:  # the sections' parsers import this module's neighbours: names for the checker only
+    from fabricate.drive.spec import ActuatorSpec
     from fabricate.gears.spec import GearSpec
     from fabricate.parts.spec import PartsSpec
     from fabricate.strength.spec import LoadSpec
@@ -118,6 +118,10 @@ class DesignSpec:
         ``[parts]``: pad, hub and mounting options (defaults when the table is absent).
     method : object
         The kind's own frozen spec (see :mod:`fabricate.synthesis`).
+    load : fabricate.strength.spec.LoadSpec or None
+        ``[load]`` (its defaults when the table is absent).
+    actuator : fabricate.drive.spec.ActuatorSpec or None
+        ``[actuator]``: the catalogue actuator that drives the design; None when the template names none.
     """
 
     name: str
@@ -132,61 +136,4 @@ class DesignSpec:
     template_text: str = ""
     process_override: ProcessOverride | None = None
     load: LoadSpec | None = None
-
-
-def load_design(path: str | Path, process: str | ProcessOverride | None = None) -> DesignSpec:
-    """Load and validate a template file (a path, or a shipped template's name) into a :class:`DesignSpec`.
-
-    ``process`` (``--process``: ``"sla"``, ``"laser"``, a profile file or a :class:`ProcessOverride`)
-    replaces the template's process profile.
-
-    Raises
-    ------
-    SpecError
-        On the first invalid field, naming its path.
-    """
-    path = find_template(path)
-    if isinstance(process, str):
-        process = process_override(process)
-    return design_from_text(read_text(path), path, process)
-
-
-def design_from_text(text: str, path: str | Path, process: ProcessOverride | None = None) -> DesignSpec:
-    """Validate a template given as text; ``path`` is where it came from (its file name goes in reports).
-
-    ``fabricate check DIR`` rebuilds from the text embedded in a report with this, so the verdict depends
-    neither on the working folder nor on later edits of the file.
-    """
-    from fabricate.gears.spec import parse_gear_spec
-    from fabricate.kinds import KINDS
-    from fabricate.parts.spec import parse_parts_spec
-
-    path = Path(path)
-    if text.startswith("\ufeff"):
-        text = text[1:]
-    root = Table(parse_toml(text, str(path)))
-    design = root.table("design")
-    name = check_design_name(design.string("name"), design.field("name"))
-    kind = design.string("kind", choices=tuple(sorted(KINDS)))
-    description = design.string("description", "")
-    design.finish()
-    process_spec = parse_process(root.table("process", {}), process)
-    checks = parse_checks(root.table("checks", {}))
-    gears = parse_gear_spec(root.table("gears", {}))
-    parts = parse_parts_spec(root.table("parts", {}))
-    from fabricate.strength.spec import parse_load
-
-    load = parse_load(root.table("load", {}))
-    method = KINDS[kind].parse_spec(root)
-    root.finish()
-    bore = getattr(gears, "bore_mm", None)
-    if bore is not None and abs(bore - process_spec.pin_diameter_mm) > 1e-9:
-        # every joint, gear axes included, turns on a pin of the process diameter
-        pin = process_spec.pin_diameter_mm
-        raise SpecError("gears.bore_mm", f"{bore:g} mm differs from the pin diameter {pin:g} mm "
-                                         "the gears turn on; set process.pin_diameter_mm to it or leave bore_mm out")
-    spec = DesignSpec(name=name, kind=kind, description=description, template=path, process=process_spec,
-                      checks=checks, gears=gears, parts=parts, method=method, template_text=text,
-                      process_override=process, load=load)
-    KINDS[kind].preflight(spec)  # counts whose product drives memory or time (each field alone is already bounded)
-    return spec
+    actuator: ActuatorSpec | None = None  # [actuator]: what drives the design (None: nothing named)

@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
+from fabricate.design import load_design
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute
 from fabricate.pipeline import BuildOutcome, run_build
 from fabricate.planar import circle_circle_intersection
 from fabricate.process import ProcessSpec
-from fabricate.spec import load_design
 
 # Test modules' own @settings(...) inherit what they do not set from this profile.
 settings.register_profile("fabricate", deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -75,7 +75,7 @@ def laser_process() -> ProcessSpec:
     return ProcessSpec(name="laser", running_clearance_mm=0.1, hole_compensation_mm=0.0, min_wall_mm=3.0,
                        min_pin_mm=2.0, layer_gap_mm=0.5, thickness_mm=3.0, kerf_mm=0.2, min_feature_mm=0.5,
                        build_volume_mm=(600.0, 400.0, 3.0), pin_diameter_mm=3.0, chord_tolerance_mm=0.005,
-                       technique="cut", layout="sheet")
+                       technique="cut", layout="sheet", retention="clip", press_fit_interference_mm=0.0)
 
 
 #: ``{template name: outcome}`` of this test process (each pytest-xdist worker has its own).

@@ -14,9 +14,9 @@ import pytest
 
 from fabricate import bounds
 from fabricate.cli import main
+from fabricate.design import design_from_text, load_design
 from fabricate.errors import SpecError
 from fabricate.hints import PartHints
-from fabricate.spec import design_from_text, load_design
 from fabricate.templates import TEMPLATE_DIR, parse_toml
 from tests.synthesis.linkage.test_linkage import GEARED
 from tests.toml_writer import toml_text
@@ -386,8 +386,8 @@ def test_the_exact_form_of_the_largest_tables_is_a_valid_template() -> None:
     import numpy as np
 
     from fabricate.bounds import MAX_LINKAGE_TABLE
+    from fabricate.design import design_from_text
     from fabricate.errors import SpecError
-    from fabricate.spec import design_from_text
     from fabricate.synthesis.linkage.exact import mechanism_toml
     from fabricate.synthesis.linkage.mechanism import build_mechanism
     from fabricate.templates import MAX_TEMPLATE_BYTES

@@ -155,7 +155,7 @@ def test_same_template_gives_byte_identical_files(builds, shipped_build, name):
 def test_lockup_inside_the_range_is_a_design_failure(monkeypatch):
     """A mechanism that cannot move through its own range: exit 1 and the report says where."""
     import fabricate.pipeline as pipeline
-    from fabricate.spec import load_design
+    from fabricate.design import load_design
     from fabricate.synthesis.base import SynthesisResult
     from tests.conftest import make_four_bar
 
@@ -202,8 +202,8 @@ def test_every_build_writes_a_mechanism_toml_that_rebuilds_its_motion(builds, na
 
     import numpy as np
 
+    from fabricate.design import load_design
     from fabricate.pipeline import synthesise
-    from fabricate.spec import load_design
 
     _, out = builds(name)
     path = tmp_path / "mechanism.toml"

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
+from fabricate.design import design_from_text
 from fabricate.errors import SpecError
 from fabricate.kinds import KINDS, EntryPoint, Kind, package_kind, register
-from fabricate.spec import design_from_text
 
 #: Modules every kind package has (fabricate/synthesis/__init__.py describes each).
 SHAPE = ("__init__.py", "spec.py", "method.py", "mechanism.py", "plots.py")

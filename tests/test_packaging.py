@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from fabricate.cli import main
-from fabricate.spec import load_design
+from fabricate.design import load_design
 from fabricate.templates import TEMPLATE_DIR
 
 ROOT = Path(__file__).resolve().parent.parent

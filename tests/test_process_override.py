@@ -18,10 +18,10 @@ import shapely
 import shapely.ops
 
 from fabricate.cli import main
+from fabricate.design import design_from_text, load_design
 from fabricate.errors import SpecError
 from fabricate.hints import PartHints
 from fabricate.process import ProcessOverride, parse_process, process_override
-from fabricate.spec import design_from_text, load_design
 from fabricate.table import Table
 from fabricate.templates import TEMPLATE_DIR, read_toml, shipped_templates
 

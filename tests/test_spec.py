@@ -90,7 +90,7 @@ def test_valid_number_lists_round_trip(values):
 
 
 def test_gear_bore_must_match_the_pin(tmp_path):
-    from fabricate.spec import load_design
+    from fabricate.design import load_design
 
     text = ("[design]\nname = 'g'\nkind = 'gear_pair'\n[gear_pair]\nfamily = 'elliptic'\neccentricity = 0.2\n"
             "closed = true\n[gears]\nmodule_mm = 1.0\nteeth = [30, 30]\nbore_mm = 3.0\n")
@@ -108,7 +108,7 @@ def test_gear_bore_must_match_the_pin(tmp_path):
 def test_a_missing_required_key_names_its_misspelling():
     """The whole message of the issue's example, from a shipped template with the typo: the unread key that
     looks like the missing one is named with the key it should be."""
-    from fabricate.spec import design_from_text
+    from fabricate.design import design_from_text
     from fabricate.templates import TEMPLATE_DIR
 
     text = (TEMPLATE_DIR / "finger_five_bar_ncg.toml").read_text(encoding="utf-8")
@@ -156,7 +156,7 @@ def test_no_required_field_of_a_shipped_template_is_offered_a_valid_field():
     from collections import defaultdict
 
     import fabricate.table as table_module
-    from fabricate.spec import load_design
+    from fabricate.design import load_design
 
     read: dict[str, set[str]] = defaultdict(set)
     required: dict[str, set[str]] = defaultdict(set)
@@ -209,7 +209,7 @@ def test_design_names_that_make_folders_are_kept(name):
 
 
 def test_a_nul_in_the_template_design_name_is_a_spec_error():
-    from fabricate.spec import design_from_text
+    from fabricate.design import design_from_text
     from fabricate.templates import TEMPLATE_DIR
 
     text = (TEMPLATE_DIR / "gear_pair_elliptic.toml").read_text(encoding="utf-8")
@@ -219,7 +219,7 @@ def test_a_nul_in_the_template_design_name_is_a_spec_error():
 
 
 def test_integers_past_a_float_are_spec_errors():
-    from fabricate.spec import design_from_text
+    from fabricate.design import design_from_text
     from fabricate.templates import TEMPLATE_DIR
 
     text = (TEMPLATE_DIR / "gear_pair_elliptic.toml").read_text(encoding="utf-8")

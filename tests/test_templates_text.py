@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from fabricate.cli import main
-from fabricate.spec import load_design
+from fabricate.design import load_design
 from fabricate.templates import MAX_TEMPLATE_BYTES, TEMPLATE_DIR
 
 SOURCE = TEMPLATE_DIR / "gear_pair_elliptic.toml"

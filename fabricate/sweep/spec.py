@@ -293,7 +293,7 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None, *
     user gave the entries that did not come from the file: with ``{"vary.gears.module_mm": "--vary
     gears.module_mm"}`` an error in that entry ends "(given as --vary gears.module_mm)".
     """
-    from fabricate.spec import design_from_text
+    from fabricate.design import design_from_text
     from fabricate.templates import find_template, parse_toml, path_kind, read_text
 
     origins = origins or {}
@@ -448,7 +448,7 @@ def _given_as(origin: str | None, where: str) -> Iterator[None]:
 def _check_known(base: dict[str, Any], f: Field, where: str, source: str) -> None:
     """A field the base template leaves at its default must be one the template's kind knows: set its first
     value and validate (a misspelt path would otherwise make every point an "unknown field" row)."""
-    from fabricate.spec import design_from_text
+    from fabricate.design import design_from_text
     from fabricate.tomlwrite import dumps
 
     data = copy.deepcopy(base)

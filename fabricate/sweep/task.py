@@ -45,9 +45,9 @@ def evaluate(text: str, stage: str) -> tuple[int, str, dict[str, Any] | None, An
     exit_code, reason, report, outcome
         ``report`` is None when the point never got one (invalid or infeasible: exit code 2; a bug: 3).
     """
+    from fabricate.design import design_from_text
     from fabricate.errors import FabricateError
     from fabricate.pipeline import run_build, run_synth
-    from fabricate.spec import design_from_text
 
     try:
         design = design_from_text(text, "point.toml")

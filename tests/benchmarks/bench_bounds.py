@@ -215,8 +215,8 @@ def worst_linkage(poses: int = bounds.MAX_SWEEP_POSES, points: int = bounds.MAX_
 
 def _largest(make: Any, lo: int, hi: int) -> int:
     """The largest ``n`` in ``lo .. hi`` whose template ``make(n)`` validates (the preflight included)."""
+    from fabricate.design import design_from_text
     from fabricate.errors import SpecError
-    from fabricate.spec import design_from_text
 
     def valid(n: int) -> bool:
         try:
@@ -265,8 +265,8 @@ def worst_exact(copies: int = bounds.MAX_COPIES) -> str:
     The driver's table is halved until the file fits :data:`fabricate.templates.MAX_TEMPLATE_BYTES` (a guard: at
     the bound of 4000 samples in all the table writes 0.44 MB of PCHIP coefficients and fits as it is).
     """
+    from fabricate.design import design_from_text
     from fabricate.hints import PadHint, PartHints
-    from fabricate.spec import design_from_text
     from fabricate.synthesis.linkage.exact import mechanism_toml
     from fabricate.synthesis.linkage.mechanism import build_mechanism
     from fabricate.templates import MAX_TEMPLATE_BYTES

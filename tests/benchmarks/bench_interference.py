@@ -28,10 +28,10 @@ CLEARANCE = 0.25
 
 
 def seed000(poses: int):
+    from fabricate.design import load_design
     from fabricate.gears import build_gear_pairs
     from fabricate.parts.build import build_parts
     from fabricate.pipeline import synthesise
-    from fabricate.spec import load_design
     from fabricate.templates import TEMPLATE_DIR
 
     design = load_design(TEMPLATE_DIR / "finger_five_bar_ncg.toml")
@@ -95,8 +95,8 @@ def main() -> None:
         print(f"{r['case']:40s} {r['poses']:5d} {r['pairs']:5d} {r['fast_s']:8.3f} {r['naive_s']:8.2f} "
               f"{r['ratio']:6.0f}x {'yes' if r['same'] else 'NO':4s}  {r['collisions']}")
     if not args.four_bar:
+        from fabricate.design import load_design
         from fabricate.pipeline import run_build
-        from fabricate.spec import load_design
         from fabricate.templates import TEMPLATE_DIR
 
         design = load_design(TEMPLATE_DIR / "finger_five_bar_ncg.toml")

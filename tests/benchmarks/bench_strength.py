@@ -17,10 +17,10 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from fabricate.checks import run_checks  # noqa: E402
+from fabricate.design import load_design  # noqa: E402
 from fabricate.gears import build_gear_pairs  # noqa: E402
 from fabricate.parts.build import build_parts  # noqa: E402
 from fabricate.pipeline import synthesise  # noqa: E402
-from fabricate.spec import load_design  # noqa: E402
 from fabricate.strength.check import design_loads, run_strength  # noqa: E402
 from fabricate.strength.statics import solve_statics  # noqa: E402
 from fabricate.templates import shipped_templates  # noqa: E402

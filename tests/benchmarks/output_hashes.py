@@ -18,8 +18,8 @@ import sys
 
 def hashes() -> dict[str, dict[str, str]]:
     """``{template: {relative path: sha256}}`` of every shipped design template's build."""
+    from fabricate.design import load_design
     from fabricate.pipeline import run_build
-    from fabricate.spec import load_design
     from fabricate.templates import shipped_templates
 
     out: dict[str, dict[str, str]] = {}

@@ -544,10 +544,10 @@ def test_laser_parts_must_be_sheet_thick(laser_process):
 # -- seed-000 through the real layers ----------------------------------------------------------------
 @pytest.fixture(scope="module")
 def seed000():
+    from fabricate.design import load_design
     from fabricate.gears import build_gear_pairs
     from fabricate.parts.build import build_parts
     from fabricate.pipeline import synthesise
-    from fabricate.spec import load_design
     from fabricate.templates import TEMPLATE_DIR
 
     design = load_design(TEMPLATE_DIR / "finger_five_bar_ncg.toml")

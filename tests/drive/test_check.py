@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from fabricate.cli import main
+from fabricate.design import design_from_text
 from fabricate.drive.check import NO_ACTUATOR, NO_LOAD, drive_markdown, input_statics, run_drive
 from fabricate.errors import SpecError
 from fabricate.pipeline import synthesise
-from fabricate.spec import design_from_text
 from fabricate.templates import shipped_templates
 
 # A crank-slider: crank r about O (drawn at 60 deg), rod l from A to the slider point S2 on the x axis.

@@ -6,9 +6,9 @@ import pytest
 
 from fabricate.catalogue.actuators import CATALOGUE
 from fabricate.cli import main
+from fabricate.design import design_from_text, load_design
 from fabricate.drive.spec import ActuatorSpec, catalogue_keys, parse_actuator
 from fabricate.errors import SpecError
-from fabricate.spec import design_from_text, load_design
 from fabricate.table import Table
 from fabricate.templates import TEMPLATE_DIR, parse_toml, shipped_templates
 from fabricate.tomlwrite import dumps

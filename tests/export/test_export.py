@@ -26,6 +26,7 @@ from ezdxf import path as dxf_path
 from ezdxf.math import bulge_to_arc
 from PIL import Image
 
+from fabricate.design import load_design
 from fabricate.export import export_all
 from fabricate.export.dxf import audit_problems, kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
 from fabricate.export.stl import (
@@ -42,7 +43,6 @@ from fabricate.kinds import KINDS
 from fabricate.parts.build import build_parts
 from fabricate.parts.spec import PartsSpec
 from fabricate.process import ProcessSpec
-from fabricate.spec import load_design
 from fabricate.templates import shipped_templates
 from tests.conftest import make_four_bar
 from tests.parts.test_build import slider_crank, spur_like, sun_planet_four_bar

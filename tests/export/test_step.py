@@ -191,7 +191,7 @@ def test_step_problems_names_a_wrong_volume_and_hole_count() -> None:
 _DIGEST = """
 import hashlib, sys
 from fabricate.pipeline import run_build
-from fabricate.spec import load_design
+from fabricate.design import load_design
 files = run_build(load_design(sys.argv[1])).files
 for path in sorted(p for p in files if p.endswith(".step")):
     print(path, hashlib.sha256(files[path]).hexdigest())

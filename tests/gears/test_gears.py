@@ -13,11 +13,11 @@ from hypothesis import strategies as st
 from scipy.special import ellipe
 from shapely.geometry import Polygon
 
+from fabricate.design import load_design
 from fabricate.errors import SpecError
 from fabricate.gears import GearSpec, build_gear_pairs, make_gear_pair, mesh_check
 from fabricate.gears.law import FormulaLaw, samples_law
 from fabricate.kinds import KINDS
-from fabricate.spec import load_design
 from fabricate.templates import TEMPLATE_DIR
 
 DATA = json.loads((Path(__file__).resolve().parents[1] / "data" / "gears_expected.json").read_text())

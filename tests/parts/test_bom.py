@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 import shapely
 
+from fabricate.design import load_design
 from fabricate.hints import PartHints
 from fabricate.parts.bom import Spacer, bill_of_materials
 from fabricate.pipeline import run_build
-from fabricate.spec import load_design
 
 
 @pytest.fixture(scope="module")

@@ -144,8 +144,8 @@ def test_gripper_statics_reproduce_the_papers_rod_force():
     """Seed 003's grasp: the can's 4.50 N on the pad (horizontal, through the arc centre) and the spring at
     B give the two-force rod the paper's static force (eqs 3-4, the synthesis' own model), and leave the
     free hinge C (k1 = 0) unloaded. Two independent statics of one grasp agree to 1e-6 (measured 5e-10)."""
+    from fabricate.design import load_design
     from fabricate.pipeline import synthesise
-    from fabricate.spec import load_design
 
     design = load_design("gripper_compliant")
     result = synthesise(design)
@@ -238,11 +238,12 @@ def test_unknown_material_exits_2_naming_the_field(tmp_path, capsys):
 
 
 def _four_bar_design(link_width, tip_force_N: float):
+    from fabricate.design import load_design
     from fabricate.gears.spec import GearSpec
     from fabricate.parts.spec import PartsSpec
-    from fabricate.spec import ChecksSpec, load_design
 
     # a real DesignSpec: the SLA profile of a shipped template (its materials, 3 mm pins), default gears and
+    from fabricate.spec import ChecksSpec
     # checks, the parts and load under test (the kind's own spec is not read by the parts or the check)
     return dataclasses.replace(load_design("finger_watt_six_bar"), name="four_bar", gears=GearSpec(),
                                parts=PartsSpec(link_width_mm=link_width), checks=ChecksSpec(),
@@ -306,9 +307,9 @@ def test_local_pitch_radius_is_the_curvature_radius_of_an_ellipse():
 def test_gear_contact_point_lies_on_both_pitch_curves_over_the_motion():
     """The pitch point the gear check reads (on the line of centres, r_a = a i / (1 + i) from axis a) is on
     gear a's and gear b's pitch curves at every pose of the elliptic pair."""
+    from fabricate.design import load_design
     from fabricate.gears import build_gear_pairs
     from fabricate.pipeline import synthesise
-    from fabricate.spec import load_design
 
     design = load_design("gear_pair_elliptic")
     mech = synthesise(design).mechanism

@@ -58,7 +58,7 @@ def test_template_holds_the_paper_tables():
 def test_template_loads_through_load_design():
     pytest.importorskip("fabricate.gears.spec")
     pytest.importorskip("fabricate.parts.spec")
-    from fabricate.spec import load_design
+    from fabricate.design import load_design
 
     design = load_design(TEMPLATE)
     assert design.kind == "five_bar_ncg"

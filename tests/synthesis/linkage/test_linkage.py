@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 from fabricate.cli import main
+from fabricate.design import design_from_text, load_design
 from fabricate.errors import LockupError, SpecError
 from fabricate.hints import PartHints
 from fabricate.pipeline import synthesise
-from fabricate.spec import design_from_text, load_design
 from fabricate.templates import TEMPLATE_DIR
 
 if sys.version_info >= (3, 11):

@@ -356,7 +356,7 @@ def test_selected_finger_keeps_its_pins_clear_and_does_not_collide(paper_result)
     assert rep["pin_to_middle_link_mm"] >= rep["pin_to_middle_link_limit_mm"] == 5.0
     build = pytest.importorskip("fabricate.parts.build")
     interference = pytest.importorskip("fabricate.checks.interference")
-    from fabricate.spec import load_design
+    from fabricate.design import load_design
 
     design = load_design(TEMPLATE)
     mech = paper_result.mechanism
