@@ -16,12 +16,14 @@ Two sizes of a hole are kept apart (:class:`HoleSize`):
 
 Retention (the profile's ``retention``)
 ---------------------------------------
-``press``  the pin is pressed into the part that holds it (``holder``) and runs in the others. It needs no
-           length beyond the stack; the shortest standard pin at least as long as the stack is taken and
-           what it has over sticks out of the holder's outer face (the holder grips it there), or, where
-           the holder is the ground's bottom face (the mounting face) or in the middle of the stack, out of
-           the top. Only when no standard length reaches the stack is the longest one pressed in short of
-           the holder's outer face, engaging the holder by at least :func:`min_press_engagement`.
+``press``  the pin is pressed into the part that holds it (``holder``, at an end of the stack where one has a
+           hole) and runs in the others. It needs no length beyond the stack: a pin that stuck out would
+           sweep through the next layer's parts (a 1.7 mm stub under ``linkage_stephenson``'s crank hits the
+           frame), so the longest standard pin no longer than the stack is taken if it keeps two thirds of
+           each end part on it (:data:`SHORT_OF_END`; it ends inside the holder first); else the shortest
+           one over the stack, sticking out where no layer lies beyond the stack (the top first; under the
+           ground, the base needs a clearance hole), else out of the holder's outer face (out of the top
+           where that face is the ground's mounting face or the holder is in the middle).
 ``clip``   the pin runs in every part and sticks out at both ends far enough for a DIN 6799 retaining
            washer (groove width m + edge margin n); what the standard length has over goes equally to
            both ends, where standard washers (DIN 125-A / DIN 988) fill it under the clip as far as they
@@ -33,7 +35,10 @@ Retention (the profile's ``retention``)
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from fabricate.catalogue.hardware import (
     PinChoice,
@@ -46,6 +51,9 @@ from fabricate.catalogue.hardware import (
 )
 from fabricate.errors import SpecError
 from fabricate.process import ProcessSpec
+
+if TYPE_CHECKING:
+    from fabricate.parts.model import Part
 
 _EPS = 1e-9
 #: Pin standard of each retention: a press-fit pin is the hardened dowel a shop stocks; a clip needs a
@@ -88,9 +96,9 @@ def hole_size(process: ProcessSpec, diameter_mm: float, fit: str) -> HoleSize:
     return HoleSize(fit, nominal, nominal + process.hole_compensation_mm)
 
 
-def min_press_engagement(pin_mm: float, holder_thickness_mm: float) -> float:
-    """Least length (mm) of a pressed pin inside its holder: its own diameter, or the whole holder when thinner."""
-    return min(pin_mm, holder_thickness_mm)
+#: A pressed pin may end this fraction of an end part's thickness short of the part's outer face (so two
+#: thirds of the part stay on the pin): a design rule of this module, not a standard's.
+SHORT_OF_END = 1.0 / 3.0
 
 
 def cap_height_mm(process: ProcessSpec, pin_mm: float) -> float:
@@ -191,7 +199,9 @@ class PinPlan:
 
 
 def plan_pin(joint: str, process: ProcessSpec, stack_z_mm: tuple[float, float], holder: str = "",
-             holder_z_mm: tuple[float, float] | None = None, holder_is_ground: bool = False) -> PinPlan:
+             holder_z_mm: tuple[float, float] | None = None, holder_is_ground: bool = False,
+             end_thickness_mm: tuple[float, float] = (0.0, 0.0),
+             free_ends: tuple[bool, bool] = (False, False)) -> PinPlan:
     """The standard pin for one joint and what goes on its ends.
 
     Parameters
@@ -207,6 +217,11 @@ def plan_pin(joint: str, process: ProcessSpec, stack_z_mm: tuple[float, float], 
         Bottom and top of the holder's part (``press``).
     holder_is_ground : bool
         The holder is the ground, whose bottom face is its mounting face: nothing sticks out of it.
+    end_thickness_mm : (float, float)
+        Thickness of the parts at the bottom and top of the stack (0 where none, e.g. a spring's coil):
+        how far a pressed pin may end inside them.
+    free_ends : (bool, bool)
+        No layer lies beyond the stack's bottom / top: where a pressed pin that must stick out does.
 
     Raises
     ------
@@ -220,7 +235,8 @@ def plan_pin(joint: str, process: ProcessSpec, stack_z_mm: tuple[float, float], 
     stack = z1 - z0
     try:
         if scheme == "press":
-            return _plan_press(joint, d, standard, (z0, z1), holder, holder_z_mm, holder_is_ground)
+            return _plan_press(joint, d, standard, (z0, z1), holder, holder_z_mm, holder_is_ground,
+                               end_thickness_mm, free_ends)
         if scheme == "clip":
             ring = e_clip(d)
             each = ring.protrusion_mm
@@ -253,33 +269,43 @@ def _washers(d: float, gap: float) -> tuple[Washer, ...]:
 
 
 def _plan_press(joint: str, d: float, standard: str, stack: tuple[float, float], holder: str,
-                holder_z: tuple[float, float] | None, holder_is_ground: bool) -> PinPlan:
+                holder_z: tuple[float, float] | None, holder_is_ground: bool,
+                end_thickness: tuple[float, float], free_ends: tuple[bool, bool]) -> PinPlan:
     z0, z1 = stack
     length = z1 - z0
     hz = holder_z if holder_z is not None else (z0, z1)
     thickness = hz[1] - hz[0]
     at_bottom = abs(hz[0] - z0) < 1e-6
     at_top = abs(hz[1] - z1) < 1e-6
-    # the end the pin sticks out of (or is pressed in short of): the holder's outer face, unless that
-    # is the ground's mounting face or the holder is in the middle of the stack
-    bottom = at_bottom and not (holder_is_ground or at_top)
     lengths = pin_lengths(d, standard)
-    if lengths[-1] >= length - _EPS:
-        choice = dowel_pin(d, length, standard)
-        over = choice.length_mm - length
-        ends = (PinEnd(protrusion_mm=over), PinEnd()) if bottom else (PinEnd(), PinEnd(protrusion_mm=over))
-        return PinPlan(joint, d, "press", holder, choice, stack, 0.0, ends, thickness)
-    # no standard length reaches: the longest, pressed in short of the holder's outer face
-    need = min_press_engagement(d, thickness)
-    short = length - lengths[-1]
-    if not (at_bottom or at_top) or thickness - short < need - _EPS:
-        raise SpecError("length", f"the stack is {length:g} mm; the longest {standard} Ø{d:g} pin is "
-                        f"{lengths[-1]:g} mm, which leaves {max(0.0, thickness - short):.3g} mm in the holder "
-                        f"{holder or '?'} (at least {need:g} mm needed)")
-    choice = PinChoice(f"{standard} {d:g} × {lengths[-1]:g}", lengths[-1])
-    recess = PinEnd(protrusion_mm=-short)
-    ends = (recess, PinEnd()) if at_bottom else (PinEnd(), recess)
-    return PinPlan(joint, d, "press", holder, choice, stack, 0.0, ends, thickness - short)
+    # the longest standard pin that still keeps PRESS_KEEP of each end part on it: it ends inside the
+    # end parts (the holder's end first) and nothing sticks out of the stack into another layer's way
+    room = (SHORT_OF_END * end_thickness[0], SHORT_OF_END * end_thickness[1])
+    fits = [v for v in lengths if v <= length + _EPS and length - v <= room[0] + room[1] + _EPS]
+    if fits:
+        value = max(fits)
+        deficit = length - value
+        first = 0 if at_bottom else 1
+        into = [0.0, 0.0]
+        into[first] = min(deficit, room[first])
+        into[1 - first] = deficit - into[first]
+        ends = (PinEnd(protrusion_mm=-into[0]), PinEnd(protrusion_mm=-into[1]))
+        engaged = thickness - (into[0] if at_bottom else into[1] if at_top else 0.0)
+        return PinPlan(joint, d, "press", holder, PinChoice(f"{standard} {d:g} × {value:g}", value), stack, 0.0,
+                       ends, engaged)
+    # none that short: the shortest over the stack, sticking out where no layer lies beyond (the top layer's
+    # top, else the bottom layer's bottom); else out of the holder's outer face (the holder grips it there),
+    # or of the top where that face is the ground's mounting face
+    choice = dowel_pin(d, length, standard)
+    over = choice.length_mm - length
+    if free_ends[1]:
+        bottom = False
+    elif free_ends[0]:
+        bottom = True  # under the bottom layer (under the ground: the base needs a clearance hole there)
+    else:
+        bottom = at_bottom and not (holder_is_ground or at_top)
+    ends = (PinEnd(protrusion_mm=over), PinEnd()) if bottom else (PinEnd(), PinEnd(protrusion_mm=over))
+    return PinPlan(joint, d, "press", holder, choice, stack, 0.0, ends, thickness)
 
 
 def washer_designation(w: Washer) -> str:
@@ -290,15 +316,19 @@ def washer_designation(w: Washer) -> str:
 def fill_layer_gap(d: float, gap: float) -> tuple[Washer, ...]:
     """Standard washers for the axial gap between two adjacent layers (or a skipped layer's length).
 
-    The fewest washers whose total is within :data:`WASHER_GAP_TOL_MM` of ``gap`` (never more); none when
-    no catalogued washer is that thin (the gap is left as axial play).
+    The fewest washers whose total is within :data:`WASHER_GAP_TOL_MM` of ``gap`` (never more); where no
+    stack comes that close, the thickest stack that fits (what is left is axial play); none when no
+    catalogued washer is that thin (the whole gap is axial play).
     """
     if gap <= _EPS:
         return ()
-    try:
-        return fill_gap(d, gap, WASHER_GAP_TOL_MM)
-    except SpecError:
-        return ()
+    tol = WASHER_GAP_TOL_MM
+    while tol < gap + WASHER_GAP_TOL_MM:
+        try:
+            return fill_gap(d, gap, min(tol, gap))
+        except SpecError:
+            tol += WASHER_GAP_TOL_MM
+    return ()
 
 
 def measure_note(process: ProcessSpec, size: HoleSize, pin_mm: float) -> str:
@@ -322,3 +352,149 @@ def hole_label(fit: str, nominal_mm: float, modelled_mm: float, process_name: st
     if abs(comp) > 1e-9:
         text += f" (CAD Ø{modelled_mm:.3f}".rstrip("0").rstrip(".") + f" incl. {comp:+.3g} {process_name} compensation)"
     return text
+
+
+def _end_records(pin: Any, plan: PinPlan, centre: np.ndarray, top_layer: int) -> list[Any]:
+    """Spacer records of what sits on the pin's ends beyond the stack (washers, then the clip), next to the
+    stack face first; in the coordinates of the pin's first body, so they move with the pin."""
+    from fabricate.parts.bom import Spacer
+
+    out = []
+    z0, z1 = plan.stack_z_mm
+    for side, end in (("bottom", plan.ends[0]), ("top", plan.ends[1])):
+        pieces: list[tuple[str, str, float, float, float]] = [
+            ("washer", washer_designation(w), w.d1_mm, w.d2_mm, w.h_mm) for w in end.washers]
+        if end.retainer is not None:
+            ring = end.retainer
+            # the ring stands in its groove: bore the pin (the groove is not modelled), its own thickness
+            pieces.append(("clip", ring.designation, plan.diameter_mm, ring.ring_od_mm, ring.groove_w_mm))
+        at = 0.0
+        for kind, designation, inner, outer, length in pieces:
+            z = z1 + at if side == "top" else z0 - at - length
+            out.append(Spacer(joint=pin.joint, body=pin.bodies[0], centre=centre, inner_diameter_mm=inner,
+                              outer_diameter_mm=outer, length_mm=length, z_mm=z,
+                              lower_layer=top_layer if side == "top" else -1, washer=True, kind=kind,
+                              designation=designation))
+            at += length
+    return out
+
+
+def retain_pins(pins: Sequence[Any], spacers: Sequence[Any], parts: Sequence[Part], process: ProcessSpec,
+                ground: str = "") -> tuple[list[Any], list[Any]]:
+    """Standard pins and washers for the stacks the parts layer sized (:func:`~fabricate.parts.bom.pins_and_spacers`).
+
+    Each pin becomes the standard pin :func:`plan_pin` picks for its stack (its ``length_mm`` and ``z_mm`` the
+    pin's own, ``stack_mm`` the stack's), with its designation, retention, holder (its first body, for a
+    press fit) and what stands on its ends. Washers between adjacent layers become standard washers (none
+    where no catalogued washer is that thin: the gap stays as axial play); a cut process's bought tubes
+    become stacks of standard washers where those fill them. Retention end pieces (washers under a clip,
+    the clip) are added as spacer records, so the stacks, the BOM and the interference proof see them.
+
+    Parameters
+    ----------
+    pins, spacers
+        :class:`~fabricate.parts.bom.Pin` and :class:`~fabricate.parts.bom.Spacer` records (``z_mm`` and
+        ``length_mm`` of a pin: its stack).
+    parts : sequence of Part
+        The body parts (holes give the pin's centre and the holder's plate).
+    process : ProcessSpec
+    ground : str
+        The ground body (its bottom face is the mounting face).
+
+    A pin no standard pin fits (a diameter outside the series, a stack longer than its longest length) is
+    cut from rod to its stack, with no retention pieces; its ``note`` says why.
+
+    Returns
+    -------
+    (pins, spacers)
+    """
+    d = float(process.pin_diameter_mm)
+    lowest = min((p.layer for p in parts), default=0)
+    highest = max((p.layer for p in parts), default=0)
+    out_pins: list[Any] = []
+    out_spacers: list[Any] = []
+    for sp in spacers:
+        if not sp.washer and process.technique == "additive":
+            out_spacers.append(sp)  # a printed tube (a part of its own)
+            continue
+        washers = fill_layer_gap(d, float(sp.length_mm))
+        if not washers and not sp.washer:
+            out_spacers.append(replace(sp, kind="tube"))  # a bought tube cut to length
+            continue
+        z = float(sp.z_mm)
+        for w in washers:
+            out_spacers.append(replace(sp, inner_diameter_mm=w.d1_mm, outer_diameter_mm=w.d2_mm, length_mm=w.h_mm,
+                                       z_mm=z, washer=True, kind="washer", designation=washer_designation(w)))
+            z += w.h_mm
+    for pin in pins:
+        stack = (float(pin.z_mm), float(pin.z_mm) + float(pin.length_mm))
+        first = next((p for p in parts if p.body == pin.bodies[0] and p.role != "spacer"
+                      and any(h.joint == pin.joint for h in p.holes)), None)
+        centre = (np.asarray(next(h.centre for h in first.holes if h.joint == pin.joint), dtype=np.float64)
+                  if first is not None else np.zeros(2))
+        press = process.retention == "press" and first is not None
+        on_pin = [p for p in parts if p.body in pin.bodies and p.role != "spacer"
+                  and any(h.joint == pin.joint for h in p.holes)]
+        ends_t = (max((p.thickness_mm for p in on_pin if abs(p.z_mm - stack[0]) < 1e-6), default=0.0),
+                  max((p.thickness_mm for p in on_pin if abs(p.z_mm + p.thickness_mm - stack[1]) < 1e-6),
+                      default=0.0))
+        note = ""
+        try:
+            plan = plan_pin(pin.joint, process, stack, pin.bodies[0] if press else "",
+                            (first.z_mm, first.z_mm + first.thickness_mm) if first is not None else None,
+                            pin.bodies[0] == ground, ends_t,
+                            (int(pin.layers[0]) == lowest, int(pin.layers[1]) == highest))
+        except SpecError as exc:
+            # no standard pin (a diameter outside the series, a stack beyond its lengths): a pin cut from rod to
+            # the stack, without retention pieces; the build goes on and says so
+            plan = PinPlan(pin.joint, d, process.retention, pin.bodies[0] if press else "",
+                           PinChoice("", round(stack[1] - stack[0], 6)), stack, 0.0, (PinEnd(), PinEnd()))
+            note = f"{exc.message.split(': ', 1)[-1]}: cut a Ø{d:g} steel rod to {plan.length_mm:.2f} mm"
+        ends = tuple(tuple(washer_designation(w) for w in e.washers)
+                     + ((e.retainer.designation,) if e.retainer is not None else ()) for e in plan.ends)
+        grooves = tuple(round(g, 6) for g in (
+            (plan.ends[0].groove_from_end_mm,) if plan.ends[0].groove_from_end_mm is not None else ()) + (
+            (plan.length_mm - plan.ends[1].groove_from_end_mm - plan.ends[1].retainer.groove_w_mm,)
+            if plan.ends[1].groove_from_end_mm is not None and plan.ends[1].retainer is not None else ()))
+        out_pins.append(replace(pin, length_mm=plan.length_mm, z_mm=plan.z_mm, designation=plan.choice.designation,
+                                stack_mm=plan.stack_mm, stack_z_mm=stack, retention=plan.retention,
+                                holder=plan.holder, allowance_mm=plan.allowance_mm,
+                                protrusion_mm=(round(plan.ends[0].protrusion_mm, 6),
+                                               round(plan.ends[1].protrusion_mm, 6)),
+                                end_items=(ends[0], ends[1]), engagement_mm=round(plan.engagement_mm, 6),
+                                grooves_mm=grooves, caps_mm=(plan.ends[0].cap_mm, plan.ends[1].cap_mm), note=note))
+        out_spacers += _end_records(pin, plan, centre, int(pin.layers[1]))
+    return out_pins, out_spacers
+
+
+def cap_parts(pins: Sequence[Any], parts: Sequence[Part], process: ProcessSpec) -> list[Part]:
+    """The bonded end caps of ``cap`` retention as parts of the process's own stock (printed, or cut from the
+    sheet): a collar round each pin end, bore the running hole, wall the process's minimum, fixed to the pin's
+    first body (so it turns with the pin)."""
+    from fabricate.parts.model import Hole, Part
+    from fabricate.parts.profiles import circle_hull
+
+    out: list[Part] = []
+    for pin in pins:
+        caps = getattr(pin, "caps_mm", (0.0, 0.0))
+        if not any(caps):
+            continue
+        first = next((p for p in parts if p.body == pin.bodies[0] and any(h.joint == pin.joint for h in p.holes)),
+                     None)
+        if first is None:
+            continue
+        centre = np.asarray(next(h.centre for h in first.holes if h.joint == pin.joint), dtype=np.float64)
+        size = hole_size(process, float(pin.diameter_mm), "running")
+        outer = size.modelled_mm + 2.0 * max(process.min_wall_mm, 0.5 * float(pin.diameter_mm))
+        z0, z1 = pin.stack_z_mm
+        for side, length in (("bottom", caps[0]), ("top", caps[1])):
+            if length <= 0.0:
+                continue
+            z = z1 if side == "top" else z0 - length
+            out.append(Part(name=f"cap_{pin.joint}_{side}".replace("+", "_"), body=pin.bodies[0],
+                            outline=circle_hull(centre[None, :], np.array([0.5 * outer])),
+                            holes=(Hole(pin.joint, centre, size.modelled_mm, float(pin.diameter_mm), "running",
+                                        size.nominal_mm),),
+                            thickness_mm=float(length), z_mm=float(z), layer=first.layer, process=process.name,
+                            role="cap"))
+    return out

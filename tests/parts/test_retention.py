@@ -10,11 +10,11 @@ import pytest
 from fabricate.catalogue.hardware import ISO2338_LENGTHS_MM, ISO8734_LENGTHS_MM, e_clip, pin_lengths
 from fabricate.errors import SpecError
 from fabricate.parts.retention import (
+    SHORT_OF_END,
     choose_holder,
     fill_layer_gap,
     hole_label,
     hole_size,
-    min_press_engagement,
     plan_pin,
 )
 from fabricate.process import parse_process, process_override
@@ -87,30 +87,46 @@ def test_nominal_and_modelled_hole_sizes_are_kept_apart():
 
 
 # -- pins --------------------------------------------------------------------------------------------------
-def test_press_pin_is_the_shortest_standard_length_over_the_stack():
-    sla = _process(profile="sla", pin_diameter_mm=3.0)
-    plan = plan_pin("A", sla, (3.3, 9.6), "crank", (3.3, 6.3))
-    assert plan.choice.designation == "ISO 8734 3 × 8" and plan.length_mm == 8.0
-    assert plan.length_mm in ISO8734_LENGTHS_MM and plan.length_mm >= plan.stack_mm + plan.allowance_mm
-    # the holder is the bottom part: what the pin has over sticks out of its outer (bottom) face
-    assert plan.ends[0].protrusion_mm == pytest.approx(8.0 - 6.3) and plan.ends[1].protrusion_mm == 0.0
-    assert plan.z_mm == pytest.approx(3.3 - 1.7)
-    # held by the ground at the bottom: its bottom face is the mounting face, so the pin sticks out on top
-    ground = plan_pin("A", sla, (0.0, 6.3), "frame", (0.0, 3.0), holder_is_ground=True)
-    assert ground.ends[0].protrusion_mm == 0.0 and ground.ends[1].protrusion_mm == pytest.approx(1.7)
+def test_press_pin_ends_inside_the_end_parts_when_a_standard_length_allows():
+    sla = _process(profile="sla", pin_diameter_mm=2.0)
+    plan = plan_pin("A", sla, (0.0, 6.3), "crank", (0.0, 3.0), end_thickness_mm=(3.0, 3.0))
+    assert plan.choice.designation == "ISO 8734 2 × 6" and plan.length_mm in ISO8734_LENGTHS_MM
+    # 0.3 mm short of the holder's (bottom) face, flush with the top: nothing sticks out of the stack
+    assert plan.ends[0].protrusion_mm == pytest.approx(-0.3) and plan.ends[1].protrusion_mm == 0.0
+    assert plan.engagement_mm == pytest.approx(2.7) and plan.z_mm == pytest.approx(0.3)
+    # a pin as long as the stack whenever one is: no shortfall at all
+    exact = plan_pin("A", sla, (0.0, 12.0), "crank", (0.0, 3.0), end_thickness_mm=(3.0, 3.0))
+    assert exact.length_mm == 12.0 and exact.ends[0].protrusion_mm == exact.ends[1].protrusion_mm == 0.0
 
 
-def test_press_pin_longer_than_the_series_is_pressed_in_short_of_the_holders_face():
+def test_press_pin_short_of_the_stack_keeps_two_thirds_of_each_end_part():
     sla = _process(profile="sla", pin_diameter_mm=3.0)
     longest = pin_lengths(3.0, "ISO 8734")[-1]
-    plan = plan_pin("A", sla, (0.0, 36.6), "palm", (0.0, 12.0))
+    plan = plan_pin("A", sla, (0.0, 36.6), "palm", (0.0, 12.0), end_thickness_mm=(12.0, 12.0))
     assert plan.length_mm == longest == 30.0
-    assert plan.ends[0].protrusion_mm == pytest.approx(-6.6) and plan.z_mm == pytest.approx(6.6)
-    assert plan.engagement_mm == pytest.approx(12.0 - 6.6)
-    assert plan.engagement_mm >= min_press_engagement(3.0, 12.0)
-    with pytest.raises(SpecError) as err:  # a 3 mm holder cannot take the 6.6 mm the pin falls short
-        plan_pin("A", sla, (0.0, 36.6), "palm", (0.0, 3.0))
+    # 6.6 mm short: the holder's end takes its third (4 mm), the top part the rest
+    assert plan.ends[0].protrusion_mm == pytest.approx(-12.0 * SHORT_OF_END)
+    assert plan.ends[1].protrusion_mm == pytest.approx(-(6.6 - 12.0 * SHORT_OF_END))
+    assert plan.engagement_mm == pytest.approx(12.0 * (1 - SHORT_OF_END))
+    with pytest.raises(SpecError) as err:  # 3 mm end parts cannot take 6.6 mm, and no pin reaches
+        plan_pin("A", sla, (0.0, 36.6), "palm", (0.0, 3.0), end_thickness_mm=(3.0, 3.0))
     assert err.value.path == "process.pin_diameter_mm" and "longest ISO 8734" in err.value.message
+
+
+def test_press_pin_that_must_stick_out_does_so_where_no_layer_lies_beyond():
+    sla = _process(profile="sla", pin_diameter_mm=3.0)  # the shortest Ø3 ISO 8734 pin is 8 mm
+    kwargs = dict(holder_z_mm=(3.3, 6.3), end_thickness_mm=(3.0, 3.0))
+    top_free = plan_pin("A", sla, (3.3, 9.6), "crank", free_ends=(False, True), **kwargs)
+    assert top_free.length_mm == 8.0 and top_free.length_mm >= top_free.stack_mm + top_free.allowance_mm
+    assert top_free.ends[0].protrusion_mm == 0.0 and top_free.ends[1].protrusion_mm == pytest.approx(1.7)
+    bottom_free = plan_pin("A", sla, (3.3, 9.6), "crank", free_ends=(True, False), **kwargs)
+    assert bottom_free.ends[0].protrusion_mm == pytest.approx(1.7) and bottom_free.z_mm == pytest.approx(1.6)
+    # layers on both sides: out of the holder's outer face (the holder grips it there)...
+    boxed = plan_pin("A", sla, (3.3, 9.6), "crank", **kwargs)
+    assert boxed.ends[0].protrusion_mm == pytest.approx(1.7)
+    # ...but never out of the ground's mounting face
+    ground = plan_pin("A", sla, (3.3, 9.6), "frame", holder_is_ground=True, **kwargs)
+    assert ground.ends[0].protrusion_mm == 0.0 and ground.ends[1].protrusion_mm == pytest.approx(1.7)
 
 
 def test_clip_pin_sticks_out_for_the_ring_at_both_ends():
