@@ -76,7 +76,8 @@ class Kind:
     parse_spec, preflight, synthesise : callable
         Its entry points (see the module docstring).
     paper : str or None
-        Short name of the paper the kind reproduces (DESIGN.md's seed table); None for a kind of no paper.
+        Short name of the paper the kind reproduces (the README's Templates table gives its seed number); None
+        for a kind of no paper.
     """
 
     name: str

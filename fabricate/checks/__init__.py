@@ -46,8 +46,8 @@ class CheckReport:
     Attributes
     ----------
     interference : dict
-        report.json's ``interference`` section: DESIGN.md keys ``poses``, ``pairs_checked``,
-        ``collisions`` [{a, b, input_deg, volume_mm3}], ``min_clearance_mm`` plus ``input_unit``, the
+        report.json's ``interference`` section (fabricate/report_schema.json, docs/report.md): ``poses``,
+        ``pairs_checked``, ``collisions`` [{a, b, input_deg, volume_mm3}], ``min_clearance_mm``, ``input_unit``, the
         per-pair table ``pairs``, ``passed`` (the sweep's verdict; None when it could not run, with a
         ``reason``), and the ``gear_mesh`` and ``printability`` results.
     failures : list of str

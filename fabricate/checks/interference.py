@@ -235,7 +235,7 @@ class InterferenceResult:
         return [(float(self.inputs[s]), float(self.inputs[e])) for s, e in zip(starts, ends, strict=True)]
 
     def report(self) -> dict[str, Any]:
-        """The ``interference`` section of report.json (DESIGN.md keys plus extras)."""
+        """The ``interference`` section of report.json (its keys: fabricate/report_schema.json, docs/report.md)."""
         collisions = []
         for p in self.collisions:
             collisions.append({

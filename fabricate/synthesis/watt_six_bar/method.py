@@ -116,8 +116,8 @@ def _report(spec: WattSixBarSpec, inputs: RegionInputs, finger: FingerPositions,
     torque = loads.torque[0]
 
     report = {
-        # "seed 004" names the Watt-I six-bar paper's file in DESIGN.md's seed table; the report's words are
-        # kept as they were (builds stay byte-identical)
+        # "seed 004" is the Watt-I six-bar paper's number in the README's Templates table; the report's words
+        # are kept as they were (builds stay byte-identical)
         "method": "generalized Burmester curves, solution region, force index K (seed 004)",
         "K": choice.K,
         "K_limit": spec.k_max,
