@@ -154,8 +154,11 @@ class PlacedSpring:
 
     @property
     def passed(self) -> bool:
-        """Whether the wire's bending stress at the largest deflection is within its allowable."""
-        return self.within_series and self.spring.stress_mpa <= self.spring.allowable_mpa * (1.0 + 1e-9)
+        """Whether the wire's bending stress at the largest deflection is within its allowable, and the motion
+        never turns the spring back past free (a torsion spring opened against its winding is loaded the way
+        it must not be, and no longer returns the joint)."""
+        return (self.within_series and self.spring.stress_mpa <= self.spring.allowable_mpa * (1.0 + 1e-9)
+                and self.deflection_deg[0] >= -1e-6)
 
     @property
     def designation(self) -> str:
@@ -548,15 +551,20 @@ def springs_report(springs: Sequence[PlacedSpring]) -> list[dict[str, Any]]:
 
 
 def spring_failures(springs: Sequence[PlacedSpring]) -> list[str]:
-    """One line per spring whose wire is stressed beyond its allowable (a strength failure)."""
+    """One line per spring whose wire is stressed beyond its allowable, or that the motion turns back past free
+    (strength failures)."""
     out = []
     for sp in springs:
         if sp.passed:
             continue
         s = sp.spring
-        why = "" if sp.within_series else " (no music wire of the series up to Ø3.18 mm holds it)"
-        out.append(f"spring at {sp.joint} ({sp.designation}): wire stress {s.stress_mpa:.0f} MPa over its allowable "
-                   f"{s.allowable_mpa:.0f} MPa at {sp.deflection_deg[1]:.1f}° deflection{why}")
+        if not sp.within_series or s.stress_mpa > s.allowable_mpa * (1.0 + 1e-9):
+            why = "" if sp.within_series else " (no music wire of the series up to Ø3.18 mm holds it)"
+            out.append(f"spring at {sp.joint} ({sp.designation}): wire stress {s.stress_mpa:.0f} MPa over its "
+                       f"allowable {s.allowable_mpa:.0f} MPa at {sp.deflection_deg[1]:.1f}° deflection{why}")
+        if sp.deflection_deg[0] < -1e-6:
+            out.append(f"spring at {sp.joint} ({sp.designation}): the motion turns it {-sp.deflection_deg[0]:.1f}° "
+                       "back past free (it would open against its winding); give it more preload")
     return out
 
 

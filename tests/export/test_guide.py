@@ -106,7 +106,7 @@ def test_guide_of_a_four_bar_fits_every_unit_once_and_draws_each_step(sla_proces
     motion = mech.sweep(41)
     design = SimpleNamespace(name="t", process=sla_process, parts=PartsSpec(),
                              gears=SimpleNamespace(hub_diameter_mm=None))
-    hints = PartHints(copies=2, springs=(SpringHint("B", 0.2, 10.0, 12.0),),
+    hints = PartHints(copies=2, springs=(SpringHint("B", 0.2, 30.0, 12.0),),
                       purchased_shared=(PurchasedItem("drive motor", 1, "turns the crank"),))
     partset = build_parts(design, mech, motion, [], hints)
     steps = guide_steps(partset, motion)

@@ -51,7 +51,7 @@ def four_bar_parts(sla_process):
 
 def test_spring_rate_stress_and_place_recomputed(sla_process):
     mech, motion, partset = four_bar_parts(sla_process)
-    hint = SpringHint("B", rate_Nmm_per_deg=0.2, preload_deg=10.0, legs_mm=12.0, note="return")
+    hint = SpringHint("B", rate_Nmm_per_deg=0.2, preload_deg=30.0, legs_mm=12.0, note="return")
     springs, parts, pins = place_springs([hint], mech, motion, partset.parts, partset.pins, sla_process)
     (sp,) = springs
     s = sp.spring
@@ -60,8 +60,8 @@ def test_spring_rate_stress_and_place_recomputed(sla_process):
     # the deflection over the motion: preload plus the joint's travel (coupler against rocker)
     rel = np.degrees(motion.relative_angle("rocker", "coupler"))
     travel = abs(rel - rel[0]).max()
-    assert sp.deflection_deg[1] == pytest.approx(10.0 + travel, rel=1e-9)
-    assert stress_from(s.wire_d_mm, s.mean_d_mm, 0.2 * (10.0 + travel)) == pytest.approx(s.stress_mpa, rel=1e-9)
+    assert sp.deflection_deg[1] == pytest.approx(30.0 + travel, rel=1e-9)
+    assert stress_from(s.wire_d_mm, s.mean_d_mm, 0.2 * (30.0 + travel)) == pytest.approx(s.stress_mpa, rel=1e-9)
     assert s.stress_mpa <= s.allowable_mpa and sp.passed and not spring_failures(springs)
     # wound up, the coil still clears its pin (the catalogue's 10 % arbor clearance)
     assert s.inner_d_wound_mm >= s.pin_diameter_mm / 0.9 - 1e-9
@@ -122,6 +122,18 @@ def test_a_spring_no_wire_can_make_is_a_failure_naming_it(sla_process):
                                                                                                           rel=1e-9)
 
 
+def test_a_spring_the_motion_turns_back_past_free_is_a_failure(sla_process):
+    mech, motion, partset = four_bar_parts(sla_process)
+    rel = np.degrees(motion.relative_angle("rocker", "coupler"))  # the crank turns round: B swings both ways
+    back = float(rel[0] - rel.min())
+    springs, _, _ = place_springs([SpringHint("B", 0.2, 10.0, 12.0)], mech, motion, partset.parts, partset.pins,
+                                  sla_process)
+    (sp,) = springs
+    assert sp.deflection_deg[0] == pytest.approx(10.0 - back, rel=1e-9) and sp.deflection_deg[0] < 0
+    (failure,) = spring_failures(springs)
+    assert failure.startswith("spring at B") and f"{back - 10.0:.1f}° back past free" in failure
+
+
 def test_no_spring_where_the_rate_is_zero(sla_process):
     mech, motion, partset = four_bar_parts(sla_process)
     springs, parts, pins = place_springs([SpringHint("B", 0.0)], mech, motion, partset.parts, partset.pins,
@@ -160,3 +172,53 @@ def test_shipped_springs_within_allowable_and_in_their_pin_stack(shipped_build, 
         else:
             assert stack["z_mm"] - 1e-9 <= z0 < z1 <= stack["z_mm"] + stack["length_mm"] + 1e-9
     assert not [f for f in outcome.report["checks"]["failures"] if f.startswith("spring at")]
+
+
+def _world(pose: np.ndarray, p: np.ndarray) -> np.ndarray:
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    return pose[:2] + np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]])
+
+
+def _leg_angle(sp, motion, i: int) -> float:
+    """The far anchor's direction from the pin less the near anchor's, in the world at pose ``i`` (degrees)."""
+    pf, pn = motion.pose(sp.far_body)[i], motion.pose(sp.near_body)[i]
+    far = _world(pf, sp.far_anchor) - _world(pf, sp.far_axis)
+    near = _world(pn, sp.near_anchor) - _world(pn, sp.near_axis)
+    return math.degrees(math.atan2(far[1], far[0]) - math.atan2(near[1], near[0]))
+
+
+@pytest.mark.parametrize(("joint", "body", "reference"), [("B", "rocker", "coupler"), ("D", "rocker", "ground")])
+def test_the_hand_winds_up_and_the_free_angle_is_the_assembled_less_the_preload(sla_process, joint, body,
+                                                                                reference):
+    """Recomputed from the anchors over the motion: the far anchor's angle round the pin against the near one
+    moves by the joint's travel, the way the deflection grows (s); the upper leg must turn counter-clockwise
+    (seen from above) against the lower one for a right-hand coil to wind up."""
+    mech, motion, partset = four_bar_parts(sla_process)
+    springs, _, _ = place_springs([SpringHint(joint, 0.2, 30.0, 12.0)], mech, motion, partset.parts,
+                                  partset.pins, sla_process)
+    (sp,) = springs
+    rel = np.degrees(motion.relative_angle(body, reference))
+    i = int(np.argmax(abs(rel - rel[0])))
+    turn = (_leg_angle(sp, motion, i) - _leg_angle(sp, motion, 0) + 180.0) % 360.0 - 180.0
+    assert abs(turn) == pytest.approx(abs(rel[i] - rel[0]), abs=1e-6)  # the legs turn by the joint's travel
+    s = math.copysign(1.0, turn)
+    upper = s if sp.side == "top" else -s  # the far leg leaves the coil's far end
+    assert sp.hand == ("RH" if upper > 0 else "LH")
+    free = (_leg_angle(sp, motion, 0) - s * 30.0) % 360.0
+    assert min(abs(free - sp.free_angle_deg), 360.0 - abs(free - sp.free_angle_deg)) == pytest.approx(0.0, abs=1e-6)
+
+
+def test_the_strength_check_fails_a_spring_over_its_allowable_by_name(sla_process):
+    from fabricate.strength.check import run_strength
+
+    mech, motion, partset = four_bar_parts(sla_process)
+    springs, parts, pins = place_springs([SpringHint("B", 40.0, 180.0, 12.0)], mech, motion, partset.parts,
+                                         partset.pins, sla_process)
+    import dataclasses
+
+    loaded = dataclasses.replace(partset, parts=tuple(parts), pins=tuple(pins), springs=springs)
+    design = SimpleNamespace(checks=SimpleNamespace(min_safety_factor=2.0), process=sla_process, load=None)
+    result = run_strength(design, loaded, mech, motion, [], loaded.hints)
+    failures = result.failures()
+    assert any(f.startswith("strength: spring at B") and "over its allowable" in f for f in failures)
+    assert result.passed is not True
