@@ -75,7 +75,8 @@ class Placement:
         p = np.asarray(xy, dtype=np.float64)
         if self.flip:
             p = p * np.array([1.0, -1.0])
-        return p @ rotation(self.angle).T + np.asarray(self.centre, dtype=np.float64)
+        out: np.ndarray = p @ rotation(self.angle).T + np.asarray(self.centre, dtype=np.float64)
+        return out
 
     def z_range(self, z0: float, z1: float) -> tuple[float, float]:
         """Entry z range -> stack z range (low, high)."""

@@ -55,6 +55,8 @@ if TYPE_CHECKING:
 
 ROTARY = ("servo", "gearmotor", "stepper")
 PUSHING = ("tendon", "linear")
+#: Roles of the parts that are bodies' plates (the rest, spacers, caps and arbors, belong to a pin).
+BODY_ROLES = ("link", "gear", "ground", "rod", "mount", "standoff")
 #: Roles of solids that move with the driven body (the rest are fixed to the ground body).
 DRIVEN_ROLES = ("output", "screw")
 #: Name of the mount plate part.
@@ -221,14 +223,10 @@ def sweep_items(partset: Any, chord_tolerance_mm: float | None = None) -> list[S
 # -- shared helpers ------------------------------------------------------------------------------------------
 def _hole(joint: str, centre: np.ndarray, nominal_mm: float, compensation_mm: float, pin_mm: float = 0.0,
           fit: str = "clearance") -> Hole:
-    """A hole with its nominal (fit) and modelled sizes kept apart where the part model has both."""
-    centre = np.asarray(centre, dtype=np.float64)
-    names = {f.name for f in dataclasses.fields(Hole)}
-    if "fit" in names and "nominal_diameter_mm" in names:
-        fits = getattr(model, "HOLE_FITS", ())
-        return Hole(joint, centre, nominal_mm + compensation_mm, pin_mm,  # type: ignore[call-arg]
-                    fit if fit in fits else "clearance", nominal_mm)
-    return Hole(joint, centre, nominal_mm + compensation_mm, pin_mm)
+    """A hole of nominal (fit) size ``nominal_mm``, modelled with the process's compensation added. A screw's
+    pilot hole (``fit="tapped"``) is labelled a clearance while the part model has no such fit."""
+    return Hole(joint, np.asarray(centre, dtype=np.float64), nominal_mm + compensation_mm, pin_mm,
+                fit if fit in model.HOLE_FITS else "clearance", nominal_mm)
 
 
 def _with(part: Part, **changes: Any) -> Part:
@@ -262,25 +260,32 @@ def _screw_size(d_mm: float) -> str:
     return fits[-1] if fits else sizes[0]
 
 
-def _bom_without(bom: Sequence[dict[str, Any]], pin: str, removed_parts: set[str], changed: Sequence[Part],
-                 process: ProcessSpec, copies: int) -> list[dict[str, Any]]:
-    """The BOM without one pin's hardware and the removed parts, with the changed parts' rows renewed."""
-    from fabricate.parts.bom import part_rows
+def _bom_without(bom: Sequence[dict[str, Any]], pin: Any, spacers: Sequence[Any], removed_parts: set[str],
+                 changed: Sequence[Part], process: ProcessSpec, copies: int) -> list[dict[str, Any]]:
+    """The BOM without one pin's hardware (the rows the parts layer makes for it and its ``spacers``, taken
+    out of the grouped rows by item) and the removed parts, with the changed parts' rows renewed."""
+    from fabricate.hints import PartHints
+    from fabricate.parts.bom import bill_of_materials, part_rows
 
     fresh = {row["item"]: row for row in part_rows(list(changed), process, copies)}
+    gone: dict[tuple[str, str], int] = {}
+    if pin is not None:
+        for row in bill_of_materials([pin], list(spacers), PartHints(), process, copies):
+            key = (str(row["item"]), str(row["kind"]))
+            gone[key] = gone.get(key, 0) + int(row["qty"])
     out = []
     for row in bom:
         item = str(row.get("item", ""))
         if item in removed_parts:
             continue
         if item in fresh:
-            out.append(fresh[item])
+            out.append(dict(fresh[item], **{k: v for k, v in row.items() if k not in fresh[item]}))
             continue
-        joints = list(row.get("joints", []) or [])
-        if pin in joints and not str(row.get("kind", "")).endswith("part"):
-            # a grouped row counts every joint's piece: take this joint's out
-            share = int(row.get("qty", 0)) // max(1, len(joints))
-            row = dict(row, qty=int(row["qty"]) - share, joints=[j for j in joints if j != pin])
+        key = (item, str(row.get("kind", "")))
+        if key in gone:
+            take = min(gone.pop(key), int(row.get("qty", 0)))
+            joints = [j for j in row.get("joints", []) or [] if j != pin.joint]
+            row = dict(row, qty=int(row["qty"]) - take, joints=joints)
             if row["qty"] <= 0:
                 continue
         out.append(row)
@@ -293,7 +298,8 @@ def _purchased(item: str, qty: int, description: str, **extra: Any) -> dict[str,
 
 
 def _screw_row(f: Fastener, copies: int) -> dict[str, Any]:
-    return {"item": f.designation, "kind": "screw", "qty": f.qty * copies, "joints": [], "source": "buy",
+    return {"item": f.designation, "designation": f.designation, "kind": "screw", "qty": f.qty * copies,
+            "joints": [], "source": "buy",
             "description": f.purpose, "clamp_mm": round(f.clamp_mm, 4), "engagement_mm": round(f.engagement_mm, 4)}
 
 
@@ -336,6 +342,9 @@ class _Rotary:
         if not pins:
             raise SpecError("actuator.driver", f"joint {self.joint!r} has no pin in the parts")
         pin = pins[0]
+        if any(sp.joint in pin.joint.split("+") for sp in getattr(self.ps, "springs", ())):
+            raise SpecError("actuator.driver", f"joint {self.joint!r} carries a torsion spring on its pin; an "
+                                               "actuator's output cannot replace that pin")
         if set(pin.bodies) - {self.driven, self.ground}:
             raise SpecError("actuator.driver", f"joint {self.joint!r} joins {', '.join(pin.bodies)} on one pin; an "
                                                "actuator's output can only replace a pin between two bodies")
@@ -702,7 +711,7 @@ class _Rotary:
             outline = fuse_polygons(outline, list(self.ground_arms), self.tol)
         new_ground = _with(ground, outline=outline, holes=tuple(ground_holes))
         # the pin's spacers go with it (printed spacer parts too)
-        removed = {p.name for p in ps.parts if p.role == "spacer" and any(h.joint == pin.joint for h in p.holes)}
+        removed = {p.name for p in ps.parts if p.role not in BODY_ROLES and any(h.joint == pin.joint for h in p.holes)}
         parts = []
         for p in ps.parts:
             if p.name in removed:
@@ -711,7 +720,8 @@ class _Rotary:
         parts += [mount, *standoff_parts]
         pins = tuple(p for p in ps.pins if p is not pin)
         spacers = tuple(s for s in ps.spacers if s.joint != pin.joint)
-        bom = _bom_without(ps.bom, pin.joint, removed, [new_driven, new_ground], self.process, ps.copies)
+        bom = _bom_without(ps.bom, pin, [s for s in ps.spacers if s.joint == pin.joint], removed,
+                           [new_driven, new_ground], self.process, ps.copies)
         from fabricate.parts.bom import part_rows
 
         bom += part_rows([mount, *standoff_parts], self.process, ps.copies)
@@ -853,7 +863,7 @@ def _attach_rod_end(design: Any, mechanism: Mechanism, motion: Motion, ps: PartS
     hole = _hole("actuator_rod_end", centre, hole_nominal, comp, pin_mm, fit="running")
     new_rod = _with(rod, outline=_fuse(rod.outline, pad, tol), holes=tuple(rod.holes) + (hole,))
     parts = tuple(new_rod if p is rod else p for p in ps.parts)
-    bom = _bom_without(ps.bom, "", set(), [new_rod], process, ps.copies)
+    bom = _bom_without(ps.bom, None, (), set(), [new_rod], process, ps.copies)
     what = "tendon or push rod" if entry.kind == "tendon" else entry.name
     bom.append(_purchased(what, ps.copies, f"{entry.kind} pulling or pushing {slider.body_b} along {slider.name}, "
                                           f"on a Ø{pin_mm:g} mm clevis pin in its rod-end hole", model=entry.key))

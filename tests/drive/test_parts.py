@@ -72,8 +72,14 @@ def test_the_output_replaces_the_driver_pin_everywhere(sla_process):
     assert all(s.joint != "O" for s in ps.spacers)
     assert all(h.joint != "O" for p in ps.parts for h in p.holes)
     assert all("O" not in row.get("joints", []) for row in ps.bom)
-    pins = sum(r["qty"] for r in ps.bom if r["kind"] == "pin")
-    assert pins == sum(r["qty"] for r in bare.bom if r["kind"] == "pin") - 1
+    def count(bom, kind):
+        return sum(r["qty"] for r in bom if r["kind"] == kind)
+
+    assert count(ps.bom, "pin") == count(bare.bom, "pin") - 1
+    # the pin's washers (and clips) leave the BOM with it, the other joints' stay
+    at_o = [getattr(sp, "kind", "") or ("washer" if sp.washer else "spacer") for sp in bare.spacers if sp.joint == "O"]
+    for kind in ("washer", "clip"):
+        assert count(ps.bom, kind) == count(bare.bom, kind) - at_o.count(kind)
     items = {r["item"]: r for r in ps.bom}
     assert items[SG90.name]["qty"] == 1 and items[SG90.name]["source"] == "buy"
     assert {MOUNT_PART, "standoff_mount_1", "standoff_mount_2"} <= {p.name for p in ps.parts}
