@@ -728,10 +728,12 @@ class _Rotary:
         bom.append(_purchased(entry.name, ps.copies, f"{entry.kind} driving {self.driven} about {self.joint} "
                               f"(catalogue {entry.key!r})", model=entry.key))
         bom += [_screw_row(f, ps.copies) for f in fasteners]
+        tubes: dict[str, int] = {}
         for s in standoffs:
             if not s.printed:
-                bom.append(_purchased(f"standoff tube {s.inner_diameter_mm:.3g}/{s.outer_diameter_mm:.3g} x "
-                                      f"{s.length_mm:.2f} mm", ps.copies, "actuator mount standoff, cut to length"))
+                item = f"standoff tube {s.inner_diameter_mm:.3g}/{s.outer_diameter_mm:.3g} x {s.length_mm:.2f} mm"
+                tubes[item] = tubes.get(item, 0) + ps.copies
+        bom += [_purchased(item, qty, "actuator mount standoff, cut to length") for item, qty in tubes.items()]
         from fabricate.parts.build import overlapping_cuts
 
         warnings = tuple(ps.warnings) + tuple(w for w in overlapping_cuts([new_driven, new_ground, mount])

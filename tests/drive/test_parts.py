@@ -46,9 +46,9 @@ def holes(part, prefix: str) -> list:
     return [h for h in part.holes if h.joint.startswith(prefix)]
 
 
-def sweep(partset, motion, extra=None):
+def sweep(partset, motion, extra=None, clearance: float = 0.25):
     return sweep_interference(partset.parts, motion, chord_tolerance_mm=partset.chord_tolerance_mm,
-                              min_clearance_mm=0.25, pins=partset.pins, spacers=partset.spacers,
+                              min_clearance_mm=clearance, pins=partset.pins, spacers=partset.spacers,
                               extra=sweep_items(partset) if extra is None else extra)
 
 
@@ -247,3 +247,18 @@ def test_without_mounting_holes_the_ground_takes_new_standoff_holes(sla_process)
     result = sweep(ps, motion)
     assert result.passed, result.failures()
     assert any(p.relation == "fixed" and "standoff" in p.a + p.b for p in result.pairs)
+
+
+def test_a_cut_process_buys_its_standoffs_and_sweeps_them(laser_process):
+    _, ps, motion = driven(laser_process, "nema17", poses=37)
+    assert not [p for p in ps.parts if p.role == "standoff"]
+    standoffs = [s for s in ps.actuator.solids if s.role == "standoff"]
+    assert len(standoffs) == len(ps.actuator.standoffs) == 2
+    (tubes,) = [r for r in ps.bom if r["item"].startswith("standoff tube")]
+    assert tubes["qty"] == 2 and tubes["source"] == "buy"
+    mount = ps.part(MOUNT_PART)
+    assert mount.thickness_mm == laser_process.thickness_mm  # cut from the same sheet
+    result = sweep(ps, motion, clearance=laser_process.running_clearance_mm)
+    mine = [f for f in result.failures() if "actuator" in f or "standoff" in f]
+    assert not mine
+    assert {p.relation for p in result.pairs if "standoff" in p.a + p.b} >= {"fixed", "moving"}
