@@ -42,7 +42,8 @@ def guide_markdown(steps: Sequence[GuideStep], name: str, copies: int = 1) -> st
     The "Parts and hardware" lines read ``- N × `item` (kind)``, N per copy (``shared`` items: in all); over
     the whole guide they add up to the bill of materials.
     """
-    tools = list(dict.fromkeys(s.tool for s in steps if s.tool and s.tool not in ("none", "as above")))
+    tools = list(dict.fromkeys(s.tool for s in steps if s.tool and s.tool not in ("none", "as above",
+                                                                                 "as the parts need")))
     per = (f"Quantities are for one copy: the design has {copies} identical copies (the BOM's quantities are "
            "for all of them); items marked shared are bought once for all copies." if copies > 1 else
            "Quantities are for the whole design.")

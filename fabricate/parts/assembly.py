@@ -10,6 +10,7 @@ assembly.md and draws a picture per step. Nothing here draws or writes.
 from __future__ import annotations
 
 import dataclasses
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -124,7 +125,8 @@ def stacks_report(stacks: list[PinStack]) -> list[dict[str, Any]]:
 HEX_KEY_MM = {"ISO 4762": {"M2": 1.5, "M2.5": 2.0, "M3": 2.5, "M4": 3.0, "M5": 4.0, "M6": 5.0},
               "ISO 7380": {"M3": 2.0, "M4": 2.5, "M5": 3.0, "M6": 4.0}}
 #: Words that mark a BOM row as the drive's (the actuator step takes it).
-DRIVE_WORDS = ("actuator", "servo", "motor", "stepper", "horn", "tendon", "push rod", "lead screw", "lead-screw")
+DRIVE_WORDS = ("actuator", "servo", "motor", "stepper", "horn", "tendon", "push rod", "lead screw", "lead-screw",
+               "mount plate", "standoff")
 
 
 @dataclass(frozen=True)
@@ -242,15 +244,19 @@ def _retention(pin: Any) -> tuple[str, str]:
 
 
 def _screw_tool(rows: Sequence[dict[str, Any]]) -> str:
+    """The hex keys the screws of ``rows`` take (ISO 4762 / ISO 7380 by thread), smallest first."""
+    keys = set()
     for row in rows:
-        item = str(row.get("item", ""))
-        for standard, keys in HEX_KEY_MM.items():
+        item = f"{row.get('item', '')} "
+        for standard, sizes in HEX_KEY_MM.items():
             if standard in item:
-                thread = next((t for t in sorted(keys, key=len, reverse=True) if f"{t} " in item + " "
-                               or f"{t}×" in item or f"{t} ×" in item or f"{t}x" in item), None)
+                thread = next((t for t in sorted(sizes, key=len, reverse=True)
+                               if re.search(rf"\b{re.escape(t)}\s*[×x ]", item)), None)
                 if thread:
-                    return f"{keys[thread]:g} mm hex key"
-    return "screwdriver or hex key to suit the screws"
+                    keys.add(sizes[thread])
+    if not keys:
+        return "screwdriver or hex key to suit the screws"
+    return " and ".join(f"{k:g} mm hex key" for k in sorted(keys))
 
 
 def _is_drive(row: dict[str, Any], actuator_words: str) -> bool:
@@ -350,8 +356,8 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
             _round_robin(give, [f"pin:{j}" for j in joints], row, per, shared)
         elif _is_drive(row, act_words):
             give("shared drive" if shared else "drive", row, per, shared)
-        elif kind == "screw":
-            give("ground", row, per, shared)
+        elif kind == "screw" or (row.get("joints") and all(str(j).startswith("mount_") for j in row["joints"])):
+            give("ground", row, per, shared)  # the ground's mounting screws and their washers
         else:
             give("shared" if shared else "purchased", row, per, shared)
 
@@ -371,7 +377,8 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
 
     new_ground = [n for n, k in part_step.items() if k == "ground"]
     screws = [r for r in rows if r.get("kind") == "screw" and not _is_drive(r, act_words)]
-    text = [f"Lay {', '.join(new_ground) or 'the ground part'} flat, the side marked by its layer down."]
+    text = [f"Lay {', '.join(new_ground) or 'the ground part'} flat on the bench, bottom face down (the z heights "
+            "below are measured up from the bottom of the stack)."]
     if screws:
         text.append("Fix it to the base plate or the test stand with the screws below through its mounting holes; "
                     "do not tighten fully until the motion check.")
@@ -426,6 +433,7 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
         mount = _words(actuator, "ground_body", "ground") if actuator is not None else ""
         text.append(f"Mount {words}{' on ' + mount if mount else ''} with its screws; couple its output to "
                     f"{driven or 'the driven part'} at the middle of its range before tightening the interface.")
+        text += [str(note) for note in getattr(actuator, "notes", ()) or ()]
         drive_screws = [r for r in rows if r.get("kind") == "screw" and _is_drive(r, act_words)]
         add("drive", "The actuator", text, _screw_tool(drive_screws), drive_parts)
     if "purchased" in units:
