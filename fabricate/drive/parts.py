@@ -176,6 +176,24 @@ class PlacedActuator:
     solids: tuple[geo.Solid, ...]
     notes: tuple[str, ...] = ()
 
+    def report(self) -> dict[str, Any]:
+        """JSON-ready summary (mm, degrees): what was placed where, and what fastens it."""
+        return {
+            "model": self.model, "name": self.name, "kind": self.kind, "driver": self.driver,
+            "driver_kind": self.driver_kind, "joint": self.joint, "driven_body": self.driven_body,
+            "ground_body": self.ground_body, "axis_mm": [round(float(v), 6) for v in self.axis],
+            "direction": [round(float(v), 6) for v in self.direction], "angle_deg": round(math.degrees(self.angle), 6),
+            "z_face_mm": round(self.z_face, 6), "side": "over" if self.flip else "under",
+            "removed_pin": self.removed_pin or None, "interface": list(self.interface),
+            "mount_part": self.mount_part or None,
+            "fasteners": [{"designation": f.designation, "qty": f.qty, "purpose": f.purpose,
+                           "clamp_mm": round(f.clamp_mm, 4), "engagement_mm": round(f.engagement_mm, 4)}
+                          for f in self.fasteners],
+            "standoffs": [{"hole": s.hole, "length_mm": round(s.length_mm, 4), "printed": s.printed}
+                          for s in self.standoffs],
+            "solids": [s.name for s in self.solids], "notes": list(self.notes),
+        }
+
     def body_of(self, solid: geo.Solid) -> str:
         """The body a solid moves with."""
         return self.driven_body if solid.role in DRIVEN_ROLES else self.ground_body

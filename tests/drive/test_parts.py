@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import io
+import json
 import math
 from types import SimpleNamespace
 
@@ -83,6 +84,9 @@ def test_the_output_replaces_the_driver_pin_everywhere(sla_process):
     items = {r["item"]: r for r in ps.bom}
     assert items[SG90.name]["qty"] == 1 and items[SG90.name]["source"] == "buy"
     assert {MOUNT_PART, "standoff_mount_1", "standoff_mount_2"} <= {p.name for p in ps.parts}
+    summary = json.loads(json.dumps(ps.actuator.report()))  # JSON-ready
+    assert summary["removed_pin"] == "O" and summary["mount_part"] == MOUNT_PART
+    assert {f["designation"] for f in summary["fasteners"]} == {f.designation for f in ps.actuator.fasteners}
 
 
 def test_horn_pattern_and_hub_bore_on_the_driven_part(sla_process):
