@@ -60,10 +60,16 @@ def test_no_actuator_leaves_the_parts_alone(sla_process, four_bar):
     assert attach_actuator(d, four_bar, motion, bare) is bare
 
 
-def test_build_parts_attaches_the_designs_actuator(sla_process, four_bar):
+@pytest.mark.parametrize("process", ["sla_process", "laser_process"])
+def test_build_parts_attaches_the_designs_actuator(process, four_bar, request):
+    process = request.getfixturevalue(process)
     motion = four_bar.sweep(31)
-    ps = build_parts(design(sla_process, "mg90s"), four_bar, motion, [])
+    ps = build_parts(design(process, "mg90s"), four_bar, motion, [])
     assert ps.actuator is not None and ps.actuator.model == "mg90s" and ps.part(MOUNT_PART).role == "mount"
+    # a mounting hole a standoff stands on takes the standoff's screw, not a base screw as well
+    used = {st.hole for st in ps.actuator.standoffs}
+    assert used
+    assert not [r for r in ps.bom if r["kind"] == "screw" and used & set(r.get("joints", []))]
 
 
 def test_the_output_replaces_the_driver_pin_everywhere(sla_process):
