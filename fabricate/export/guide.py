@@ -134,6 +134,16 @@ def guide_pictures(partset: PartSet, motion: Motion, steps: Sequence[GuideStep])
                 np.array([centre + z_far * OBLIQUE, far + z_far * OBLIQUE, far + far_down * OBLIQUE])]
         springs[sp.joint] = (sp.z_mm[1], coils, legs)
         corners += coils
+    # the actuator's body, output and screws (its catalogue solids as placed): drawn from its step on
+    actuator: list[tuple[float, np.ndarray, list[np.ndarray]]] = []
+    placed = partset.actuator
+    if placed is not None:
+        for solid in placed.solids:
+            pose = poses.get(placed.body_of(solid), np.zeros(3))
+            quads, top, _ = _prism([_world(np.asarray(r, dtype=np.float64), pose) for r in solid.rings],
+                                   float(solid.z0), float(solid.z1))
+            actuator.append((float(solid.z1), quads, top))
+            corners.append(quads.reshape(-1, 2))
     allpts = np.concatenate(corners) if corners else np.zeros((1, 2))
     lo, hi = allpts.min(axis=0), allpts.max(axis=0)
     pad = 0.04 * float(max(hi - lo)) + 1.0
@@ -149,10 +159,13 @@ def guide_pictures(partset: PartSet, motion: Motion, steps: Sequence[GuideStep])
         layers: list[tuple[float, int, str, str]] = [(solids[n][0], 0, "part", n) for n in step.placed if n in solids]
         layers += [(pins[j][0], 1, "pin", j) for j in step.pins if j in pins]
         layers += [(springs[j][0], 2, "spring", j) for j in step.springs if j in springs]
+        if step.actuator:
+            layers += [(z1, 3, "actuator", str(k)) for k, (z1, _, _) in enumerate(actuator)]
         for _, _, kind, name in sorted(layers):
-            if kind == "part":
-                _, quads, top = solids[name]
-                face, side = NEW if name in step.new else OLD
+            if kind in ("part", "actuator"):
+                _, quads, top = solids[name] if kind == "part" else actuator[int(name)]
+                new = name in step.new if kind == "part" else step.new_actuator
+                face, side = NEW if new else OLD
                 ax.add_collection(PolyCollection(list(quads), facecolors=side, edgecolors=side, linewidths=0.3))
                 ax.add_patch(PathPatch(_face_path(top), facecolor=face, edgecolor=EDGE, linewidth=0.4))
             elif kind == "pin":

@@ -186,6 +186,8 @@ class GuideStep:
         Pins in place after this step; ``new_pins`` those this step adds.
     springs : tuple of str
         Spring joints in place after this step; ``new_springs`` those this step adds.
+    actuator, new_actuator : bool
+        Whether the actuator is in place after this step; whether this step mounts it.
     """
 
     number: int
@@ -199,6 +201,8 @@ class GuideStep:
     new_pins: tuple[str, ...] = ()
     springs: tuple[str, ...] = ()
     new_springs: tuple[str, ...] = ()
+    actuator: bool = False
+    new_actuator: bool = False
 
     @property
     def picture(self) -> str:
@@ -366,14 +370,17 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
     pins_in: list[str] = []
     springs_in: list[str] = []
 
+    mounted = [False]
+
     def add(key: str, title: str, text: Sequence[str], tool: str, new: Sequence[str] = (),
-            new_pins: Sequence[str] = (), new_springs: Sequence[str] = ()) -> None:
+            new_pins: Sequence[str] = (), new_springs: Sequence[str] = (), new_actuator: bool = False) -> None:
         placed.extend(n for n in new if n not in placed)
         pins_in.extend(new_pins)
         springs_in.extend(new_springs)
+        mounted[0] = mounted[0] or new_actuator
         steps.append(GuideStep(len(steps) + 1, title, tuple(units.pop(key, [])), tuple(text), tool,
                                tuple(placed), tuple(new), tuple(pins_in), tuple(new_pins), tuple(springs_in),
-                               tuple(new_springs)))
+                               tuple(new_springs), mounted[0], new_actuator))
 
     new_ground = [n for n, k in part_step.items() if k == "ground"]
     screws = [r for r in rows if r.get("kind") == "screw" and not _is_drive(r, act_words)]
@@ -435,7 +442,8 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
                     f"{driven or 'the driven part'} at the middle of its range before tightening the interface.")
         text += [str(note) for note in getattr(actuator, "notes", ()) or ()]
         drive_screws = [r for r in rows if r.get("kind") == "screw" and _is_drive(r, act_words)]
-        add("drive", "The actuator", text, _screw_tool(drive_screws), drive_parts)
+        add("drive", "The actuator", text, _screw_tool(drive_screws), drive_parts,
+            new_actuator=actuator is not None)
     if "purchased" in units:
         add("purchased", "Bought parts of each copy", ["Fit the bought parts below as their descriptions in the "
                                                        "bill of materials say."], "as the parts need")
@@ -482,4 +490,4 @@ def guide_report(steps: Sequence[GuideStep]) -> list[dict[str, Any]]:
     return [{"step": s.number, "title": s.title, "text": list(s.text), "tool": s.tool,
              "items": [{"item": i.item, "kind": i.kind, "qty": i.qty, "shared": i.shared} for i in s.items],
              "new_parts": list(s.new), "new_pins": list(s.new_pins), "new_springs": list(s.new_springs),
-             "picture": s.picture} for s in steps]
+             "new_actuator": s.new_actuator, "picture": s.picture} for s in steps]
