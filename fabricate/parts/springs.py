@@ -505,7 +505,8 @@ def spring_bom_rows(springs: Sequence[PlacedSpring], copies: int = 1) -> list[di
             continue
         s = sp.spring
         rows[sp.designation] = {
-            "item": sp.designation, "kind": "spring", "qty": copies, "joints": [sp.joint],
+            "item": sp.designation, "designation": sp.designation, "kind": "spring", "qty": copies,
+            "joints": [sp.joint],
             "wire_d_mm": round(s.wire_d_mm, 4), "mean_d_mm": round(s.mean_d_mm, 4),
             "active_turns": round(s.active_turns, 4), "legs_mm": [sp.leg_radii_mm[0], sp.leg_radii_mm[1]],
             "hand": sp.hand, "rate_Nmm_per_deg": round(s.rate_nmm_per_deg, 6),
