@@ -1,0 +1,547 @@
+"""``mechanism.xml``: the built mechanism as an MJCF model for MuJoCo, with its closed loops, gear laws,
+springs, actuator and the mass properties of the parts as made.
+
+Model
+-----
+- Units are SI (m, kg, s, N, N·m, rad): fabricate's mm and N·mm are converted here. Every body's frame is
+  fabricate's body frame, placed at the motion's first pose, so MuJoCo's initial configuration (``qpos0``)
+  is that pose and a body's named points are at their fabricate coordinates (x 0.001).
+- The bodies form a kinematic tree rooted at the ground (a fixed body). Its edges are the mechanism's
+  joints, chosen sliders first, then the drivers', the gear axes' and the springs' joints (so each of
+  those is a MuJoCo joint with a coordinate), then the others in order; every joint the tree cannot hold
+  closes its loop with an equality ``connect`` at the pin. Hinges turn about +z (the plane's normal);
+  a hinge's ``ref`` is the relative angle theta_child - theta_parent at the first pose, so its ``qpos``
+  is that relative angle (rad); a slide's is the driver's coordinate (m).
+- Part geoms are the build's own STL files (``parts/NAME.stl``, mm, scaled by 0.001), placed at the part's
+  height ``z_mm``. Mass and inertia are written explicitly (``<inertial>`` with ``fullinertia``): the
+  parts' exported meshes integrated exactly (divergence theorem on their triangles) at the process profile's
+  density, so nothing depends on MuJoCo's mesh-inertia settings. Pins, washers, springs and the actuator's
+  body are not in the masses (bom.csv lists them).
+- Gear pairs couple their joints by a joint equality ``y - y0 = a0 + a1 (x - x0) + ... + a4 (x - x0)^4``
+  (MuJoCo's quartic) fitted to the gear law over the pair's working range. Where one quartic misses the law
+  by more than :data:`GEAR_FIT_TOLERANCE_RAD` (a full-turn non-circular pair), the range is split into
+  segments, one equality each; the one holding the first pose is active, the others are written
+  ``active="false"`` and :func:`activate_gear_segments` switches them as the joint turns (call it before each
+  ``mj_step``; ``<custom>`` numerics ``gear_<pair>_segments`` hold the segment bounds). MuJoCo has no
+  arbitrary-function equality without a compiled plugin; this keeps the file loadable by the stock package.
+- Torsion springs are joint ``stiffness`` with ``springref`` at the spring's free angle (the preload
+  back from the first pose): linear, as fabricate's statics count them while the spring is wound.
+- The design's actuator is a ``<motor>`` on the driven joint, its control the effort along the driver's
+  coordinate (N·m or N), limited to the catalogue rating fabricate's drive check holds it to.
+- Every driver also gets a joint equality ``drive_K`` (inactive): activate it and set ``eq_data[0]`` to
+  (coordinate - qpos0) to prescribe that coordinate kinematically, as fabricate's drivers do. Drivers
+  beyond the first stand for stops and the object (the underactuated finger, the gripper): they are free
+  joints in the file.
+- Every named point is a site ``BODY.POINT``; the tip point is also the site ``tip``.
+- Part-part collisions are off (``contype=2 conaffinity=1``: parts collide with anything of contype 1,
+  such as an object, but not with each other; MuJoCo collides convex hulls of meshes, and a plate's hull
+  covers the pins of its neighbours).
+
+Solver settings that keep the loops closed (written in ``<option>`` and the equalities' defaults):
+timestep 1e-4 s, implicitfast integrator, Newton solver with tolerance 1e-10, equality ``solref`` with a
+time constant of two timesteps (the least MuJoCo accepts) and ``solimp`` 0.9999 (the greatest impedance):
+the pins stay closed to about a micrometre under the design's loads (tests/export/test_mjcf.py).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from fabricate.errors import SpecError
+from fabricate.export.mass import MM, MassProperties, body_mass_properties
+from fabricate.mechanism import Driver, Mechanism, Motion, Revolute, Slider
+
+if TYPE_CHECKING:
+    from fabricate.gears.pair import GearPair
+    from fabricate.parts.build import PartSet
+    from fabricate.spec import DesignSpec
+
+#: Largest error (rad) of a gear law's quartic fit before the range is split into segments.
+GEAR_FIT_TOLERANCE_RAD = 5e-5
+#: Most segments one gear law is split into.
+MAX_GEAR_SEGMENTS = 64
+#: Simulation timestep (s) written in ``<option>``.
+TIMESTEP_S = 1e-4
+
+
+@dataclass(frozen=True)
+class GearFit:
+    """A gear law as MuJoCo joint equalities: ``joint_b - qb0 = poly_k(joint_a - qa0)`` on segment k.
+
+    Attributes
+    ----------
+    name : str
+        The gear coupling.
+    joint_a, joint_b : str
+        The MuJoCo joints of gear a (x) and gear b (y).
+    bounds : (k + 1,) array
+        Segment bounds in ``joint_a - qa0`` (rad), increasing.
+    coefficients : (k, 5) array
+        Each segment's a0..a4.
+    max_error_rad : float
+        Largest difference between the fitted polynomials and the law over the range (on a dense grid).
+    """
+
+    name: str
+    joint_a: str
+    joint_b: str
+    bounds: np.ndarray
+    coefficients: np.ndarray
+    max_error_rad: float
+
+
+@dataclass(frozen=True)
+class TreeJoint:
+    """A mechanism joint held by the kinematic tree: ``child`` hangs from ``parent`` at it; ``sign`` is +1
+    when the joint's coordinate (relative angle body_b - body_a, or the slide's coordinate) is MuJoCo's
+    ``qpos``, -1 when it is its negative."""
+
+    name: str
+    parent: str
+    child: str
+    sign: float
+
+
+@dataclass(frozen=True)
+class Tree:
+    """Which body hangs from which (``joints`` in parent-first order) and the joints left to ``connect``."""
+
+    joints: tuple[TreeJoint, ...]
+    loops: tuple[Revolute | Slider, ...]
+    unreached: tuple[str, ...]
+
+    def joint(self, name: str) -> TreeJoint | None:
+        return next((j for j in self.joints if j.name == name), None)
+
+
+# -- kinematic tree -----------------------------------------------------------------------------------
+
+def driver_joint(mechanism: Mechanism, driver: Driver) -> Revolute | Slider | None:
+    """The joint whose coordinate a driver sets: its slider, or the revolute between its two bodies."""
+    for j in mechanism.joints:
+        if driver.kind == "slide" and isinstance(j, Slider) and j.name == driver.joint:
+            return j
+        if driver.kind == "angle" and isinstance(j, Revolute) and {j.body_a, j.body_b} == {driver.body,
+                                                                                              driver.reference}:
+            return j
+    return None
+
+
+def _gear_joint(mechanism: Mechanism, name: str, gear: str, carrier: str) -> Revolute | None:
+    for j in mechanism.joints:
+        if isinstance(j, Revolute) and {j.body_a, j.body_b} == {gear, carrier} and (not name or j.name == name):
+            return j
+    return next((j for j in mechanism.joints if isinstance(j, Revolute) and {j.body_a, j.body_b} == {gear, carrier}),
+                None)
+
+
+def kinematic_tree(mechanism: Mechanism, spring_joints: Sequence[str] = ()) -> Tree:
+    """The spanning tree of the mechanism's joints from the ground (see the module docstring)."""
+    joints = list(mechanism.joints)
+    wanted: list[str] = [j.name for j in joints if isinstance(j, Slider)]
+    for d in mechanism.drivers:
+        j = driver_joint(mechanism, d)
+        if j is not None:
+            wanted.append(j.name)
+    for g in mechanism.gears:
+        for name, gear in ((g.axis_a, g.gear_a), (g.axis_b, g.gear_b)):
+            j = _gear_joint(mechanism, name, gear, g.carrier)
+            if j is not None:
+                wanted.append(j.name)
+    wanted += list(spring_joints)
+    order = {name: k for k, name in enumerate(dict.fromkeys(wanted))}
+    ranked = sorted(joints, key=lambda j: (order.get(j.name, len(order)), joints.index(j)))
+    root = {b: b for b in mechanism.body_names}
+
+    def find(b: str) -> str:
+        while root[b] != b:
+            root[b] = root[root[b]]
+            b = root[b]
+        return b
+
+    edges: list[Revolute | Slider] = []
+    loops: list[Revolute | Slider] = []
+    for j in ranked:
+        ra, rb = find(j.body_a), find(j.body_b)
+        if ra == rb:
+            loops.append(j)
+        else:
+            root[ra] = rb
+            edges.append(j)
+    # orient from the ground, breadth first
+    tree: list[TreeJoint] = []
+    reached = {mechanism.ground}
+    frontier = [mechanism.ground]
+    while frontier:
+        nxt: list[str] = []
+        for parent in frontier:
+            for j in edges:
+                if parent in (j.body_a, j.body_b):
+                    child = j.body_b if parent == j.body_a else j.body_a
+                    if child in reached:
+                        continue
+                    reached.add(child)
+                    nxt.append(child)
+                    tree.append(TreeJoint(j.name, parent, child, 1.0 if child == j.body_b else -1.0))
+        frontier = nxt
+    loops.sort(key=joints.index)
+    unreached = tuple(b for b in mechanism.body_names if b not in reached)
+    return Tree(tuple(tree), tuple(loops), unreached)
+
+
+def _slide_coordinate(mechanism: Mechanism, motion: Motion, j: Slider, i: int = 0) -> float:
+    """(p_b - p_a) . u at pose ``i`` (mm), u the slider's unit axis fixed in body_a."""
+    axis = np.asarray(j.axis, dtype=np.float64) / math.hypot(*j.axis)
+    theta_a = float(motion.pose(j.body_a)[i, 2])
+    u = np.array([math.cos(theta_a) * axis[0] - math.sin(theta_a) * axis[1],
+                  math.sin(theta_a) * axis[0] + math.cos(theta_a) * axis[1]])
+    pa = motion.point(j.name, j.body_a)[i]
+    pb = motion.point(j.name, j.body_b)[i]
+    return float((pb - pa) @ u)
+
+
+def joint_coordinates(mechanism: Mechanism, motion: Motion, tree: Tree) -> dict[str, np.ndarray]:
+    """Every tree joint's MuJoCo ``qpos`` over the motion (rad, or m for a slide), shape (n,)."""
+    out: dict[str, np.ndarray] = {}
+    by_name = {j.name: j for j in mechanism.joints}
+    for tj in tree.joints:
+        j = by_name[tj.name]
+        if isinstance(j, Slider):
+            values = np.array([_slide_coordinate(mechanism, motion, j, i) for i in range(len(motion.inputs))]) * MM
+        else:
+            values = motion.relative_angle(j.body_b, j.body_a)
+        out[tj.name] = tj.sign * np.asarray(values, dtype=np.float64)
+    return out
+
+
+def driver_targets(mechanism: Mechanism, motion: Motion, tree: Tree) -> list[tuple[str, float, np.ndarray]]:
+    """Per driver: its MuJoCo joint, the sign from the driver's coordinate to that joint's ``qpos``, and the
+    ``qpos`` the driver sets at each input of the motion."""
+    coordinates = joint_coordinates(mechanism, motion, tree)
+    out = []
+    for d in mechanism.drivers:
+        j = driver_joint(mechanism, d)
+        tj = tree.joint(j.name) if j is not None else None
+        if tj is None or j is None:
+            continue
+        # the driver's coordinate is theta_body - theta_reference (or the slide's from the reference); the
+        # joint's is theta_b - theta_a (or the slide's of body_b along body_a)
+        sign = tj.sign if j.body_b == d.body else -tj.sign
+        out.append((tj.name, sign, coordinates[tj.name]))
+    return out
+
+
+# -- gear laws ------------------------------------------------------------------------------------------
+
+def fit_gear(mechanism: Mechanism, motion: Motion, tree: Tree, coupling_index: int) -> GearFit | None:
+    """The gear law of coupling ``coupling_index`` as quartic joint equalities (None where the tree does not
+    hold both gears' axes)."""
+    g = mechanism.gears[coupling_index]
+    ja = _gear_joint(mechanism, g.axis_a, g.gear_a, g.carrier)
+    jb = _gear_joint(mechanism, g.axis_b, g.gear_b, g.carrier)
+    ta = tree.joint(ja.name) if ja is not None else None
+    tb = tree.joint(jb.name) if jb is not None else None
+    if ja is None or jb is None or ta is None or tb is None:
+        return None
+    # x = theta_a - theta_c = sa * qpos_a, y = theta_b - theta_c = sb * qpos_b
+    sa = ta.sign * (1.0 if ja.body_b == g.gear_a else -1.0)
+    sb = tb.sign * (1.0 if jb.body_b == g.gear_b else -1.0)
+    x_motion = motion.relative_angle(g.gear_a, g.carrier)
+    y_motion = motion.relative_angle(g.gear_b, g.carrier)
+    qa0, qb0 = sa * float(x_motion[0]), sb * float(y_motion[0])
+    lo, hi = sorted(float(v) for v in g.working_range)
+    if hi - lo <= 0.0:
+        lo, hi = float(np.min(x_motion)), float(np.max(x_motion))
+    lo, hi = min(lo, float(np.min(x_motion))), max(hi, float(np.max(x_motion)))
+    # the working range in u = qpos_a - qa0
+    u_lo, u_hi = sorted((sa * lo - qa0, sa * hi - qa0))
+
+    def target(u: np.ndarray) -> np.ndarray:
+        return sb * np.asarray(g.law(sa * (qa0 + u)), dtype=np.float64) - qb0
+
+    segments = 1
+    while True:
+        bounds = np.linspace(u_lo, u_hi, segments + 1)
+        coefficients = np.zeros((segments, 5))
+        worst = 0.0
+        for k in range(segments):
+            # Chebyshev nodes for the fit, a dense even grid (ends included) to measure it
+            nodes = 0.5 * (bounds[k] + bounds[k + 1]) + 0.5 * (bounds[k + 1] - bounds[k]) * np.cos(
+                np.pi * (np.arange(40) + 0.5) / 40)
+            fit = np.polynomial.Polynomial.fit(nodes, target(nodes), 4).convert()
+            coefficients[k, :len(fit.coef)] = fit.coef
+            grid = np.linspace(bounds[k], bounds[k + 1], 201)
+            worst = max(worst, float(np.max(np.abs(np.polynomial.polynomial.polyval(grid, coefficients[k])
+                                                   - target(grid)))))
+        if worst <= GEAR_FIT_TOLERANCE_RAD or segments >= MAX_GEAR_SEGMENTS:
+            return GearFit(g.name, ja.name, jb.name, bounds, coefficients, worst)
+        segments *= 2
+
+
+def active_segment(fit: GearFit, u: float) -> int:
+    """The segment of ``fit`` whose range holds ``u`` (= qpos_a - qa0); the nearest one outside the range."""
+    return int(np.clip(np.searchsorted(fit.bounds, u, side="right") - 1, 0, len(fit.coefficients) - 1))
+
+
+def activate_gear_segments(model: Any, data: Any) -> None:
+    """Switch each segmented gear equality of a ``mechanism.xml`` model to the segment holding its joint's
+    current angle (``data.eq_active``); call before each ``mujoco.mj_step``. Does nothing for a model whose
+    gear laws fit in one quartic."""
+    import mujoco
+
+    for k in range(model.nnumeric):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_NUMERIC, k)
+        if not name or not name.startswith("gear_") or not name.endswith("_segments"):
+            continue
+        start, size = int(model.numeric_adr[k]), int(model.numeric_size[k])
+        bounds = np.asarray(model.numeric_data[start:start + size])
+        pair = name[len("gear_"):-len("_segments")]
+        first = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_EQUALITY, f"gear_{pair}_0")
+        joint_a = int(model.eq_obj2id[first])
+        u = float(data.qpos[model.jnt_qposadr[joint_a]] - model.qpos0[model.jnt_qposadr[joint_a]])
+        chosen = int(np.clip(np.searchsorted(bounds, u, side="right") - 1, 0, size - 2))
+        for s in range(size - 1):
+            data.eq_active[first + s] = 1 if s == chosen else 0
+
+
+# -- the document ---------------------------------------------------------------------------------------
+
+def _num(x: float, digits: int = 12) -> str:
+    value = float(x) + 0.0  # no "-0"
+    if abs(value) < 1e-300:
+        value = 0.0
+    return f"{value:.{digits}g}"
+
+
+def _vec(values: Sequence[float] | np.ndarray, digits: int = 12) -> str:
+    return " ".join(_num(v, digits) for v in values)
+
+
+def _quat(angle: float) -> str:
+    return _vec([math.cos(angle / 2.0), 0.0, 0.0, math.sin(angle / 2.0)], 15)
+
+
+_COLOURS = {"ground": "0.55 0.57 0.6 1", "gear": "0.85 0.55 0.2 1", "link": "0.25 0.5 0.8 1",
+            "spacer": "0.7 0.7 0.7 1", "mount": "0.4 0.4 0.45 1"}
+
+
+def actuator_limit(design: DesignSpec, driver: Driver) -> tuple[float, str, str] | None:
+    """The design actuator's rating in SI (N·m or N), its kind and model name; None without ``[actuator]``."""
+    from fabricate.drive.check import rating
+
+    spec = design.actuator
+    if spec is None:
+        return None
+    entry = spec.entry()
+    unit = "N·mm" if driver.kind == "angle" else "N"
+    try:
+        value, kind, _ = rating(entry, unit)
+    except SpecError:  # an entry without this rating: no actuator in the file (the drive check says why)
+        return None
+    return (value * MM if driver.kind == "angle" else value), kind, entry.name
+
+
+def _actuator_lines(design: DesignSpec, mechanism: Mechanism, tree: Tree,
+                    targets: list[tuple[str, float, np.ndarray]]) -> list[str]:
+    """``<actuator>``: a motor on the driven joint, its control the effort along the driver's coordinate,
+    limited to the catalogue rating (none without ``[actuator]`` or a rating)."""
+    spec = design.actuator
+    if spec is None or spec.driver >= len(mechanism.drivers):
+        return []
+    driver = mechanism.drivers[spec.driver]
+    limit = actuator_limit(design, driver)
+    joint = driver_joint(mechanism, driver)
+    held = tree.joint(joint.name) if joint is not None else None
+    if limit is None or held is None:
+        return []
+    sign = next(sg for name, sg, _ in targets if name == held.name)
+    value, kind, label = limit
+    unit = "N·m" if driver.kind == "angle" else "N"
+    return ['  <actuator>',
+            f'    <!-- {label}: {kind} {_num(value, 6)} {unit}; the control is the effort along the driver -->',
+            f'    <motor name="actuator" joint={quoteattr(held.name)} gear="{_num(sign)}" '
+            f'ctrlrange="{_num(-value)} {_num(value)}" forcerange="{_num(-value)} {_num(value)}"/>',
+            '  </actuator>']
+
+
+def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motion: Motion,
+                   gear_pairs: Sequence[GearPair], stl: Mapping[str, bytes]) -> bytes:
+    """``mechanism.xml``: the mechanism as an MJCF document (see the module docstring); deterministic.
+
+    Parameters
+    ----------
+    design : DesignSpec
+        Its process density, ``[actuator]`` and name.
+    partset : PartSet
+        The parts (geoms, masses), the synthesis' hints (tip point, springs).
+    mechanism, motion : Mechanism, Motion
+        The first pose of ``motion`` is the model's initial configuration.
+    gear_pairs : sequence of GearPair
+        Unused beyond the mechanism's gear couplings (the laws are the couplings'); kept for the caller's
+        symmetry with the other exporters.
+    stl : mapping of str to bytes
+        ``{part name: STL bytes}``, the files at ``parts/NAME.stl``.
+    """
+    del gear_pairs  # the couplings carry the laws
+    hints = partset.hints
+    springs = [s for s in hints.springs if s.rate_Nmm_per_deg > 0.0
+               and any(isinstance(j, Revolute) and j.name == s.joint for j in mechanism.joints)]
+    tree = kinematic_tree(mechanism, [s.joint for s in springs])
+    masses = body_mass_properties(partset, stl, design.process.density_g_cm3)
+    coordinates = joint_coordinates(mechanism, motion, tree)
+    by_joint = {j.name: j for j in mechanism.joints}
+    notes: list[str] = []
+    first = motion.poses_at(0)
+
+    lines = ['<mujoco model=' + quoteattr(design.name) + '>',
+             f'  <!-- made by fabricate from {design.name}: SI units (m, kg, N); see fabricate/export/mjcf.py -->',
+             '  <compiler angle="radian" autolimits="true" inertiafromgeom="false"/>',
+             f'  <option timestep="{_num(TIMESTEP_S)}" integrator="implicitfast" solver="Newton" iterations="200" '
+             'tolerance="1e-10" gravity="0 0 -9.81"/>',
+             '  <default>',
+             f'    <equality solref="{_num(2 * TIMESTEP_S)} 1" solimp="0.9999 0.9999 0.001 0.5 2"/>',
+             '    <geom contype="2" conaffinity="1" condim="3" friction="0.3 0.005 0.0001"/>',
+             '  </default>',
+             '  <asset>']
+    for part in partset.parts:
+        lines.append(f'    <mesh name={quoteattr(part.name)} file={quoteattr(f"parts/{part.name}.stl")} '
+                     'scale="0.001 0.001 0.001"/>')
+    lines.append('  </asset>')
+
+    # sites: every named point of a body, and the tip
+    tip = hints.tip_point if hints.tip_point in mechanism.point_names() else None
+    tip_body = None
+    if tip is not None:
+        owners = [b for b, pad in (hints.pads or {}).items() if pad.point == tip]
+        tip_body = owners[0] if owners else mechanism.point_owner(tip)
+
+    def body_xml(name: str, indent: str) -> list[str]:
+        out: list[str] = []
+        m = masses.get(name)
+        if m is None or m.mass <= 0.0:
+            notes.append(f"body {name} has no printed part: a nominal 1 g point mass")
+            m = MassProperties(1e-3, np.zeros(3), np.eye(3) * 1e-9)
+        i = m.inertia
+        out.append(f'{indent}<inertial pos="{_vec(m.com)}" mass="{_num(m.mass)}" '
+                   f'fullinertia="{_vec([i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2]])}"/>')
+        for part in partset.parts:
+            if part.body == name:
+                out.append(f'{indent}<geom name={quoteattr(part.name)} type="mesh" mesh={quoteattr(part.name)} '
+                           f'pos="0 0 {_num(part.z_mm * MM)}" rgba="{_COLOURS.get(part.role, "0.6 0.6 0.6 1")}"/>')
+        body = mechanism.body(name)
+        for point, xy in body.points.items():
+            out.append(f'{indent}<site name={quoteattr(f"{name}.{point}")} pos="{_vec([xy[0] * MM, xy[1] * MM, 0])}" '
+                       'size="0.0008"/>')
+            if point == tip and name == tip_body:
+                out.append(f'{indent}<site name="tip" pos="{_vec([xy[0] * MM, xy[1] * MM, 0])}" size="0.0015" '
+                           'rgba="1 0.2 0.2 1"/>')
+        return out
+
+    def joint_xml(tj: TreeJoint, indent: str) -> str:
+        j = by_joint[tj.name]
+        ref = float(coordinates[tj.name][0])
+        child = mechanism.body(tj.child)
+        anchor = child.point(j.name)
+        if isinstance(j, Slider):
+            axis = np.asarray(j.axis, dtype=np.float64) / math.hypot(*j.axis)
+            if tj.child == j.body_b:  # the axis is fixed in body_a; body_b's frame is turned by `angle` from it
+                c, s = math.cos(j.angle), math.sin(j.angle)
+                axis = np.array([c * axis[0] + s * axis[1], -s * axis[0] + c * axis[1]])
+            # body_a the child: moving it along +u lowers the coordinate, and its qpos is minus the coordinate
+            return (f'{indent}<joint name={quoteattr(j.name)} type="slide" pos="{_vec([*(anchor * MM), 0])}" '
+                    f'axis="{_vec([*axis, 0])}" ref="{_num(ref, 15)}"{spring_attr(tj)}/>')
+        return (f'{indent}<joint name={quoteattr(j.name)} type="hinge" pos="{_vec([*(anchor * MM), 0])}" '
+                f'axis="0 0 1" ref="{_num(ref, 15)}"{spring_attr(tj)}/>')
+
+    def spring_attr(tj: TreeJoint) -> str:
+        for s in springs:
+            if s.joint != tj.name:
+                continue
+            j = by_joint[tj.name]
+            rel = np.degrees(motion.relative_angle(j.body_b, j.body_a))
+            sense = 1.0 if rel[-1] >= rel[0] else -1.0
+            free = math.radians(float(rel[0]) - sense * s.preload_deg)  # the relative angle where it is unwound
+            stiffness = s.rate_Nmm_per_deg * 180.0 / math.pi * MM  # N·m/rad
+            return f' stiffness="{_num(stiffness)}" springref="{_num(tj.sign * free, 15)}"'
+        return ""
+
+    children: dict[str, list[TreeJoint]] = {}
+    for tj in tree.joints:
+        children.setdefault(tj.parent, []).append(tj)
+
+    def subtree(tj: TreeJoint, indent: str) -> list[str]:
+        parent, child = first[tj.parent], first[tj.child]
+        c, s = math.cos(parent[2]), math.sin(parent[2])
+        d = child[:2] - parent[:2]
+        local = np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
+        out = [f'{indent}<body name={quoteattr(tj.child)} pos="{_vec([*(local * MM), 0])}" '
+               f'quat="{_quat(float(child[2] - parent[2]))}">', joint_xml(tj, indent + "  ")]
+        out += body_xml(tj.child, indent + "  ")
+        for grandchild in children.get(tj.child, []):
+            out += subtree(grandchild, indent + "  ")
+        out.append(f"{indent}</body>")
+        return out
+
+    ground = mechanism.ground
+    lines += ['  <worldbody>', f'    <body name={quoteattr(ground)}>']
+    lines += body_xml(ground, "      ")
+    for tj in children.get(ground, []):
+        lines += subtree(tj, "      ")
+    lines += ['    </body>', '  </worldbody>']
+    for name in tree.unreached:
+        notes.append(f"body {name} is joined to nothing the ground reaches: left out")
+
+    # equalities: loops, gear laws, drivers
+    lines.append('  <equality>')
+    for j in tree.loops:
+        if isinstance(j, Slider):
+            notes.append(f"slider {j.name} closes a loop: MuJoCo has no equality for it, the loop is open")
+            continue
+        anchor = mechanism.body(j.body_a).point(j.name) * MM
+        lines.append(f'    <connect name={quoteattr(f"pin_{j.name}")} body1={quoteattr(j.body_a)} '
+                     f'body2={quoteattr(j.body_b)} anchor="{_vec([*anchor, 0])}"/>')
+    fits: list[GearFit] = []
+    for k, g in enumerate(mechanism.gears):
+        fit = fit_gear(mechanism, motion, tree, k)
+        if fit is None:
+            notes.append(f"gear {g.name}: its axes are not both joints of the tree, the law is not coupled")
+            continue
+        fits.append(fit)
+        start = active_segment(fit, 0.0)
+        for s, coef in enumerate(fit.coefficients):
+            active = "" if s == start else ' active="false"'
+            lines.append(f'    <joint name={quoteattr(f"gear_{g.name}_{s}")} joint1={quoteattr(fit.joint_b)} '
+                         f'joint2={quoteattr(fit.joint_a)} polycoef="{_vec(coef, 17)}"{active}/>')
+    targets = driver_targets(mechanism, motion, tree)
+    for k, (joint, _, _) in enumerate(targets):
+        lines.append(f'    <joint name="drive_{k}" joint1={quoteattr(joint)} polycoef="0 0 0 0 0" active="false"/>')
+    lines.append('  </equality>')
+
+    lines += _actuator_lines(design, mechanism, tree, targets)
+    if fits and any(len(f.coefficients) > 1 for f in fits):
+        lines.append('  <custom>')
+        for f in fits:
+            if len(f.coefficients) > 1:
+                lines.append(f'    <numeric name={quoteattr(f"gear_{f.name}_segments")} size="{len(f.bounds)}" '
+                             f'data="{_vec(f.bounds, 17)}"/>')
+        lines.append('  </custom>')
+    for f in fits:
+        lines.append(f'  <!-- gear {f.name}: {len(f.coefficients)} quartic segment(s), largest error of the fit '
+                     f'{_num(f.max_error_rad, 3)} rad -->')
+    for note in notes:
+        lines.append(f"  <!-- {note} -->")
+    lines.append('</mujoco>')
+    return ("\n".join(lines) + "\n").encode("utf-8")
+
+
+def gear_fits(mechanism: Mechanism, motion: Motion, spring_joints: Sequence[str] = ()) -> list[GearFit]:
+    """The gear fits :func:`mechanism_mjcf` writes (for reports and tests)."""
+    tree = kinematic_tree(mechanism, spring_joints)
+    fits = [fit_gear(mechanism, motion, tree, k) for k in range(len(mechanism.gears))]
+    return [f for f in fits if f is not None]
