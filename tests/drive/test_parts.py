@@ -26,6 +26,7 @@ from fabricate.errors import SpecError
 from fabricate.export.stl import SolidCache, part_stl
 from fabricate.parts.build import build_parts
 from fabricate.parts.spec import PartsSpec
+from fabricate.templates import shipped_templates
 from tests.conftest import make_four_bar
 from tests.parts.test_build import slider_crank
 
@@ -272,3 +273,24 @@ def test_a_cut_process_buys_its_standoffs_and_sweeps_them(laser_process):
     mine = [f for f in result.failures() if "actuator" in f or "standoff" in f]
     assert not mine
     assert {p.relation for p in result.pairs if "standoff" in p.a + p.b} >= {"fixed", "moving"}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("template", [p.stem for p in shipped_templates()])
+def test_every_shipped_template_has_its_actuator_in_the_parts_and_the_proof(template, shipped_build):
+    outcome = shipped_build(template)
+    placed = outcome.partset.actuator
+    assert placed is not None and placed.model == outcome.design.actuator.model
+    driven_part = next(p for p in outcome.partset.parts if p.body == placed.driven_body
+                       and p.role not in ("spacer", "cap", "arbor"))
+    cuts = {h.joint for h in driven_part.holes} | ({"actuator_shaft_bore", "actuator_spline_bore"}
+                                                     if getattr(driven_part, "slots", ()) else set())
+    assert set(placed.interface) <= cuts
+    pairs = outcome.report["interference"]["pairs"]
+    names = {n for row in pairs for n in (row["a"], row["b"])}
+    if placed.driver_kind == "angle":  # a rotary actuator: its mount in the parts, its solids in the proof
+        assert outcome.partset.part(MOUNT_PART).role == "mount"
+        assert placed.removed_pin and all(p.joint != placed.removed_pin for p in outcome.partset.pins)
+        assert {s.name for s in placed.solids} <= names
+        assert any(s.role == "body" for s in placed.solids)
+    assert not [f for f in outcome.failures if "actuator" in f or "standoff" in f]
