@@ -36,8 +36,9 @@ import numpy as np
 import shapely
 import shapely.ops
 
+from fabricate.catalogue.actuators import Hole as MountHole
 from fabricate.catalogue.actuators import Shaft
-from fabricate.catalogue.hardware import ISO4762, ISO7089, screw
+from fabricate.catalogue.hardware import ISO4762, ISO7089, Screw, screw
 from fabricate.drive import geometry as geo
 from fabricate.errors import SpecError
 from fabricate.mechanism import Driver, Mechanism, Motion, Revolute, Slider
@@ -394,6 +395,29 @@ class _Rotary:
             short = z_face + shaft.length_mm < z_d + 0.5 * t_d - 1e-9
         return math.inf if short else z_face
 
+    def _horn_layout(self, thickness_mm: float) -> tuple[float, str, float, Screw, tuple[MountHole, ...]]:
+        """The horn's interface on a driven part ``thickness_mm`` thick: hub bore (nominal), screw size, pilot
+        (nominal), the screw, and the arm holes used."""
+        horn = self.entry.horn
+        assert horn is not None  # called for a servo with a catalogued horn only
+        bore = geo.hub_bore_mm(horn, self.c, 0.0)
+        size = geo.horn_screw_size(horn)
+        pilot = geo.PILOT_FRACTION * float(size.lstrip("M"))
+        horn_screw = geo.screw_into(size, horn.arm_thickness_mm, thickness_mm)
+        used = geo.horn_holes(horn, bore + self.comp, pilot + self.comp, self.wall, horn_screw.head_d_mm)
+        return bore, size, pilot, horn_screw, used
+
+    def _output_reach(self) -> float:
+        """Radius (mm) the output sweeps about its axis: the horn cut back past its screws (and their heads),
+        or the shaft."""
+        horn = self.entry.horn
+        if horn is None:
+            return 0.5 * self._shaft().diameter_mm
+        _, _, _, horn_screw, used = self._horn_layout(float(self.process.thickness_mm))
+        r = max(math.hypot(h.x, h.y) for h in used)
+        hole = min(h.diameter_mm for h in horn.arm_holes)
+        return max(0.5 * horn.hub_d_mm, r + hole, r + 0.5 * horn_screw.head_d_mm)
+
     def _shaft(self) -> Shaft:
         """The output the driven part sits on without a horn: the motor's shaft, or a servo's spline (round:
         the part is pressed on it)."""
@@ -412,7 +436,7 @@ class _Rotary:
             return math.inf
         entry = self.entry
         corners = [np.hypot(x, y) for b in entry.body or () for x in (b.x0, b.x1) for y in (b.y0, b.y1)]
-        out_reach = geo.horn_reach(entry.horn) if entry.horn is not None else 0.5 * self._shaft().diameter_mm
+        out_reach = self._output_reach()
         depth = min([b.z0 for b in entry.body or ()], default=0.0)
         near = (driven.z_mm + driven.thickness_mm, z_face) if flip else (z_face, driven.z_mm)
         far = geo.Placement(np.zeros(2), 0.0, flip, z_face).z_range(depth, 0.0)
@@ -479,7 +503,7 @@ class _Rotary:
             z0, z1 = place.z_range(b.z0, b.z1)
             if z0 < hi - 1e-9 and z1 > lo + 1e-9:
                 forbidden.append(shapely.Polygon(geo.placed_ring(geo.rectangle(b.x0, b.y0, b.x1, b.y1), place)))
-        out_reach = geo.horn_reach(entry.horn) if entry.horn is not None else 0.5 * self._shaft().diameter_mm
+        out_reach = self._output_reach()
         forbidden.append(shapely.Point(*place.centre).buffer(out_reach, 64))
         t = float(self.process.thickness_mm)
         for mh in entry.mounting_holes or ():  # the plate's own screws: their holes and heads
@@ -638,12 +662,7 @@ class _Rotary:
             horn, spline = entry.horn, entry.spline
             assert horn is not None and spline is not None  # a servo entry has both (catalogue)
             seat0, seat1 = geo.horn_seat_z(entry)
-            bore = geo.hub_bore_mm(horn, self.c, 0.0)
-            size = geo.horn_screw_size(horn)
-            d = float(size.lstrip("M"))
-            pilot = geo.PILOT_FRACTION * d
-            horn_screw = geo.screw_into(size, horn.arm_thickness_mm, t_d)
-            used = geo.horn_holes(horn, bore + self.comp, pilot + self.comp, self.wall, horn_screw.head_d_mm)
+            bore, size, pilot, horn_screw, used = self._horn_layout(t_d)
             at = geo.horn_pattern(used, c_d, alpha, flip)
             holes.append(_hole("actuator_hub", c_d, bore, self.comp, fit="clearance"))
             interface.append("actuator_hub")
