@@ -1,0 +1,260 @@
+"""The mount of a rotary actuator: a plate on its flange (part role ``"mount"``), its screws, and the
+standoffs that stand it on the ground part (on the ground's mounting holes that keep clear of the actuator and
+of what moves, else on new holes in the ground's free material, else on arms the ground part grows); and the
+turn of the actuator's body that lets the standoffs clear it. A mixin of
+:class:`fabricate.drive.rotary.RotaryPlacement`, which sets the attributes declared here."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import shapely
+import shapely.ops
+
+from fabricate.catalogue.hardware import ISO4762, screw
+from fabricate.drive import geometry as geo
+from fabricate.drive.parts import MOUNT_PART, Fastener, Standoff, fit_hole, screw_size
+from fabricate.parts.model import BulgePath, Hole, Part
+from fabricate.parts.profiles import circle_hull
+
+if TYPE_CHECKING:
+    from fabricate.catalogue.actuators import Actuator
+    from fabricate.mechanism import Mechanism, Motion
+    from fabricate.parts.build import PartSet
+    from fabricate.process import ProcessSpec
+
+
+class MountPlacement:
+    """The mount plate and standoffs of a rotary actuator (a mixin: see the module docstring)."""
+
+    design: Any
+    mechanism: Mechanism
+    motion: Motion
+    ps: PartSet
+    entry: Actuator
+    process: ProcessSpec
+    tol: float
+    ground: str
+    c: float
+    comp: float
+    wall: float
+    notes: list[str]
+    new_ground_holes: list[Hole]
+    ground_arms: list[np.ndarray]
+
+    def _output_reach(self) -> float:
+        raise NotImplementedError  # RotaryPlacement's
+
+    def _orient(self, angle: float, centre: np.ndarray, ground: Part, flip: bool, z_face: float) -> float:
+        """The turn nearest ``angle`` (10 degree steps) at which the standoffs on the ground's mounting holes
+        keep clear of the actuator's body between its mount plate and the ground part."""
+        entry = self.entry
+        mounting = [h for h in ground.holes if h.joint.startswith("mount_")]
+        if not mounting or not entry.body:
+            return angle
+        pz = geo.mount_plate_z(entry)
+        # the ground part's near face in the entry's z: the standoffs run from the plate up to it
+        faces = [(g - z_face) if not flip else (z_face - g) for g in (ground.z_mm, ground.z_mm + ground.thickness_mm)]
+        near = min(faces)
+        boxes = [b for b in entry.body if b.z1 > pz + 1e-9 and b.z0 < near - 1e-9]
+        rects = [geo.rectangle(b.x0 - self.c, b.y0 - self.c, b.x1 + self.c, b.y1 + self.c) for b in boxes]
+        discs = [(np.asarray(h.centre, dtype=float), 0.5 * h.diameter_mm + max(self.wall, 0.25 * h.diameter_mm))
+                 for h in mounting]
+        for k in sorted(range(-18, 19), key=lambda k: (abs(k), k)):
+            turn = angle + math.radians(10.0 * k)
+            place = geo.Placement(centre, turn, flip, z_face)
+            shapes = [shapely.Polygon(geo.placed_ring(r, place)) for r in rects]
+            if all(shape.distance(shapely.Point(c)) >= r for shape in shapes for c, r in discs):
+                return turn
+        return angle
+
+    def _standoff_sites(self, place: geo.Placement, ground: Part, lo: float, hi: float) -> list[Hole]:
+        """Where the standoffs stand on the ground part (holes of the ground): its mounting holes that keep
+        clear of the actuator (body, output) and of every part moving between the plate and the ground; else
+        two new holes (``standoff_1``, ``standoff_2``), as far apart as the ground part's free material allows;
+        none if it has none."""
+        from fabricate.parts.build import swept_region
+
+        entry, c = self.entry, self.c
+        nominal = float(self.design.parts.mounting_hole_mm) + 2.0 * c
+        hole_d = nominal + self.comp
+        outer = hole_d + 2.0 * max(self.wall, 0.25 * hole_d)
+        forbidden = []
+        for b in entry.body or ():
+            z0, z1 = place.z_range(b.z0, b.z1)
+            if z0 < hi - 1e-9 and z1 > lo + 1e-9:
+                forbidden.append(shapely.Polygon(geo.placed_ring(geo.rectangle(b.x0, b.y0, b.x1, b.y1), place)))
+        out_reach = self._output_reach()
+        forbidden.append(shapely.Point(*place.centre).buffer(out_reach, 64))
+        t = float(self.process.thickness_mm)
+        for mh in entry.mounting_holes or ():  # the plate's own screws: their holes and heads
+            f = geo.fastening(entry, mh, t, c, self.comp)
+            head = ISO4762[f.size].head_d_mm if f.tapped else 0.0
+            radius = max(0.5 * f.plate_hole_mm + self.wall, 0.5 * head)
+            forbidden.append(shapely.Point(*place.plan(np.array([mh.x, mh.y]))).buffer(radius, 32))
+        if self.ground == self.mechanism.ground:
+            moving = {p.body: p.outline for p in self.ps.parts if p.body != self.ground
+                      and p.z_mm < hi - 1e-9 and p.z_mm + p.thickness_mm > lo + 1e-9}
+            if moving:
+                forbidden.append(swept_region(moving, self.motion))
+        keep_out = shapely.union_all(forbidden).buffer(0.5 * outer + c)
+        existing = [h for h in ground.holes if h.joint.startswith("mount_")]
+        clear = [h for h in existing if not keep_out.contains(shapely.Point(h.centre))
+                 and keep_out.distance(shapely.Point(h.centre)) > 0.0]
+        if len(clear) >= min(2, len(existing)) and clear:
+            return clear
+        # new sites on the ground part's own material, clear of its holes
+        inset = max(0.5 * outer, 0.5 * hole_d + self.wall)
+        region = shapely.Polygon(ground.outline.polygon(0.05)).buffer(-inset)
+        for h in ground.holes:
+            region = region.difference(shapely.Point(h.centre).buffer(0.5 * (h.diameter_mm + hole_d) + self.wall))
+        region = region.difference(keep_out)
+        if region.is_empty or region.area < 1e-6:
+            return self._standoff_arms(place, ground, keep_out, nominal, hole_d, outer) or clear
+        xs, ys = np.meshgrid(*(np.arange(a, b + 0.25, 0.25) for a, b in
+                               zip(region.bounds[:2], region.bounds[2:], strict=True)))
+        pts = np.column_stack([xs.ravel(), ys.ravel()])
+        pts = pts[shapely.contains_xy(region, pts[:, 0], pts[:, 1])]
+        if len(pts) == 0:
+            pts = np.array(region.representative_point().coords)
+        if len(pts) == 1:
+            picks = pts
+        else:
+            gaps = np.hypot(*(pts[:, None, :] - pts[None, :, :]).transpose(2, 0, 1)) if len(pts) < 1500 else None
+            if gaps is None:  # a coarse pair: the points farthest along the region's long direction
+                u = pts - pts.mean(axis=0)
+                axis = np.linalg.svd(u, full_matrices=False)[2][0]
+                picks = pts[[int(np.argmin(u @ axis)), int(np.argmax(u @ axis))]]
+            else:
+                i, j = np.unravel_index(int(np.argmax(gaps)), gaps.shape)
+                picks = pts[[i, j]] if gaps[i, j] >= outer + self.wall else pts[[i]]
+        self.new_ground_holes = [fit_hole(f"actuator_standoff_{k + 1}", p, nominal, self.comp, fit="clearance")
+                                 for k, p in enumerate(picks)]
+        return list(self.new_ground_holes)
+
+    def _standoff_arms(self, place: geo.Placement, ground: Part, keep_out: Any, nominal: float, hole_d: float,
+                       outer: float) -> list[Hole]:
+        """Two standoff sites off the ground part, each on an arm the ground part grows to reach it (in its own
+        layer, clear of what moves there): the sites nearest the ground part that clear ``keep_out``, at least
+        three standoffs apart. Sets :attr:`ground_arms`; [] when no site is found."""
+        from fabricate.parts.build import swept_region
+
+        if self.ground != self.mechanism.ground:
+            return []
+        body = shapely.Polygon(ground.outline.polygon(0.05))
+        g0, g1 = ground.z_mm, ground.z_mm + ground.thickness_mm
+        same_layer = {p.body: p.outline for p in self.ps.parts if p.body != self.ground
+                      and p.z_mm < g1 - 1e-9 and p.z_mm + p.thickness_mm > g0 + 1e-9}
+        swept = swept_region(same_layer, self.motion).buffer(self.c + 0.5) if same_layer else shapely.Polygon()
+        boss = max(0.5 * outer, 0.5 * hole_d + self.wall)
+        reach = max([math.hypot(x, y) for b in self.entry.body or () for x in (b.x0, b.x1) for y in (b.y0, b.y1)],
+                    default=20.0) + 4.0 * outer
+        xs, ys = np.meshgrid(*(np.arange(-reach, reach + 1.0, 1.0),) * 2)
+        pts = np.column_stack([xs.ravel(), ys.ravel()]) + np.asarray(place.centre, dtype=float)
+        pts = pts[~shapely.contains_xy(keep_out, pts[:, 0], pts[:, 1])]
+        pts = pts[shapely.distance(keep_out, shapely.points(pts)) > 0.0]
+        order = np.argsort(shapely.distance(body, shapely.points(pts)))
+        sites: list[np.ndarray] = []
+        arms: list[np.ndarray] = []
+        for k in order:
+            p = pts[k]
+            if any(float(np.hypot(*(p - q))) < 3.0 * outer for q in sites):
+                continue
+            near = np.array(shapely.ops.nearest_points(body, shapely.Point(p))[0].coords[0])
+            arm = circle_hull(np.array([near, p]), np.array([boss, boss])) if np.hypot(*(p - near)) > 1e-6 \
+                else circle_hull(p[None, :], boss)
+            ring = arm.polygon(0.05)
+            if not swept.is_empty and shapely.Polygon(ring).intersects(swept):
+                continue
+            sites.append(p)
+            arms.append(ring)
+            if len(sites) == 2:
+                break
+        if len(sites) < 2:
+            return []
+        self.ground_arms = arms
+        self.new_ground_holes = [fit_hole(f"actuator_standoff_{k + 1}", p, nominal, self.comp, fit="clearance")
+                                 for k, p in enumerate(sites)]
+        return list(self.new_ground_holes)
+
+    def _mount(self, place: geo.Placement, ground: Part, flip: bool
+               ) -> tuple[Part, list[Fastener], list[Standoff], list[Part], list[geo.Solid]]:
+        """The mount plate on the actuator's flange, its screws, and the standoffs to the ground part."""
+        from fabricate.parts.build import SlottedPart, safe_name
+
+        entry, process, tol = self.entry, self.process, self.tol
+        t = float(process.thickness_mm)
+        pz = geo.mount_plate_z(entry)
+        z0, z1 = place.z_range(pz, pz + t)
+        holes: list[Hole] = []
+        circles: list[tuple[np.ndarray, float]] = []
+        fasteners: list[Fastener] = []
+        solids: list[geo.Solid] = []
+        by_screw: dict[tuple[str, float, float, str], int] = {}
+        for k, mh in enumerate(entry.mounting_holes or ()):
+            f = geo.fastening(entry, mh, t, self.c, self.comp)
+            centre = place.plan(np.array([mh.x, mh.y]))
+            nominal = f.plate_hole_mm - self.comp
+            holes.append(fit_hole(f"actuator_screw_{k + 1}", centre, nominal, self.comp,
+                               fit="clearance" if f.tapped else "tapped"))
+            circles.append((centre, 0.5 * f.plate_hole_mm + self.wall))
+            s = screw(f.size, f.clamp_mm, f.engagement_mm)
+            key = (s.designation, s.clamp_mm, s.engagement_mm,
+                   "actuator to its mount plate" + (" (into its tapped holes)" if f.tapped
+                                                     else " (taps into the plate)"))
+            by_screw[key] = by_screw.get(key, 0) + 1
+            if f.tapped:  # the head bears on the plate's far face from the actuator
+                solids.append(geo.Solid(f"actuator_screw_head_{k + 1}", "fixing",
+                                        (geo.circle_ring(centre, s.head_d_mm, tol),),
+                                        *place.z_range(pz + t, pz + t + s.head_h_mm)))
+        fasteners += [Fastener(d, n, purpose, clamp, engage) for (d, clamp, engage, purpose), n in by_screw.items()]
+        slots = [BulgePath.polyline(geo.placed_ring(r, place)) for r in geo.plate_cutouts(entry, pz, pz + t, self.c)]
+        for cut in slots:
+            circles += [(v, self.wall) for v in cut.vertices]
+        circles.append((np.asarray(place.centre, dtype=float), self.wall))
+        standoffs: list[Standoff] = []
+        standoff_parts: list[Part] = []
+        g0, g1 = float(ground.z_mm), float(ground.z_mm + ground.thickness_mm)
+        lo, hi = (g1, z0) if flip else (z1, g0)
+        mounting = self._standoff_sites(place, ground, lo, hi) if hi - lo > 1e-6 else []
+        if mounting:
+            size = screw_size(float(self.design.parts.mounting_hole_mm))
+            d = float(size.lstrip("M"))
+            printed = process.technique == "additive"
+            count = 0
+            for h in mounting:
+                inner = float(h.diameter_mm)
+                outer = inner + 2.0 * max(self.wall, 0.25 * inner)
+                st = Standoff(h.joint, np.asarray(h.centre, dtype=float), inner, outer, hi - lo, lo, printed)
+                standoffs.append(st)
+                pilot = geo.PILOT_FRACTION * d
+                name = h.joint.removeprefix("actuator_")
+                holes.append(fit_hole(f"actuator_{name}", st.centre, pilot, self.comp, fit="tapped"))
+                circles.append((st.centre, max(0.5 * outer, 0.5 * (pilot + self.comp) + self.wall)))
+                ring = circle_hull(st.centre[None, :], 0.5 * outer)
+                if printed:
+                    standoff_parts.append(Part(name=safe_name(name if name.startswith("standoff") else
+                                                              f"standoff_{name}"), body=self.ground, outline=ring,
+                                               holes=(fit_hole(h.joint, st.centre, inner - self.comp, self.comp),),
+                                               thickness_mm=st.length_mm, z_mm=st.z_mm, layer=ground.layer,
+                                               process=process.name, role="standoff"))
+                else:
+                    solids.append(geo.Solid(name if name.startswith("standoff") else f"standoff_{name}", "standoff",
+                                            (geo.circle_ring(st.centre, outer, tol),
+                                             geo.circle_ring(st.centre, inner, tol)[::-1]), st.z_mm,
+                                            st.z_mm + st.length_mm))
+                count += 1
+            fix = geo.screw_into(size, float(ground.thickness_mm) + (hi - lo), t)
+            fasteners.append(Fastener(fix.designation, count, "mount plate to the ground part through the standoffs "
+                                      "(taps into the plate)", fix.clamp_mm, fix.engagement_mm))
+        else:
+            self.notes.append("no place on the ground part for the mount's standoffs: fix the mount plate to the "
+                              "same base as the ground part")
+        outline = circle_hull(np.array([c for c, _ in circles]), np.array([r for _, r in circles]))
+        layers = [p.layer for p in self.ps.parts]
+        plate = SlottedPart(name=MOUNT_PART, body=self.ground, outline=outline, holes=tuple(holes), thickness_mm=t,
+                            z_mm=z0, layer=max(layers) + 1 if flip else min(layers) - 1, process=process.name,
+                            role="mount", slots=tuple(slots))
+        return plate, fasteners, standoffs, standoff_parts, solids
