@@ -400,6 +400,7 @@ def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, pa
         except SpecError as exc:
             raise GeometryError(f"spring at {name}: {exc}") from None
         pin_mm = float(pin.diameter_mm)
+        # no leg length given: 2.5 x (pin + 2 mm), a design choice (long enough to reach past a boss)
         legs_default = float(legs_hint) if legs_hint else 2.5 * (pin_mm + 2.0)
         legs = (legs_default, legs_default)
         ends = _ends(pin, parts_by, process)
@@ -460,7 +461,7 @@ def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, pa
         anchor = Hole(f"spring_{name}", near_at, hole, 0.0, "running", nominal)
         far_hole = Hole(f"spring_{name}", far_at, hole, 0.0, "running", nominal)
         for part, extra in ((near_part, anchor), (far_part, far_hole)):
-            idx = parts.index(part)
+            idx = next(i for i, p in enumerate(parts) if p.name == part.name)
             parts[idx] = replace(parts[idx], holes=tuple(parts[idx].holes) + (extra,))
         # axial runs: the near leg's end into its plate (half its thickness); the far leg from the coil's far
         # end back past the coil and the plates between, to the middle of the far plate
