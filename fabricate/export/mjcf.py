@@ -53,7 +53,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from fabricate.errors import SpecError
+from fabricate.errors import FabricateError, SpecError
 from fabricate.export.mass import MM, MassProperties, body_mass_properties
 from fabricate.mechanism import Driver, Mechanism, Motion, Revolute, Slider
 
@@ -390,8 +390,7 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
     """
     del gear_pairs  # the couplings carry the laws
     hints = partset.hints
-    springs = [s for s in hints.springs if s.rate_Nmm_per_deg > 0.0
-               and any(isinstance(j, Revolute) and j.name == s.joint for j in mechanism.joints)]
+    springs = [s for s in hints.springs if s.joint in spring_joints(partset, mechanism)]
     tree = kinematic_tree(mechanism, [s.joint for s in springs])
     masses = body_mass_properties(partset, stl, design.process.density_g_cm3)
     coordinates = joint_coordinates(mechanism, motion, tree)
@@ -494,14 +493,11 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
     for tj in children.get(ground, []):
         lines += subtree(tj, "      ")
     lines += ['    </body>', '  </worldbody>']
-    for name in tree.unreached:
-        notes.append(f"body {name} is joined to nothing the ground reaches: left out")
 
     # equalities: loops, gear laws, drivers
     lines.append('  <equality>')
     for j in tree.loops:
         if isinstance(j, Slider):
-            notes.append(f"slider {j.name} closes a loop: MuJoCo has no equality for it, the loop is open")
             continue
         anchor = mechanism.body(j.body_a).point(j.name) * MM
         lines.append(f'    <connect name={quoteattr(f"pin_{j.name}")} body1={quoteattr(j.body_a)} '
@@ -510,7 +506,6 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
     for k, g in enumerate(mechanism.gears):
         fit = fit_gear(mechanism, motion, tree, k)
         if fit is None:
-            notes.append(f"gear {g.name}: its axes are not both joints of the tree, the law is not coupled")
             continue
         fits.append(fit)
         start = active_segment(fit, 0.0)
@@ -534,10 +529,57 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
     for f in fits:
         lines.append(f'  <!-- gear {f.name}: {len(f.coefficients)} quartic segment(s), largest error of the fit '
                      f'{_num(f.max_error_rad, 3)} rad -->')
-    for note in notes:
+    for note in structure_notes(mechanism, tree) + notes:
         lines.append(f"  <!-- {note} -->")
     lines.append('</mujoco>')
     return ("\n".join(lines) + "\n").encode("utf-8")
+
+
+def structure_notes(mechanism: Mechanism, tree: Tree) -> list[str]:
+    """What the model cannot hold of the mechanism (empty for every shipped template)."""
+    notes = [f"body {name} is joined to nothing the ground reaches: left out" for name in tree.unreached]
+    notes += [f"slider {j.name} closes a loop: MuJoCo has no equality for it, the loop is open"
+              for j in tree.loops if isinstance(j, Slider)]
+    for g in mechanism.gears:
+        ja = _gear_joint(mechanism, g.axis_a, g.gear_a, g.carrier)
+        jb = _gear_joint(mechanism, g.axis_b, g.gear_b, g.carrier)
+        if ja is None or jb is None or tree.joint(ja.name) is None or tree.joint(jb.name) is None:
+            notes.append(f"gear {g.name}: its axes are not both joints of the tree, the law is not coupled")
+    return notes
+
+
+def spring_joints(partset: PartSet, mechanism: Mechanism) -> list[str]:
+    """The revolute joints whose torsion spring (a rate above 0) the model carries as joint stiffness."""
+    return [s.joint for s in partset.hints.springs if s.rate_Nmm_per_deg > 0.0
+            and any(isinstance(j, Revolute) and j.name == s.joint for j in mechanism.joints)]
+
+
+def simulation_section(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motion: Motion) -> dict[str, Any]:
+    """report.json's ``simulation``: what mechanism.xml holds and how (fabricate/report_schema.json)."""
+    tree = kinematic_tree(mechanism, spring_joints(partset, mechanism))
+    fits = [fit for fit in (fit_gear(mechanism, motion, tree, k) for k in range(len(mechanism.gears)))
+            if fit is not None]
+    actuator = None
+    spec = design.actuator
+    if spec is not None and spec.driver < len(mechanism.drivers):
+        driver = mechanism.drivers[spec.driver]
+        limit = actuator_limit(design, driver)
+        joint = driver_joint(mechanism, driver)
+        if limit is not None and joint is not None and tree.joint(joint.name) is not None:
+            actuator = {"joint": joint.name, "model": limit[2], "limit": limit[0],
+                        "unit": "N·m" if driver.kind == "angle" else "N", "rating": limit[1]}
+    return {
+        "mjcf": "mechanism.xml",
+        "joints": [tj.name for tj in tree.joints],
+        "connect": [j.name for j in tree.loops if isinstance(j, Revolute)],
+        "gear_fits": [{"pair": f.name, "joints": [f.joint_a, f.joint_b], "segments": len(f.coefficients),
+                       "max_error_rad": float(f"{f.max_error_rad:.4g}")} for f in fits],
+        "springs": spring_joints(partset, mechanism),
+        "actuator": actuator,
+        "solver": {"timestep_s": TIMESTEP_S, "integrator": "implicitfast", "solver": "Newton",
+                   "equality_solref": [2 * TIMESTEP_S, 1.0], "equality_solimp": [0.9999, 0.9999, 0.001, 0.5, 2.0]},
+        "notes": structure_notes(mechanism, tree),
+    }
 
 
 def gear_fits(mechanism: Mechanism, motion: Motion, spring_joints: Sequence[str] = ()) -> list[GearFit]:
@@ -545,3 +587,23 @@ def gear_fits(mechanism: Mechanism, motion: Motion, spring_joints: Sequence[str]
     tree = kinematic_tree(mechanism, spring_joints)
     fits = [fit_gear(mechanism, motion, tree, k) for k in range(len(mechanism.gears))]
     return [f for f in fits if f is not None]
+
+
+def load_model(files: Mapping[str, bytes]) -> Any:
+    """A build's ``mechanism.xml`` as a ``mujoco.MjModel``, its meshes from the build's own STL files in
+    ``files`` (``{relative path: bytes}``, as :attr:`fabricate.Build.files`); nothing is read from disk.
+
+    Raises
+    ------
+    FabricateError
+        When ``files`` holds no ``mechanism.xml`` (a synthesis-only run, or a build that stopped before its
+        exports), or the ``mujoco`` package is not installed (the ``sim`` extra).
+    """
+    if "mechanism.xml" not in files:
+        raise FabricateError("no mechanism.xml in this result: only a build that got to its exports makes one")
+    try:
+        import mujoco
+    except ImportError:
+        raise FabricateError("MuJoCo is not installed: pip install 'fabricate[sim]'") from None
+    assets = {path: data for path, data in files.items() if path.startswith("parts/") and path.endswith(".stl")}
+    return mujoco.MjModel.from_xml_string(files["mechanism.xml"].decode("utf-8"), assets)

@@ -30,8 +30,7 @@ TEMPLATES = ("finger_five_bar_ncg", "finger_watt_six_bar", "finger_underactuated
 
 def load_model(build: BuildOutcome) -> Any:
     """The build's mechanism.xml with its STL files as MuJoCo assets (nothing on disk)."""
-    assets = {path: data for path, data in build.files.items() if path.startswith("parts/") and path.endswith(".stl")}
-    return mujoco.MjModel.from_xml_string(build.files["mechanism.xml"].decode("utf-8"), assets)
+    return build.mujoco_model()
 
 
 def _spring_joints(build: BuildOutcome) -> list[str]:
