@@ -351,10 +351,12 @@ def _interference(t: Table, material: Material | None, name: str, key: str) -> f
     else 0."""
     default = material.press_fit_interference_mm if material is not None else None
     if default is None and name in shipped_profiles():
+        # the shipped profile's value for the same material: the profile has no such material (no
+        # [materials] at all), or has it under the same name without the field
         shipped = read_toml(TEMPLATE_DIR / f"process_{name}.toml")
-        row = shipped.get("materials", {}).get(key, {})
+        row = shipped.get("materials", {}).get(key or shipped.get("material", ""), {})
         value = row.get("press_fit_interference_mm") if isinstance(row, dict) else None
-        if isinstance(value, (int, float)) and material is not None and material.name == row.get("name"):
+        if isinstance(value, (int, float)) and (material is None or material.name == row.get("name")):
             default = float(value)
     return t.number("press_fit_interference_mm", default if default is not None else 0.0, min=0.0,
                     max=MAX_INTERFERENCE_MM)
