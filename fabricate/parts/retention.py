@@ -469,7 +469,8 @@ def retain_pins(pins: Sequence[Any], spacers: Sequence[Any], parts: Sequence[Par
 def cap_parts(pins: Sequence[Any], parts: Sequence[Part], process: ProcessSpec) -> list[Part]:
     """The bonded end caps of ``cap`` retention as parts of the process's own stock (printed, or cut from the
     sheet): a collar round each pin end, bore the running hole, wall the process's minimum, fixed to the pin's
-    first body (so it turns with the pin)."""
+    first body (so it turns with the pin). Their role is ``spacer`` (named ``cap_<pin>_<end>``): like a spacer
+    each bears on the face next to it, which the interference proof allows (touching, never overlapping)."""
     from fabricate.parts.model import Hole, Part
     from fabricate.parts.profiles import circle_hull
 
@@ -495,7 +496,7 @@ def cap_parts(pins: Sequence[Any], parts: Sequence[Part], process: ProcessSpec) 
                             holes=(Hole(pin.joint, centre, size.modelled_mm, float(pin.diameter_mm), "running",
                                         size.nominal_mm),),
                             thickness_mm=float(length), z_mm=float(z), layer=first.layer, process=process.name,
-                            role="cap"))
+                            role="spacer"))  # it bears on the stack's end face like a spacer does
     return out
 
 
