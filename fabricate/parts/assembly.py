@@ -403,11 +403,14 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
         text = [f"Stack, bottom to top: {listing}.",
                 f"Push {_pin_words(pin)} through the stack from z {float(pin.z_mm):.2f} mm; every part "
                 "but the one that holds the pin must turn freely on it."]
-        if spring is not None:
-            end = "top" if spring.side == "top" else "bottom"
-            text.append(f"Leave the pin's {end} end free: the torsion spring goes on it in the next step.")
+        clip_over_coil = spring is not None and getattr(pin, "retention", "") == "clip" and not spring.arbor
+        if clip_over_coil and spring is not None:
+            text.append(f"Retention: {retention}. Fit the {'bottom' if spring.side == 'top' else 'top'} end's now; "
+                        f"the {spring.side} end's go on over the torsion spring in the next step.")
         else:
             text.append(f"Retention: {retention}.")
+            if spring is not None:
+                text.append(f"The torsion spring goes on the pin's {spring.side} end in the next step.")
         add(f"pin:{pin.joint}", f"Pin {pin.joint}", text, tool, new, new_pins=(pin.joint,))
         if spring is not None:
             s = spring.spring
@@ -423,9 +426,8 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
                     f"Wind the far leg {spring.deflection_deg[0]:.0f}° {way} (seen from above) and drop its end into "
                     f"the anchor hole in {spring.far_part} ({spring.leg_radii_mm[1]:g} mm from the pin; the leg's "
                     f"end runs {spring.leg_axial_mm[1]:.1f} mm along the pin to it).",
-                    f"Retention: {retention}; " + ("the clip beyond the coil also keeps the spring on the pin."
-                                                   if "clip" in retention.lower() and not spring.arbor else
-                                                   "the legs' ends in their anchor holes keep the coil in place.")]
+                    "Fit the pin's end items over the coil now: its clip keeps the spring on the pin." if clip_over_coil
+                    else "The legs' ends in their anchor holes keep the coil in place."]
             add(f"spring:{pin.joint}", f"Torsion spring at {spring.joint}", text,
                 "long-nose pliers (to wind and place the legs)",
                 [n for n, k in part_step.items() if k == f"spring:{pin.joint}"], new_springs=(spring.joint,))
