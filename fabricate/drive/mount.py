@@ -18,6 +18,7 @@ from fabricate.drive import geometry as geo
 from fabricate.drive.parts import MOUNT_PART, Fastener, Standoff, fit_hole, screw_size
 from fabricate.parts.model import BulgePath, Hole, Part
 from fabricate.parts.profiles import circle_hull
+from fabricate.planar import rotation
 
 if TYPE_CHECKING:
     from fabricate.catalogue.actuators import Actuator
@@ -99,6 +100,7 @@ class MountPlacement:
                       and p.z_mm < hi - 1e-9 and p.z_mm + p.thickness_mm > lo + 1e-9}
             if moving:
                 forbidden.append(swept_region(moving, self.motion))
+            forbidden += self._pin_hardware(lo, hi)
         keep_out = shapely.union_all(forbidden).buffer(0.5 * outer + c)
         existing = [h for h in ground.holes if h.joint.startswith("mount_")]
         clear = [h for h in existing if not keep_out.contains(shapely.Point(h.centre))
@@ -133,6 +135,25 @@ class MountPlacement:
         self.new_ground_holes = [fit_hole(f"actuator_standoff_{k + 1}", p, nominal, self.comp, fit="clearance")
                                  for k, p in enumerate(picks)]
         return list(self.new_ground_holes)
+
+    def _pin_hardware(self, lo: float, hi: float) -> list[Any]:
+        """Plan regions (ground frame) the pins' washers and tubes between ``lo`` and ``hi`` take: a disc on a
+        ground pin, the path a moving one sweeps (a washer may be wider than the boss it sits on)."""
+        out = []
+        pick = np.unique(np.linspace(0, len(self.motion.inputs) - 1, min(90, len(self.motion.inputs)))
+                         .round().astype(int))
+        for sp in self.ps.spacers:
+            if not (sp.z_mm < hi - 1e-9 and sp.z_mm + sp.length_mm > lo + 1e-9):
+                continue
+            r = 0.5 * float(sp.outer_diameter_mm)
+            centre = np.asarray(sp.centre, dtype=float)
+            if sp.body == self.ground:
+                out.append(shapely.Point(*centre).buffer(r, 32))
+                continue
+            poses = self.motion.pose(sp.body)[pick]
+            path = np.einsum("nij,j->ni", rotation(poses[:, 2]), centre) + poses[:, :2]
+            out.append(shapely.LineString(path).buffer(r, 16) if len(path) > 1 else shapely.Point(*path[0]).buffer(r))
+        return out
 
     def _standoff_arms(self, place: geo.Placement, ground: Part, keep_out: Any, nominal: float, hole_d: float,
                        outer: float) -> list[Hole]:
