@@ -357,7 +357,10 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
         elif kind == "spring" and joints:
             _round_robin(give, [f"spring:{j}" if j in springs else f"pin:{j}" for j in joints], row, per, shared)
         elif joints and not _is_drive(row, act_words):
-            _round_robin(give, [f"pin:{j}" for j in joints], row, per, shared)
+            # as many to each pin as its stack holds (washers, clips by designation); the rest dealt in turn
+            held = {j: sum(i.item == name for i in stack_of[j].items) if j in stack_of else 0 for j in joints}
+            _round_robin(give, [f"pin:{j}" for j in joints], row, per, shared,
+                         [held[j] for j in joints] if kind not in ("pin",) else None)
         elif _is_drive(row, act_words):
             give("shared drive" if shared else "drive", row, per, shared)
         elif kind == "screw" or (row.get("joints") and all(str(j).startswith("mount_") for j in row["joints"])):
@@ -478,10 +481,17 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
     return tuple(steps)
 
 
-def _round_robin(give: Any, keys: Sequence[str], row: dict[str, Any], qty: int, shared: bool) -> None:
-    """Deal a row's units to its pins' steps one at a time, in the row's joint order."""
+def _round_robin(give: Any, keys: Sequence[str], row: dict[str, Any], qty: int, shared: bool,
+                 held: Sequence[int] | None = None) -> None:
+    """Deal a row's units to its pins' steps: first what each pin's stack holds of it (``held``, in the
+    row's joint order, as far as the units go), then the rest one at a time in turn."""
     counts = dict.fromkeys(keys, 0)
-    for k in range(qty):
+    left = qty
+    for key, n in zip(keys, held or (), strict=False):
+        take = min(n, left)
+        counts[key] += take
+        left -= take
+    for k in range(left):
         counts[keys[k % len(keys)]] += 1
     for key, n in counts.items():
         give(key, row, n, shared)

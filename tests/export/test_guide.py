@@ -92,8 +92,11 @@ def test_report_md_puts_the_interference_table_last(shipped_build):
     assert "| a | b | contact |" in md[md.index("## Interference"):]
 
 
-def test_guide_of_a_four_bar_fits_every_unit_once_and_draws_each_step(sla_process):
-    """Fast: a four-bar in two copies with a spring and a shared motor, built by the parts layer alone."""
+@pytest.mark.parametrize("process", ["sla_process", "laser_process"])
+def test_guide_of_a_four_bar_fits_every_unit_once_and_draws_each_step(process, request):
+    """Fast: a four-bar in two copies with a spring and a shared motor, built by the parts layer alone (printed
+    and cut: spacers printed or bought, each process's retention)."""
+    chosen = request.getfixturevalue(process)
     from types import SimpleNamespace
 
     from fabricate.export.guide import guide_markdown, guide_pictures, guide_steps
@@ -104,7 +107,7 @@ def test_guide_of_a_four_bar_fits_every_unit_once_and_draws_each_step(sla_proces
 
     mech = make_four_bar()
     motion = mech.sweep(41)
-    design = SimpleNamespace(name="t", process=sla_process, parts=PartsSpec(),
+    design = SimpleNamespace(name="t", process=chosen, parts=PartsSpec(),
                              gears=SimpleNamespace(hub_diameter_mm=None))
     hints = PartHints(copies=2, springs=(SpringHint("B", 0.2, 30.0, 12.0),),
                       purchased_shared=(PurchasedItem("drive motor", 1, "turns the crank"),))
