@@ -27,7 +27,8 @@ Model
 - Torsion springs are joint ``stiffness`` with ``springref`` at the spring's free angle (the preload
   back from the first pose): linear, as fabricate's statics count them while the spring is wound.
 - The design's actuator is a ``<motor>`` on the driven joint, its control the effort along the driver's
-  coordinate (N·m or N), limited to the catalogue rating fabricate's drive check holds it to.
+  coordinate (N·m or N), limited to the catalogue rating fabricate's drive check holds it to (divided among
+  the copies it drives: a three-finger gripper's one finger gets a third).
 - Every driver also gets a joint equality ``drive_K`` (inactive): activate it and set ``eq_data[0]`` to
   (coordinate - qpos0) to prescribe that coordinate kinematically, as fabricate's drivers do. Drivers
   beyond the first stand for stops and the object (the underactuated finger, the gripper): they are free
@@ -331,8 +332,10 @@ _COLOURS = {"ground": "0.55 0.57 0.6 1", "gear": "0.85 0.55 0.2 1", "link": "0.2
             "spacer": "0.7 0.7 0.7 1", "mount": "0.4 0.4 0.45 1"}
 
 
-def actuator_limit(design: DesignSpec, driver: Driver) -> tuple[float, str, str] | None:
-    """The design actuator's rating in SI (N·m or N), its kind and model name; None without ``[actuator]``."""
+def actuator_limit(design: DesignSpec, driver: Driver, copies: int = 1) -> tuple[float, str, str] | None:
+    """The design actuator's rating in SI (N·m or N) shared by the ``copies`` of the mechanism it drives
+    together (one finger's share of a three-finger gripper's drive), its kind and model name; None without
+    ``[actuator]`` or without a rating of the driver's kind."""
     from fabricate.drive.check import rating
 
     spec = design.actuator
@@ -344,18 +347,19 @@ def actuator_limit(design: DesignSpec, driver: Driver) -> tuple[float, str, str]
         value, kind, _ = rating(entry, unit)
     except SpecError:  # an entry without this rating: no actuator in the file (the drive check says why)
         return None
+    value /= max(1, int(copies))
     return (value * MM if driver.kind == "angle" else value), kind, entry.name
 
 
 def _actuator_lines(design: DesignSpec, mechanism: Mechanism, tree: Tree,
-                    targets: list[tuple[str, float, np.ndarray]]) -> list[str]:
+                    targets: list[tuple[str, float, np.ndarray]], copies: int) -> list[str]:
     """``<actuator>``: a motor on the driven joint, its control the effort along the driver's coordinate,
     limited to the catalogue rating (none without ``[actuator]`` or a rating)."""
     spec = design.actuator
     if spec is None or spec.driver >= len(mechanism.drivers):
         return []
     driver = mechanism.drivers[spec.driver]
-    limit = actuator_limit(design, driver)
+    limit = actuator_limit(design, driver, copies)
     joint = driver_joint(mechanism, driver)
     held = tree.joint(joint.name) if joint is not None else None
     if limit is None or held is None:
@@ -363,8 +367,9 @@ def _actuator_lines(design: DesignSpec, mechanism: Mechanism, tree: Tree,
     sign = next(sg for name, sg, _ in targets if name == held.name)
     value, kind, label = limit
     unit = "N·m" if driver.kind == "angle" else "N"
+    share = f" (its share: one actuator drives the {copies} copies)" if copies > 1 else ""
     return ['  <actuator>',
-            f'    <!-- {label}: {kind} {_num(value, 6)} {unit}; the control is the effort along the driver -->',
+            f'    <!-- {label}: {kind} {_num(value, 6)} {unit}{share}; the control is the effort along the driver -->',
             f'    <motor name="actuator" joint={quoteattr(held.name)} gear="{_num(sign)}" '
             f'ctrlrange="{_num(-value)} {_num(value)}" forcerange="{_num(-value)} {_num(value)}"/>',
             '  </actuator>']
@@ -518,7 +523,7 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
         lines.append(f'    <joint name="drive_{k}" joint1={quoteattr(joint)} polycoef="0 0 0 0 0" active="false"/>')
     lines.append('  </equality>')
 
-    lines += _actuator_lines(design, mechanism, tree, targets)
+    lines += _actuator_lines(design, mechanism, tree, targets, max(1, int(partset.copies)))
     if fits and any(len(f.coefficients) > 1 for f in fits):
         lines.append('  <custom>')
         for f in fits:
@@ -563,7 +568,7 @@ def simulation_section(design: DesignSpec, partset: PartSet, mechanism: Mechanis
     spec = design.actuator
     if spec is not None and spec.driver < len(mechanism.drivers):
         driver = mechanism.drivers[spec.driver]
-        limit = actuator_limit(design, driver)
+        limit = actuator_limit(design, driver, partset.copies)
         joint = driver_joint(mechanism, driver)
         if limit is not None and joint is not None and tree.joint(joint.name) is not None:
             actuator = {"joint": joint.name, "model": limit[2], "limit": limit[0],

@@ -253,3 +253,96 @@ def test_mjcf_statics_match_fabricate(shipped_build: Callable[[str], BuildOutcom
 @pytest.mark.parametrize("name", TEMPLATES)
 def test_mjcf_mass_properties_match_trimesh(shipped_build: Callable[[str], BuildOutcome], name: str) -> None:
     assert mass_errors(shipped_build(name)) < 1e-6
+
+
+# -- contacts: MuJoCo's collisions of the part meshes against fabricate's interference proof ---------------
+
+def deepest_contacts(build: BuildOutcome, rows: np.ndarray) -> dict[frozenset[str], float]:
+    """With every part colliding with every other (parents and children too), the deepest penetration (mm,
+    > 0) MuJoCo reports per pair of part geoms over the motion's ``rows`` (pairs without contact left out)."""
+    assert build.motion is not None
+    mech, motion = build.motion.mechanism, build.motion
+    model = load_model(build)
+    # the bodies' own flags too: MuJoCo's broad phase filters by them, compiled from the file's geoms
+    for flags in (model.geom_contype, model.geom_conaffinity, model.body_contype, model.body_conaffinity):
+        flags[:] = 1
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT)
+    data = mujoco.MjData(model)
+    tree = kinematic_tree(mech, _spring_joints(build))
+    qpos = joint_coordinates(mech, motion, tree)
+    address = {name: int(model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)])
+               for name in qpos}
+    deepest: dict[frozenset[str], float] = {}
+    for i in rows:
+        for name, values in qpos.items():
+            data.qpos[address[name]] = values[i]
+        mujoco.mj_fwdPosition(model, data)
+        for c in data.contact[:data.ncon]:
+            pair = frozenset((mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, c.geom1),
+                              mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, c.geom2)))
+            deepest[pair] = max(deepest.get(pair, 0.0), -float(c.dist) * 1e3)
+    return deepest
+
+
+def convex_parts(build: BuildOutcome) -> set[str]:
+    """Parts whose outline is convex (MuJoCo collides a mesh by its convex hull, so only these are exact)."""
+    from shapely.geometry import Polygon
+
+    assert build.partset is not None
+    out = set()
+    for part in build.partset.parts:
+        outline = Polygon(part.outline.polygon(build.partset.chord_tolerance_mm))
+        if outline.convex_hull.area - outline.area <= 1e-6 * outline.area:
+            out.add(part.name)
+    return out
+
+
+def clearance_disagreements(build: BuildOutcome, step: int = 10) -> tuple[list[str], int]:
+    """Pairs of convex parts fabricate proves clear (clearance > 0 at every pose) that MuJoCo finds
+    penetrating by more than 1 µm, and the number of pairs compared."""
+    assert build.motion is not None
+    deepest = deepest_contacts(build, np.arange(0, len(build.motion.inputs), step))
+    convex = convex_parts(build)
+    wrong, compared = [], 0
+    for pair in build.report["interference"]["pairs"]:
+        if pair["a"] not in convex or pair["b"] not in convex or not pair["min_clearance_mm"] > 0.0:
+            continue
+        compared += 1
+        depth = deepest.get(frozenset((pair["a"], pair["b"])), 0.0)
+        if depth > 1e-3:
+            wrong.append(f"{pair['a']}-{pair['b']}: clearance {pair['min_clearance_mm']} mm, MuJoCo {depth:.4f} mm")
+    return wrong, compared
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", TEMPLATES)
+def test_mjcf_contacts_agree_with_the_interference_proof(shipped_build: Callable[[str], BuildOutcome],
+                                                         name: str) -> None:
+    wrong, compared = clearance_disagreements(shipped_build(name))
+    if compared == 0:  # the gear pair: its gears and carrier are not convex, MuJoCo collides their hulls
+        pytest.skip("no pair of convex parts to compare")
+    assert not wrong
+
+
+@pytest.mark.slow
+def test_mjcf_contacts_find_the_collision_of_the_14_mm_link_six_bar() -> None:
+    """The Watt six-bar with 14 mm links: fabricate's interference check rejects it (the proximal link runs
+    into the spacer at d0); MuJoCo's collision of the same meshes finds the same two parts in contact, and
+    no penetration between convex parts fabricate proves clear."""
+    import re
+
+    from fabricate.design import design_from_text
+    from fabricate.pipeline import run_build
+    from fabricate.templates import find_template
+
+    text = find_template("finger_watt_six_bar").read_text(encoding="utf-8")
+    text = re.sub(r"^link_width_mm\s*=.*$", "link_width_mm = 14.0", text, count=1, flags=re.M)
+    build = run_build(design_from_text(text, "finger_watt_six_bar.toml"))
+    assert build.motion is not None
+    collisions = build.report["interference"]["collisions"]
+    assert collisions
+    deepest = deepest_contacts(build, np.arange(0, len(build.motion.inputs), 10))
+    for hit in collisions:
+        assert deepest.get(frozenset((hit["a"], hit["b"])), 0.0) > 1e-3
+    wrong, _ = clearance_disagreements(build)
+    assert not wrong
