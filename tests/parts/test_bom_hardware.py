@@ -217,3 +217,25 @@ def test_shipped_pins_hardware_and_holes(template, shipped_build):
         assert entry["nominal_mm"] == pytest.approx(h.nominal_mm) and entry["modelled_mm"] == pytest.approx(
             h.diameter_mm)
     assert "## Pins, fits and what to measure" in outcome.files["report.md"].decode("utf-8")
+
+
+def test_interference_proof_sees_the_standard_pins_and_their_end_pieces(four_bar, laser_process):
+    """The proof sweeps each pin over its own length (stack and clip ends), and each clip and washer on its end
+    as a ring where it stands; a pin shortened to its stack would leave the clips floating."""
+    from fabricate.checks.interference import pin_items, pins_from_parts_layer, spacer_items
+    from tests.parts.test_build import design_for
+
+    partset = build_parts(design_for(laser_process, PartsSpec()), four_bar, four_bar.sweep(61), [])
+    items = {it.name: it for it in pin_items(pins_from_parts_layer(partset.pins, partset.parts), 0.005)}
+    rings = spacer_items(partset.spacers, partset.parts, 0.005)
+    for pin in partset.pins:
+        item = items[f"pin_{pin.joint}"]
+        assert (item.z0, item.z1) == pytest.approx((pin.z_mm, pin.z_mm + pin.length_mm))
+        assert item.z0 < pin.stack_z_mm[0] and item.z1 > pin.stack_z_mm[1]  # clips stand beyond both faces
+        ends = sorted((r for r in rings if pin.joint in r.joints and (r.z1 <= pin.stack_z_mm[0] + 1e-9
+                                                                     or r.z0 >= pin.stack_z_mm[1] - 1e-9)),
+                      key=lambda r: r.z0)
+        clips = [r for r in ends if r.source.kind == "clip"]
+        assert len(clips) == 2 and all(item.z0 - 1e-9 <= r.z0 and r.z1 <= item.z1 + 1e-9 for r in ends)
+        # each clip's groove: where the report tells the maker to cut it, from the pin's bottom end
+        assert sorted(round(r.z0 - pin.z_mm, 6) for r in clips) == pytest.approx(list(pin.grooves_mm))
