@@ -29,6 +29,7 @@ from fabricate.synthesis.base import SynthesisResult
 
 if TYPE_CHECKING:
     from fabricate.checks import CheckReport
+    from fabricate.drive.check import DriveResult
     from fabricate.gears.pair import GearPair
     from fabricate.parts.build import PartSet
     from fabricate.strength.check import StrengthResult
@@ -85,6 +86,13 @@ class BuildOutcome:
     def failures(self) -> list[str]:
         """Why the design fails, one line per failure (empty when it passes)."""
         return list(self.report.get("checks", {}).get("failures", []))
+
+    def mujoco_model(self) -> Any:
+        """The build's ``mechanism.xml`` loaded in MuJoCo (a ``mujoco.MjModel``, meshes from :attr:`files`);
+        needs the ``sim`` extra. See :func:`fabricate.export.mjcf.load_model`."""
+        from fabricate.export.mjcf import load_model
+
+        return load_model(self.files)
 
     def write(self, out: str | Path, *, force: bool = False) -> Path:
         """Write the files to folder ``out`` atomically, with the CLI's rules: ``out`` must be new, empty or
@@ -187,7 +195,8 @@ def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
     # no check runs here: the report says so, so nothing reads as "checks passed"
     report["checks"] = {"passed": not failures, "failures": failures,
                         "not_checked": [{"check": name, "reason": SYNTH_ONLY}
-                                        for name in ("interference", "gear mesh", "printability", "strength")]}
+                                        for name in ("interference", "gear mesh", "printability", "strength",
+                                                     "drive")]}
     return _finish(design, report, files, exit_code=1 if failures else 0, synthesis=result, motion=motion)
 
 
@@ -213,6 +222,7 @@ class BuildRun:
     partset: PartSet | None = None
     checks: CheckReport | None = None
     strength: StrengthResult | None = None
+    drive: DriveResult | None = None
     failures: list[str] = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -288,6 +298,7 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
         _export(run, with_step)
         _check(run)
         _check_strength(run)
+        _check_drive(run)
         _verdict(run)
         _plots(run, pictures)
     finally:
@@ -346,8 +357,11 @@ def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
         return dict(optional.step_files) if optional.step_files is not None else export_step(design, partset,
                                                                                              motion)
 
+    from fabricate.export.guide import guide_picture_files
+
     return [lambda: synthesis_plots(result), lambda: gear_pictures(gear_pairs),
-            lambda: export_previews(design, partset, motion), step_job]
+            lambda: export_previews(design, partset, motion), step_job,
+            lambda: guide_picture_files(partset, motion)]
 
 
 def _record_optional_outputs(run: BuildRun) -> bool:
@@ -366,7 +380,10 @@ def _record_optional_outputs(run: BuildRun) -> bool:
 def _export(run: BuildRun, with_step: bool) -> None:
     """Part files, drawings, plates or sheets, the BOM and assembly, motion.csv and mechanism.toml."""
     from fabricate.export import assembly_csv, export_all, motion_csv
-    from fabricate.parts.assembly import assembly_steps, pin_stacks, stacks_report
+    from fabricate.export.guide import guide_markdown, guide_steps
+    from fabricate.parts.assembly import assembly_steps, guide_report, pin_stacks, stacks_report
+    from fabricate.parts.retention import hardware_report
+    from fabricate.parts.springs import springs_report
     from fabricate.synthesis.linkage.exact import mechanism_toml
 
     run.enter("exports")
@@ -376,11 +393,24 @@ def _export(run: BuildRun, with_step: bool) -> None:
     run.files.update(exported)
     run.report["parts"] = parts_report
     run.report["bom"] = list(getattr(run.partset, "bom", []))
+    run.report["hardware"] = hardware_report(run.partset, run.design.process)  # pins, fits, what to measure
+    if getattr(run.partset, "springs", ()):
+        run.report["springs"] = springs_report(run.partset.springs)
     stacks = pin_stacks(run.partset)
-    run.report["assembly"] = {"pins": stacks_report(stacks), "steps": assembly_steps(stacks, run.partset.copies)}
+    guide = guide_steps(run.partset, run.motion)  # assembly.md; its pictures are drawn by _picture_jobs
+    run.report["assembly"] = {"pins": stacks_report(stacks), "steps": assembly_steps(stacks, run.partset.copies),
+                              "guide": guide_report(guide)}
+    run.files["assembly.md"] = guide_markdown(guide, run.design.name, run.partset.copies).encode("utf-8")
     run.files["assembly.csv"] = assembly_csv(stacks)
     run.files["motion.csv"] = motion_csv(run.mechanism, run.motion)
     run.files["mechanism.toml"] = mechanism_toml(run.design, run.mechanism, run.synthesis.parts)
+    # the MuJoCo model: its meshes are the part STL files just exported (fabricate/export/mjcf.py)
+    from fabricate.export.mjcf import mechanism_mjcf, simulation_section
+
+    stl = {part.name: run.files[f"parts/{part.name}.stl"] for part in run.partset.parts}
+    run.files["mechanism.xml"] = mechanism_mjcf(run.design, run.partset, run.mechanism, run.motion, run.gear_pairs,
+                                                stl)
+    run.report["simulation"] = simulation_section(run.design, run.partset, run.mechanism, run.motion)
 
 
 def _check(run: BuildRun) -> None:
@@ -410,6 +440,18 @@ def _check_strength(run: BuildRun) -> None:
     run.failures += run.strength.failures()
 
 
+def _check_drive(run: BuildRun) -> None:
+    """The actuator against the input effort the statics compute at every pose: report.json's ``drive``."""
+    from fabricate.drive.check import run_drive
+
+    run.enter("drive")
+    assert run.partset is not None  # the parts stage ran
+    run.drive = run_drive(run.design, run.mechanism, run.motion, run.synthesis.parts, run.strength,
+                          copies=run.partset.copies)
+    run.report["drive"] = run.drive.report()
+    run.failures += run.drive.failures()
+
+
 def _verdict(run: BuildRun) -> None:
     """report.json's ``checks``: passed is over the checks that ran; those that could not run are listed,
     never passed."""
@@ -417,6 +459,8 @@ def _verdict(run: BuildRun) -> None:
     not_checked = [dict(entry) for entry in run.checks.not_checked]
     if run.strength.reason is not None:
         not_checked.append({"check": "strength", "reason": run.strength.reason})
+    if run.drive is not None and run.drive.reason is not None:
+        not_checked.append({"check": "drive", "reason": run.drive.reason})
     run.report["checks"] = {"passed": not run.failures, "failures": run.failures, "not_checked": not_checked}
 
 
@@ -428,6 +472,10 @@ def _plots(run: BuildRun, pictures: Background) -> None:
     assert run.checks is not None and run.strength is not None  # both checks ran
     if run.strength.findings:
         run.files["plots/strength.png"] = strength_plot(run.strength, run.mechanism.input_unit)
+    if run.drive is not None and run.drive.reason is None:
+        from fabricate.drive.plots import drive_plot
+
+        run.files["plots/drive.png"] = drive_plot(run.drive)
     for name, data in sorted(run.checks.figures().items()):
         run.files[f"plots/{name}"] = data
     run.files.update(pictures.result())

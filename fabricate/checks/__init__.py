@@ -144,9 +144,14 @@ def run_checks(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motio
         if gear_pairs:
             not_checked.append({"check": "gear mesh", "reason": NO_POSES})
     else:
+        from fabricate.drive.parts import sweep_items as actuator_items
+        from fabricate.parts.springs import spring_sweep_items
+
         sweep = sweep_interference(parts, motion, chord_tolerance_mm=process.chord_tolerance_mm,
                                    min_clearance_mm=float(required), pins=pins or None,
-                                   spacers=tuple(getattr(partset, "spacers", ()) or ()))
+                                   spacers=tuple(getattr(partset, "spacers", ()) or ()),
+                                   extra=actuator_items(partset)
+                                   + spring_sweep_items(getattr(partset, "springs", ()), process.chord_tolerance_mm))
         meshes = tuple(check_gear_meshes(gear_pairs, motion))
         if not sweep.pairs:
             not_checked.append({"check": "interference", "reason": NO_PAIRS})

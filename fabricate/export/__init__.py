@@ -39,8 +39,8 @@ if TYPE_CHECKING:  # ezdxf loads with fabricate.export.dxf: only when a DXF is m
     from fabricate.spec import DesignSpec
 
 #: bom.csv's leading columns; any other key of the report's BOM rows follows, sorted by name.
-BOM_COLUMNS = ("item", "kind", "qty", "process", "material", "thickness_mm", "volume_mm3", "mass_g",
-               "diameter_mm", "length_mm", "inner_diameter_mm", "outer_diameter_mm", "rate_Nmm_per_deg",
+BOM_COLUMNS = ("item", "designation", "kind", "source", "qty", "process", "material", "thickness_mm", "volume_mm3",
+               "mass_g", "diameter_mm", "length_mm", "inner_diameter_mm", "outer_diameter_mm", "rate_Nmm_per_deg",
                "preload_deg", "legs_mm", "shared", "joints", "description")
 
 
@@ -206,7 +206,7 @@ class _Making:
                    area_mm=(float(process.build_volume_mm[0]), float(process.build_volume_mm[1])),
                    margin_mm=spec.sheet_margin_mm if sheets else spec.plate_spacing_mm,
                    spacing_mm=spec.sheet_spacing_mm, copies=max(1, int(getattr(partset, "copies", 1) or 1)),
-                   drawing=DxfStyle(process.arcs, tol), cutting=DxfStyle(process.arcs, tol, min_text),
+                   drawing=DxfStyle(process.arcs, tol, hole_labels=True), cutting=DxfStyle(process.arcs, tol, min_text),
                    colours=(process.cut_colour, process.engrave_colour))
 
 
@@ -262,7 +262,8 @@ def _part_entry(part: Part, problems: list[str], stl_volume: float, placed: list
         "volume_mm3": round(part.volume_mm3(), 4), "stl_volume_mm3": round(stl_volume, 4),
         "layer": part.layer,
         "holes": [{"joint": h.joint, "diameter_mm": round(h.diameter_mm, 6),
-                   "cut_diameter_mm": round(h.diameter_mm - kerf, 6)} for h in part.holes],
+                   "cut_diameter_mm": round(h.diameter_mm - kerf, 6), "fit": h.fit,
+                   "nominal_diameter_mm": round(h.nominal_mm, 6)} for h in part.holes],
         "role": part.role, "body": part.body, "thickness_mm": part.thickness_mm,
         "z_mm": round(part.z_mm, 6), "area_mm2": round(part.area_mm2(), 4), "gear": part.gear,
         "slots": len(getattr(part, "slots", ())), "stl_problems": problems,

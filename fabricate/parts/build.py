@@ -18,16 +18,18 @@ Shapes
   fixed in the reference body (two pins so the rod cannot turn).
 - The ground part gets mounting holes on the side away from the moving parts, pushed out until the
   screw heads clear everything that moves.
-- Holes: pin + 2 x radial running clearance + the process's hole compensation (the finished hole; the
-  laser kerf is applied by the DXF exporter only). Joints at one spot of a body (a compound hinge)
-  share one hole and one pin.
+- Holes (:mod:`fabricate.parts.retention`): a NOMINAL size by fit — running pin + 2 x radial running
+  clearance, press (the part holding a pressed pin) pin - the profile's interference, mounting screw
+  + 2 x clearance — modelled with the process's hole compensation added (the laser kerf is applied by
+  the DXF exporter only). Joints at one spot of a body (a compound hinge) share one hole and one pin.
 
 Layers and pins
 ---------------
 Bodies that come within the clearance of each other anywhere over the motion get different layers
 (:mod:`fabricate.parts.layers`); meshing gears share one. The layers are then ordered so that no body
 sweeps over a pin between the two layers it joins (there a spacer fills the skipped layers). Pins are
-cut to their stack; spacers (SLA: printed parts when at least a layer thick) and washers fill the gaps.
+standard pins (ISO 8734 / ISO 2338) chosen for their stack and retention (:mod:`fabricate.parts.retention`);
+spacers (SLA: printed parts when at least a layer thick) and standard washers fill the gaps.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -44,16 +46,27 @@ import shapely
 from fabricate.errors import GeometryError, SpecError
 from fabricate.hints import PadHint, PartHints
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
-from fabricate.parts.bom import Pin, Spacer, bill_of_materials, part_rows, pins_and_spacers
+from fabricate.parts.bom import (
+    Pin,
+    Spacer,
+    bill_of_materials,
+    mounting_rows,
+    part_rows,
+    pins_and_spacers,
+    with_sources,
+)
 from fabricate.parts.features import pad_segment, slider_guides
 from fabricate.parts.layers import assign_layers, conflict_graph, layer_z, order_layers, pin_crossings
 from fabricate.parts.model import BulgePath, Hole, Part, circle_polygon
 from fabricate.parts.profiles import circle_hull, fuse_polygons
+from fabricate.parts.retention import cap_parts, choose_holder, hole_size, retain_pins
 from fabricate.parts.spec import PartsSpec
+from fabricate.parts.springs import PlacedSpring, place_springs, with_spring_rows
 from fabricate.planar import rotation
 from fabricate.process import ProcessSpec
 
 if TYPE_CHECKING:  # the gears and the design sit above the parts layer
+    from fabricate.drive.parts import PlacedActuator
     from fabricate.gears.pair import GearPair
     from fabricate.spec import DesignSpec
 
@@ -109,6 +122,10 @@ class PartSet:
     warnings : tuple of str
         Geometry the mechanism forces but nobody can make: holes that run into each other (their
         centres closer than their radii). Parts are still built; the report should carry these.
+    actuator : PlacedActuator or None
+        What drives the design, as placed (:mod:`fabricate.drive.parts`); None without ``[actuator]``.
+    springs : tuple of PlacedSpring
+        The torsion springs, sized and placed on their pins (:mod:`fabricate.parts.springs`).
     """
 
     parts: tuple[Part, ...]
@@ -124,6 +141,8 @@ class PartSet:
     copies: int = 1
     hints: PartHints = field(default_factory=PartHints)
     warnings: tuple[str, ...] = ()
+    actuator: PlacedActuator | None = None
+    springs: tuple[PlacedSpring, ...] = ()
 
     def part(self, name: str) -> Part:
         for p in self.parts:
@@ -146,17 +165,23 @@ class Sizes:
     mount_hole_mm: float
     mount_boss_radius_mm: float
     hub_mm: float
+    hole_nominal_mm: float = 0.0
+    press_hole_mm: float = 0.0
+    press_nominal_mm: float = 0.0
+    mount_nominal_mm: float = 0.0
 
 
 def derive_sizes(process: ProcessSpec, parts: PartsSpec, hints: PartHints,
                  gear_hub_mm: float | None = None) -> Sizes:
     """Hole and boss sizes from the process and the ``[parts]`` table.
 
-    The modelled hole is the finished hole: pin + 2 × radial running clearance + the process's hole
-    compensation (SLA prints holes undersize). The laser kerf is applied only to the cut path (DXF).
+    Every hole has a nominal size by its fit (:func:`~fabricate.parts.retention.hole_size`) and is modelled
+    with the process's hole compensation added (SLA prints holes undersize). The laser kerf is applied only to
+    the cut path (DXF).
     """
     pin = process.pin_diameter_mm
-    hole = pin + 2.0 * process.running_clearance_mm + process.hole_compensation_mm
+    running, press = hole_size(process, pin, "running"), hole_size(process, pin, "press")
+    hole = running.modelled_mm
     wall = parts.boss_wall_mm if parts.boss_wall_mm is not None else max(process.min_wall_mm, 0.5 * pin)
     if process.technique == "cut":
         wall = max(wall, process.thickness_mm)  # a web cut from sheet stock is at least the stock thick
@@ -164,10 +189,13 @@ def derive_sizes(process: ProcessSpec, parts: PartsSpec, hints: PartHints,
     width = parts.link_width_mm if parts.link_width_mm is not None else hints.link_width_mm
     if width is not None:
         radius = max(radius, 0.5 * float(width))
-    mount = parts.mounting_hole_mm + 2.0 * process.running_clearance_mm + process.hole_compensation_mm
+    mounting = hole_size(process, parts.mounting_hole_mm, "clearance")
+    mount = mounting.modelled_mm
     hub = parts.hub_diameter_mm or gear_hub_mm or 2.0 * radius
     return Sizes(pin_mm=pin, hole_mm=hole, boss_radius_mm=radius, mount_hole_mm=mount,
-                 mount_boss_radius_mm=mount / 2.0 + wall, hub_mm=max(hub, hole + 2.0 * process.min_wall_mm))
+                 mount_boss_radius_mm=mount / 2.0 + wall, hub_mm=max(hub, hole + 2.0 * process.min_wall_mm),
+                 hole_nominal_mm=running.nominal_mm, press_hole_mm=press.modelled_mm,
+                 press_nominal_mm=press.nominal_mm, mount_nominal_mm=mounting.nominal_mm)
 
 
 def safe_name(name: str) -> str:
@@ -244,26 +272,38 @@ def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_p
     outlines = _outlines(drawing, mechanism, motion, sizes, parts_spec, process)
     layers = _layers(outlines, drawing.holes, pin_joints, mechanism, motion, gear_pairs, sizes.boss_radius_mm,
                      process.running_clearance_mm)
+    pin_joints = _press_fits(drawing, pin_joints, layers, sizes, process, mechanism.ground)
 
     parts = _body_parts(drawing, mechanism, outlines, layers, process)
     pins, spacers = pins_and_spacers(pin_joints, layers, sizes.pin_mm, sizes.hole_mm, 2.0 * sizes.boss_radius_mm,
                                      process.thickness_mm, process.layer_gap_mm,
                                      {(body, h.joint): h.centre for body, hs in drawing.holes.items() for h in hs})
+    # torsion springs on their pins' extensions: anchor holes in the parts, the pins lengthened
+    springs, parts, pins = place_springs(hints.springs, mechanism, motion, parts, pins, process, mechanism.ground)
     parts += _printed_spacers(spacers, process, sizes.pin_mm)
     _check_pin_webs(parts, process)
+    # standard pins over the stacks and their retention, standard washers (parts/retention.py)
+    pins, spacers = retain_pins(pins, spacers, parts, process, mechanism.ground)
+    parts += cap_parts(pins, parts, process)
     warnings = overlapping_cuts(parts)
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
         raise GeometryError(f"part names collide after sanitising: {sorted(names)}")
     copies = hints.copies or 1
-    mounting = sum(1 for h in drawing.holes[mechanism.ground] if h.joint.startswith("mount_"))
-    bom = part_rows(parts, process, copies) + bill_of_materials(pins, spacers, hints, process, copies,
-                                                                 mounting=mounting,
-                                                                 mounting_mm=parts_spec.mounting_hole_mm)
-    return PartSet(parts=tuple(parts), bom=bom, pins=tuple(pins), spacers=tuple(spacers), layers=layers,
-                   process=process.name, chord_tolerance_mm=tol, thickness_mm=process.thickness_mm,
-                   layer_gap_mm=process.layer_gap_mm, kerf_mm=process.kerf_mm, copies=copies, hints=hints,
-                   warnings=tuple(warnings))
+    bom = part_rows(parts, process, copies) + bill_of_materials(pins, spacers, hints, process, copies)
+    bom = with_spring_rows(bom, springs, copies)
+    partset = PartSet(parts=tuple(parts), bom=bom, pins=tuple(pins), spacers=tuple(spacers), layers=layers,
+                      process=process.name, chord_tolerance_mm=tol, thickness_mm=process.thickness_mm,
+                      layer_gap_mm=process.layer_gap_mm, kerf_mm=process.kerf_mm, copies=copies, hints=hints,
+                      warnings=tuple(warnings), springs=springs)
+    from fabricate.drive.parts import attach_actuator  # the drive sits above the parts layer
+
+    partset = attach_actuator(design, mechanism, motion, partset)
+    # the ground's mounting screws, but in the holes the actuator's standoffs stand on (the drive's screws)
+    taken = {s.hole for s in partset.actuator.standoffs} if partset.actuator is not None else set()
+    free = [h.joint for h in drawing.holes[mechanism.ground] if h.joint.startswith("mount_") and h.joint not in taken]
+    screws = mounting_rows(free, parts_spec.mounting_hole_mm, process.thickness_mm, copies) if free else []
+    return replace(partset, bom=with_sources(list(partset.bom) + screws))  # print / cut / buy on every row
 
 
 @dataclass
@@ -315,8 +355,30 @@ def _add_joints(drawing: _Drawing, mechanism: Mechanism, motion: Motion, sizes: 
                 pin_joints.append((name, (joint.body_a, joint.body_b)))
     pin_joints, pin_holes = merge_coincident_pins(pin_joints, pin_holes)
     for name, body, centre in pin_holes:
-        drawing.holes[body].append(Hole(name, centre, sizes.hole_mm, sizes.pin_mm))
+        drawing.holes[body].append(Hole(name, centre, sizes.hole_mm, sizes.pin_mm, "running", sizes.hole_nominal_mm))
     return pin_joints
+
+
+def _press_fits(drawing: _Drawing, pin_joints: Sequence[tuple[str, tuple[str, ...]]], layers: Mapping[str, int],
+                sizes: Sizes, process: ProcessSpec, ground: str) -> list[tuple[str, tuple[str, ...]]]:
+    """With ``retention = "press"``: each pin's holder (:func:`~fabricate.parts.retention.choose_holder`, a body
+    with a round hole at an end of its stack) comes first among its bodies and its hole becomes the press fit.
+
+    Returns
+    -------
+    list of (pin name, bodies; the holder first)
+    """
+    if process.retention != "press":
+        return list(pin_joints)
+    out = []
+    for name, bodies in pin_joints:
+        holed = [b for b in bodies if any(h.joint == name for h in drawing.holes[b])]
+        holder = choose_holder(bodies, layers, holed, ground)
+        drawing.holes[holder] = [replace(h, diameter_mm=sizes.press_hole_mm, fit="press",
+                                         nominal_diameter_mm=sizes.press_nominal_mm) if h.joint == name else h
+                                 for h in drawing.holes[holder]]
+        out.append((name, (holder,) + tuple(b for b in bodies if b != holder)))
+    return out
 
 
 def _add_pads(drawing: _Drawing, mechanism: Mechanism, pads: Mapping[str, PadHint], parts_spec: PartsSpec,
@@ -429,7 +491,8 @@ def _printed_spacers(spacers: Sequence[Spacer], process: ProcessSpec, pin_mm: fl
         suffix = f"_{seen[sp.joint]}" if per_pin[sp.joint] > 1 else ""
         parts.append(Part(name=safe_name(f"spacer_{sp.joint}{suffix}"), body=sp.body,
                           outline=circle_hull(sp.centre[None, :], sp.outer_diameter_mm / 2.0),
-                          holes=(Hole(sp.joint, sp.centre, sp.inner_diameter_mm, pin_mm),),
+                          holes=(Hole(sp.joint, sp.centre, sp.inner_diameter_mm, pin_mm, "running",
+                                      sp.inner_diameter_mm - process.hole_compensation_mm),),
                           thickness_mm=sp.length_mm, z_mm=sp.z_mm, layer=sp.lower_layer + 1,
                           process=process.name, role="spacer"))
     return parts
@@ -574,5 +637,6 @@ def _add_mounting(mechanism: Mechanism, motion: Motion, ground: str,
         ok = np.all(gaps >= r_mount + clearance_mm + 0.5, axis=1)
         chosen = centres[int(np.argmax(ok))] if ok.any() else centres[-1]
     for k, centre in enumerate(chosen):
-        holes[ground].append(Hole(f"mount_{k + 1}", centre, sizes.mount_hole_mm, 0.0))
+        holes[ground].append(Hole(f"mount_{k + 1}", centre, sizes.mount_hole_mm, 0.0, "clearance",
+                                  sizes.mount_nominal_mm))
         circles[ground].append((centre, r_mount))

@@ -33,6 +33,7 @@ import numpy as np
 
 from fabricate.errors import GeometryError
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
+from fabricate.parts.springs import spring_failures
 from fabricate.planar import rotation
 from fabricate.strength.features import (
     FeatureLoads,
@@ -79,6 +80,7 @@ class StrengthResult:
     loads: tuple[str, ...] = ()
     notes: list[str] = field(default_factory=list)
     reason: str | None = None  # why the check could not run (then nothing passed or failed)
+    spring_failures: list[str] = field(default_factory=list)  # springs over their wire's allowable
 
     def per_part(self) -> dict[str, Finding]:
         worst: dict[str, Finding] = {}
@@ -92,12 +94,12 @@ class StrengthResult:
         """Whether every part keeps the safety factor; None when the check could not run (:attr:`reason`)."""
         if self.reason is not None:
             return None
-        return all(f.safety_factor >= self.min_safety_factor for f in self.findings)
+        return not self.spring_failures and all(f.safety_factor >= self.min_safety_factor for f in self.findings)
 
     def failures(self) -> list[str]:
         if self.reason is not None:
-            return []
-        out = []
+            return list(self.spring_failures)
+        out = list(self.spring_failures)
         for name, f in sorted(self.per_part().items(), key=lambda kv: kv[1].safety_factor):
             if f.safety_factor >= self.min_safety_factor:
                 continue
@@ -343,6 +345,8 @@ def run_strength(design: DesignSpec, partset: PartSet, mechanism: Mechanism, mot
     material = design.process.part_material()
     pin_material = design.process.pin_material_spec()
     result = StrengthResult([], None, required, np.asarray(motion.inputs))
+    # each torsion spring's wire against its allowable (fabricate/parts/springs.py): no part material needed
+    result.spring_failures = [f"strength: {text}" for text in spring_failures(partset.springs)]
     if material is None or pin_material is None:
         result.reason = NO_MATERIALS
         return result
@@ -354,10 +358,10 @@ def run_strength(design: DesignSpec, partset: PartSet, mechanism: Mechanism, mot
         result.reason = NO_LOAD
         return result
     if any(sp.rate_Nmm_per_deg > 0.0 for sp in hints.springs):
-        # the springs are bought parts (BOM rows with rate, preload, legs): their wire stress is the maker's
-        # rating; what the check covers is the torque they put on the printed parts
-        result.notes.append("springs are bought torsion springs (bom.csv): choose one rated for the torque "
-                            "above; their torque loads the parts here")
+        # the springs are specified and their wire checked (report.json's springs); here their torque loads
+        # the printed parts
+        result.notes.append("the torsion springs (report.json's springs, bom.csv) are sized and their wire "
+                            "stress checked against its allowable; their torque loads the parts here")
     statics = solve_statics(mechanism, motion, loads.forces, loads.torques, loads.efforts, loads.reaction)
     result.statics = statics
     if loads.reaction is not None:

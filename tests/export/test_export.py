@@ -28,7 +28,7 @@ from PIL import Image
 
 from fabricate.design import load_design
 from fabricate.export import export_all
-from fabricate.export.dxf import audit_problems, kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
+from fabricate.export.dxf import DxfStyle, audit_problems, kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
 from fabricate.export.stl import (
     SolidCache,
     assembly_3mf,
@@ -53,7 +53,7 @@ SLA = ProcessSpec(name="sla", running_clearance_mm=0.25, hole_compensation_mm=0.
 LASER = ProcessSpec(name="laser", running_clearance_mm=0.1, hole_compensation_mm=0.0, min_wall_mm=3.0,
                     min_pin_mm=2.0, layer_gap_mm=0.5, thickness_mm=3.0, kerf_mm=0.2, min_feature_mm=0.5,
                     build_volume_mm=(600.0, 400.0, 3.0), pin_diameter_mm=3.0, chord_tolerance_mm=0.005,
-                    technique="cut", layout="sheet")
+                    technique="cut", layout="sheet", retention="clip", press_fit_interference_mm=0.0)
 PROCESSES = {"sla": SLA, "laser": LASER}
 FIXTURES = ("four_bar", "slider_crank", "geared_four_bar")
 TEMPLATES = tuple(p.stem for p in shipped_templates())
@@ -118,14 +118,17 @@ def perimeter_mm(part) -> float:
 
 
 def expected_cut_diameter(hole, c) -> float:
-    """Finished hole minus the kerf, from the process and the design alone (never from the part model):
-    pin (or the mounting screw of ``[parts]``) + 2 x radial clearance (+ SLA compensation) - kerf."""
+    """Modelled hole minus the kerf, from the process and the design alone (never from the part model's sizes,
+    only its fit): a running or clearance hole is the pin (or the mounting screw of ``[parts]``) + 2 x radial
+    clearance, a press-fit hole the pin - the profile's interference; + SLA compensation - kerf."""
     process = c.process
     if hole.joint.startswith("mount_"):
-        nominal = c.design.parts.mounting_hole_mm
+        nominal = c.design.parts.mounting_hole_mm + 2 * process.running_clearance_mm
+    elif hole.fit == "press":
+        nominal = process.pin_diameter_mm - process.press_fit_interference_mm
     else:
-        nominal = process.pin_diameter_mm
-    return nominal + 2 * process.running_clearance_mm + process.hole_compensation_mm - process.kerf_mm
+        nominal = process.pin_diameter_mm + 2 * process.running_clearance_mm
+    return nominal + process.hole_compensation_mm - process.kerf_mm
 
 
 def bulge_path_polygon(vertices, bulges, chord_mm: float = 1e-4) -> shapely.Polygon:
@@ -443,7 +446,7 @@ def test_previews_and_report_entries(name):
         assert entry["volume_mm3"] == pytest.approx(part.volume_mm3(), abs=1e-4)
         assert entry["layer"] == part.layer and entry["process"] == c.process.name
         assert [h["joint"] for h in entry["holes"]] == [h.joint for h in part.holes]
-    assert c.files["bom.csv"].startswith(b"item,kind,qty")
+    assert c.files["bom.csv"].startswith(b"item,designation,kind,source,qty")
 
 
 @pytest.mark.parametrize("name", _marked([CASES[0], CASES[-1]]))
@@ -463,7 +466,7 @@ def test_encoders_are_pure_functions_of_their_input():
     kerf = c.process.kerf_mm
     assert part_stl(parts[0], cache) == c.files[f"parts/{parts[0].name}.stl"]
     assert part_dxf(parts[0], kerf) == c.files[f"cut/{parts[0].name}.dxf"]
-    assert part_dxf(parts[0], 0.0) == c.files[f"drawings/{parts[0].name}.dxf"]
+    assert part_dxf(parts[0], 0.0, DxfStyle(hole_labels=True)) == c.files[f"drawings/{parts[0].name}.dxf"]
     area = c.process.build_volume_mm[:2]
     layout = sheet_layout(parts, kerf, area, c.design.parts.sheet_margin_mm, c.design.parts.sheet_spacing_mm)
     assert sheet_dxf(parts, kerf, layout, area, 0) == c.files["cut/sheet_1.dxf"]

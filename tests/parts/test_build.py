@@ -24,6 +24,7 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from fabricate.catalogue.hardware import ISO8734_LENGTHS_MM
 from fabricate.errors import GeometryError, SpecError
 from fabricate.hints import PadHint, PartHints, PurchasedItem, SpringHint
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
@@ -261,7 +262,10 @@ def test_slider_guide_pins_and_slot(sla_process, tail_side):
     np.testing.assert_allclose(guides["G"].centre, [10.0, -4.0], atol=1e-9)
     np.testing.assert_allclose(guides["G_guide"].centre, np.array([10.0, -4.0]) - tail_side * spacing * unit,
                                atol=1e-9)
-    assert all(h.diameter_mm == pytest.approx(hole_mm, abs=1e-12) for h in guides.values())
+    # the guide pins are pressed into the ground (1.95 nominal, modelled with the 0.2 compensation); the rod
+    # runs on them in its slot
+    assert all(h.fit == "press" and h.diameter_mm == pytest.approx(2.0 - 0.05 + 0.2, abs=1e-12)
+               and h.nominal_mm == pytest.approx(1.95, abs=1e-12) for h in guides.values())
     assert all(h.pin_diameter_mm == 2.0 for h in guides.values())
     assert all(h.pin_diameter_mm == 0.0 for h in ground.holes if h.joint.startswith("mount_"))
     assert sorted((p.joint, tuple(sorted(p.bodies))) for p in partset.pins) == [
@@ -461,10 +465,13 @@ def test_printed_spacer_roles_heights_and_bill_of_materials(sla_process):
     bom = partset.bom
     rows = {r["item"]: r for r in bom if r["kind"] == "printed part"}
     assert set(rows) == {p.name for p in partset.parts} and all(r["qty"] == 2 for r in rows.values())
-    assert [(r["item"], r["qty"]) for r in bom if r["kind"] == "screw"] == [("screw M2.5", 2 * 2)]
+    # M2.5 through the 3 mm plate and a 0.5 mm washer, 1.5 d = 3.75 mm engaged: 7.25 -> the 8 mm screw
+    assert [(r["item"], r["qty"]) for r in bom if r["kind"] == "screw"] == [("ISO 4762 M2.5 × 8", 2 * 2)]
     assert not [r for r in bom if r["kind"] == "spacer"]
     neighbours = sum(abs(layers[j.body_a] - layers[j.body_b]) == 1 for j in mech.joints)
-    assert sum(r["qty"] for r in bom if r["kind"] == "washer") == 2 * neighbours
+    pin_washers = [r for r in bom if r["kind"] == "washer" and not r["joints"][0].startswith("mount_")]
+    assert [r["item"] for r in pin_washers] == ["DIN 125-A 2.2"]  # one 0.3 mm washer fills each 0.3 mm gap
+    assert sum(r["qty"] for r in pin_washers) == 2 * neighbours
     single = build_parts(design, mech, motion, [], PartHints(copies=None))
     assert single.copies == 1 and all(r["qty"] == 1 for r in single.bom if r["kind"] == "printed part")
 
@@ -483,8 +490,10 @@ def test_gaps_thinner_than_a_plate_stay_washers(sla_process):
     skips = {j.name: abs(layers[j.body_a] - layers[j.body_b]) for j in mech.joints}
     printed = {p.name: p.thickness_mm for p in partset.parts if p.role == "spacer"}
     assert printed == pytest.approx({f"spacer_{n}": k * (t + 2.0) - t for n, k in skips.items() if k > 1})
-    (washers,) = [r for r in partset.bom if r["kind"] == "washer"]
-    assert washers["length_mm"] == pytest.approx(2.0) and washers["qty"] == sum(k == 1 for k in skips.values())
+    # a 2 mm gap: six 0.3 mm DIN 125-A 2.2 washers (1.8 mm, the most that fits), 0.2 mm of axial play
+    (washers,) = [r for r in partset.bom if r["kind"] == "washer" and not r["joints"][0].startswith("mount_")]
+    assert washers["item"] == "DIN 125-A 2.2" and washers["length_mm"] == pytest.approx(0.3)
+    assert washers["qty"] == 6 * sum(k == 1 for k in skips.values())
 
 
 def test_overlapping_holes_are_refused_wherever_the_body_frame_sits(sla_process):
@@ -1136,13 +1145,18 @@ def test_four_bar_parts(four_bar, process_name, request):
         for body in (joint.body_a, joint.body_b):
             hole = next(h for h in by_body[body].holes if h.joint == joint.name)
             np.testing.assert_allclose(hole.centre, four_bar.body(body).point(joint.name), atol=1e-12)
-            assert hole.diameter_mm == pytest.approx(sizes.hole_mm, abs=1e-9)
+            pin = next(p for p in partset.pins if p.joint == joint.name)
+            # the part holding a pressed pin has the press fit, the others the running fit (process profile)
+            press = process.retention == "press" and body == pin.holder
+            assert hole.fit == ("press" if press else "running")
+            assert hole.diameter_mm == pytest.approx(sizes.press_hole_mm if press else sizes.hole_mm, abs=1e-9)
+            assert hole.diameter_mm - hole.nominal_mm == pytest.approx(process.hole_compensation_mm, abs=1e-12)
         # bodies sharing a pin never share a layer
         assert partset.layers[joint.body_a] != partset.layers[joint.body_b]
     # a binary link is the rounded slot of its two bosses: area known in closed form
     crank = by_body["crank"]
     r, length = sizes.boss_radius_mm, 15.0
-    area = 2 * r * length + math.pi * r * r - 2 * math.pi * sizes.hole_mm ** 2 / 4
+    area = 2 * r * length + math.pi * r * r - sum(math.pi * h.diameter_mm ** 2 / 4 for h in crank.holes)
     assert crank.area_mm2() == pytest.approx(area, rel=1e-12)
     assert crank.volume_mm3() == pytest.approx(area * process.thickness_mm, rel=1e-12)
     # ground carries the mounting holes
@@ -1180,15 +1194,18 @@ def test_pins_and_spacers_fill_the_stack(four_bar, sla_process):
     t, g = sla_process.thickness_mm, sla_process.layer_gap_mm
     for pin in partset.pins:
         lo, hi = pin.layers
-        assert pin.length_mm == pytest.approx((hi - lo) * (t + g) + t, abs=1e-12)
-        assert pin.z_mm == pytest.approx(lo * (t + g), abs=1e-12)
+        assert pin.stack_mm == pytest.approx((hi - lo) * (t + g) + t, abs=1e-12)
+        assert pin.stack_z_mm[0] == pytest.approx(lo * (t + g), abs=1e-12)
+        # the pin itself: a standard length, its ends beyond (or inside) the stack's faces
+        assert pin.length_mm in ISO8734_LENGTHS_MM and pin.designation == f"ISO 8734 2 × {pin.length_mm:g}"
+        assert pin.z_mm == pytest.approx(pin.stack_z_mm[0] - pin.protrusion_mm[0], abs=1e-12)
+        assert pin.length_mm == pytest.approx(pin.stack_mm + sum(pin.protrusion_mm), abs=1e-12)
     spacer_total = {}
     for sp in partset.spacers:
         spacer_total[sp.joint] = spacer_total.get(sp.joint, 0.0) + sp.length_mm
     for pin in partset.pins:
-        lo, hi = pin.layers
-        # plates plus spacers/washers make up the whole pin length
-        assert 2 * t + spacer_total.get(pin.joint, 0.0) == pytest.approx(pin.length_mm, abs=1e-12)
+        # plates plus spacers/washers fill the stack (0.3 mm gaps take one 0.3 mm DIN 125-A 2.2 washer)
+        assert 2 * t + spacer_total.get(pin.joint, 0.0) == pytest.approx(pin.stack_mm, abs=1e-12)
     pins = [row for row in partset.bom if row["kind"] == "pin"]
     assert sum(row["qty"] for row in pins) == len(four_bar.joints)
 

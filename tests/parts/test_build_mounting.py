@@ -156,14 +156,18 @@ def test_mounting_hole_count_size_and_names(four_bar, sla_process, count):
 
 def test_no_mounting_holes_leaves_the_ground_a_plain_link(four_bar, sla_process):
     """With ``mounting_holes = 0`` the ground bar O-D is just the rounded slot of its two joint bosses:
-    area 2 r L + pi r^2 - 2 pi (hole/2)^2 (closed form, relative 1e-9)."""
+    area 2 r L + pi r^2 - the two holes (closed form, relative 1e-9): a running hole 2 + 2 x 0.25 + 0.2 where a
+    pin runs, a press hole 2 - 0.05 + 0.2 where the ground holds the pin."""
     motion = four_bar.sweep(61)
     partset = build_parts(design_for(sla_process, PartsSpec(mounting_holes=0)), four_bar, motion, [])
     _, _, r = sla_sizes(sla_process)
-    hole = sla_process.pin_diameter_mm + 2 * sla_process.running_clearance_mm + sla_process.hole_compensation_mm
+    running = sla_process.pin_diameter_mm + 2 * sla_process.running_clearance_mm + sla_process.hole_compensation_mm
+    press = sla_process.pin_diameter_mm - sla_process.press_fit_interference_mm + sla_process.hole_compensation_mm
     ground = partset.part("ground")
+    held = sum(p.holder == "ground" for p in partset.pins)
+    holes = [press] * held + [running] * (2 - held)
     assert mounts(partset) == []
-    assert ground.area_mm2() == pytest.approx(2 * r * 40.0 + math.pi * r * r - 2 * math.pi * hole ** 2 / 4,
+    assert ground.area_mm2() == pytest.approx(2 * r * 40.0 + math.pi * r * r - sum(math.pi * h ** 2 / 4 for h in holes),
                                               rel=1e-9)
 
 

@@ -260,7 +260,7 @@ def test_auto_link_width_is_the_smallest_width_that_passes():
     mech = make_four_bar()
     motion = mech.sweep(121)
     hints = PartHints(tip_point="B", pads={"rocker": PadHint("B")})
-    design = _four_bar_design("auto", 25.0)
+    design = _four_bar_design("auto", 45.0)
 
     def build(d):
         return build_parts(d, mech, motion, [], hints)
@@ -269,12 +269,13 @@ def test_auto_link_width_is_the_smallest_width_that_passes():
     assert len(tried) <= 12 and width == pytest.approx(round(width / RESOLUTION_MM) * RESOLUTION_MM, abs=1e-9)
 
     def least(w: float) -> float:
-        d = _four_bar_design(w, 25.0)
+        d = _four_bar_design(w, 45.0)
         result = run_strength(d, build(d), mech, motion, [], hints)
         return min(f.safety_factor for f in result.findings if f.kind in ("link", "hole"))
 
     default = least(None)
-    assert default < 2.0  # the plain bosses are too narrow at 25 N: the sizing had work to do
+    # the plain bosses are too narrow at 45 N (25 N: no longer, with the holders' smaller press-fit holes)
+    assert default < 2.0  # the sizing had work to do
     assert least(width) >= 2.0
     assert least(width - RESOLUTION_MM) < 2.0
 
