@@ -38,6 +38,7 @@ class MountPlacement:
     process: ProcessSpec
     tol: float
     ground: str
+    joint: str
     c: float
     comp: float
     wall: float
@@ -49,27 +50,76 @@ class MountPlacement:
         raise NotImplementedError  # RotaryPlacement's
 
     def _orient(self, angle: float, centre: np.ndarray, ground: Part, flip: bool, z_face: float) -> float:
-        """The turn nearest ``angle`` (10 degree steps) at which the standoffs on the ground's mounting holes
-        keep clear of the actuator's body between its mount plate and the ground part."""
+        """The turn nearest ``angle`` (10 degree steps) at which the actuator's body keeps clear of the
+        standoffs on the ground's mounting holes (between its mount plate and the ground part) and of the
+        pins, washers and tubes fixed to the ground (or swept by a moving one) at the body's heights."""
         entry = self.entry
-        mounting = [h for h in ground.holes if h.joint.startswith("mount_")]
-        if not mounting or not entry.body:
+        if not entry.body:
             return angle
+        t = float(self.process.thickness_mm)
         pz = geo.mount_plate_z(entry)
-        # the ground part's near face in the entry's z: the standoffs run from the plate up to it
-        faces = [(g - z_face) if not flip else (z_face - g) for g in (ground.z_mm, ground.z_mm + ground.thickness_mm)]
-        near = min(faces)
-        boxes = [b for b in entry.body if b.z1 > pz + 1e-9 and b.z0 < near - 1e-9]
-        rects = [geo.rectangle(b.x0 - self.c, b.y0 - self.c, b.x1 + self.c, b.y1 + self.c) for b in boxes]
-        discs = [(np.asarray(h.centre, dtype=float), 0.5 * h.diameter_mm + max(self.wall, 0.25 * h.diameter_mm))
-                 for h in mounting]
+        place0 = geo.Placement(centre, angle, flip, z_face)
+        plate = place0.z_range(pz, pz + t)
+        g0, g1 = float(ground.z_mm), float(ground.z_mm + ground.thickness_mm)
+        lo, hi = (g1, plate[0]) if flip else (plate[1], g0)
+        obstacles: list[tuple[Any, float, float]] = [
+            (shapely.Point(*h.centre).buffer(0.5 * h.diameter_mm + max(self.wall, 0.25 * h.diameter_mm), 32), lo, hi)
+            for h in ground.holes if h.joint.startswith("mount_")]
+        standoffs = [geom for geom, _, _ in obstacles]
+        obstacles += self._pin_obstacles()
+        if not obstacles:
+            return angle
+        screws = []  # the plate's own screws, their holes and heads: the standoffs must stand clear of them
+        for mh in entry.mounting_holes or ():
+            f = geo.fastening(entry, mh, t, self.c, self.comp)
+            head = ISO4762[f.size].head_d_mm if f.tapped else 0.0
+            screws.append((np.array([mh.x, mh.y]), max(0.5 * f.plate_hole_mm + self.wall, 0.5 * head)))
         for k in sorted(range(-18, 19), key=lambda k: (abs(k), k)):
             turn = angle + math.radians(10.0 * k)
             place = geo.Placement(centre, turn, flip, z_face)
-            shapes = [shapely.Polygon(geo.placed_ring(r, place)) for r in rects]
-            if all(shape.distance(shapely.Point(c)) >= r for shape in shapes for c, r in discs):
+            clear = not any(geom.distance(shapely.Point(*place.plan(xy))) < r for xy, r in screws for geom in standoffs)
+            for b in entry.body:
+                z0, z1 = place.z_range(b.z0, b.z1)
+                ring = geo.rectangle(b.x0 - self.c, b.y0 - self.c, b.x1 + self.c, b.y1 + self.c)
+                shape = shapely.Polygon(geo.placed_ring(ring, place))
+                if not clear or any(o0 < z1 - 1e-9 and o1 > z0 + 1e-9 and shape.intersects(geom)
+                                    for geom, o0, o1 in obstacles):
+                    clear = False
+                    break
+            if clear:
                 return turn
         return angle
+
+    def _pin_obstacles(self) -> list[tuple[Any, float, float]]:
+        """Pins, washers and tubes as (plan region in the ground's frame, z0, z1): discs for those the ground
+        holds, the path swept for the others."""
+        out: list[tuple[Any, float, float]] = []
+        pick = np.unique(np.linspace(0, len(self.motion.inputs) - 1, min(90, len(self.motion.inputs)))
+                         .round().astype(int))
+        base = self.motion.pose(self.ground)[pick]
+
+        def region(body: str, centre: np.ndarray, r: float) -> Any:
+            if body == self.ground:
+                return shapely.Point(*centre).buffer(r, 32)
+            poses = self.motion.pose(body)[pick]
+            world = np.einsum("nij,j->ni", rotation(poses[:, 2]), centre) + poses[:, :2]
+            local = np.einsum("nji,nj->ni", rotation(base[:, 2]), world - base[:, :2])
+            return shapely.LineString(local).buffer(r, 16) if len(local) > 1 else shapely.Point(*local[0]).buffer(r)
+
+        for sp in self.ps.spacers:
+            if self.joint in sp.joint.split("+"):
+                continue  # the driver pin's: they go with it
+            out.append((region(sp.body, np.asarray(sp.centre, dtype=float), 0.5 * float(sp.outer_diameter_mm)),
+                        float(sp.z_mm), float(sp.z_mm + sp.length_mm)))
+        holes = {(p.body, h.joint): h.centre for p in self.ps.parts for h in p.holes}
+        for pin in self.ps.pins:
+            if self.joint in pin.joint.split("+"):
+                continue
+            centre = holes.get((pin.bodies[0], pin.joint))
+            if centre is not None:
+                out.append((region(pin.bodies[0], np.asarray(centre, dtype=float), 0.5 * float(pin.diameter_mm)),
+                            float(pin.z_mm), float(pin.z_mm + pin.length_mm)))
+        return out
 
     def _standoff_sites(self, place: geo.Placement, ground: Part, lo: float, hi: float) -> list[Hole]:
         """Where the standoffs stand on the ground part (holes of the ground): its mounting holes that keep
@@ -143,7 +193,7 @@ class MountPlacement:
         pick = np.unique(np.linspace(0, len(self.motion.inputs) - 1, min(90, len(self.motion.inputs)))
                          .round().astype(int))
         for sp in self.ps.spacers:
-            if not (sp.z_mm < hi - 1e-9 and sp.z_mm + sp.length_mm > lo + 1e-9):
+            if self.joint in sp.joint.split("+") or not (sp.z_mm < hi - 1e-9 and sp.z_mm + sp.length_mm > lo + 1e-9):
                 continue
             r = 0.5 * float(sp.outer_diameter_mm)
             centre = np.asarray(sp.centre, dtype=float)
@@ -174,8 +224,12 @@ class MountPlacement:
                     default=20.0) + 4.0 * outer
         xs, ys = np.meshgrid(*(np.arange(-reach, reach + 1.0, 1.0),) * 2)
         pts = np.column_stack([xs.ravel(), ys.ravel()]) + np.asarray(place.centre, dtype=float)
-        pts = pts[~shapely.contains_xy(keep_out, pts[:, 0], pts[:, 1])]
-        pts = pts[shapely.distance(keep_out, shapely.points(pts)) > 0.0]
+        # clear of the ground's own holes by a wall (a new hole beside an old one)
+        taken = shapely.union_all([shapely.Point(*h.centre).buffer(0.5 * (h.diameter_mm + hole_d) + self.wall, 32)
+                                   for h in ground.holes]) if ground.holes else shapely.Polygon()
+        blocked = shapely.union_all([keep_out, taken])
+        pts = pts[~shapely.contains_xy(blocked, pts[:, 0], pts[:, 1])]
+        pts = pts[shapely.distance(blocked, shapely.points(pts)) > 0.0]
         order = np.argsort(shapely.distance(body, shapely.points(pts)))
         sites: list[np.ndarray] = []
         arms: list[np.ndarray] = []
@@ -186,7 +240,7 @@ class MountPlacement:
             near = np.array(shapely.ops.nearest_points(body, shapely.Point(p))[0].coords[0])
             arm = circle_hull(np.array([near, p]), np.array([boss, boss])) if np.hypot(*(p - near)) > 1e-6 \
                 else circle_hull(p[None, :], boss)
-            ring = arm.polygon(0.05)
+            ring = arm.polygon(self.tol)  # the wall round the new hole is measured on these chords
             if not swept.is_empty and shapely.Polygon(ring).intersects(swept):
                 continue
             sites.append(p)

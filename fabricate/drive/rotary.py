@@ -163,6 +163,12 @@ class RotaryPlacement(MountPlacement):
         axis = shapely.Point(*self.mechanism.body(self.driven).point(self.joint))
         pose_d = self.motion.pose(self.driven)[picks]
         cost = 0.0
+        # pins, washers and tubes in the body's heights within its reach (its turn may still dodge them)
+        body_reach = max(corners, default=0.0) + self.c
+        at = shapely.Point(*self.mechanism.body(self.ground).point(self.joint))
+        for geom, z0, z1 in self._pin_obstacles():
+            if z0 < far[1] - 1e-9 and z1 > far[0] + 1e-9 and geom.distance(at) < body_reach:
+                cost += 3.0
         for part in self.ps.parts:
             z0, z1 = part.z_mm, part.z_mm + part.thickness_mm
             reach = max([r for (lo, hi), r in spans if z0 < hi - 1e-9 and z1 > lo + 1e-9], default=None)
@@ -315,11 +321,14 @@ class RotaryPlacement(MountPlacement):
         place_g = geo.Placement(c_g, angle, flip, z_face)
         # the ground's hole at the joint: a clearance for whatever of the output passes its thickness
         g0, g1 = float(ground.z_mm), float(ground.z_mm + ground.thickness_mm)
-        clear = default_clear
+        passes = []
         for z0, z1, diameter in passing:
             lo, hi = place_d.z_range(z0, z1)
             if lo < g1 - 1e-9 and hi > g0 + 1e-9:
-                clear = max(clear, diameter + 2.0 * self.c)
+                passes.append(diameter + 2.0 * self.c)
+        old = next(h for h in ground.holes if h.joint == pin.joint)
+        # nothing passes (the ground lies beyond the driven part): the pin's hole stays as it was
+        clear = max([default_clear, *passes]) if passes else old.nominal_mm
         ground_holes = [h for h in ground.holes if h.joint != pin.joint]
         ground_holes.append(fit_hole("actuator_clearance", c_g, clear, self.comp, fit="clearance"))
         solids += geo.body_solids(entry, place_g)
@@ -328,7 +337,7 @@ class RotaryPlacement(MountPlacement):
         solids += mount_solids
         ground_pad = circle_hull(np.asarray(c_g, dtype=float)[None, :], 0.5 * (clear + self.comp) + self.wall)
         ground_holes += self.new_ground_holes
-        outline = fuse_pad(ground.outline, ground_pad, self.tol)
+        outline = fuse_pad(ground.outline, ground_pad, self.tol) if passes else ground.outline
         if self.ground_arms:
             outline = fuse_polygons(outline, list(self.ground_arms), self.tol)
         new_ground = with_changes(ground, outline=outline, holes=tuple(ground_holes))
