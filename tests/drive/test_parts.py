@@ -29,6 +29,7 @@ from fabricate.parts.spec import PartsSpec
 from fabricate.templates import shipped_templates
 from tests.conftest import make_four_bar
 from tests.parts.test_build import slider_crank
+from tests.parts.test_build_mounting import swing_mechanism
 
 
 def design(process, model: str | None, **actuator) -> SimpleNamespace:
@@ -294,3 +295,27 @@ def test_every_shipped_template_has_its_actuator_in_the_parts_and_the_proof(temp
         assert {s.name for s in placed.solids} <= names
         assert any(s.role == "body" for s in placed.solids)
     assert not [f for f in outcome.failures if "actuator" in f or "standoff" in f]
+
+
+@pytest.mark.parametrize("model", ["sg90", "nema17"])
+def test_the_grounds_hole_clears_what_passes_it_and_only_that(sla_process, model):
+    c, comp = sla_process.running_clearance_mm, sla_process.hole_compensation_mm
+    # a lever over a ground bar: the actuator goes over the lever, nothing passes the ground
+    bare, ps, _ = driven(sla_process, model, mech=swing_mechanism(), poses=21)
+    assert ps.actuator.flip
+    (hole,) = holes(ps.part("ground"), "actuator_clearance")
+    (pin_hole,) = [h for h in bare.part("ground").holes if h.joint == "O"]
+    assert hole.diameter_mm == pytest.approx(pin_hole.diameter_mm)
+    np.testing.assert_array_equal(ps.part("ground").outline.vertices, bare.part("ground").outline.vertices)
+    # the four-bar's coupler sweeps over O above the crank: the actuator goes under, through the ground
+    _, ps, _ = driven(sla_process, model, poses=21)
+    assert not ps.actuator.flip
+    (hole,) = holes(ps.part("ground"), "actuator_clearance")
+    axis = ps.actuator.axis
+    passing = [s for s in ps.actuator.solids if s.role in ("output", "screw")
+               and s.z0 < ps.part("ground").z_mm + ps.part("ground").thickness_mm and s.z1 > ps.part("ground").z_mm]
+    reach = max(float(np.max(np.hypot(*(s.rings[0] - axis).T))) for s in passing)
+    # the hole is what passes plus the running clearance all round (the rings are inscribed polygons)
+    assert hole.diameter_mm == pytest.approx(2 * reach + 2 * c + comp, abs=2 * ps.chord_tolerance_mm)
+    outline = shapely.Polygon(ps.part("ground").outline.polygon(0.001))
+    assert outline.exterior.distance(shapely.Point(axis)) >= hole.diameter_mm / 2 + sla_process.min_wall_mm - 1e-3
