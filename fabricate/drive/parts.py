@@ -229,7 +229,7 @@ def attach_actuator(design: Any, mechanism: Mechanism, motion: Motion, partset: 
                                       f"{driver.kind} driver of {driver.body!r}: it takes {want}")
 
 
-def sweep_items(partset: Any, chord_tolerance_mm: float | None = None) -> list[SweepItem]:
+def sweep_items(partset: Any) -> list[SweepItem]:
     """The actuator's solids as interference-sweep items of kind ``"actuator"`` (none without an actuator)."""
     from fabricate.checks.interference import SweepItem
 
