@@ -410,7 +410,7 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
              'tolerance="1e-10" gravity="0 0 -9.81"/>',
              '  <default>',
              f'    <equality solref="{_num(2 * TIMESTEP_S)} 1" solimp="0.9999 0.9999 0.001 0.5 2"/>',
-             '    <geom contype="2" conaffinity="1" condim="3" friction="0.3 0.005 0.0001"/>',
+             '    <geom contype="2" conaffinity="1"/>',
              '  </default>',
              '  <asset>']
     for part in partset.parts:
