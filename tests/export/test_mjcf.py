@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import io
+import math
 import os
 from collections.abc import Callable
 from pathlib import Path
@@ -21,7 +22,7 @@ import pytest
 
 from fabricate.export.mass import mesh_mass_properties, stl_triangles
 from fabricate.export.mjcf import activate_gear_segments, driver_targets, joint_coordinates, kinematic_tree
-from fabricate.mechanism import Revolute
+from fabricate.mechanism import Body, Driver, GearCoupling, Mechanism, Revolute
 from fabricate.pipeline import BuildOutcome
 
 # headless offscreen rendering (the grasp example's GIF): MuJoCo picks its GL backend when first imported
@@ -229,6 +230,60 @@ def test_mesh_mass_properties_of_a_box_match_trimesh() -> None:
     np.testing.assert_allclose(np.diag(props.inertia), [m * (8 ** 2 + 3 ** 2) / 12, m * (30 ** 2 + 3 ** 2) / 12,
                                                         m * (30 ** 2 + 8 ** 2) / 12], rtol=1e-9)
     assert np.max(np.abs(props.inertia - np.diag(np.diag(props.inertia)))) < 1e-9
+
+
+def _gear_train(law: Any, turn_deg: float) -> Mechanism:
+    """Two gears on a fixed carrier (centres 30 mm apart), gear a driven through ``turn_deg``."""
+    return Mechanism(
+        name="gears",
+        bodies=(Body("carrier", {"OA": (0.0, 0.0), "OB": (30.0, 0.0)}), Body("gear_a", {"OA": (0.0, 0.0)}),
+                Body("gear_b", {"OB": (0.0, 0.0), "mark": (10.0, 0.0)})),
+        ground="carrier", joints=(Revolute("OA", "carrier", "gear_a"), Revolute("OB", "carrier", "gear_b")),
+        gears=(GearCoupling("pair", "carrier", "gear_a", "gear_b", law, "OA", "OB", (0.0, math.radians(turn_deg))),),
+        drivers=(Driver("angle", "gear_a", "carrier"),), input_range=(0.0, turn_deg),
+        assembly={"gear_a": (0.0, 0.0, 0.0), "gear_b": (30.0, 0.0, float(law(0.0)))})
+
+
+def test_kinematic_tree_of_a_four_bar_closes_one_pin_and_holds_the_driver(four_bar: Mechanism) -> None:
+    tree = kinematic_tree(four_bar)
+    # the driver's O first, then A and B in order; D, the last, would close the loop: a connect
+    assert [j.name for j in tree.loops] == ["D"]
+    assert len(tree.joints) == 3 and not tree.unreached
+    held = {j.name for j in tree.joints}
+    assert "O" in held and tree.loops[0].name not in held  # the driven joint is a MuJoCo joint
+    motion = four_bar.sweep(13)
+    (joint, sign, qpos), = driver_targets(four_bar, motion, tree)
+    np.testing.assert_allclose(sign * qpos, np.radians(motion.inputs), atol=1e-12)
+    # every tree joint's qpos is its relative angle: the parent's angle plus it gives the child's
+    for tj in tree.joints:
+        q = joint_coordinates(four_bar, motion, tree)[tj.name]
+        np.testing.assert_allclose(motion.pose(tj.parent)[:, 2] + q, motion.pose(tj.child)[:, 2], atol=1e-12)
+
+
+def test_gear_fit_is_one_exact_quartic_for_a_quartic_law_and_segments_a_full_turn_law() -> None:
+    from fabricate.export.mjcf import GEAR_FIT_TOLERANCE_RAD, fit_gear
+    from fabricate.mechanism import LinearLaw
+
+    linear = _gear_train(LinearLaw(-1.5, 0.2), 60.0)
+    motion = linear.sweep(61)
+    (fit,) = [fit_gear(linear, motion, kinematic_tree(linear), 0)]
+    assert fit is not None and len(fit.coefficients) == 1 and fit.max_error_rad < 1e-12
+    assert fit.coefficients[0][1] == pytest.approx(-1.5, abs=1e-9)  # the slope, relative to the first pose
+
+    def wavy(x: Any, nu: int = 0) -> Any:  # an elliptic pair's kind of law: x plus a periodic part
+        x = np.asarray(x, dtype=np.float64)
+        return -(x + 0.3 * np.sin(x)) if nu == 0 else -(1.0 + 0.3 * np.cos(x)) if nu == 1 else 0.3 * np.sin(x)
+
+    full = _gear_train(wavy, 360.0)
+    motion = full.sweep(361)
+    fit = fit_gear(full, motion, kinematic_tree(full), 0)
+    assert fit is not None and len(fit.coefficients) > 1 and fit.max_error_rad <= GEAR_FIT_TOLERANCE_RAD
+    # the segments cover the turn and each polynomial meets the law inside its own segment
+    assert fit.bounds[0] == pytest.approx(0.0, abs=1e-12) and fit.bounds[-1] == pytest.approx(2 * math.pi)
+    u = np.linspace(0.0, 2 * math.pi, 1001)
+    k = np.clip(np.searchsorted(fit.bounds, u, side="right") - 1, 0, len(fit.coefficients) - 1)
+    values = np.array([np.polynomial.polynomial.polyval(x, fit.coefficients[i]) for x, i in zip(u, k, strict=True)])
+    assert np.max(np.abs(values - wavy(u))) <= GEAR_FIT_TOLERANCE_RAD
 
 
 # -- every shipped template (full builds: slow) -----------------------------------------------------------
