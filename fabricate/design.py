@@ -22,6 +22,9 @@ from fabricate.strength.spec import parse_load
 from fabricate.table import Table
 from fabricate.templates import find_template, parse_toml, read_text
 
+#: The template tables every kind shares (read here); every other top-level table is the kind's own.
+GENERIC_SECTIONS = ("design", "process", "checks", "gears", "parts", "load", "actuator")
+
 
 def load_design(path: str | Path, process: str | ProcessOverride | None = None) -> DesignSpec:
     """Load and validate a template file (a path, or a shipped template's name) into a :class:`DesignSpec`.

@@ -15,6 +15,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "2")
 
 import numpy as np  # noqa: E402
 
+from fabricate.design import GENERIC_SECTIONS
 from fabricate.synthesis import watt_six_bar as wsb  # noqa: E402
 from fabricate.synthesis.watt_six_bar.method import synthesise_spec  # noqa: E402
 from fabricate.synthesis.watt_six_bar.region import finger_positions, solution_region, stage_one  # noqa: E402
@@ -25,7 +26,7 @@ from fabricate.templates import TEMPLATE_DIR, read_toml  # noqa: E402
 
 def _spec() -> WattSixBarSpec:
     root = Table(read_toml(TEMPLATE_DIR / "finger_watt_six_bar.toml"))
-    for generic in ("design", "process", "checks", "gears", "parts", "load"):
+    for generic in GENERIC_SECTIONS:
         if root.has(generic):
             root.table(generic)
     return wsb.parse_spec(root)

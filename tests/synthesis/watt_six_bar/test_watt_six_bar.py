@@ -15,6 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from fabricate.design import GENERIC_SECTIONS
 from fabricate.errors import SpecError
 from fabricate.synthesis import watt_six_bar as wsb
 from fabricate.synthesis.watt_six_bar.burmester import (
@@ -67,7 +68,7 @@ def _template_root(path: Path = TEMPLATE, edit=None) -> Table:
     if edit is not None:
         edit(data)
     root = Table(data)
-    for generic in ("design", "process", "checks", "gears", "parts", "load"):
+    for generic in GENERIC_SECTIONS:
         if root.has(generic):
             root.table(generic)
     return root

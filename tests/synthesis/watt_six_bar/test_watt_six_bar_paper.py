@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from fabricate.design import GENERIC_SECTIONS
 from fabricate.synthesis import watt_six_bar as wsb
 from fabricate.synthesis.watt_six_bar.burmester import distance_to_curve, dyad_curve, sample_curve
 from fabricate.synthesis.watt_six_bar.method import synthesise_spec
@@ -259,7 +260,7 @@ def test_circuit_defects_agree_with_an_independent_branch_test(theta, key):
 
 def test_fitted_angles_select_an_exact_region_point_next_to_mechanism_1():
     root = Table(read_toml(TEMPLATE_DIR / "finger_watt_six_bar.toml"))
-    for generic in ("design", "process", "checks", "gears", "parts", "load"):
+    for generic in GENERIC_SECTIONS:
         if root.has(generic):
             root.table(generic)
     spec = wsb.parse_spec(root)
