@@ -123,7 +123,7 @@ def export_all(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motio
     GeometryError
         When a written STL does not read back as a closed solid (a bug, never a design finding).
     """
-    from fabricate.export.dxf import kinematic_dxf
+    from fabricate.export.kinematic import kinematic_dxf
     from fabricate.export.step import step_available
     from fabricate.export.stl import SolidCache, assembly_3mf
 

@@ -28,7 +28,8 @@ from PIL import Image
 
 from fabricate.design import load_design
 from fabricate.export import export_all
-from fabricate.export.dxf import DxfStyle, audit_problems, kinematic_dxf, part_dxf, sheet_dxf, sheet_layout
+from fabricate.export.dxf import DxfStyle, audit_problems, part_dxf, sheet_dxf, sheet_layout
+from fabricate.export.kinematic import kinematic_dxf
 from fabricate.export.stl import (
     SolidCache,
     assembly_3mf,

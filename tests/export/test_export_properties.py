@@ -203,7 +203,7 @@ def test_kinematic_drawing_of_a_bent_four_bar():
     """The kinematic DXF at one pose: a LINKS line and an aligned dimension of the link's true length for
     each pair of joints of a body, a JOINTS circle and a label with the world coordinates at each joint, two
     ordinate dimensions per joint; units mm; the measurements read back equal the closed-form lengths."""
-    from fabricate.export.dxf import kinematic_dxf
+    from fabricate.export.kinematic import kinematic_dxf
     from tests.conftest import make_four_bar
 
     mech = make_four_bar()
@@ -261,7 +261,8 @@ def test_cut_files_are_metric_with_fixed_layer_colours():
     is not plotted; the kinematic drawing carries the dimension styles it uses."""
     from ezdxf import units
 
-    from fabricate.export.dxf import document_bytes, kinematic_dxf, new_document
+    from fabricate.export.dxf import document_bytes, new_document
+    from fabricate.export.kinematic import kinematic_dxf
     from tests.conftest import make_four_bar
 
     doc = ezdxf.read(io.StringIO(part_dxf(slotted_link(), KERF).decode("utf-8")))
@@ -384,7 +385,7 @@ def test_kinematic_drawing_rules_for_ternary_links_free_points_and_hinges():
     style sized from it."""
     from types import SimpleNamespace
 
-    from fabricate.export.dxf import kinematic_dxf
+    from fabricate.export.kinematic import kinematic_dxf
     from fabricate.mechanism import Body
 
     bodies = (Body("base", {"O": (0.0, 0.0), "D": (40.0, 0.0), "Q": (20.0, 10.0)}),
