@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from fabricate.drive.check import DriveResult
-from fabricate.plotting import figure, png_bytes
+from fabricate.plotting import figure, legend, png_bytes
 
 
 def drive_plot(result: DriveResult) -> bytes:
@@ -11,6 +13,11 @@ def drive_plot(result: DriveResult) -> bytes:
 
     Only for a check that ran (``result.reason is None``). Deterministic bytes.
     """
+    return png_bytes(drive_figure(result))
+
+
+def drive_figure(result: DriveResult) -> Any:
+    """The figure :func:`drive_plot` renders."""
     assert result.reason is None and result.actuator is not None and result.spec is not None  # a check that ran
     fig = figure((8.0, 4.0), 100)
     ax = fig.add_subplot(1, 1, 1)
@@ -24,12 +31,12 @@ def drive_plot(result: DriveResult) -> bytes:
     k = result.peak
     ax.plot([x[k]], [y[k]], "o", color="tab:blue", ms=4)
     ax.annotate(f"{y[k]:.4g} {result.unit} at {x[k]:.4g} {result.input_unit}", (x[k], y[k]),
-                textcoords="offset points", xytext=(4, 6), fontsize=7)
+                textcoords="offset points", xytext=(4, 6), fontsize=8)
     ax.set_xlabel(f"input ({result.input_unit})")
     ax.set_ylabel(f"{'torque' if result.unit == 'N·mm' else 'force'} ({result.unit})")
     ax.set_title(f"Drive: {result.actuator.name}"[:90], fontsize=9)
     ax.set_ylim(bottom=0.0, top=1.15 * max(result.rating, float(y.max(initial=0.0))))
     ax.grid(True, lw=0.3)
-    ax.legend(fontsize=7, loc="lower right")
+    legend(ax, loc="best", framealpha=0.85)
     fig.subplots_adjust(left=0.1, right=0.97, bottom=0.12, top=0.9)
-    return png_bytes(fig)
+    return fig

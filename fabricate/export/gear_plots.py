@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from fabricate.plotting import figure, gif_bytes, png_bytes
+from fabricate.plotting import figure, gif_bytes, legend, palette, png_bytes
 
 if TYPE_CHECKING:
     from fabricate.gears.pair import GearPair
@@ -35,10 +35,14 @@ def _placed(pair: GearPair, x_a: float) -> tuple[np.ndarray, np.ndarray, np.ndar
 
 def _draw_pair(ax: Any, pair: GearPair, x_a: float, zoom: bool) -> None:
     out_a, out_b, pitch_a, pitch_b = _placed(pair, x_a)
-    ax.fill(out_a[:, 0], out_a[:, 1], color="#4c72b0", alpha=0.55, lw=0.6, ec="#1f3b63")
-    ax.fill(out_b[:, 0], out_b[:, 1], color="#dd8452", alpha=0.55, lw=0.6, ec="#7a3d17")
-    ax.plot(pitch_a[:, 0], pitch_a[:, 1], "--", color="#1f3b63", lw=0.5)
-    ax.plot(pitch_b[:, 0], pitch_b[:, 1], "--", color="#7a3d17", lw=0.5)
+    teeth = pair.report()["teeth"]
+    ax.fill(out_a[:, 0], out_a[:, 1], color="#4c72b0", alpha=0.55, lw=0.6, ec="#1f3b63",
+            label=f"gear a, z = {teeth[0]}")
+    ax.fill(out_b[:, 0], out_b[:, 1], color="#dd8452", alpha=0.55, lw=0.6, ec="#7a3d17",
+            label=f"gear b, z = {teeth[1]}")
+    # both pitch curves in one dark grey: the fill says whose each is, the legend what the dashes are
+    ax.plot(pitch_a[:, 0], pitch_a[:, 1], "--", color="0.25", lw=0.5, label="pitch curves")
+    ax.plot(pitch_b[:, 0], pitch_b[:, 1], "--", color="0.25", lw=0.5)
     for centre, bore in (((0.0, 0.0), pair.bore_a_mm), ((pair.center_distance_mm, 0.0), pair.bore_b_mm)):
         t = np.linspace(0, 2 * np.pi, 60)
         ax.plot(centre[0] + 0.5 * bore * np.cos(t), centre[1] + 0.5 * bore * np.sin(t), color="k", lw=0.6)
@@ -53,6 +57,11 @@ def _draw_pair(ax: Any, pair: GearPair, x_a: float, zoom: bool) -> None:
 
 def pair_png(pair: GearPair, x_a: float) -> bytes:
     """The pair in mesh at driving angle ``x_a`` (rad): whole pair and a zoom on the pitch point."""
+    return png_bytes(pair_figure(pair, x_a))
+
+
+def pair_figure(pair: GearPair, x_a: float) -> Any:
+    """The figure :func:`pair_png` renders, with a legend naming each gear and the pitch curves."""
     fig = figure((10.0, 4.6), 110)
     ax1, ax2 = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
     _draw_pair(ax1, pair, x_a, zoom=False)
@@ -67,8 +76,10 @@ def pair_png(pair: GearPair, x_a: float) -> bytes:
     for ax in (ax1, ax2):
         ax.set_xlabel("x (mm)")
         ax.tick_params(labelsize=7)
+    legend(ax1, loc="upper left", framealpha=0.8)
+    legend(ax2, loc="upper left", framealpha=0.8)
     fig.subplots_adjust(left=0.06, right=0.98, bottom=0.12, top=0.92, wspace=0.15)
-    return png_bytes(fig)
+    return fig
 
 
 def pair_gif(pair: GearPair, frames: int, size_px: int = 384, frame_ms: int = 80) -> bytes:
@@ -117,15 +128,25 @@ def pair_gif(pair: GearPair, frames: int, size_px: int = 384, frame_ms: int = 80
 
 def law_png(law: Law, working_range: tuple[float, float], center_distance_mm: float) -> bytes:
     """The ratio law: driven against driving angle, and the transmission ratio."""
+    return png_bytes(law_figure(law, working_range, center_distance_mm))
+
+
+def law_figure(law: Law, working_range: tuple[float, float], center_distance_mm: float) -> Any:
+    """The figure :func:`law_png` renders: two curves on twin axes, one legend naming both (and its axis)."""
     lo, hi = working_range
     x = np.linspace(lo, hi, 400)
     fig, ax = _figure((6.0, 3.6), 100)
-    ax.plot(np.degrees(x), -np.degrees(np.asarray(law(x))), color="#4c72b0", label="driven angle (deg)")
+    angle_colour, ratio_colour = palette(2)
+    ax.plot(np.degrees(x), -np.degrees(np.asarray(law(x))), color=angle_colour,
+            label="driven angle (deg, left axis)")
     ax.set_xlabel("driving angle x_a (deg)")
-    ax.set_ylabel("driven angle (deg)")
+    ax.set_ylabel("driven angle (deg)", color=angle_colour)
     ax2 = ax.twinx()
-    ax2.plot(np.degrees(x), -np.asarray(law(x, 1)), color="#dd8452", label="ratio i")
-    ax2.set_ylabel("transmission ratio i = -law'")
+    ax2.plot(np.degrees(x), -np.asarray(law(x, 1)), color=ratio_colour, ls="--", label="ratio i (right axis)")
+    ax2.set_ylabel("transmission ratio i = -law'", color=ratio_colour)
     ax.set_title(f"gear law, centre distance {center_distance_mm:.3f} mm", fontsize=9)
+    # one legend for both axes, on the twin (drawn last, so no curve crosses it)
+    handles = ax.get_legend_handles_labels()[0] + ax2.get_legend_handles_labels()[0]
+    legend(ax2, handles, [h.get_label() for h in handles], loc="best", framealpha=0.85)
     fig.subplots_adjust(left=0.12, right=0.86, bottom=0.14, top=0.9)
-    return png_bytes(fig)
+    return fig

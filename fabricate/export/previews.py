@@ -1,8 +1,8 @@
 """Pictures of the assembly: a PNG at several poses (matplotlib) and a GIF of the motion (Pillow).
 
 Both are deterministic: the PNG carries no software/date metadata and the GIF frames are drawn with
-Pillow's rasteriser from fixed pixel maps. Parts are drawn bottom layer first, each layer in its own
-colour, holes as background discs.
+Pillow's rasteriser from fixed pixel maps. Parts are drawn bottom layer first, each part in its own colour
+(:func:`fabricate.plotting.palette`: no two parts alike), holes as background discs.
 """
 
 from __future__ import annotations
@@ -14,15 +14,14 @@ import numpy as np
 
 from fabricate.parts.model import Part, circle_polygon
 from fabricate.planar import transform_points
-from fabricate.plotting import gif_bytes, png_bytes, pyplot
+from fabricate.plotting import DISTINCT_HEX, figure, gif_bytes, legend, palette_rgb255, png_bytes
 
 if TYPE_CHECKING:
     from fabricate.mechanism import Motion
     from fabricate.parts.assembly import PinStack
 
-#: Layer colours (RGB 0-255), cycled.
-PALETTE = [(31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189),
-           (140, 86, 75), (227, 119, 194), (127, 127, 127), (188, 189, 34), (23, 190, 207)]
+#: Part colours (RGB 0-255): the shared distinct palette (its first ten are matplotlib's tab10, as before).
+PALETTE = palette_rgb255(len(DISTINCT_HEX))
 
 #: Outline tolerance (mm) for pictures.
 PREVIEW_CHORD_MM = 0.05
@@ -48,9 +47,13 @@ def frame_label(value: float, unit: str) -> str:
 
 
 def part_colours(parts: Sequence[Part]) -> dict[str, int]:
-    """A palette index per part: neighbours in the part list (meshing gears, a link and its spacer) differ,
-    which colouring by layer did not give (a gear pair shares one layer)."""
+    """A :data:`PALETTE` index per part, in part-list order: every part its own colour up to the palette's
+    length (meshing gears on one layer, a link and its spacer, the eleventh part and the first all differ)."""
     return {part.name: k % len(PALETTE) for k, part in enumerate(parts)}
+
+
+def _part_rgb(index: int) -> np.ndarray:
+    return np.array(PALETTE[index], dtype=np.float64) / 255.0
 
 
 def _shapes(parts: Sequence[Part]) -> list[tuple[Part, np.ndarray, list[tuple[np.ndarray, float]]]]:
@@ -88,29 +91,44 @@ def assembly_png(parts: Sequence[Part], motion: Motion, poses: int = 4, tip_poin
     title : str
         Figure title.
     """
-    from matplotlib.collections import PolyCollection
+    return png_bytes(assembly_figure(parts, motion, poses, tip_point, title), 100)
 
-    plt = pyplot()
+
+def assembly_figure(parts: Sequence[Part], motion: Motion, poses: int = 4, tip_point: str | None = None,
+                    title: str = "") -> Any:
+    """The figure :func:`assembly_png` renders: the panels, and below them a legend naming every part's
+    colour (and the tip's path)."""
+    from matplotlib.collections import PolyCollection
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
 
     shapes = _shapes(parts)
     part_colour = part_colours(parts)
     indices = pose_indices(len(motion.inputs), poses)
     lo, hi = _extent(shapes, motion, indices)
-    fig, axes = plt.subplots(1, len(indices), figsize=(3.2 * len(indices), 3.4), squeeze=False,
-                             sharex=True, sharey=True)
-    unit = getattr(motion.mechanism, "input_unit", "deg")
     trace = None
     if tip_point:
         try:
             trace = motion.point(tip_point)
         except KeyError:
             trace = None
+    width = 3.2 * len(indices)
+    # the legend under the panels: as many columns as fit the width, a row of 0.2 in each
+    entries = len(parts) + (trace is not None)
+    columns = max(1, min(entries, int(width // 1.9)))
+    rows = -(-entries // columns)
+    legend_in = 0.1 + 0.18 * rows
+    panels_in = 3.4
+    height = panels_in + legend_in
+    fig = figure((width, height), 100)
+    axes = fig.subplots(1, len(indices), squeeze=False, sharex=True, sharey=True)
+    unit = getattr(motion.mechanism, "input_unit", "deg")
     for ax, i in zip(axes[0], indices, strict=True):
         body_poses = motion.poses_at(i)
         plates, faces, edges, holes_xy = [], [], [], []
         for part, outline, holes in shapes:
             pose = body_poses.get(part.body, np.zeros(3))
-            colour = np.array(PALETTE[part_colour[part.name]]) / 255.0
+            colour = _part_rgb(part_colour[part.name])
             plates.append(transform_points(pose, outline))
             faces.append((*colour, 0.55))
             edges.append(tuple(colour * 0.6))
@@ -133,9 +151,19 @@ def assembly_png(parts: Sequence[Part], motion: Motion, poses: int = 4, tip_poin
         ax.set_xlabel("x (mm)", fontsize=7)
     if title:
         fig.suptitle(title, fontsize=9)
-    # fixed margins: tight_layout costs more than the drawing itself
-    fig.subplots_adjust(left=0.06, right=0.99, bottom=0.14, top=0.86, wspace=0.08)
-    return png_bytes(fig, 100)
+    # a legend of proxies in the parts' own face colours (each part named once, in part-list order)
+    handles: list[Any] = [Patch(facecolor=(*_part_rgb(part_colour[part.name]), 0.55),
+                                edgecolor=tuple(_part_rgb(part_colour[part.name]) * 0.6), label=part.name)
+                          for part in parts]
+    if trace is not None:
+        handles.append(Line2D([], [], color="black", linewidth=0.6, linestyle="--", label=f"path of {tip_point}"))
+    legend(fig, handles=handles, loc="lower center", ncol=columns, frameon=False, bbox_to_anchor=(0.5, 0.0),
+           handlelength=1.5, columnspacing=1.2)
+    # fixed margins (tight_layout costs more than the drawing itself): the panels keep their 3.4 in, the
+    # legend takes the rest
+    fig.subplots_adjust(left=0.06, right=0.99, bottom=(legend_in + 0.45) / height,
+                        top=1.0 - 0.48 / height, wspace=0.08)
+    return fig
 
 
 def motion_gif(parts: Sequence[Part], motion: Motion, frames: int = 24, size_px: int = 360,
@@ -209,9 +237,28 @@ def exploded_png(parts: Sequence[Part], poses: Mapping[str, np.ndarray], stacks:
         From :func:`fabricate.parts.assembly.pin_stacks`.
     title : str
     """
+    return png_bytes(exploded_figure(parts, poses, stacks, title), 100)
+
+
+def _pin_centre(stack: PinStack, placed: Mapping[str, Any], poses: Mapping[str, np.ndarray]) -> np.ndarray | None:
+    """Where ``stack``'s pin is in the plan (world xy): the centre of its hole in the first part of its stack
+    that has one, else in any part that does (a printed spacer)."""
+    # a compound pin's holes carry its whole name ("A+A_k"), a simple one its joint
+    joints = set(stack.pin.split("+")) | {stack.pin}
+    names = [item.item for item in stack.items if item.item in placed] + sorted(placed)
+    for name in names:
+        part = placed[name][2]
+        hole = next((h for h in part.holes if h.joint in joints), None)
+        if hole is not None:
+            return transform_points(poses.get(part.body, np.zeros(3)), hole.centre)
+    return None
+
+
+def exploded_figure(parts: Sequence[Part], poses: Mapping[str, np.ndarray], stacks: Sequence[PinStack],
+                    title: str = "") -> Any:
+    """The figure :func:`exploded_png` renders. Each pin's axis is a line whose gid is ``"pin <name>"``."""
     from matplotlib.collections import PolyCollection
 
-    plt = pyplot()
     shapes = _shapes(parts)
     part_colour = part_colours(parts)
     placed = {part.name: (transform_points(poses.get(part.body, np.zeros(3)), outline), holes, part)
@@ -225,10 +272,11 @@ def exploded_png(parts: Sequence[Part], poses: Mapping[str, np.ndarray], stacks:
     def project(xy: np.ndarray, z: float) -> np.ndarray:
         return np.asarray(xy, dtype=np.float64) + z * stretch * lift
 
-    fig, ax = plt.subplots(figsize=(7.0, 7.0))
+    fig = figure((7.0, 7.0), 100)
+    ax = fig.add_subplot(1, 1, 1)
     for name in sorted(placed, key=lambda n: (placed[n][2].z_mm, n)):
         outline, holes, part = placed[name]
-        colour = np.array(PALETTE[part_colour[name]]) / 255.0
+        colour = _part_rgb(part_colour[name])
         pose = poses.get(part.body, np.zeros(3))
         z_mid = part.z_mm + 0.5 * part.thickness_mm  # one face per part: the gaps are what is exploded
         face = project(outline, z_mid)
@@ -239,29 +287,20 @@ def exploded_png(parts: Sequence[Part], poses: Mapping[str, np.ndarray], stacks:
         ax.add_collection(PolyCollection(holes_xy, facecolors="white", edgecolors="0.3", linewidths=0.4))
         label = face.mean(axis=0)
         small = float(np.ptp(outline, axis=0).max()) < 0.15 * span  # a label would hide it: put it beside
-        ax.annotate(name, label, fontsize=7, ha="left" if small else "center", va="center",
+        ax.annotate(name, label, fontsize=8, ha="left" if small else "center", va="center",
                     xytext=(8, 0) if small else (0, 0), textcoords="offset points",
                     bbox={"facecolor": "white", "alpha": 0.7, "edgecolor": "none", "pad": 0.5})
     for stack in stacks:
-        joints = set(stack.pin.split("+"))
-        centre = None
-        for item in stack.items:
-            entry = placed.get(item.item)
-            if entry is not None:
-                part = entry[2]
-                hole = next((h for h in part.holes if h.joint in joints), None)
-                if hole is not None:
-                    centre = transform_points(poses.get(part.body, np.zeros(3)), hole.centre)
-                    break
-        if centre is None:
+        centre = _pin_centre(stack, placed, poses)
+        if centre is None:  # no part has the pin's hole: nothing to draw it through
             continue
         ends = np.array([project(centre, stack.z_mm - 0.5), project(centre, stack.z_mm + stack.length_mm + 0.5)])
-        ax.plot(ends[:, 0], ends[:, 1], color="black", lw=0.8, ls="--")
-        ax.annotate(f"pin {stack.pin}", ends[1], fontsize=6, xytext=(2, 2), textcoords="offset points")
+        ax.plot(ends[:, 0], ends[:, 1], color="black", lw=0.8, ls="--", gid=f"pin {stack.pin}")
+        ax.annotate(f"pin {stack.pin}", ends[1], fontsize=8, xytext=(2, 2), textcoords="offset points")
     ax.autoscale_view()
     ax.set_aspect("equal")
     ax.set_axis_off()
     ax.set_title(f"{title} exploded along the pins (z stretched x{stretch:.2g})" if title else "exploded",
                  fontsize=9)
     fig.subplots_adjust(left=0.02, right=0.98, bottom=0.02, top=0.94)
-    return png_bytes(fig, 100)
+    return fig

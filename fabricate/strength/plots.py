@@ -2,13 +2,42 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from fabricate.plotting import png_bytes, pyplot
+from fabricate.plotting import figure, legend, png_bytes, series_styles
 from fabricate.strength.check import StrengthResult
 
 #: Parts drawn: the most loaded ones (the rest are in report.md's table).
 MAX_PARTS = 12
+
+
+def strength_figure(result: StrengthResult, input_unit: str, max_parts: int = MAX_PARTS) -> Any:
+    """The figure :func:`strength_plot` renders (a matplotlib Figure, for callers that look at its artists).
+
+    Each drawn part has its own colour (:func:`fabricate.plotting.series_styles`: no two alike however many
+    are drawn) and a legend entry.
+    """
+    fig = figure((10.0, 4.5), 100)
+    ax = fig.add_subplot(1, 1, 1)
+    worst = sorted(result.per_part().values(), key=lambda f: f.safety_factor)[:max_parts]
+    x = result.inputs
+    drawn = [f for f in worst if f.curve is not None and len(f.curve) == len(x)]
+    for f, style in zip(drawn, series_styles(len(drawn)), strict=True):
+        ax.plot(x, np.asarray(f.curve) / f.allowable_MPa, lw=1.3, label=f"{f.part}: {f.feature}"[:70], **style)
+    ax.axhline(1.0 / result.min_safety_factor, color="red", ls="--", lw=1.0,
+               label=f"limit (safety factor {result.min_safety_factor:g})")
+    ax.set_xlabel(f"input ({input_unit})")
+    ax.set_ylabel("stress / allowable")
+    ax.set_title("Strength over the motion: governing stress of each part")
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, lw=0.3)
+    legend(ax, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    # fixed margins (tight_layout would draw the figure twice); the legend's 70-character entries need the
+    # right third of the figure at 8 pt
+    fig.subplots_adjust(left=0.07, right=0.6, bottom=0.11, top=0.92)
+    return fig
 
 
 def strength_plot(result: StrengthResult, input_unit: str, max_parts: int = MAX_PARTS) -> bytes:
@@ -17,22 +46,4 @@ def strength_plot(result: StrengthResult, input_unit: str, max_parts: int = MAX_
     A part's curve is its governing feature's stress at every pose divided by that feature's allowable;
     the red line is 1 / required safety factor (above it the part fails the check). Deterministic bytes.
     """
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(10.0, 4.5), dpi=100)
-    worst = sorted(result.per_part().values(), key=lambda f: f.safety_factor)[:max_parts]
-    x = result.inputs
-    for f in worst:
-        if f.curve is None or len(f.curve) != len(x):
-            continue
-        ax.plot(x, np.asarray(f.curve) / f.allowable_MPa, lw=1.3, label=f"{f.part}: {f.feature}"[:70])
-    ax.axhline(1.0 / result.min_safety_factor, color="red", ls="--", lw=1.0,
-               label=f"limit (safety factor {result.min_safety_factor:g})")
-    ax.set_xlabel(f"input ({input_unit})")
-    ax.set_ylabel("stress / allowable")
-    ax.set_title("Strength over the motion: governing stress of each part")
-    ax.set_ylim(bottom=0.0)
-    ax.grid(True, lw=0.3)
-    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    # fixed margins (tight_layout would draw the figure twice)
-    fig.subplots_adjust(left=0.07, right=0.7, bottom=0.11, top=0.92)
-    return png_bytes(fig)
+    return png_bytes(strength_figure(result, input_unit, max_parts))

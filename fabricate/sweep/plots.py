@@ -8,7 +8,7 @@ import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from fabricate.plotting import figure, png_bytes
+from fabricate.plotting import figure, legend, png_bytes
 
 #: More plots than this are not drawn (a sweep of 16 fields x 64 metrics would make 1024).
 MAX_PLOTS = 64
@@ -47,7 +47,7 @@ def metric_plot(rows: Sequence[Mapping[str, Any]], field: str, metric: str) -> b
     ax.set_xlabel(field)
     ax.set_ylabel(metric)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
+    legend(ax, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
     fig.tight_layout()
     return png_bytes(fig)
 
@@ -71,7 +71,7 @@ def feasibility_map(rows: Sequence[Mapping[str, Any]], x: str, y: str) -> bytes:
                 xs, ys = zip(*pts, strict=True)
                 ax.scatter(xs, ys, s=30, label=f"{label} ({len(pts)})", **style)
         # below the axes: a legend inside would hide points of a full grid
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
+        legend(ax, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
     else:
         xy = sorted(spots)
         share = [sum(c == 0 for c in spots[k]) / len(spots[k]) for k in xy]
@@ -80,7 +80,7 @@ def feasibility_map(rows: Sequence[Mapping[str, Any]], x: str, y: str) -> bytes:
         for (px, py) in xy:
             codes = spots[(px, py)]
             ax.annotate(f"{sum(c == 0 for c in codes)}/{len(codes)}", (px, py), textcoords="offset points",
-                        xytext=(0, 7), ha="center", fontsize=6)
+                        xytext=(0, 7), ha="center", fontsize=7)
         fig.colorbar(dots, ax=ax, label="share of points passing every check")
     ax.set_xlabel(x)
     ax.set_ylabel(y)

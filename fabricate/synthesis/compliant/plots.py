@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fabricate.plotting import png_bytes, pyplot
+from fabricate.plotting import legend, palette, png_bytes, pyplot
 
 
 def _png(fig) -> bytes:
@@ -20,11 +20,12 @@ def compliant_figures(spec, path, grasp, motion, optimum) -> dict[str, bytes]:
     out: dict[str, bytes] = {}
     strokes, f_static, f_hover = grasp_force_curve(path, spec.springs, spec.load.mu)
     fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(strokes, f_static, label="static load F_n1 (eqs 3-4)")
-    ax.plot(strokes, f_hover, "--", label="hover F_n (eqs 5-6)")
+    static_colour, hover_colour = palette(2)
+    ax.plot(strokes, f_static, color=static_colour, label="static load F_n1 (eqs 3-4)")
+    ax.plot(strokes, f_hover, "--", color=hover_colour, label="hover F_n (eqs 5-6)")
     ax.axhline(spec.load.hover_force, color="grey", lw=0.8)
     ax.axvline(grasp.stroke, color="grey", lw=0.8)
-    ax.plot([grasp.stroke], [grasp.fn_static], "o", color="C0")
+    ax.plot([grasp.stroke], [grasp.fn_static], "o", color=static_colour)
     ax.annotate(f"F_n1 = {grasp.fn_static:.2f} N\nF_n2 = {grasp.fn_hover:.2f} N",
                 (grasp.stroke, grasp.fn_static), textcoords="offset points", xytext=(8, -30))
     ax.set_xlim(strokes[0] if len(strokes) else 0, grasp.stroke + 4.0)
@@ -32,17 +33,20 @@ def compliant_figures(spec, path, grasp, motion, optimum) -> dict[str, bytes]:
     ax.set_xlabel("drive rod stroke (mm)")
     ax.set_ylabel("grasp force (N)")
     ax.set_title(f"D = {spec.load.diameter:g} mm can: grasp force against stroke")
-    ax.legend(loc="upper left")
+    legend(ax, loc="upper left")
     out["grasp_force.png"] = _png(fig)
 
     fig, ax = plt.subplots(figsize=(5, 6))
     g = spec.geometry
-    for k in np.linspace(0, len(motion.strokes) - 1, 6).astype(int):
+    # one colour per pose (palette order, not the pose's index: two indices ten apart shared a colour), named
+    # by its stroke in the legend
+    shown = np.linspace(0, len(motion.strokes) - 1, 6).astype(int)
+    for k, colour in zip(shown, palette(len(shown)), strict=True):
         st = finger_state(g, motion.phi1[k], motion.phi2[k])
         pts = np.array([[0.0, 0.0], st.B, st.C, st.D, st.E, st.M])
-        ax.plot(pts[:5, 0], pts[:5, 1], "-o", ms=3, color=f"C{k % 10}")
-        ax.plot(pts[4:, 0], pts[4:, 1], ":", color=f"C{k % 10}")
-        circ = plt.Circle(st.pad_centre, g.r, fill=False, lw=0.5, color=f"C{k % 10}")
+        ax.plot(pts[:5, 0], pts[:5, 1], "-o", ms=3, color=colour, label=f"stroke {motion.strokes[k]:.1f} mm")
+        ax.plot(pts[4:, 0], pts[4:, 1], ":", color=colour)
+        circ = plt.Circle(st.pad_centre, g.r, fill=False, lw=0.5, color=colour)
         ax.add_patch(circ)
     wall = spec.load.radius - g.l1
     ax.axvline(wall, color="k", lw=1.5)
@@ -53,5 +57,6 @@ def compliant_figures(spec, path, grasp, motion, optimum) -> dict[str, bytes]:
     if optimum is not None:
         title += f"\noptimum dN = {optimum.delta_n:.3f} N"
     ax.set_title(title)
+    legend(ax, loc="best", framealpha=0.85)
     out["closing.png"] = _png(fig)
     return out

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from fabricate.plotting import png_bytes, pyplot
+from fabricate.plotting import legend, png_bytes, pyplot
 
 #: Figure size (inches) and resolution shared by every plot.
 FIGSIZE = (6.4, 4.8)
@@ -58,7 +58,7 @@ def hinge_curves_png(data: Any) -> bytes:
     ax.set_xlabel("x / mm")
     ax.set_ylabel("y / mm")
     ax.set_title("Hinge curves of A and B (first pose)")
-    ax.legend(fontsize=7, loc="best")
+    legend(ax, loc="best")
     return _png(fig)
 
 
@@ -88,7 +88,7 @@ def feasible_domain_png(data: Any) -> bytes:
     y0, y1 = spec.a_y_mm
     ax_a.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], "k--", lw=0.8, label="A limits")
     for ax in (ax_a, ax_b):
-        ax.legend(fontsize=7, loc="best")
+        legend(ax, loc="best")
     return _png(fig)
 
 
@@ -101,12 +101,12 @@ def gear_ratio_png(data: Any) -> bytes:
     ax_i.plot(x, law.ratio, "b-", label="i = -dx_b/dx_a")
     ax_i.plot(np.degrees(law.knots_a), -law.law(law.knots_a, 1), "ko", ms=4, label="poses")
     ax_i.set_ylabel("transmission ratio")
-    ax_i.legend(fontsize=7)
+    legend(ax_i)
     ax_r.plot(x, law.r_a, "g-", label="sun (O) pitch radius")
     ax_r.plot(x, law.r_b, "m-", label="planet (A) pitch radius")
     ax_r.set_xlabel("x_a: ground rotation relative to arm OA / deg")
     ax_r.set_ylabel("radius / mm")
-    ax_r.legend(fontsize=7)
+    legend(ax_r)
     ax_i.set_title(f"Non-circular gear pair, centre distance {law.centre_distance:.2f} mm")
     return _png(fig)
 
@@ -129,7 +129,7 @@ def trajectory_png(data: Any) -> bytes:
     ax.set_ylabel("y / mm")
     err = data.position_error
     ax.set_title(f"Fingertip trajectory (pose error max {err.max():.3f} mm, mean {err.mean():.3f} mm)")
-    ax.legend(fontsize=7, loc="best")
+    legend(ax, loc="best")
     return _png(fig)
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fabricate.plotting import png_bytes, pyplot
+from fabricate.plotting import legend, png_bytes, pyplot
 from fabricate.synthesis.watt_six_bar.burmester import CubicCurve, grid_in_range, sample_curve
 
 _BRANCH_COLOURS = ("tab:blue", "tab:orange", "tab:green")
@@ -69,7 +69,7 @@ def plot_curve_d(spec, region, choice) -> bytes:
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
     ax.set_title("Solution curve C_d of joint d (position 1) and its feasible segments")
-    ax.legend(fontsize=6, loc="lower right", markerscale=1)
+    legend(ax, loc="lower right", markerscale=1)
     ax.grid(True, lw=0.3)
     return _png(fig)
 
@@ -96,7 +96,7 @@ def plot_curve_d0(spec, finger, choice) -> bytes:
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
     ax.set_title(f"C_d0 for d = ({choice.d[0]:.2f}, {choice.d[1]:.2f}) mm")
-    ax.legend(fontsize=6, loc="lower right", markerscale=1)
+    legend(ax, loc="lower right", markerscale=1)
     ax.grid(True, lw=0.3)
     return _png(fig)
 
@@ -129,7 +129,7 @@ def plot_region(spec, region, refined, choice) -> bytes:
     ax.set_xlabel("d_x (mm)")
     ax.set_ylabel("d0_x (mm)")
     ax.set_title(f"Solution region (step {spec.step_mm:g} mm), coloured by K")
-    ax.legend(fontsize=6, loc="best", markerscale=1.5)
+    legend(ax, loc="best", markerscale=1.5)
     ax.grid(True, lw=0.3)
     return _png(fig)
 
