@@ -58,15 +58,19 @@ def _bom_csv(rows: list[dict[str, Any]]) -> bytes:
 
 
 def assembly_csv(stacks: list[PinStack]) -> bytes:
-    """assembly.csv: one row per item on a pin, bottom to top (pin, position, item, kind, z in mm)."""
+    """assembly.csv: one row per item on a pin, bottom to top (pin, position, item, kind, z in mm, note).
+
+    ``item`` is the BOM's name for it (a part's name, the hardware's item); how it sits where that is not
+    through a hole ("in its slot") is the ``note``, so the column can be looked up in bom.csv as it is.
+    """
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(["pin", "position", "item", "kind", "z_bottom_mm", "z_top_mm", "pin_diameter_mm",
-                     "pin_length_mm"])
+                     "pin_length_mm", "note"])
     for stack in stacks:
         for k, item in enumerate(stack.items, start=1):
             writer.writerow([stack.pin, k, item.item, item.kind, f"{item.z_mm[0]:.3f}", f"{item.z_mm[1]:.3f}",
-                             f"{stack.diameter_mm:g}", f"{stack.length_mm:.3f}"])
+                             f"{stack.diameter_mm:g}", f"{stack.length_mm:.3f}", item.note])
     return buffer.getvalue().encode("utf-8")
 
 

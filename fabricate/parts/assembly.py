@@ -31,11 +31,20 @@ class StackItem:
         ``part``, ``spacer``, ``washer``, ``clip`` (a retainer on the pin's end) or ``spring`` (beyond the stack).
     z_mm : (float, float)
         Bottom and top along the pin (mm, the assembly's z).
+    note : str
+        How it sits on the pin where that is not through a hole (``in its slot``: a slider's guide); the item
+        stays the BOM's name.
     """
 
     item: str
     kind: str
     z_mm: tuple[float, float]
+    note: str = ""
+
+    @property
+    def label(self) -> str:
+        """The item as the guide's text names it: with its note in brackets."""
+        return f"{self.item} ({self.note})" if self.note else self.item
 
 
 @dataclass(frozen=True)
@@ -72,8 +81,11 @@ def pin_stacks(partset: PartSet) -> list[PinStack]:
                 continue  # a spring's arbor on another pin of the same plate
             # a pin through a body passes its hole, or rides in its slot (a slider's guide)
             on_hole = any(h.joint in joints for h in part.holes)
-            name = part.name if on_hole or not getattr(part, "slots", ()) else f"{part.name} (in its slot)"
-            items.append(StackItem(name, "part", (round(part.z_mm, 6), round(part.z_mm + part.thickness_mm, 6))))
+            if not on_hole and part.role in ("mount", "standoff"):
+                continue  # the drive's mount plate and standoffs sit on the ground's screws, not on its pins
+            note = "" if on_hole or not getattr(part, "slots", ()) else "in its slot"
+            items.append(StackItem(part.name, "part", (round(part.z_mm, 6), round(part.z_mm + part.thickness_mm, 6)),
+                                   note))
         printed = {round(part.z_mm, 6): part.name for part in partset.parts
                    if part.role == "spacer" and any(h.joint in joints for h in part.holes)}
         for spacer in partset.spacers:
@@ -92,7 +104,7 @@ def pin_stacks(partset: PartSet) -> list[PinStack]:
         for spring in getattr(partset, "springs", ()) or ():
             if spring.pin == pin.joint:
                 items.append(StackItem(spring.designation, "spring", (spring.z_mm[0], spring.z_mm[1])))
-        items.sort(key=lambda s: (s.z_mm[0], s.z_mm[1], s.item))
+        items.sort(key=lambda s: (s.z_mm[0], s.z_mm[1], s.label))
         stacks.append(PinStack(pin.joint, float(pin.diameter_mm), float(pin.length_mm), float(pin.z_mm),
                                tuple(items)))
     return stacks
@@ -102,8 +114,8 @@ def assembly_steps(stacks: list[PinStack], copies: int = 1) -> list[str]:
     """Numbered steps for people: one per pin, the ground's pins first, each stack bottom to top."""
     steps = []
     for k, stack in enumerate(stacks, start=1):
-        order = ", ".join(f"{s.item} ({s.kind}, z {s.z_mm[0]:.2f}–{s.z_mm[1]:.2f} mm)" if s.kind != "part"
-                          else f"{s.item} (z {s.z_mm[0]:.2f}–{s.z_mm[1]:.2f} mm)" for s in stack.items)
+        order = ", ".join(f"{s.label} ({s.kind}, z {s.z_mm[0]:.2f}–{s.z_mm[1]:.2f} mm)" if s.kind != "part"
+                          else f"{s.label} (z {s.z_mm[0]:.2f}–{s.z_mm[1]:.2f} mm)" for s in stack.items)
         steps.append(f"{k}. Pin {stack.pin} (Ø{stack.diameter_mm:g} × {stack.length_mm:.2f} mm, from z "
                      f"{stack.z_mm:.2f} mm): slide on, bottom to top: {order}; then retain the pin.")
     if copies > 1:
@@ -115,7 +127,7 @@ def stacks_report(stacks: list[PinStack]) -> list[dict[str, Any]]:
     """JSON-ready stacks for report.json (``assembly.pins``)."""
     return [{"pin": s.pin, "diameter_mm": s.diameter_mm, "length_mm": round(s.length_mm, 6),
              "z_mm": round(s.z_mm, 6),
-             "stack": [{"item": i.item, "kind": i.kind, "z_mm": list(i.z_mm)} for i in s.items]} for s in stacks]
+             "stack": [{"item": i.label, "kind": i.kind, "z_mm": list(i.z_mm)} for i in s.items]} for s in stacks]
 
 
 # -- the assembly guide (assembly.md): numbered steps a person follows ------------------------------------
@@ -399,8 +411,8 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
         new = [n for n, k in part_step.items() if k == f"pin:{pin.joint}"]
         arbors = {sp.arbor for sp in springs.values()}
         on = [i for i in (stack.items if stack else ()) if i.kind != "spring" and i.item not in arbors]
-        listing = "; ".join(f"{i.item} ({i.kind}, z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" if i.kind != "part"
-                            else f"{i.item} (z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" for i in on)
+        listing = "; ".join(f"{i.label} ({i.kind}, z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" if i.kind != "part"
+                            else f"{i.label} (z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" for i in on)
         retention, tool = _retention(pin)
         spring = springs.get(pin.joint)
         text = [f"Stack, bottom to top: {listing}.",
