@@ -20,6 +20,22 @@ Modules downstream never test a process by its name; they read what it can do:
 plus the numbers every process has: ``min_feature_mm``, ``min_wall_mm``, ``min_pin_mm``, the fits
 (``running_clearance_mm``, ``hole_compensation_mm``, ``kerf_mm``) and ``min_text_mm``.
 
+Printers
+--------
+A plate layout prints on a printer: ``printer = "prusa_sl1s"`` (a preset of :mod:`fabricate.catalogue.printers`)
+in the profile or the template's ``[process]``, or ``--printer NAME`` on the command line (which wins over
+both and survives ``--process``). The printer's build volume replaces ``build_volume_mm``; a template that
+gives its own ``build_volume_mm`` and names no printer prints on that area (a printer of its own). A profile
+says which printers it serves by ``printer_technique`` (``"sla"``, ``"fdm"``); a printer of another technique,
+or any printer with a sheet layout, is a SpecError.
+
+First layer
+-----------
+``first_layer_compensation_mm`` is how far the first layer of an additive process spreads beyond its contour
+(FDM "elephant foot", resin bottom-layer bloom). The exported meshes keep the nominal contour; the value is
+the slicer's compensation to set (PrusaSlicer ``elefant_foot_compensation``: the first layer's contour is
+inset by it), recorded in the report, and the real-client test slices with it.
+
 Fits and retention
 ------------------
 Every pin runs in the holes of all but (at most) one of the parts it joins. How it is kept in is the
@@ -62,6 +78,8 @@ RETENTIONS = ("press", "clip", "cap")
 #: Largest diametral press-fit interference (mm): beyond ~0.5 mm a pin of any catalogued size splits a
 #: printed or cut boss (hoop strain interference / pin of 10 % and more).
 MAX_INTERFERENCE_MM = 0.5
+#: What a profile's printers are (``printer_technique``): "" for a process that prints on none.
+PRINTER_TECHNIQUES = ("", "sla", "fdm")
 #: A process name (``method``; a shipped profile's file is ``process_<name>.toml``).
 _PROCESS_NAME = re.compile(r"[a-z][a-z0-9_-]{0,39}")
 
@@ -184,6 +202,13 @@ class ProcessSpec:
     press_fit_interference_mm : float
         Diametral interference of a press-fit hole (nominal hole = pin - interference); 0 when the process
         does not press-fit (``retention`` is then not ``"press"``).
+    printer : str
+        The printer preset whose build volume ``build_volume_mm`` is ("" when the area is the profile's or
+        the template's own).
+    printer_technique : str
+        The technique of the printers the profile serves (``"sla"``, ``"fdm"``, "" for none).
+    first_layer_compensation_mm : float
+        How far the first layer spreads (see the module docstring); 0 when the process has no such effect.
     """
 
     name: str
@@ -210,6 +235,11 @@ class ProcessSpec:
     pin_material: str = ""
     retention: str = "press"  # the default profile's (process_sla.toml)
     press_fit_interference_mm: float = 0.05
+    printer: str = ""
+    printer_technique: str = ""
+    first_layer_compensation_mm: float = 0.0
+    sheets: tuple[tuple[str, float, float], ...] = ()  # [sheets]: standard stock (name, w, h), smallest first
+    shop: tuple[tuple[str, float], ...] = ()  # [shop]: the cut shop's rules (fabricate.checks.shop)
 
     def part_material(self) -> Material | None:
         """The :class:`Material` of the parts (None if the profile has none)."""
@@ -227,17 +257,29 @@ class ProcessOverride:
     Attributes
     ----------
     source : str
-        A shipped profile's name (``"sla"``, ``"laser"``...) or the profile file's name.
+        A shipped profile's name (``"sla"``, ``"laser"``...) or the profile file's name; "" when only the
+        printer is chosen.
     text : str
-        The profile's TOML text (embedded in report.json so ``check`` rebuilds with it).
+        The profile's TOML text (embedded in report.json so ``check`` rebuilds with it); "" when only the
+        printer is chosen (the template's own profile is used).
+    printer : str
+        ``--printer``: the printer preset that replaces the profile's and the template's ("" for none).
     """
 
     source: str
     text: str
+    printer: str = ""
 
 
-def process_override(name_or_path: str | Path) -> ProcessOverride:
-    """Resolve ``--process``: a shipped profile name or a profile file."""
+def process_override(name_or_path: str | Path | None, printer: str | None = None) -> ProcessOverride:
+    """Resolve ``--process`` (a shipped profile name or a profile file; None: the template's) and
+    ``--printer`` (a preset name)."""
+    if printer is not None:
+        from fabricate.catalogue.printers import printer as find_printer
+
+        find_printer(printer, "--printer")
+        base = process_override(name_or_path) if name_or_path is not None else ProcessOverride("", "")
+        return ProcessOverride(base.source, base.text, printer)
     profiles = shipped_profiles()
     if not isinstance(name_or_path, (str, Path)):
         named = ", ".join(f'"{p}"' for p in profiles)
@@ -261,10 +303,13 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
     """Read ``[process]``: a profile name plus overrides of the profile's fields.
 
     With ``override`` (``--process``) the profile is the override's and of the template's own fields only
-    :data:`DESIGN_PROCESS_FIELDS` are kept.
+    :data:`DESIGN_PROCESS_FIELDS` are kept; its ``printer`` (``--printer``) replaces any other.
     """
     from fabricate.bounds import MIN_CHORD_TOLERANCE_MM
 
+    cli_printer = override.printer if override is not None else ""
+    if override is not None and not override.text:
+        override = None  # only --printer: the template's own profile
     profile = table.string("profile", DEFAULT_PROFILE, choices=shipped_profiles())
     if override is None:
         base_path = TEMPLATE_DIR / f"process_{profile}.toml"
@@ -304,7 +349,7 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
         thickness_mm=t.number("thickness_mm", positive=True, max=100.0),
         kerf_mm=t.number("kerf_mm", 0.0, min=0.0, max=2.0),
         min_feature_mm=t.number("min_feature_mm", positive=True, max=10.0),
-        build_volume_mm=tuple(t.array("build_volume_mm", shape=(3,), positive=True, max=10000.0).tolist()),
+        build_volume_mm=_build_volume(t, table, cli_printer, override is None),
         pin_diameter_mm=t.number("pin_diameter_mm", positive=True, max=50.0),
         chord_tolerance_mm=t.number("chord_tolerance_mm", 0.005, min=MIN_CHORD_TOLERANCE_MM, max=1.0),
         technique=_capability(t, "technique", name, TECHNIQUES),
@@ -319,8 +364,14 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
         pin_material=pin_material,
         retention=_capability(t, "retention", name, RETENTIONS, fallback="clip"),
         press_fit_interference_mm=_interference(t, materials.get(material), name, material),
+        printer=_printer_name(t, table, cli_printer, override is None),
+        printer_technique=_capability(t, "printer_technique", name, PRINTER_TECHNIQUES, fallback=""),
+        first_layer_compensation_mm=t.number("first_layer_compensation_mm", 0.0, min=0.0, max=2.0),
+        sheets=_sheets(t.table("sheets", {})),
+        shop=_shop(t.table("shop", {})),
     )
     t.finish()
+    _check_printer(spec, "--printer" if cli_printer else t.field("printer"))
     if spec.retention == "press" and spec.press_fit_interference_mm <= 0.0:
         why = (f"{materials[material].name} takes no press fit (the profile gives it no press_fit_interference_mm)"
                if material in materials else "the profile gives no press_fit_interference_mm")
@@ -330,6 +381,47 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
         raise SpecError(t.field("pin_diameter_mm"),
                         f"pin {spec.pin_diameter_mm:g} mm is below the process minimum {spec.min_pin_mm:g} mm")
     return spec
+
+
+def _printer_name(t: Table, template: Table, cli_printer: str, template_fields: bool) -> str:
+    """The printer preset in use: ``--printer``; else the merged table's ``printer``, unless the template gives
+    its own ``build_volume_mm`` without naming a printer (its own area); "" for none."""
+    if cli_printer:
+        if t.has("printer"):
+            t.string("printer")
+        return cli_printer
+    own_area = template_fields and "build_volume_mm" in template.data and "printer" not in template.data
+    name = t.string("printer", "")
+    return "" if own_area else name
+
+
+def _build_volume(t: Table, template: Table, cli_printer: str, template_fields: bool) -> tuple[float, float, float]:
+    """``build_volume_mm``: the printer's (see :func:`_printer_name`), else the table's."""
+    from fabricate.catalogue.printers import printer
+
+    name = _printer_name(t, template, cli_printer, template_fields)
+    if not name:
+        return tuple(t.array("build_volume_mm", shape=(3,), positive=True, max=10000.0).tolist())
+    if t.has("build_volume_mm"):  # validated, then replaced by the printer's
+        t.array("build_volume_mm", shape=(3,), positive=True, max=10000.0)
+    field = "--printer" if cli_printer else t.field("printer")
+    return tuple(float(v) for v in printer(name, field).build_volume_mm)
+
+
+def _check_printer(spec: ProcessSpec, field: str) -> None:
+    """A printer must print what the profile makes: a plate layout of its own technique."""
+    if not spec.printer:
+        return
+    from fabricate.catalogue.printers import printer, printers_for
+
+    preset = printer(spec.printer, field)
+    if spec.layout != "plate":
+        raise SpecError(field, f"the {spec.name} process nests parts on sheets; a printer ({spec.printer}) is for "
+                               "a plate layout")
+    if preset.technique != spec.printer_technique:
+        fitting = ", ".join(printers_for(spec.printer_technique)) or "none"
+        raise SpecError(field, f"{spec.printer} is an {preset.technique.upper()} printer; the {spec.name} profile "
+                               f"prints on {spec.printer_technique.upper() or 'no'} printers ({fitting})")
 
 
 def _capability(t: Table, key: str, name: str, choices: tuple[str, ...], fallback: str | None = None) -> str:
@@ -360,6 +452,24 @@ def _interference(t: Table, material: Material | None, name: str, key: str) -> f
             default = float(value)
     return t.number("press_fit_interference_mm", default if default is not None else 0.0, min=0.0,
                     max=MAX_INTERFERENCE_MM)
+
+
+def _sheets(t: Table) -> tuple[tuple[str, float, float], ...]:
+    """``[sheets]``: ``NAME = [width, height]`` (mm) of each standard stock sheet, smallest area first."""
+    sizes = [(key, *(float(v) for v in t.array(key, shape=(2,), positive=True, max=10000.0))) for key in t.data]
+    return tuple(sorted(sizes, key=lambda s: (s[1] * s[2], s[1], s[0])))
+
+
+#: ``[shop]`` rules (mm) a cut part is checked against (fabricate.checks.shop).
+SHOP_RULES = ("min_hole_mm", "min_web_mm", "min_hole_edge_mm")
+
+
+def _shop(t: Table) -> tuple[tuple[str, float], ...]:
+    """``[shop]``: the shop's minimum hole, web between cuts and hole-to-edge distance (mm); absent rules are
+    not given (the check takes its defaults)."""
+    rules = tuple((key, t.number(key, min=0.0, max=100.0)) for key in SHOP_RULES if t.has(key))
+    t.finish()
+    return rules
 
 
 def _colour(t: Table, key: str, default: str) -> str:

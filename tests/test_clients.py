@@ -1,5 +1,8 @@
-"""admesh, a real STL client, reads every mesh a build writes as one closed part of the reported volume
-with nothing to repair (.ci/run installs it; the test skips only where it is absent)."""
+"""Real clients read what a build writes: admesh reads every mesh as one closed part of the reported volume
+with nothing to repair; PrusaSlicer arranges and slices every print plate on the bed of the printer it was
+packed for (SLA presets via --export-sla, FDM via --export-gcode) without "could not fit"; LibreCAD prints the
+kinematic drawing's dimensions legibly. (.ci/run installs them; each test skips only where its client is absent.)
+"""
 
 from __future__ import annotations
 
@@ -8,11 +11,17 @@ import shutil
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from fabricate.catalogue.printers import PRINTERS, Printer, printer
+from fabricate.design import load_design
 from fabricate.output import write_output
+from fabricate.pipeline import BuildOutcome, run_build
+from fabricate.templates import shipped_templates
 
-pytestmark = pytest.mark.skipif(shutil.which("admesh") is None, reason="admesh not installed")
+needs_admesh = pytest.mark.skipif(shutil.which("admesh") is None, reason="admesh not installed")
+needs_prusaslicer = pytest.mark.skipif(shutil.which("prusa-slicer") is None, reason="PrusaSlicer not installed")
 
 
 def _admesh(path: Path) -> dict[str, float]:
@@ -28,6 +37,7 @@ def _admesh(path: Path) -> dict[str, float]:
     return stats
 
 
+@needs_admesh
 @pytest.mark.slow
 @pytest.mark.parametrize("template", ["gear_pair_elliptic", "finger_five_bar_ncg"])
 def test_admesh_reads_every_part_whole_without_repair(template, tmp_path, shipped_build):
@@ -52,6 +62,7 @@ def test_admesh_reads_every_part_whole_without_repair(template, tmp_path, shippe
                                                              rel=1e-5)
 
 
+@needs_admesh
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("librecad") is None or shutil.which("pdftoppm") is None,
                     reason="LibreCAD or poppler-utils not installed")
@@ -76,12 +87,126 @@ def test_librecad_draws_dimension_text_at_least_2_5_mm(tmp_path, shipped_build):
     subprocess.run(["pdftoppm", "-r", "254", "-png", "kinematic.pdf", "page"], cwd=tmp_path, check=True,
                    timeout=120)
     image = np.asarray(Image.open(next(tmp_path.glob("page*.png"))).convert("RGB")).astype(int)
-    # layer DIMENSIONS is ACI 2 (yellow): its small connected blobs are the dimension digits
-    yellow = (image[:, :, 0] > 180) & (image[:, :, 1] > 180) & (image[:, :, 2] < 120)
-    labels, count = ndimage.label(yellow, structure=np.ones((3, 3)))
+    # the dimension layers are ACI 5 (blue): their small connected blobs are the dimension digits
+    blue = (image[:, :, 0] < 120) & (image[:, :, 1] < 120) & (image[:, :, 2] > 180)
+    labels, count = ndimage.label(blue, structure=np.ones((3, 3)))
     sizes = np.array([(s[0].stop - s[0].start, s[1].stop - s[1].start) for s in ndimage.find_objects(labels)])
     px_per_mm = 254 / 25.4
     glyphs = sizes[(sizes[:, 0] < 10 * px_per_mm) & (sizes[:, 1] < 1.2 * sizes[:, 0]) & (sizes[:, 0] > 3)]
     assert len(glyphs) >= 10  # the link lengths' and ordinates' digits
     # digit height is the font's cap height, ~0.9-1.0 of the text height
     assert np.median(glyphs[:, 0]) / px_per_mm >= 0.9 * MIN_DRAWING_TEXT_MM
+
+
+# -- PrusaSlicer: every plate on its printer's bed -------------------------------------------------------------
+def _prusaslicer_config(printer: Printer, first_layer_mm: float) -> str:
+    """A PrusaSlicer config of the preset's bed and height (SLA: the exposure area at 10 px/mm, no supports or
+    pad, which would grow the print past the plate; FDM: 0.4 mm nozzle, solid infill), with the profile's
+    first-layer compensation."""
+    x, y, z = printer.build_volume_mm
+    lines = [f"bed_shape = 0x0,{x:g}x0,{x:g}x{y:g},0x{y:g}", f"max_print_height = {z:g}",
+             f"elefant_foot_compensation = {first_layer_mm:g}"]
+    if printer.technique == "sla":
+        lines += ["printer_technology = SLA", f"display_width = {x:g}", f"display_height = {y:g}",
+                  f"display_pixels_x = {round(10 * x)}", f"display_pixels_y = {round(10 * y)}",
+                  "display_orientation = landscape", "supports_enable = 0", "pad_enable = 0", "layer_height = 0.05"]
+    else:
+        lines += ["printer_technology = FFF", "nozzle_diameter = 0.4", "filament_diameter = 1.75", "layer_height = 0.2",
+                  "first_layer_height = 0.2", "perimeters = 2", "fill_density = 100%", "fill_pattern = rectilinear",
+                  "skirts = 0"]
+    return "\n".join(lines) + "\n"
+
+
+def _stl_bounds(data: bytes) -> np.ndarray:
+    """(2, 3) min and max corner of a binary STL's vertices."""
+    count = int(np.frombuffer(data, dtype="<u4", count=1, offset=80)[0])
+    records = np.frombuffer(data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]),
+                            count=count, offset=84)
+    vertices = records["v"].reshape(-1, 3)
+    return np.array([vertices.min(axis=0), vertices.max(axis=0)])
+
+
+def _slice_plates(plates: dict[str, bytes], printer: Printer, first_layer_mm: float, margin_mm: float,
+                  folder: Path) -> None:
+    """Each plate lies inside the bed less the margin as placed, and PrusaSlicer arranges it on the preset's bed
+    (the default: the plate is one object, which must fit) and slices it: exit 0, a non-empty print file and
+    no "could not fit"."""
+    assert plates
+    folder.mkdir(parents=True, exist_ok=True)
+    config = folder / f"{printer.name}.ini"
+    config.write_text(_prusaslicer_config(printer, first_layer_mm))
+    x, y, z = printer.build_volume_mm
+    sla = printer.technique == "sla"
+    for rel, data in sorted(plates.items()):
+        lo, hi = _stl_bounds(data)
+        # float32 vertices: 1e-4 mm
+        assert lo[0] >= margin_mm - 1e-4 and lo[1] >= margin_mm - 1e-4, (printer.name, rel, lo)
+        assert hi[0] <= x - margin_mm + 1e-4 and hi[1] <= y - margin_mm + 1e-4 and hi[2] <= z + 1e-4, \
+            (printer.name, rel, hi)
+        stl = folder / rel.replace("/", "_")
+        stl.write_bytes(data)
+        out = stl.with_suffix(".sl1" if sla else ".gcode")
+        run = subprocess.run(["prusa-slicer", "--loglevel", "1", "--load", str(config),
+                              "--export-sla" if sla else "--export-gcode", "-o", str(out), str(stl)],
+                             capture_output=True, text=True, timeout=300)
+        said = run.stdout + run.stderr
+        assert "could not fit" not in said, (printer.name, rel, said[-400:])
+        assert run.returncode == 0 and out.is_file() and out.stat().st_size > 0, (printer.name, rel, said[-400:])
+
+
+def _relaid(outcome: BuildOutcome, printer_name: str, process: str | None = None) -> tuple[dict[str, bytes], float]:
+    """The build's plates packed for another printer as the exporter packs plates (``plate_layout`` of the
+    printed meshes, one STL per plate), in the build volume the template gets with ``--printer`` (only the build
+    volume differs, so the parts are the build's): plate files and the plate margin."""
+    from fabricate.export.stl import SolidCache, placed_flat_mesh, plate_layout, plate_stl
+
+    design = load_design(outcome.design.template, process, printer_name)
+    assert design.process.printer == printer_name
+    partset = outcome.partset
+    margin = outcome.design.parts.plate_spacing_mm
+    cache = SolidCache(partset.chord_tolerance_mm)
+    copies = max(1, int(getattr(partset, "copies", 1) or 1))
+    made = [part for part in partset.parts for _ in range(copies)]
+    placements = plate_layout(made, cache, design.process.build_volume_mm[:2], margin)
+    files = {}
+    for number in sorted({pl.sheet for pl in placements}):
+        meshes = [placed_flat_mesh(part, cache, pl) for part, pl in zip(made, placements, strict=True)
+                  if pl.sheet == number]
+        files[f"plates/plate_{number + 1}.stl"] = plate_stl(meshes)
+    return files, margin
+
+
+#: Every template's own build (its profile's printer: the SL1S, the Saturn 3 for the gripper's palm).
+@needs_prusaslicer
+@pytest.mark.slow
+@pytest.mark.parametrize("template", [p.stem for p in shipped_templates()])
+def test_prusaslicer_slices_every_plate_of_every_template(template, tmp_path, shipped_build):
+    outcome = shipped_build(template)
+    info = outcome.report["design"]["printer"]
+    plates = {k: v for k, v in outcome.files.items() if k.startswith("plates/") and k.endswith(".stl")}
+    assert len(plates) == len({i for p in outcome.report["parts"] for i in p["plate"]["index"]})
+    assert all(p["plate"]["fits"] for p in outcome.report["parts"])
+    _slice_plates(plates, printer(info["name"]), info["first_layer_compensation_mm"],
+                  outcome.design.parts.plate_spacing_mm, tmp_path)
+
+
+#: The FDM builds the per-preset test re-lays (built once per test process).
+_FDM_BUILDS: dict[str, BuildOutcome] = {}
+
+
+@needs_prusaslicer
+@pytest.mark.slow
+@pytest.mark.parametrize("preset", sorted(PRINTERS))
+def test_prusaslicer_slices_plates_on_every_printer_preset(preset, tmp_path, shipped_build):
+    """Jansen's leg (8 parts, 3 SL1S plates) and the Watt six-bar packed for each preset's bed: SLA presets
+    with the SLA build's parts, FDM presets with the template built with --process fdm."""
+    spec = printer(preset)
+    for template in ("jansen_leg", "finger_watt_six_bar"):
+        if spec.technique == "sla":
+            outcome, process = shipped_build(template), None
+        else:
+            if template not in _FDM_BUILDS:
+                _FDM_BUILDS[template] = run_build(load_design(template, "fdm"))
+            outcome, process = _FDM_BUILDS[template], "fdm"
+        plates, margin = _relaid(outcome, preset, process)
+        _slice_plates(plates, spec, outcome.design.process.first_layer_compensation_mm, margin, tmp_path / template)

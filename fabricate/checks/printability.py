@@ -12,9 +12,11 @@ Checks against the process profile (:class:`fabricate.process.ProcessSpec`), by 
 - *tooth tip land*: the narrowest tooth tip of every gear pair (from the gears package) is at least
   ``min_feature_mm``;
 - *pins*: at least ``min_pin_mm`` in diameter;
-- *build volume / sheet*: on a plate layout parts lie flat within the build area (their smallest rotated
-  bounding rectangle, either way round) and are no taller than the build height; on a sheet layout they
-  fit the sheet and are as thick as it (spacers are tubes, not cut from the sheet).
+- *build volume / sheet*: on a plate layout parts lie flat within the printer's build area less the layout's
+  margin (the gap kept at the plate's edge), at some rotation on the plate (the smallest box either way
+  round, or across the diagonal: :func:`fabricate.export.layout.fitting_angle`, the turn the plates use) and
+  are no taller than the build height; on a sheet layout they fit the sheet less its margin the same way and
+  are as thick as it (spacers are tubes, not cut from the sheet).
 
 Webs around holes are exact (circle to circle, hole to the outline's true lines and arcs); the files
 are polygonised at the chord tolerance (chords inside the outline's arcs, holes' polygons inside their
@@ -138,7 +140,7 @@ def footprint(part: Part, chord_tolerance_mm: float) -> tuple[float, float]:
 
 
 def check_printability(parts: Sequence[Part], process: ProcessSpec, gear_pairs: Sequence[GearPair] = (),
-                       pins: Sequence[Pin] = ()) -> PrintabilityResult:
+                       pins: Sequence[Pin] = (), margin_mm: float = 0.0) -> PrintabilityResult:
     """Judge every part, gear pair and pin against the process profile.
 
     Parameters
@@ -149,11 +151,16 @@ def check_printability(parts: Sequence[Part], process: ProcessSpec, gear_pairs: 
         Their ``checks["tip_land_min_mm"]`` is compared with ``min_feature_mm``.
     pins : sequence
         Objects with ``joint`` and ``diameter_mm``.
+    margin_mm : float
+        Free border the layout keeps at the plate's or sheet's edge (``[parts] plate_spacing_mm`` /
+        ``sheet_margin_mm``): a part must fit inside it.
     """
+    from fabricate.export.layout import fitting_angle
+
     tol = float(process.chord_tolerance_mm)
     failures: list[str] = []
     rows = []
-    build = sorted(process.build_volume_mm[:2], reverse=True)
+    usable = (float(process.build_volume_mm[0]) - 2 * margin_mm, float(process.build_volume_mm[1]) - 2 * margin_mm)
     for part in parts:
         walls = hole_walls(part, tol)
         weakest = min(walls, key=lambda w: w[1]) if walls else None
@@ -165,7 +172,7 @@ def check_printability(parts: Sequence[Part], process: ProcessSpec, gear_pairs: 
             failures.append(f"printability: {part.name} has a feature thinner than "
                             f"{process.min_feature_mm:.3f} mm (reaching {thin:.3f} mm beyond the opened outline)")
         long_side, short_side = footprint(part, tol)
-        in_area = long_side <= build[0] + 1e-9 and short_side <= build[1] + 1e-9
+        in_area = min(usable) > 0 and fitting_angle(part.polygons(tol)[0], *usable) is not None
         height = float(process.build_volume_mm[2])
         sheet = process.layout == "sheet"
         if sheet:
@@ -176,10 +183,14 @@ def check_printability(parts: Sequence[Part], process: ProcessSpec, gear_pairs: 
         else:
             thick_ok = part.thickness_mm <= height + 1e-9
         if not in_area or (not sheet and not thick_ok):
-            where = "sheet" if sheet else "build volume"
+            where = "sheet" if sheet else (f"{process.printer} build volume" if process.printer else "build volume")
+            inside = ""
+            if not in_area and margin_mm > 0:
+                inside = (f" inside its {margin_mm:g} mm margin ({usable[0]:g} × {usable[1]:g} mm usable, at any "
+                          f"rotation on the {'sheet' if sheet else 'plate'})")
             failures.append(f"printability: {part.name} ({long_side:.1f} × {short_side:.1f} × "
                             f"{part.thickness_mm:g} mm) does not fit the {where} "
-                            f"{' × '.join(f'{v:g}' for v in process.build_volume_mm)} mm")
+                            f"{' × '.join(f'{v:g}' for v in process.build_volume_mm)} mm{inside}")
         fits = in_area and thick_ok
         rows.append(PartPrintability(part.name, None if weakest is None else float(weakest[1]),
                                      "" if weakest is None else weakest[0], thin, (long_side, short_side),

@@ -446,22 +446,22 @@ def test_laser_thickness_gives_the_sheet_message_not_the_build_volumes(laser_pro
 
 
 def test_laser_spacer_need_not_be_sheet_thick(laser_process):
-    """A 10 mm spacer (a tube, not cut from the sheet) passes and fits; one larger than the 600 x 400 sheet
-    fails with the sheet's 'does not fit' message only."""
+    """A 10 mm spacer (a tube, not cut from the sheet) passes and fits; one longer than the 600 x 400 sheet's
+    721 mm diagonal fails with the sheet's 'does not fit' message only."""
     result = check_printability([box_part("sp", (10, 10), thickness=10.0, role="spacer", process="laser")],
                                 laser_process)
     assert result.passed and result.parts[0].fits
-    result = check_printability([box_part("sp", (601, 10), thickness=10.0, role="spacer", process="laser")],
+    result = check_printability([box_part("sp", (801, 10), thickness=10.0, role="spacer", process="laser")],
                                 laser_process)
-    assert result.failures == ("printability: sp (601.0 × 10.0 × 10 mm) does not fit the sheet 600 × 400 × 3 mm",)
+    assert result.failures == ("printability: sp (801.0 × 10.0 × 10 mm) does not fit the sheet 600 × 400 × 3 mm",)
     assert not result.parts[0].fits
 
 
 def test_laser_part_too_large_and_too_thick_gives_both_messages(laser_process):
-    """700 x 20 x 4 on a 600 x 400 x 3 sheet: the thickness message, then the sheet's."""
-    result = check_printability([box_part("p", (700, 20), thickness=4.0, process="laser")], laser_process)
+    """800 x 20 x 4 on a 600 x 400 x 3 sheet: the thickness message, then the sheet's."""
+    result = check_printability([box_part("p", (800, 20), thickness=4.0, process="laser")], laser_process)
     assert result.failures == ("printability: p is 4 mm thick, the sheet 3 mm",
-                               "printability: p (700.0 × 20.0 × 4 mm) does not fit the sheet 600 × 400 × 3 mm")
+                               "printability: p (800.0 × 20.0 × 4 mm) does not fit the sheet 600 × 400 × 3 mm")
     assert not result.parts[0].fits
 
 
@@ -567,3 +567,35 @@ def test_report_of_a_checked_part(sla_process):
     assert result.report() == {"process": "sla", "tip_land_mm": {}, "passed": True, "parts": [
         {"name": "plate", "min_wall_mm": 3.5, "min_wall_hole": "A", "thin_feature_mm": 0.0,
          "footprint_mm": [20.0, 10.0], "thickness_mm": 3.0, "fits": True}]}
+
+
+# -- check_printability: the layout's margin, turns that fit, the printer --------------------------------------
+def test_the_margin_is_part_of_the_build_area(sla_process):
+    """Issue 26: the gripper's 129.88 x 45.07 mm palm was placed at x 4.0-133.9 on a 130 x 80 plate and passed.
+    With the plates' 4 mm margin the usable area is 122 x 72: that palm (at every turn) fails, naming the part,
+    its size, the area and the margin; without a margin it fits."""
+    palm = box_part("palm", (129.88, 45.07))
+    assert check_printability([palm], sla_process).passed
+    result = check_printability([palm], sla_process, margin_mm=4.0)
+    assert result.failures == ("printability: palm (129.9 × 45.1 × 3 mm) does not fit the build volume "
+                               "130 × 80 × 160 mm inside its 4 mm margin (122 × 72 mm usable, at any rotation on "
+                               "the plate)",)
+    assert not result.parts[0].fits
+
+
+def test_the_printer_is_named(sla_process):
+    process = dataclasses.replace(sla_process, printer="prusa_sl1s", build_volume_mm=(127.0, 80.0, 150.0))
+    result = check_printability([box_part("palm", (129.88, 45.07))], process, margin_mm=4.0)
+    assert result.failures[0].startswith("printability: palm (129.9 × 45.1 × 3 mm) does not fit the prusa_sl1s "
+                                         "build volume 127 × 80 × 150 mm inside its 4 mm margin")
+
+
+@pytest.mark.parametrize(("size", "fits_area"), [((121.9, 71.9), True), ((122.1, 20.0), True),
+                                                  ((100.0, 72.1), False), ((130.0, 10.0), True),
+                                                  ((150.0, 10.0), False)])
+def test_a_part_fits_if_some_turn_on_the_plate_fits(sla_process, size, fits_area):
+    """Usable 122 x 72 (130 x 80, margin 4): 121.9 x 71.9 fits as it is; 122.1 x 20 and 130 x 10 only across
+    the diagonal (141.6 mm); 100 x 72.1 is too wide both ways round and across (its short side exceeds 72 at
+    every turn); 150 x 10 is longer than the diagonal."""
+    result = check_printability([box_part("p", size, angle_deg=17.0)], sla_process, margin_mm=4.0)
+    assert result.passed is fits_area and result.parts[0].fits is fits_area
