@@ -1,16 +1,25 @@
 """The kinematic drawing (``drawings/kinematic.dxf``): joints, link centre lines and their dimensions at one pose.
 
-Its documents come from :mod:`fabricate.export.dxf` (R2010 in mm, fixed metadata, the layer colours).
+Its documents come from :mod:`fabricate.export.dxf` (R2010 in mm, fixed metadata). Every text is black (by
+layer, ACI 7) or blue (dimensions), which prints on white paper. The dimensions are aligned and linear ones
+only: LibreCAD 2.2 draws no ordinate dimension and FreeCAD 0.20's importer reads one as the length of its
+leader. Labels are placed where their box, measured with ezdxf's font metrics, meets no other text.
 """
 
 from __future__ import annotations
 
+import itertools
+import math
 from collections.abc import Mapping
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import ezdxf
+import ezdxf.bbox
 import numpy as np
+import shapely
+import shapely.ops
 
+from fabricate.errors import GeometryError
 from fabricate.export.dxf import DIMSTYLE, MIN_DRAWING_TEXT_MM, document_bytes, new_document
 from fabricate.planar import transform_points
 
@@ -18,8 +27,28 @@ if TYPE_CHECKING:
     from fabricate.mechanism import Mechanism
 
 
+#: Layer colours for paper (ACI): 7 prints black on white (white on a dark screen), 5 is blue; never yellow
+#: (2) or cyan (4), which vanish on white paper.
+PAPER_COLOURS = {"LINKS": 7, "JOINTS": 7, "LABELS": 7, "DIMENSIONS": 5, "COORDINATES": 5}
+
+#: Label candidates: distances of the label box from its point (text heights) and directions tried, in order
+#: (up-right first, where the drawing always put it); past the first ring a leader joins label and point.
+_RINGS = (0.5, 1.5, 3.0, 4.5, 6.5, 9.0, 12.0, 16.0, 21.0, 28.0, 36.0, 46.0, 60.0, 80.0, 110.0, 150.0)
+_DIRECTIONS = tuple(math.radians(a) for a in (45, 135, -45, -135, 90, -90, 0, 180, 22.5, 157.5, -22.5, -157.5,
+                                              67.5, 112.5, -67.5, -112.5))
+
+
 def kinematic_dxf(mechanism: Mechanism, poses: Mapping[str, np.ndarray]) -> bytes:
     """Kinematic drawing at one pose: joints, link centre lines, link-length and joint-coordinate dimensions.
+
+    Links get aligned dimensions of their length on layer ``DIMENSIONS``. Every joint is located from the
+    world origin by linear dimensions on layer ``COORDINATES``: its x in rows below the drawing, its y in
+    columns left of it (baseline dimensioning, shortest nearest; positive and negative values in separate
+    rows, so no two texts meet). They are plain linear dimensions, which LibreCAD draws and FreeCAD reads at
+    their value (ordinate dimensions are not drawn by LibreCAD and FreeCAD reads them as their leader's
+    length). Each point is labelled with its names and world coordinates, the label placed where its box
+    meets no other label, dimension text, circle or link line (a leader joins it to its point when it
+    stands off).
 
     Parameters
     ----------
@@ -28,6 +57,9 @@ def kinematic_dxf(mechanism: Mechanism, poses: Mapping[str, np.ndarray]) -> byte
         World pose of every body (the first pose of the motion).
     """
     doc = new_document(("LINKS", "JOINTS", "DIMENSIONS", "LABELS"), dimensions=True)
+    doc.layers.add("COORDINATES")
+    for name, colour in PAPER_COLOURS.items():
+        doc.layers.get(name).color = colour
     msp = doc.modelspace()
     joint_names = {j.name for j in mechanism.joints}
     world: dict[str, np.ndarray] = {}
@@ -43,6 +75,11 @@ def kinematic_dxf(mechanism: Mechanism, poses: Mapping[str, np.ndarray]) -> byte
     doc.dimstyles.new(DIMSTYLE, dxfattribs=dict(sizes))  # ezdxf adds its name to the dict it is given
     for variable, value in sizes.items():
         doc.header[f"${variable.upper()}"] = value
+    # link dimensions are tried out in a scratch document (a dimension's text box is known once rendered)
+    scratch = new_document(("DIMENSIONS",), dimensions=True)
+    scratch.dimstyles.new(DIMSTYLE, dxfattribs=dict(sizes))
+    obstacles: list[shapely.Geometry] = []  # what a label must not touch
+    dimension_texts: list[shapely.Geometry] = []  # what a link dimension's text must not touch
     drawn: set[tuple[str, ...]] = set()
     for body in mechanism.bodies:
         names = [n for n in body.points if n in joint_names] or list(body.points)
@@ -56,26 +93,148 @@ def kinematic_dxf(mechanism: Mechanism, poses: Mapping[str, np.ndarray]) -> byte
                     continue
                 drawn.add(key)
                 msp.add_line(tuple(pa), tuple(pb), dxfattribs={"layer": "LINKS"})
-                dim = msp.add_aligned_dim(p1=tuple(pa), p2=tuple(pb), distance=3.0 * text_h, dimstyle=DIMSTYLE,
+                obstacles.append(shapely.LineString([pa, pb]))
+                distance = _link_dimension_offset(scratch.modelspace(), pa, pb, text_h, dimension_texts)
+                dim = msp.add_aligned_dim(p1=tuple(pa), p2=tuple(pb), distance=distance, dimstyle=DIMSTYLE,
                                           dxfattribs={"layer": "DIMENSIONS"})
                 dim.render()
-    # points at one spot (a compound hinge) get one label and one pair of ordinate dimensions
+                obstacles += _dimension_marks(dim.dimension)
+                dimension_texts += dimension_text_boxes(dim.dimension)
+    # points at one spot (a compound hinge) get one label and one pair of coordinate dimensions
     spots: dict[tuple[float, float], list[str]] = {}
     for name in sorted(world):
         spots.setdefault((round(float(world[name][0]), 6), round(float(world[name][1]), 6)), []).append(name)
+    circles = []
     for names in spots.values():
         p = world[names[0]]
         is_joint = any(n in joint_names for n in names)
-        msp.add_circle(tuple(p), 0.6 * text_h if is_joint else 0.3 * text_h,
-                       dxfattribs={"layer": "JOINTS" if is_joint else "LABELS"})
-        label = f"{', '.join(names)} ({p[0]:.3f}, {p[1]:.3f})"
-        text = msp.add_text(label, height=text_h, dxfattribs={"layer": "LABELS"})
-        text.set_placement((float(p[0] + text_h), float(p[1] + text_h)),
-                           align=ezdxf.enums.TextEntityAlignment.BOTTOM_LEFT)
-        if is_joint:
-            for add, offset in ((msp.add_ordinate_x_dim, (0.0, -4.0 * text_h)),
-                                (msp.add_ordinate_y_dim, (-4.0 * text_h, 0.0))):
-                dim = add(feature_location=tuple(p), offset=offset, dimstyle=DIMSTYLE,
-                          dxfattribs={"layer": "DIMENSIONS"})
-                dim.render()
+        radius = 0.6 * text_h if is_joint else 0.3 * text_h
+        msp.add_circle(tuple(p), radius, dxfattribs={"layer": "JOINTS" if is_joint else "LABELS"})
+        obstacles.append(shapely.Point(p).buffer(radius, quad_segs=4))
+        circles.append((names, p, radius, is_joint))
+    joints = [p for _, p, _, is_joint in circles if is_joint]
+    if joints:
+        # below and left of everything drawn so far (points, links and their dimensions)
+        drawn_low = np.min([np.array(list(world.values())).min(axis=0)]
+                           + [np.array(g.bounds[:2]) for g in obstacles], axis=0)
+        obstacles += _coordinate_dimensions(msp, np.array(joints), drawn_low - 2.0 * text_h, text_h)
+    for names, p, radius, _ in circles:
+        # a label keeps a text height clear of every other point, so that it is read as its own point's
+        others = [shapely.Point(q).buffer(r + text_h, quad_segs=4) for _, q, r, _ in circles if q is not p]
+        _place_label(msp, f"{', '.join(names)} ({p[0]:.3f}, {p[1]:.3f})", p, radius, text_h, obstacles,
+                     shapely.union_all(others) if others else shapely.Polygon())
     return document_bytes(doc)
+
+
+def _link_dimension_offset(scratch: Any, pa: np.ndarray, pb: np.ndarray, text_h: float,
+                           texts: list[Any]) -> float:
+    """How far (mm, signed: which side) a link's aligned dimension stands off the link: 3 text heights on its
+    left unless its text would then meet another dimension's; then the first of further offsets, either
+    side, where it meets none (3 text heights when none is free)."""
+    tree = shapely.STRtree(texts) if texts else None
+    for steps in (3.0, -3.0, 4.5, -4.5, 6.0, -6.0, 8.0, -8.0, 10.0, -10.0, 12.5, -12.5):
+        trial = scratch.add_aligned_dim(p1=tuple(pa), p2=tuple(pb), distance=steps * text_h, dimstyle=DIMSTYLE)
+        trial.render()
+        boxes = dimension_text_boxes(trial.dimension)
+        scratch.delete_entity(trial.dimension)
+        if tree is None or not any(len(tree.query(box.buffer(0.2 * text_h, join_style="mitre"),
+                                                  predicate="intersects")) for box in boxes):
+            return steps * text_h
+    return 3.0 * text_h
+
+
+def _coordinate_dimensions(msp: Any, joints: np.ndarray, low: np.ndarray, text_h: float) -> list[Any]:
+    """Linear dimensions from the world origin to every joint's x (rows below ``low`` y) and y (columns left
+    of ``low`` x); returns their text boxes and lines.
+
+    Rows go out by length (a longer dimension's extension line then crosses no shorter one), positive values
+    before negative ones; a value too short to hold its text between the arrows (which readers then set
+    beside an arrow, along the row) goes to the outermost rows, where no extension line crosses that text.
+    """
+    boxes = []
+    for axis, angle in ((0, 0.0), (1, 90.0)):
+        values = sorted({round(float(v), 6) for v in joints[:, axis]} - {0.0},
+                        key=lambda v: (abs(v) < 6.0 * text_h, v < 0, abs(v)))
+        for row, value in enumerate(values):
+            target = joints[np.argmin(np.abs(joints[:, axis] - value))]
+            # 3.5 text heights a row: a text set on either side of its line (readers choose) meets no other row's
+            base = [0.0, 0.0]
+            base[1 - axis] = float(low[1 - axis] - 3.5 * text_h * row)
+            dim = msp.add_linear_dim(base=tuple(base), p1=(0.0, 0.0), p2=tuple(float(c) for c in target),
+                                     angle=angle, dimstyle=DIMSTYLE, dxfattribs={"layer": "COORDINATES"})
+            dim.render()
+            boxes += _dimension_marks(dim.dimension)
+    return boxes
+
+
+def dimension_text_boxes(dimension: Any) -> list[shapely.Polygon]:
+    """Boxes (shapely, model space) of the text a rendered DIMENSION shows."""
+    boxes = []
+    for entity in dimension.virtual_entities():
+        if entity.dxftype() in ("MTEXT", "TEXT"):
+            extents = ezdxf.bbox.extents([entity])
+            boxes.append(shapely.box(extents.extmin.x, extents.extmin.y, extents.extmax.x, extents.extmax.y))
+    return boxes
+
+
+def _dimension_marks(dimension: Any) -> list[Any]:
+    """What a rendered DIMENSION draws, as shapes a label must keep off: its text boxes and its lines."""
+    lines = [shapely.LineString([tuple(e.dxf.start)[:2], tuple(e.dxf.end)[:2]])
+             for e in dimension.virtual_entities() if e.dxftype() == "LINE"]
+    return dimension_text_boxes(dimension) + lines
+
+
+def text_box(text: Any) -> shapely.Polygon:
+    """Box (shapely, model space) of a TEXT entity, from ezdxf's font metrics."""
+    extents = ezdxf.bbox.extents([text])
+    return shapely.box(extents.extmin.x, extents.extmin.y, extents.extmax.x, extents.extmax.y)
+
+
+def _place_label(msp: Any, label: str, p: np.ndarray, radius: float, text_h: float,
+                 obstacles: list[Any], others: Any) -> None:
+    """A point's label at the first candidate spot whose box (with a margin) meets no obstacle and not
+    ``others`` (the region round the other points), with a leader from the point's circle when it stands
+    off; the box and leader join the obstacles."""
+    text = msp.add_text(label, height=text_h, dxfattribs={"layer": "LABELS"})
+    text.set_placement((0.0, 0.0), align=ezdxf.enums.TextEntityAlignment.BOTTOM_LEFT)
+    box = text_box(text)
+    x0, y0, x1, y1 = box.bounds
+    half = np.array([0.5 * (x1 - x0), 0.5 * (y1 - y0)])
+    centre_offset = np.array([0.5 * (x0 + x1), 0.5 * (y0 + y1)])  # the box centre from the insert point
+    margin = 0.25 * text_h
+    tree = shapely.STRtree(obstacles)
+    best = None
+    # first a spot whose leader crosses no text; failing that (a point inside a crowd of texts) any free box
+    for strict, ring, angle in itertools.product((True, False), _RINGS, _DIRECTIONS):
+        u = np.array([math.cos(angle), math.sin(angle)])
+        # the box's centre so that its nearest side stands `ring` text heights beyond the circle along u
+        reach = radius + ring * text_h + min(half[0] / max(abs(u[0]), 1e-9), half[1] / max(abs(u[1]), 1e-9))
+        centre = p + u * reach
+        candidate = shapely.box(*(centre - half), *(centre + half))
+        if (len(tree.query(candidate.buffer(margin, join_style="mitre"), predicate="intersects"))
+                or candidate.intersects(others)):
+            continue
+        leader = None
+        if ring > 1.5:
+            near = shapely.ops.nearest_points(candidate, shapely.Point(p))[0]
+            # from just outside the point's own circle (an obstacle too) to the box's nearest point
+            leader = shapely.LineString([p + u * (radius + 0.1 * text_h), (near.x, near.y)])
+            # a leader may cross lines and the circles of close points, never a text box (a rectangle)
+            # unless it starts inside one (a dimension's text over the point: no leader avoids it)
+            start = shapely.Point(leader.coords[0])
+            if strict and any(obstacles[i].geom_type == "Polygon" and len(obstacles[i].exterior.coords) == 5
+                              and not obstacles[i].contains(start)
+                              for i in tree.query(leader, predicate="intersects")):
+                continue
+        best = (centre, leader, candidate)
+        break
+    if best is None:  # the outermost ring lies beyond everything drawn: cannot happen
+        raise GeometryError(f"kinematic drawing: no room for the label {label!r}")
+    centre, leader, candidate = best
+    insert = centre - centre_offset
+    text.set_placement((float(insert[0]), float(insert[1])), align=ezdxf.enums.TextEntityAlignment.BOTTOM_LEFT)
+    if leader is not None:
+        (a, b) = leader.coords
+        msp.add_line(tuple(a), tuple(b), dxfattribs={"layer": "LABELS"})
+        obstacles.append(leader)
+    obstacles.append(candidate)

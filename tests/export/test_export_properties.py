@@ -201,8 +201,9 @@ def test_plate_keeps_parts_apart_and_inside():
 
 def test_kinematic_drawing_of_a_bent_four_bar():
     """The kinematic DXF at one pose: a LINKS line and an aligned dimension of the link's true length for
-    each pair of joints of a body, a JOINTS circle and a label with the world coordinates at each joint, two
-    ordinate dimensions per joint; units mm; the measurements read back equal the closed-form lengths."""
+    each pair of joints of a body, a JOINTS circle and a label with the world coordinates at each joint, a
+    linear dimension from the origin for each distinct non-zero joint coordinate; units mm; the measurements
+    read back equal the closed-form lengths."""
     from fabricate.export.kinematic import kinematic_dxf
     from tests.conftest import make_four_bar
 
@@ -219,7 +220,7 @@ def test_kinematic_drawing_of_a_bent_four_bar():
         ends = ((e.dxf.start.x, e.dxf.start.y), (e.dxf.end.x, e.dxf.end.y))
         lines.add(tuple(sorted(k for end in ends for k, p in world.items() if np.allclose(p, end, atol=1e-9))))
     assert lines == {("D", "O"), ("A", "O"), ("A", "B"), ("B", "D")}
-    aligned = sorted(round(d.get_measurement(), 6) for d in msp.query("DIMENSION")
+    aligned = sorted(round(d.get_measurement(), 6) for d in msp.query('DIMENSION[layer=="DIMENSIONS"]')
                      if d.dimtype in (0, 1))  # linear (ezdxf writes the aligned ones rotated)
     assert aligned == [15.0, 30.0, 40.0, 40.0]
     joints = msp.query('CIRCLE[layer=="JOINTS"]')
@@ -228,12 +229,11 @@ def test_kinematic_drawing_of_a_bent_four_bar():
         assert any(np.allclose((c.dxf.center.x, c.dxf.center.y), p, atol=1e-9) for c in joints), name
     labels = [t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]')]
     assert f"A ({a[0]:.3f}, {a[1]:.3f})" in labels and "D (40.000, 0.000)" in labels
-    ordinates = [d for d in msp.query("DIMENSION") if d.dimtype == 6]
-    assert len(ordinates) == 8
-    # an ordinate measurement is the feature point relative to the origin: its x for an x-ordinate
-    measured = sorted(round(abs(d.get_measurement().x if d.dxf.dimtype & 64 else d.get_measurement().y), 6)
-                      for d in ordinates)
-    expected = sorted(round(abs(v), 6) for p in world.values() for v in p)
+    coordinates = msp.query('DIMENSION[layer=="COORDINATES"]')
+    assert all(d.dimtype == 0 for d in coordinates)  # linear, never ordinate (LibreCAD draws none)
+    # one per distinct non-zero coordinate: x of A, D, B; y of A, B (O and D lie on y = 0)
+    measured = sorted(round(d.get_measurement(), 6) for d in coordinates)
+    expected = sorted({round(abs(v), 6) for p in world.values() for v in p} - {0.0})
     assert measured == pytest.approx(expected, abs=1e-6)
 
 
@@ -347,9 +347,9 @@ def test_label_goes_on_the_larger_piece_or_falls_back():
 
 
 def test_sheet_dxf_draws_the_first_sheet_with_its_placed_parts():
-    """Sheet 0 of the cut file: its SHEET border is the sheet's rectangle (not plotted) and every part placed
-    on it is cut where the layout put it: outline area = the stadium grown by kerf / 2 (closed form), centred
-    on the placed centre of the part's outline, its holes placed likewise."""
+    """Sheet 0 of the cut file: no border (a shop would cut it), the sheet's rectangle is the drawing's limits,
+    and every part placed on it is cut where the layout put it: outline area = the stadium grown by kerf / 2
+    (closed form), centred on the placed centre of the part's outline, its holes placed likewise."""
     from fabricate.export.dxf import sheet_dxf
 
     parts = links()
@@ -357,10 +357,8 @@ def test_sheet_dxf_draws_the_first_sheet_with_its_placed_parts():
     layout = sheet_layout(parts, KERF, sheet, 5.0, 2.0)
     doc = ezdxf.read(io.StringIO(sheet_dxf(parts, KERF, layout, sheet).decode("utf-8")))
     msp = doc.modelspace()
-    borders = [np.array(e.get_points("xy")) for e in msp.query('LWPOLYLINE[layer=="SHEET"]')]
-    assert any(np.allclose(sorted(map(tuple, b)), [(0.0, 0.0), (0.0, 60.0), (120.0, 0.0), (120.0, 60.0)])
-               for b in borders)
-    assert doc.layers.get("SHEET").dxf.plot == 0
+    assert {e.dxf.layer for e in msp} == {"CUT", "ENGRAVE"} and "SHEET" not in doc.layers
+    assert tuple(doc.header["$LIMMIN"])[:2] == (0.0, 0.0) and tuple(doc.header["$LIMMAX"])[:2] == sheet
     outlines = [(exact_area(e), contour(e, 1e-3).centroid) for e in msp.query('LWPOLYLINE[layer=="CUT"]')]
     circles = [(c.dxf.center.x, c.dxf.center.y, 2 * c.dxf.radius) for c in msp.query('CIRCLE[layer=="CUT"]')]
     on_first = [(p, pl) for p, pl in zip(parts, layout, strict=True) if pl.sheet == 0]
@@ -408,8 +406,8 @@ def test_kinematic_drawing_rules_for_ternary_links_free_points_and_hinges():
     quad = (30.0, math.hypot(10, 15), math.hypot(30, 15), math.hypot(20, 15), 15.0, 20.0)  # AB AC AF BC BF CF
     assert lengths == sorted(round(v, 6) for v in (40.0, *quad, 0.5, 20.0, 20.0))
     dims = msp.query("DIMENSION")
-    assert all(d.dxf.layer == "DIMENSIONS" for d in dims)
-    linear = [d for d in dims if d.dimtype in (0, 1)]
+    assert all(d.dxf.layer in ("DIMENSIONS", "COORDINATES") for d in dims)
+    linear = [d for d in dims if d.dimtype in (0, 1) and d.dxf.layer == "DIMENSIONS"]
     assert sorted(round(d.get_measurement(), 6) for d in linear) == lengths
     for d in linear:  # the dimension line stands 3 text heights off the link
         p2, p3, p = (np.array([v.x, v.y]) for v in (d.dxf.defpoint2, d.dxf.defpoint3, d.dxf.defpoint))
@@ -429,14 +427,12 @@ def test_kinematic_drawing_rules_for_ternary_links_free_points_and_hinges():
     assert "N (10.000, -9.800)" in labels  # 0.2 mm away: a spot of its own
     d_label = labels["D (40.000, 0.000)"]
     assert (d_label.dxf.halign, d_label.dxf.valign) == (0, 1)  # BOTTOM_LEFT
-    np.testing.assert_allclose([d_label.dxf.align_point.x, d_label.dxf.align_point.y], [40 + text_h, text_h])
     assert style.dxf.dimlfac == 1.0
     assert all(d.dxf.dimstyle == "FABRICATE" for d in dims)
-    for d in (d for d in dims if d.dimtype == 6):  # ordinate leaders run 4 text heights down / left
-        p2, p3 = np.array([d.dxf.defpoint2.x, d.dxf.defpoint2.y]), np.array([d.dxf.defpoint3.x, d.dxf.defpoint3.y])
-        expected = [0.0, -4 * text_h] if d.dxf.dimtype & 64 else [-4 * text_h, 0.0]
-        np.testing.assert_allclose(p3 - p2, expected, atol=1e-9)
-    assert {layer.dxf.name for layer in doc.layers} >= {"LINKS", "JOINTS", "DIMENSIONS", "LABELS"}
+    for d in (d for d in dims if d.dxf.layer == "COORDINATES"):  # from the origin to a joint, along x or y
+        assert tuple(d.dxf.defpoint2)[:2] == (0.0, 0.0) and d.dxf.angle in (0.0, 90.0)
+        assert d.get_measurement() == pytest.approx(abs(d.dxf.defpoint3[0 if d.dxf.angle == 0.0 else 1]))
+    assert {layer.dxf.name for layer in doc.layers} >= {"LINKS", "JOINTS", "DIMENSIONS", "LABELS", "COORDINATES"}
 
 
 def test_segment_style_and_minimum_text():
@@ -466,13 +462,13 @@ def test_segment_style_and_minimum_text():
     assert len(read(part_dxf(part, KERF, at_minimum)).query("TEXT")) == 1
 
 
-def test_sheet_dxf_border_is_closed_and_parts_match_placements():
+def test_sheet_dxf_paths_are_closed_and_parts_match_placements():
     from fabricate.export.dxf import sheet_dxf
 
     parts = links(3)
     layout = sheet_layout(parts, KERF, (120.0, 60.0), 5.0, 2.0)
     msp = read(sheet_dxf(parts, KERF, layout, (120.0, 60.0)))
-    assert all(e.closed for e in msp.query('LWPOLYLINE[layer=="SHEET"]'))
+    assert msp.query("LWPOLYLINE") and all(e.closed for e in msp.query("LWPOLYLINE"))
     with pytest.raises(ValueError):
         sheet_dxf(parts, KERF, layout[:-1], (120.0, 60.0))
 
