@@ -11,7 +11,8 @@ Files
 ``assembly.3mf``           the assembly at the first pose (one object per part)
 ``parts/<name>.step``      B-rep solid of each part on z = 0 (only with the extra ``cad``: OCP)
 ``assembly.step``          the assembly at the first pose, one named solid per part (extra ``cad``)
-``sheet.dxf``              every part nested on the process sheet, labelled on ENGRAVE
+``cut/sheet_N.dxf|.svg``   laser builds: the parts nested on the smallest standard sheet that holds them,
+                           labelled with text outlines on ENGRAVE (report.json's ``cut``)
 ``kinematic.dxf``          joints, link centre lines and dimensions at the first pose
 ``previews/assembly.png``  the assembly at several poses
 ``previews/motion.gif``    the motion
@@ -30,7 +31,8 @@ from fabricate.errors import GeometryError
 from fabricate.export.layout import Placement, fits
 
 if TYPE_CHECKING:  # ezdxf loads with fabricate.export.dxf: only when a DXF is made
-    from fabricate.export.dxf import DxfStyle
+    from fabricate.export.dxf import DxfStyle, Sheet
+    from fabricate.export.labels import PartLabel
     from fabricate.export.stl import SolidCache
     from fabricate.mechanism import Mechanism, Motion
     from fabricate.parts.assembly import PinStack
@@ -90,7 +92,8 @@ def motion_csv(mechanism: Mechanism, motion: Motion) -> bytes:
 
 
 def export_all(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motion: Motion, previews: bool = True,
-               step: bool = True, with_step: bool | None = None) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
+               step: bool = True, with_step: bool | None = None,
+               sections: dict[str, Any] | None = None) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
     """Every export of a part set.
 
     Parameters
@@ -110,6 +113,9 @@ def export_all(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motio
     with_step : bool, optional
         Whether STEP files are part of this build (default: whether OCP is installed); ``fabricate check``
         rebuilds with the answer the folder's build recorded.
+    sections : dict, optional
+        The report: a cut process adds its ``cut`` section to it (:func:`cut_section`: sheets and their
+        utilisation, every part's number and label, the parts left unlabelled).
 
     Returns
     -------
@@ -138,18 +144,21 @@ def export_all(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motio
     parts = list(partset.parts)
     # every copy of every part is made: a three-finger gripper prints or cuts three finger sets
     made = [part for part in parts for _ in range(making.copies)]
-    placements = _lay_out(made, making, cache)
+    placements, sheets = _lay_out(made, making, cache)
+    labels = _labels(parts, making)
     where: dict[str, list[Placement]] = {}
     for part, placement in zip(made, placements, strict=True):
         where.setdefault(part.name, []).append(placement)
     files: dict[str, bytes] = {}
     entries: list[dict[str, Any]] = []
     for part in parts:
-        part_files, problems, stl_volume = _part_files(part, making, cache)
+        part_files, problems, stl_volume = _part_files(part, making, cache, labels.get(part.name))
         files.update(part_files)
         entries.append(_part_entry(part, problems, stl_volume, where[part.name], making, with_step,
-                                   getattr(partset, "warnings", ())))
-    files.update(_layout_files(made, placements, making, cache, design.name))
+                                   getattr(partset, "warnings", ()), sheets))
+    files.update(_layout_files(made, placements, making, cache, design.name, sheets, labels))
+    if sections is not None and making.cut:
+        sections["cut"] = cut_section(sheets, labels)
     first = motion.poses_at(0)
     files["assembly.3mf"] = assembly_3mf(parts, cache, first, title=design.name)
     if with_step and step:
@@ -182,9 +191,14 @@ class _Making:
     copies : int
         Identical copies of every part.
     drawing, cutting : DxfStyle
-        DXF for CAD (every label), and for the cutter (only labels the process can engrave).
+        DXF for CAD (every label, as TEXT), and for the cutter (labels as outlines, only those the process
+        can engrave).
     colours : (str, str)
         SVG strokes of cuts and of engraving.
+    stock : tuple of (name, width, height)
+        The process's standard sheets (``ProcessSpec.sheets``; empty: the sheet is ``area_mm``).
+    label_margin_mm : float
+        How far a label keeps inside its part (the process's smallest feature).
     """
 
     cut: bool
@@ -198,6 +212,8 @@ class _Making:
     drawing: DxfStyle
     cutting: DxfStyle
     colours: tuple[str, str]
+    stock: tuple[tuple[str, float, float], ...] = ()
+    label_margin_mm: float = 0.5
 
     @classmethod
     def of(cls, design: DesignSpec, partset: PartSet) -> _Making:
@@ -210,22 +226,47 @@ class _Making:
                    area_mm=(float(process.build_volume_mm[0]), float(process.build_volume_mm[1])),
                    margin_mm=spec.sheet_margin_mm if sheets else spec.plate_spacing_mm,
                    spacing_mm=spec.sheet_spacing_mm, copies=max(1, int(getattr(partset, "copies", 1) or 1)),
-                   drawing=DxfStyle(process.arcs, tol, hole_labels=True), cutting=DxfStyle(process.arcs, tol, min_text),
-                   colours=(process.cut_colour, process.engrave_colour))
+                   drawing=DxfStyle(process.arcs, tol, hole_labels=True),
+                   cutting=DxfStyle(process.arcs, tol, min_text, labels="outlines",
+                                    label_margin_mm=float(process.min_feature_mm)),
+                   colours=(process.cut_colour, process.engrave_colour),
+                   stock=tuple(getattr(process, "sheets", ())), label_margin_mm=float(process.min_feature_mm))
 
 
-def _lay_out(made: list[Part], making: _Making, cache: SolidCache) -> list[Placement]:
-    """Where every made part goes: nested on sheets (by its cut outline), or laid out on print plates."""
+def _lay_out(made: list[Part], making: _Making, cache: SolidCache) -> tuple[list[Placement], list[Sheet]]:
+    """Where every made part goes: nested on sheets (by its cut outline, each sheet the smallest standard
+    stock that holds its parts), or laid out on print plates (no sheets)."""
     if making.sheets:
-        from fabricate.export.dxf import sheet_layout
+        from fabricate.export.dxf import sized_sheets
 
-        return sheet_layout(made, making.kerf_mm, making.area_mm, making.margin_mm, making.spacing_mm)
+        return sized_sheets(made, making.kerf_mm, making.stock, making.area_mm, making.margin_mm, making.spacing_mm)
     from fabricate.export.stl import plate_layout
 
-    return plate_layout(made, cache, making.area_mm, making.margin_mm)
+    return plate_layout(made, cache, making.area_mm, making.margin_mm), []
 
 
-def _part_files(part: Part, making: _Making, cache: SolidCache) -> tuple[dict[str, bytes], list[str], float]:
+def _labels(parts: list[Part], making: _Making) -> dict[str, PartLabel]:
+    """A cut process's label of every part (its name, else its number, else none); none for a printer."""
+    if not making.cut:
+        return {}
+    from fabricate.export.labels import label_parts
+
+    return label_parts(parts, making.min_text_mm, making.label_margin_mm)
+
+
+def cut_section(sheets: Sequence[Sheet], labels: dict[str, PartLabel]) -> dict[str, Any]:
+    """report.json's ``cut``: every sheet with its stock, size and utilisation (part area / sheet area), the
+    overall utilisation, every part's number and engraved label (the key from number to name), and the parts
+    left unlabelled (no room even for the number)."""
+    area = sum(s.size_mm[0] * s.size_mm[1] for s in sheets)
+    return {"sheets": [s.report() for s in sheets],
+            "utilisation": round(sum(s.part_area_mm2 for s in sheets) / area, 4) if area else None,
+            "labels": [label.report() for label in labels.values()],
+            "unlabelled": [name for name, label in labels.items() if label.label is None]}
+
+
+def _part_files(part: Part, making: _Making, cache: SolidCache,
+                label: PartLabel | None = None) -> tuple[dict[str, bytes], list[str], float]:
     """A part's own files: its STL, its DXF at finished size (for CAD) and, for a cut process, its cut path.
 
     Returns
@@ -247,18 +288,22 @@ def _part_files(part: Part, making: _Making, cache: SolidCache) -> tuple[dict[st
         raise GeometryError(f"part {part.name}: STL {', '.join(problems)}")
     files = {f"parts/{part.name}.stl": stl, f"drawings/{part.name}.dxf": part_dxf(part, 0.0, making.drawing)}
     if making.cut:
-        files[f"cut/{part.name}.dxf"] = part_dxf(part, making.kerf_mm, making.cutting)
+        engraved = _engraved(label)
+        files[f"cut/{part.name}.dxf"] = part_dxf(part, making.kerf_mm, making.cutting, label=engraved)
         files[f"cut/{part.name}.svg"] = part_svg(part, making.kerf_mm, min_text_mm=making.min_text_mm,
-                                                 colours=making.colours)
+                                                 colours=making.colours, label=engraved)
     return files, problems, mesh_volume(vertices, faces)
 
 
 def _part_entry(part: Part, problems: list[str], stl_volume: float, placed: list[Placement], making: _Making,
-                with_step: bool, warnings: Sequence[str]) -> dict[str, Any]:
-    """A part's entry in the report's ``parts`` (see :func:`export_all`); ``placed``: where its copies went."""
+                with_step: bool, warnings: Sequence[str], sheets: Sequence[Sheet] = ()) -> dict[str, Any]:
+    """A part's entry in the report's ``parts`` (see :func:`export_all`); ``placed``: where its copies went,
+    ``sheets``: the laser layout's sheets (each copy fits its own sheet's size)."""
+    from fabricate.export.dxf import cut_area
+
     kerf = making.kerf_mm
     cut_dxf, cut_svg = (f"cut/{part.name}.dxf", f"cut/{part.name}.svg") if making.cut else (None, None)
-    return {
+    entry: dict[str, Any] = {
         "name": part.name, "process": part.process, "stl": f"parts/{part.name}.stl",
         "dxf": f"drawings/{part.name}.dxf", "cut_dxf": cut_dxf, "cut_svg": cut_svg,
         "step": f"parts/{part.name}.step" if with_step else None,
@@ -273,14 +318,20 @@ def _part_entry(part: Part, problems: list[str], stl_volume: float, placed: list
         "slots": len(getattr(part, "slots", ())), "stl_problems": problems,
         ("sheet" if making.sheets else "plate"): {
             "index": [pl.sheet + 1 for pl in placed],
-            "fits": all(fits(pl, making.area_mm, making.margin_mm) for pl in placed)},
+            "fits": all(fits(pl, sheets[pl.sheet].size_mm if sheets else making.area_mm, making.margin_mm)
+                        for pl in placed)},
         "warnings": [w for w in warnings if w.startswith(f"part {part.name}:")],
     }
+    if making.cut:  # what a reader of the cut DXF's layer CUT measures (kerf applied)
+        entry["cut_area_mm2"] = round(cut_area(part, kerf), 4)
+    return entry
 
 
 def _layout_files(made: list[Part], placements: list[Placement], making: _Making, cache: SolidCache,
-                  title: str) -> dict[str, bytes]:
-    """One file pair per sheet (cut DXF and SVG) or per print plate (STL and 3MF, each copy named)."""
+                  title: str, sheets: Sequence[Sheet] = (),
+                  labels: dict[str, PartLabel] | None = None) -> dict[str, bytes]:
+    """One file pair per sheet (cut DXF and SVG, each the size of its sheet) or per print plate (STL and 3MF,
+    each copy named)."""
     from fabricate.export.dxf import sheet_dxf
     from fabricate.export.stl import model_3mf, placed_flat_mesh, plate_stl
     from fabricate.export.svg import sheet_svg
@@ -292,11 +343,13 @@ def _layout_files(made: list[Part], placements: list[Placement], making: _Making
                  if pl.sheet == number]
         if making.sheets:
             sheet_parts, sheet_places = [part for part, _, _ in on_it], [pl for _, pl, _ in on_it]
-            files[f"cut/sheet_{number + 1}.dxf"] = sheet_dxf(sheet_parts, kerf, sheet_places, area, number,
-                                                             making.cutting)
-            files[f"cut/sheet_{number + 1}.svg"] = sheet_svg(sheet_parts, kerf, sheet_places, area, number,
+            size = sheets[number].size_mm if sheets else area
+            engraved = [_engraved((labels or {}).get(part.name)) for part in sheet_parts]
+            files[f"cut/sheet_{number + 1}.dxf"] = sheet_dxf(sheet_parts, kerf, sheet_places, size, number,
+                                                             making.cutting, labels=engraved)
+            files[f"cut/sheet_{number + 1}.svg"] = sheet_svg(sheet_parts, kerf, sheet_places, size, number,
                                                              title=f"{title} sheet", min_text_mm=making.min_text_mm,
-                                                             colours=making.colours)
+                                                             colours=making.colours, labels=engraved)
         else:
             meshes = [placed_flat_mesh(part, cache, pl) for part, pl, _ in on_it]
             names = [copy_name(part.name, k % copies, copies) for part, _, k in on_it]
@@ -304,6 +357,14 @@ def _layout_files(made: list[Part], placements: list[Placement], making: _Making
             files[f"plates/plate_{number + 1}.3mf"] = model_3mf(
                 [(name, *mesh) for name, mesh in zip(names, meshes, strict=True)], f"{title} plate {number + 1}")
     return files
+
+
+def _engraved(label: PartLabel | None) -> Any:
+    """What a cut file engraves on a part: its placed label, "" (none) when it has no room for one, None (the
+    writer's default) when no label was worked out."""
+    if label is None:
+        return None
+    return label.label if label.label is not None else ""
 
 
 def copy_name(name: str, index: int, copies: int) -> str:

@@ -2,9 +2,18 @@
 
 Every document is R2010 in millimetres ($INSUNITS = 4, $MEASUREMENT = 1). Cut geometry goes on layer
 ``CUT`` (red): each outline is one closed LWPOLYLINE whose arcs are bulges, each hole a CIRCLE, each slot
-a closed LWPOLYLINE. Labels go on ``ENGRAVE`` (blue). The laser kerf is applied to the cut path only:
-outlines are offset out by kerf / 2 and holes in by kerf / 2 (a hole's CIRCLE is its modelled diameter
-minus the kerf), so the finished part has the modelled size.
+a closed LWPOLYLINE. Nothing else is on ``CUT``. The laser kerf is applied to the cut path only: outlines
+are offset out by kerf / 2 and holes in by kerf / 2 (a hole's CIRCLE is its modelled diameter minus the
+kerf), so the finished part has the modelled size.
+
+Labels go on ``ENGRAVE`` (blue). In a cut file (:attr:`DxfStyle.labels` ``"outlines"``) a label is the
+outline of its text, closed bulge-free LWPOLYLINEs (:mod:`fabricate.export.labels`), never a TEXT entity: a
+shop's software has not the font, or no text support at all (OpenSCAD: "Unsupported DXF Entity 'TEXT'").
+A sheet (``cut/sheet_N.dxf``) holds its parts and nothing else: no border a shop cutting every contour would
+cut; its size is the drawing limits ($LIMMIN/$LIMMAX) and extents.
+
+A drawing (``drawings/NAME.dxf``, for CAD, never sent to a cutter) keeps TEXT: its part name and hole notes
+are to be read and edited in LibreCAD or FreeCAD, which draw TEXT in their own fonts.
 
 A part's drawing (``drawings/NAME.dxf``, :attr:`DxfStyle.hole_labels`) also labels every hole on layer
 ``HOLES`` (never in a cut file): the NOMINAL hole and its fit, what the finished part should measure, and
@@ -29,7 +38,8 @@ import shapely
 from ezdxf import units
 from shapely.ops import polylabel
 
-from fabricate.export.layout import Placement, shelf_pack
+from fabricate.export.labels import Label, label_part
+from fabricate.export.layout import Placement, fits, shelf_pack
 from fabricate.parts.model import BulgePath, Hole, Part
 from fabricate.parts.profiles import offset_path
 
@@ -93,6 +103,14 @@ def cut_geometry(part: Part, kerf_mm: float) -> tuple[BulgePath, list[tuple[np.n
     return outline, holes, slots
 
 
+def cut_area(part: Part, kerf_mm: float) -> float:
+    """Exact area (mm^2) the cut path encloses: the offset outline less the shrunk holes and slots (what a
+    reader of the cut DXF's layer CUT measures)."""
+    outline, holes, slots = cut_geometry(part, kerf_mm)
+    return (abs(outline.area()) - sum(np.pi * d * d / 4.0 for _, d in holes)
+            - sum(abs(s.area()) for s in slots))
+
+
 def _label_spot(part: Part, text: str) -> tuple[np.ndarray, float]:
     """A point inside the part far from its edges and holes, and a text height that fits there.
 
@@ -132,29 +150,37 @@ class DxfStyle:
     hole_labels : bool
         Label every hole on layer ``HOLES`` with its nominal size, fit and compensation (drawings only: a
         cutter would engrave them).
+    labels : str
+        ``"text"``: the part's name as a TEXT entity (drawings). ``"outlines"``: the label's glyph outlines
+        as closed polylines (cut files; see the module docstring).
+    label_margin_mm : float
+        Outlined labels keep this far inside the part and off its holes and slots.
     """
 
     arcs: str = "bulge"
     chord_tolerance_mm: float = 0.005
     min_text_mm: float = 0.0
     hole_labels: bool = False
+    labels: str = "text"
+    label_margin_mm: float = 0.5
 
 
 EXACT = DxfStyle()
 
 
 def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None = None,
-             label: str | None = None, style: DxfStyle = EXACT) -> None:
+             label: str | Label | None = None, style: DxfStyle = EXACT) -> None:
     """Draw a part's cut path (CUT) and its label (ENGRAVE) into a modelspace.
 
     Parameters
     ----------
     placement : Placement, optional
         Rotation and offset onto a sheet; None keeps the part's own coordinates.
-    label : str, optional
-        Text engraved at the roomiest inside point (default: the part name).
+    label : str or Label, optional
+        Text engraved at the roomiest inside point (default: the part name; "" none), or a placed
+        :class:`Label` (outlines; :func:`fabricate.export.labels.label_part`).
     style : DxfStyle
-        Arcs as bulges or segments, and the smallest label drawn.
+        Arcs as bulges or segments, the smallest label drawn, TEXT or outlined labels.
     """
     outline, holes, slots = cut_geometry(part, kerf_mm)
 
@@ -172,6 +198,14 @@ def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None =
         msp.add_circle((float(c[0]), float(c[1])), float(diameter) / 2.0, dxfattribs={"layer": "CUT"})
     if style.hole_labels:
         _hole_labels(msp, part, place)
+    if style.labels == "outlines" or isinstance(label, Label):
+        engraved = label if isinstance(label, Label) else engraved_label(part, style, label)
+        if engraved is not None:
+            for ring in engraved.polygons():
+                xy = place(ring)
+                msp.add_lwpolyline([(float(x), float(y)) for x, y in xy], format="xy", close=True,
+                                   dxfattribs={"layer": "ENGRAVE"})
+        return
     label = label if label is not None else part.name
     spot, height = _label_spot(part, label)
     if height < style.min_text_mm:  # the process cannot engrave it legibly
@@ -207,10 +241,19 @@ def _hole_labels(msp: Any, part: Part, place: Callable[[np.ndarray], np.ndarray]
         text.set_placement((x_text, y), align=ezdxf.enums.TextEntityAlignment.MIDDLE_LEFT)
 
 
-def part_dxf(part: Part, kerf_mm: float, style: DxfStyle = EXACT) -> bytes:
-    """DXF of one part in its own (body) coordinates (with the layer ``HOLES`` when the style labels holes)."""
+def engraved_label(part: Part, style: DxfStyle, text: str | None = None) -> Label | None:
+    """The outlined label a cut file engraves when it is given none: the part's name (or ``text``) if it fits
+    at the style's smallest label, else nothing (the build numbers parts instead: see
+    :func:`fabricate.export.labels.label_parts`)."""
+    return label_part(part, "", style.min_text_mm, style.label_margin_mm, text=text).label
+
+
+def part_dxf(part: Part, kerf_mm: float, style: DxfStyle = EXACT, label: Label | str | None = None) -> bytes:
+    """DXF of one part in its own (body) coordinates (with the layer ``HOLES`` when the style labels holes).
+
+    ``label``: the placed label of a cut file, or a text ("" none; default: see :func:`engraved_label`)."""
     doc = new_document(("CUT", "ENGRAVE", "HOLES") if style.hole_labels else ("CUT", "ENGRAVE"))
-    add_part(doc.modelspace(), part, kerf_mm, style=style)
+    add_part(doc.modelspace(), part, kerf_mm, label=label, style=style)
     return document_bytes(doc)
 
 
@@ -222,16 +265,116 @@ def sheet_layout(parts: Sequence[Part], kerf_mm: float, sheet_mm: tuple[float, f
 
 
 def sheet_dxf(parts: Sequence[Part], kerf_mm: float, placements: Sequence[Placement],
-              sheet_mm: tuple[float, float], sheet: int = 0, style: DxfStyle = EXACT) -> bytes:
-    """Sheet number ``sheet``: its border (layer SHEET, not plotted) and the parts placed on it."""
-    doc = new_document(("CUT", "ENGRAVE", "SHEET"))
+              sheet_mm: tuple[float, float], sheet: int = 0, style: DxfStyle = EXACT,
+              labels: Sequence[Label | str | None] | None = None) -> bytes:
+    """Sheet number ``sheet``: the parts placed on it, and nothing else (see the module docstring).
+
+    ``labels``: each part's placed label, in the order of ``parts`` (default: see :func:`engraved_label`).
+    The sheet's size is the drawing's limits and extents, so a viewer opens on the whole sheet."""
+    doc = new_document(("CUT", "ENGRAVE"))
     msp = doc.modelspace()
-    msp.add_lwpolyline([(0.0, 0.0), (sheet_mm[0], 0.0), (sheet_mm[0], sheet_mm[1]), (0.0, sheet_mm[1])],
-                       format="xy", close=True, dxfattribs={"layer": "SHEET"})
-    for part, placement in zip(parts, placements, strict=True):
+    for k, (part, placement) in enumerate(zip(parts, placements, strict=True)):
         if placement.sheet == sheet:
-            add_part(msp, part, kerf_mm, placement, style=style)
+            add_part(msp, part, kerf_mm, placement, label=None if labels is None else labels[k], style=style)
+    corner = (float(sheet_mm[0]), float(sheet_mm[1]))
+    msp.reset_limits((0.0, 0.0), corner)  # ezdxf writes the modelspace's limits to $LIMMIN / $LIMMAX
+    msp.reset_extents((0.0, 0.0, 0.0), (*corner, 0.0))
     return document_bytes(doc)
+
+
+@dataclass(frozen=True)
+class Sheet:
+    """One sheet of a laser layout: which standard stock it is and how much of it the parts use.
+
+    Attributes
+    ----------
+    index : int
+        From 0 (file ``cut/sheet_{index + 1}``).
+    name : str
+        The stock's name in the profile's ``[sheets]`` (e.g. Ponoko's ``"P2"``), or ``"bed"`` for the
+        process's sheet (``build_volume_mm``) when the profile names none.
+    size_mm : (float, float)
+        Width and height as laid out (a stock may be used turned a quarter).
+    part_area_mm2 : float
+        Area of the parts on it (finished size: outline less holes and slots).
+    cut_area_mm2 : float
+        Area the sheet's cut paths enclose (kerf applied: what a reader of its layer CUT measures).
+    parts : tuple of str
+        The part names on it, one per copy, in layout order.
+    """
+
+    index: int
+    name: str
+    size_mm: tuple[float, float]
+    part_area_mm2: float
+    cut_area_mm2: float
+    parts: tuple[str, ...]
+
+    @property
+    def utilisation(self) -> float:
+        """Part area over sheet area."""
+        return self.part_area_mm2 / (self.size_mm[0] * self.size_mm[1])
+
+    def report(self) -> dict[str, Any]:
+        """report.json's row of the sheet (see :func:`fabricate.export.cut_report`)."""
+        return {"index": self.index + 1, "file": f"cut/sheet_{self.index + 1}.dxf", "stock": self.name,
+                "size_mm": [round(v, 3) for v in self.size_mm], "part_area_mm2": round(self.part_area_mm2, 3),
+                "cut_area_mm2": round(self.cut_area_mm2, 3),
+                "utilisation": round(self.utilisation, 4), "parts": list(self.parts)}
+
+
+def sized_sheets(parts: Sequence[Part], kerf_mm: float, stock: Sequence[tuple[str, float, float]],
+                 bed_mm: tuple[float, float], margin_mm: float,
+                 spacing_mm: float) -> tuple[list[Placement], list[Sheet]]:
+    """Nest the parts, each sheet on the smallest standard stock that holds its parts.
+
+    The parts are first nested on the largest stock that fits the bed (or the bed itself when the profile
+    names no stock, or none fits), which fixes how many sheets there are and which parts go on each; then
+    each sheet's parts are nested again on every smaller stock (as listed, then a quarter turn), smallest
+    area first, and the first that holds them all on one sheet is that sheet's.
+
+    Parameters
+    ----------
+    parts : sequence of Part
+        Every part made (copies repeated).
+    stock : sequence of (name, width, height)
+        The profile's standard sheets (``ProcessSpec.sheets``).
+    bed_mm : (float, float)
+        The largest sheet the process takes (``build_volume_mm[:2]``).
+
+    Returns
+    -------
+    placements : list of Placement
+        In the order of ``parts``; ``sheet`` indexes ``sheets``.
+    sheets : list of Sheet
+    """
+    def holds(size: tuple[float, float]) -> bool:
+        return (size[0] <= bed_mm[0] + 1e-9 and size[1] <= bed_mm[1] + 1e-9) or (
+            size[1] <= bed_mm[0] + 1e-9 and size[0] <= bed_mm[1] + 1e-9)
+
+    usable = sorted(((name, (float(w), float(h))) for name, w, h in stock if holds((w, h))),
+                    key=lambda s: (s[1][0] * s[1][1], s[1][0], s[0]))
+    largest = usable[-1] if usable else ("bed", (float(bed_mm[0]), float(bed_mm[1])))
+    outlines = [cut_geometry(p, kerf_mm)[0].polygon(0.05) for p in parts]
+    placements = shelf_pack(outlines, largest[1], margin_mm, spacing_mm + kerf_mm)
+    sheets: list[Sheet] = []
+    for number in sorted({pl.sheet for pl in placements}):
+        on = [k for k, pl in enumerate(placements) if pl.sheet == number]
+        chosen, placed = largest, [placements[k] for k in on]
+        for name, (w, h) in usable[:-1]:
+            for size in dict.fromkeys(((w, h), (h, w))):
+                trial = shelf_pack([outlines[k] for k in on], size, margin_mm, spacing_mm + kerf_mm)
+                if all(pl.sheet == 0 and fits(pl, size, margin_mm) for pl in trial):
+                    chosen, placed = (name, size), trial
+                    break
+            if chosen[0] != largest[0]:
+                break
+        for k, pl in zip(on, placed, strict=True):
+            placements[k] = Placement(pl.angle, pl.offset, len(sheets), pl.size)
+        sheets.append(Sheet(len(sheets), chosen[0], chosen[1], sum(parts[k].area_mm2() for k in on),
+                            sum(cut_area(parts[k], kerf_mm) for k in on), tuple(parts[k].name for k in on)))
+    return placements, sheets
+
 
 
 def audit_problems(data: bytes) -> list[str]:
@@ -262,3 +405,44 @@ def read_dxf(data: bytes) -> tuple[list[str], list[float]]:
         problems.append(f"drawing units are {units.unit_name(doc.units)}, not mm")
     diameters = sorted(2.0 * float(e.dxf.radius) for e in doc.modelspace().query('CIRCLE[layer=="CUT"]'))
     return problems, diameters
+
+
+def cut_file_problems(data: bytes) -> list[str]:
+    """What a shop's preflight rejects in a cut DXF (empty: it takes the file as sent).
+
+    Text of any kind (TEXT, MTEXT: the label must be outlines), a layer other than CUT and ENGRAVE, anything
+    on CUT but closed LWPOLYLINEs and CIRCLEs, an open polyline, a contour crossing itself, and two CUT
+    contours that touch, cross or repeat each other (a line the beam would cut twice).
+    """
+    from ezdxf import path as dxf_path
+
+    problems, _ = read_dxf(data)
+    if problems:
+        return problems
+    doc = ezdxf.read(io.StringIO(data.decode("utf-8")))
+    rings: list[tuple[str, Any]] = []
+    for e in doc.modelspace():
+        kind, layer = e.dxftype(), e.dxf.layer
+        where = f"{kind} on {layer}"
+        if kind in ("TEXT", "MTEXT", "ATTRIB", "ATTDEF", "INSERT"):
+            problems.append(f"{where}: live text or a block (a shop wants outlines)")
+        elif layer not in ("CUT", "ENGRAVE"):
+            problems.append(f"{where}: a layer that is neither a cut nor an engraving")
+        elif kind == "LWPOLYLINE":
+            if not e.closed:
+                problems.append(f"{where}: an open path")
+            elif layer == "CUT":
+                ring = shapely.LinearRing([(v.x, v.y) for v in dxf_path.make_path(e).flattening(0.001)])
+                if not ring.is_simple:
+                    problems.append(f"{where}: a contour crossing itself")
+                rings.append((where, ring))
+        elif kind == "CIRCLE" and layer == "CUT":
+            rings.append((where, shapely.Point(e.dxf.center.x, e.dxf.center.y).buffer(e.dxf.radius, 64).exterior))
+        elif layer == "CUT":
+            problems.append(f"{where}: not a closed contour")
+    lines = [ring for _, ring in rings]
+    tree = shapely.STRtree(lines)
+    for i, j in zip(*tree.query(lines, predicate="intersects"), strict=True):
+        if i < j:
+            problems.append(f"{rings[i][0]} and {rings[j][0]} touch, cross or repeat (a line cut twice)")
+    return problems

@@ -6,7 +6,9 @@ mishandle). Conventions the shops follow: hairline strokes (0.01 mm) with no fil
 coloured by operation: pure red ``#ff0000`` cuts, pure blue ``#0000ff`` engraves (the defaults of
 LightBurn's layer palette and Glowforge's colour-to-step mapping; a process profile may set others).
 Outlines are ``path`` elements whose arcs are SVG elliptical arcs with equal radii, holes are ``circle``
-elements, labels ``text`` on the engrave colour. Cut order: holes and slots before the outline, so a part
+elements, labels the outlines of their text on the engrave colour (closed ``path`` elements, never a
+``text`` element: a shop's software may lack the font or ignore text; see :mod:`fabricate.export.labels`);
+a sheet's SVG is its parts and nothing else (no border). Cut order: holes and slots before the outline, so a part
 is cut free last. Each hole's ``circle`` carries a ``title`` (shown by Inkscape, ignored by the cutter): its
 nominal size and fit, the CAD size with the process's compensation, and the cut path's diameter (the
 drawing's hole label, see :mod:`fabricate.export.dxf`). Encoders return bytes; nothing here writes files.
@@ -20,6 +22,7 @@ from xml.sax.saxutils import escape, quoteattr
 
 import numpy as np
 
+from fabricate.export.labels import Label
 from fabricate.export.layout import Placement
 from fabricate.parts.model import BulgePath, Part
 
@@ -72,10 +75,10 @@ class _Canvas:
                 f'r="{_num(diameter / 2.0)}" {_stroke(colour)}')
         return f"{head}><title>{escape(title)}</title></circle>" if title else f"{head}/>"
 
-    def text(self, spot: np.ndarray, height: float, label: str, colour: str) -> str:
-        return (f'<text x="{_num(float(spot[0]))}" y="{_num(self.height - float(spot[1]))}" '
-                f'font-size="{_num(height)}" font-family="sans-serif" text-anchor="middle" '
-                f'dominant-baseline="middle" fill="{colour}" stroke="none">{escape(label)}</text>')
+    def outlines(self, rings: Sequence[np.ndarray], colour: str, title: str) -> str:
+        """Closed polygons (a label's glyphs) as one path of straight segments, titled with the text."""
+        d = " ".join("M " + " L ".join(self.xy(p) for p in ring) + " Z" for ring in rings)
+        return f'<path d="{d}" {_stroke(colour)}><title>{escape(title)}</title></path>'
 
     def document(self, title: str, body: Sequence[str]) -> bytes:
         head = (f'<?xml version="1.0" encoding="UTF-8"?>\n'
@@ -91,8 +94,8 @@ def _stroke(colour: str) -> str:
 
 
 def _part_elements(canvas: _Canvas, part: Part, kerf_mm: float, placement: Placement | None,
-                   label: str | None, min_text_mm: float, colours: tuple[str, str]) -> list[str]:
-    from fabricate.export.dxf import _label_spot, cut_geometry, hole_label
+                   label: Label | str | None, min_text_mm: float, colours: tuple[str, str]) -> list[str]:
+    from fabricate.export.dxf import DxfStyle, cut_geometry, engraved_label, hole_label
 
     outline, holes, slots = cut_geometry(part, kerf_mm)
 
@@ -110,16 +113,17 @@ def _part_elements(canvas: _Canvas, part: Part, kerf_mm: float, placement: Place
                  for hole, (centre, diameter) in zip(part.holes, holes, strict=True)]
     elements += [canvas.path(placed(slot), cut) for slot in slots]
     elements.append(canvas.path(placed(outline), cut))
-    text = part.name if label is None else label
-    spot, height = _label_spot(part, text)
-    if text and height >= min_text_mm:  # a label the process cannot engrave legibly is left out
-        elements.append(canvas.text(place(spot[None, :])[0], height, text, engrave))
+    if not isinstance(label, Label):  # the name (or text) where it fits at the smallest legible size, else none
+        label = engraved_label(part, DxfStyle(min_text_mm=min_text_mm, labels="outlines"), label)
+    if label is not None:
+        elements.append(canvas.outlines([place(ring) for ring in label.polygons()], engrave, label.text))
     elements.append("</g>")
     return elements
 
 
 def part_svg(part: Part, kerf_mm: float, *, min_text_mm: float = 0.0,
-             colours: tuple[str, str] = (CUT_COLOUR, ENGRAVE_COLOUR), margin_mm: float = 1.0) -> bytes:
+             colours: tuple[str, str] = (CUT_COLOUR, ENGRAVE_COLOUR), margin_mm: float = 1.0,
+             label: Label | str | None = None) -> bytes:
     """SVG of one part's cut path (kerf-compensated like its DXF), on a canvas just around it.
 
     Parameters
@@ -133,6 +137,9 @@ def part_svg(part: Part, kerf_mm: float, *, min_text_mm: float = 0.0,
         Cut and engrave stroke colours.
     margin_mm : float
         Empty border around the part.
+    label : Label or str, optional
+        The placed label, or a text to fit ("": none; default: the name where it fits at ``min_text_mm``,
+        see :func:`fabricate.export.dxf.engraved_label`).
     """
     from fabricate.export.dxf import cut_geometry
 
@@ -141,16 +148,20 @@ def part_svg(part: Part, kerf_mm: float, *, min_text_mm: float = 0.0,
     hi = outline.max(axis=0) + margin_mm
     shift = Placement(0.0, -lo, 0, hi - lo)
     canvas = _Canvas(*(hi - lo))
-    return canvas.document(part.name, _part_elements(canvas, part, kerf_mm, shift, None, min_text_mm, colours))
+    return canvas.document(part.name, _part_elements(canvas, part, kerf_mm, shift, label, min_text_mm, colours))
 
 
 def sheet_svg(parts: Sequence[Part], kerf_mm: float, placements: Sequence[Placement], sheet_mm: tuple[float, float],
               sheet: int, *, title: str = "sheet", min_text_mm: float = 0.0,
-              colours: tuple[str, str] = (CUT_COLOUR, ENGRAVE_COLOUR)) -> bytes:
-    """SVG of sheet number ``sheet``: the parts placed on it, the canvas the sheet's size (mm)."""
+              colours: tuple[str, str] = (CUT_COLOUR, ENGRAVE_COLOUR),
+              labels: Sequence[Label | str | None] | None = None) -> bytes:
+    """SVG of sheet number ``sheet``: the parts placed on it, the canvas the sheet's size (mm).
+
+    ``labels``: each part's placed label, in the order of ``parts`` (default as :func:`part_svg`)."""
     canvas = _Canvas(*sheet_mm)
     body: list[str] = []
-    for part, placement in zip(parts, placements, strict=True):
+    for k, (part, placement) in enumerate(zip(parts, placements, strict=True)):
         if placement.sheet == sheet:
-            body += _part_elements(canvas, part, kerf_mm, placement, None, min_text_mm, colours)
+            body += _part_elements(canvas, part, kerf_mm, placement, None if labels is None else labels[k],
+                                   min_text_mm, colours)
     return canvas.document(f"{title} {sheet + 1}", body)

@@ -1,5 +1,6 @@
 """SVG read back with a real SVG reader (svgelements) equals the DXF geometry read back with ezdxf:
-outline area, exact arcs (one SVG arc per DXF bulge), holes (centres and diameters), kerf applied alike."""
+outline area, exact arcs (one SVG arc per DXF bulge), holes (centres and diameters), kerf applied alike; labels
+are engraved outlines (never ``text``), on the engrave colour."""
 
 from __future__ import annotations
 
@@ -26,12 +27,17 @@ def parts(request, shipped_build):
 
 
 def _read_svg(data: bytes):
+    """The document, its height, its cut paths, its circles and its engraved paths (the labels)."""
     svg = svgelements.SVG.parse(io.BytesIO(data), ppi=25.4)  # 1 user unit = 1 mm
+    assert not any(isinstance(e, svgelements.Text) for e in svg.elements())  # a shop takes no live text
+    assert b"<text" not in data
     height = float(svg.viewbox.height)
     paths = [e for e in svg.elements() if isinstance(e, svgelements.Path)]
     circles = [e for e in svg.elements() if isinstance(e, svgelements.Circle)]
-    texts = [e for e in svg.elements() if isinstance(e, svgelements.Text)]
-    return svg, height, paths, circles, texts
+    engraved = [e for e in paths if str(e.stroke).lower() == ENGRAVE_COLOUR]
+    cut = [e for e in paths if str(e.stroke).lower() == CUT_COLOUR]
+    assert len(cut) + len(engraved) == len(paths)
+    return svg, height, cut, circles, engraved
 
 
 def _svg_polygon(path, height: float, n: int = 20000) -> shapely.Polygon:
@@ -100,17 +106,19 @@ def test_svg_is_in_millimetres_with_operation_colours(parts):
     assert float(svg.viewbox.width) == pytest.approx(width_mm)  # one user unit is one millimetre
     for element in paths + circles:
         assert str(element.stroke).lower() == CUT_COLOUR and element.fill.value is None
-    assert all(str(t.fill).lower() == ENGRAVE_COLOUR for t in texts)
+    assert texts and all(t.fill.value is None for t in texts)  # the label: an outline on the engrave colour
 
 
 def test_small_labels_are_left_out(parts):
-    heights = []
-    for part in parts:
-        _, _, _, _, texts = _read_svg(part_svg(part, KERF))
-        heights += [float(t.font_size) for t in texts]
+    from fabricate.export.dxf import DxfStyle, engraved_label
+
+    labels = [engraved_label(p, DxfStyle(labels="outlines")) for p in parts]
+    heights = [label.height_mm for label in labels if label is not None]
     cut = float(np.median(heights))
     kept = sum(len(_read_svg(part_svg(p, KERF, min_text_mm=cut))[4]) for p in parts)
     assert kept == sum(h >= cut for h in heights) and kept < len(heights)
+    # a part with no room for any label (a thin spacer ring) is engraved with nothing
+    assert all(not _read_svg(part_svg(p, KERF))[4] for p, label in zip(parts, labels, strict=True) if label is None)
 
 
 def test_sheet_svg_holds_every_part_of_its_sheet_inside_the_sheet(parts):
