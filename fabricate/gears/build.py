@@ -12,6 +12,7 @@ with the centre distance fixed the module follows (``m = perimeter_a / (pi z_a)`
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
@@ -20,6 +21,7 @@ from scipy.spatial import cKDTree
 
 from fabricate.bounds import MAX_MESH_STEP_TEETH, MAX_TEETH, MESH_SECONDS_PER_TOOTH_STEP
 from fabricate.errors import SpecError
+from fabricate.gears.auto import ModuleLimits, choose_module
 from fabricate.gears.checks import (
     check_feasible,
     curvature_summary,
@@ -36,7 +38,7 @@ from fabricate.gears.spec import GearSpec
 from fabricate.gears.teeth import GearTeeth, cut_gear
 
 if TYPE_CHECKING:
-    from fabricate.mechanism import Law, Mechanism
+    from fabricate.mechanism import GearCoupling, Law, Mechanism
 
 #: Default module of a sector when the template leaves it open (SLA-sized), mm.
 DEFAULT_SECTOR_MODULE_MM = 0.5
@@ -356,14 +358,22 @@ class _Bare(PitchCurves):
         self.a = float(center_distance)
 
 
-def build_gear_pairs(mechanism: Mechanism, spec: GearSpec, chord_tolerance_mm: float) -> list[GearPair]:
+def build_gear_pairs(mechanism: Mechanism, spec: GearSpec, chord_tolerance_mm: float,
+                     limits: Callable[[], ModuleLimits] | None = None) -> list[GearPair]:
     """One checked :class:`GearPair` per gear coupling of ``mechanism``.
 
     The centre distance is the distance between the coupling's axis points in the carrier; a
     coupling whose working range covers a full turn makes closed gears unless ``spec.closed`` says
     otherwise.
+
+    With ``limits`` (called once when needed: the process's and the load's limits,
+    :func:`fabricate.gears.auto.module_limits`) a module the
+    template leaves open (``module_mm`` absent or ``"auto"``, and no ``teeth`` of a closed pair) is chosen by
+    :func:`fabricate.gears.auto.choose_module`: the pair records how (``module_choice``). Without ``limits`` an
+    open module is the old default (a sector 0.5 mm; a closed pair needs teeth or a module).
     """
     pairs = []
+    known: list[ModuleLimits] = []  # the limits, once asked for
     for g in mechanism.gears:
         carrier = mechanism.body(g.carrier)
         if g.axis_a in carrier.points and g.axis_b in carrier.points:
@@ -373,7 +383,37 @@ def build_gear_pairs(mechanism: Mechanism, spec: GearSpec, chord_tolerance_mm: f
             d = body.point(g.axis_b) - body.point(g.axis_a)
         lo, hi = g.working_range
         closed = spec.closed if spec.closed is not None else bool(hi - lo >= TWO_PI - 1e-9)
-        pairs.append(make_gear_pair(g.law, float(np.hypot(*d)), (lo, hi), spec, closed=closed, name=g.name,
-                                    chord_tolerance_mm=chord_tolerance_mm, coupling=g.name, carrier=g.carrier,
-                                    body_a=g.gear_a, body_b=g.gear_b, axis_a=g.axis_a, axis_b=g.axis_b))
+
+        def make(s: GearSpec, mesh: bool, g: GearCoupling = g, d: np.ndarray = d, closed: bool = closed
+                 ) -> GearPair:
+            return make_gear_pair(g.law, float(np.hypot(*d)), g.working_range, s, closed=closed, name=g.name,
+                                  chord_tolerance_mm=chord_tolerance_mm, coupling=g.name, carrier=g.carrier,
+                                  body_a=g.gear_a, body_b=g.gear_b, axis_a=g.axis_a, axis_b=g.axis_b,
+                                  run_mesh_check=mesh)
+
+        if limits is None or spec.module_mm is not None or (closed and spec.teeth is not None):
+            pairs.append(make(spec, True))
+            continue
+        # the scan cuts each candidate without the method comparison or the mesh check; the chosen module is
+        # then cut and checked in full, exactly as a template fixing it would be
+        known = known or [limits()]
+        convex = _convex(g.law, float(np.hypot(*d)), g.working_range)
+        scanned, choice = choose_module(lambda s: make(replace(s, compare_methods=False), False), spec, known[0],
+                                        convex=convex)
+        assert scanned.spec.module_mm is not None  # every candidate is cut with its module fixed
+        full = make(replace(spec, module_mm=scanned.spec.module_mm), True)
+        pairs.append(replace(full, module_choice=choice))
     return pairs
+
+
+def _convex(law: Law, center_distance: float, working_range: tuple[float, float]) -> bool:
+    """Both pitch curves convex, with a margin, over the working range and a quarter turn beyond each end (the
+    spare teeth of a sector lie beyond the range; a closed pair's range is its whole turn)."""
+    lo, hi = working_range
+    x = np.linspace(lo - 0.5 * np.pi, hi + 0.5 * np.pi, 721) if hi - lo < TWO_PI - 1e-9 else \
+        np.linspace(lo, lo + TWO_PI, 721)
+    try:
+        curv = curvature_summary(_Bare(law, center_distance), x)
+    except (SpecError, ValueError, FloatingPointError, ZeroDivisionError):
+        return False  # a law that cannot be followed that far: no shortcut, every candidate is cut
+    return bool(min(curv["min_curvature_a_per_mm"], curv["min_curvature_b_per_mm"]) > 0.0)

@@ -109,6 +109,9 @@ class GearPair:
     checks : dict
         Numbers of the boolean-free checks.
     mesh : MeshResult or None
+    module_choice : dict or None
+        How ``module_mm = "auto"`` chose the module (:func:`fabricate.gears.auto.choose_module`); None when the
+        template fixed it (a module, or a closed pair's teeth).
     """
 
     name: str
@@ -139,6 +142,7 @@ class GearPair:
     rack_origin: float = 0.0
     checks: dict[str, Any] = field(default_factory=dict)
     mesh: MeshResult | None = None
+    module_choice: dict[str, Any] | None = None
 
     @property
     def module_mm(self) -> float:
@@ -184,12 +188,16 @@ class GearPair:
             "bore_mm": [float(self.bore_a_mm), float(self.bore_b_mm)],
             "outline_vertices": [int(len(self.outline_a)), int(len(self.outline_b))],
         })
+        if self.module_choice is not None:  # only an automatic module: a fixed one's report is unchanged
+            out["module_choice"] = self.module_choice
         return out
 
     def failures(self) -> list[str]:
         """Human-readable failed checks (empty when the pair is fine)."""
         c, out = self.checks, []
         m = self.module
+        if self.module_choice is not None and not self.module_choice["found"]:
+            out.append(f"module auto: {self.module_choice['unsatisfied']}")
         if c["undercut"]:
             out.append(f"undercut: min pitch radius of curvature {c['min_pitch_radius_of_curvature_mm']:.3g} mm "
                        f"< {c['undercut_limit_radius_mm']:.3g} mm; use module <= "

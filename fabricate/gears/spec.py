@@ -6,8 +6,12 @@ and the centre distance come from the mechanism (a :class:`~fabricate.mechanism.
 
 Keys (all optional)
 -------------------
-``module_mm``            float in [0.05, 50]. Module m in mm. Absent: chosen automatically — for a closed pair from
-                         the tooth count and centre distance, for a sector 0.5 mm (an SLA-sized module).
+``module_mm``            float in [0.05, 50], or ``"auto"`` (the default when absent). Module m in mm. A number
+                         fixes it: a process that cannot make its teeth fails the build naming the tooth feature
+                         (tip land, undercut, Lewis/Hertz safety). ``"auto"``: the smallest standard module
+                         (DIN 780-1 series 1 and 2) whose teeth the process makes and the load allows
+                         (:mod:`fabricate.gears.auto`); a closed pair given ``teeth`` takes the module its tooth
+                         count and centre distance give instead.
 ``pressure_angle_deg``   float in [10, 35], default 20. Pressure angle of the generating rack. Above about
                          22 degrees the default root fillet no longer fits the rack's tooth space and
                          is reduced to the largest that does (above about 31 degrees also the default
@@ -70,7 +74,8 @@ class GearSpec:
     Attributes
     ----------
     module_mm : float or None
-        Module in mm; None means "choose" (see the module docstring).
+        Module in mm; None means ``"auto"`` (see the module docstring; a closed pair with ``teeth`` takes the
+        module they give).
     pressure_angle_deg : float
         Rack pressure angle, degrees.
     addendum, dedendum, root_fillet : float
@@ -138,7 +143,11 @@ def parse_gear_spec(table: Table) -> GearSpec:
     SpecError
         On a field out of range, naming ``gears.<key>`` and the accepted range.
     """
-    module = table.number("module_mm", None, min=MIN_MODULE_MM, max=50.0)
+    # "auto" and an absent key are the same request: the module is chosen (fabricate.gears.auto)
+    auto = table.has("module_mm") and table.raw("module_mm") == "auto"
+    if table.has("module_mm") and isinstance(table.raw("module_mm"), str) and not auto:
+        raise SpecError(table.field("module_mm"), f'expected a module in mm or "auto", got "{table.raw("module_mm")}"')
+    module = None if auto else table.number("module_mm", None, min=MIN_MODULE_MM, max=50.0)
     pressure = table.number("pressure_angle_deg", 20.0, min=10.0, max=35.0)
     addendum = table.number("addendum", 1.0, min=0.3, max=1.5)
     dedendum = table.number("dedendum", 1.25, min=0.5, max=2.0)

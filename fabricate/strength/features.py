@@ -340,19 +340,30 @@ def _tooth_normal_force(pair: GearPair, torque_b: np.ndarray, motion: Motion) ->
     return normal
 
 
-def gear_findings(pair: GearPair, torque_b: np.ndarray, mechanism: Mechanism, motion: Motion, parts: list[Part],
-                  material: Material) -> list[Finding]:
-    """Lewis root bending and Hertz contact of one gear pair at every pose, under the statics' torque.
+@dataclass(frozen=True)
+class ToothStresses:
+    """Lewis root bending of each gear and Hertz contact of a pair at every pose (:func:`tooth_stresses`).
+
+    ``lewis`` maps the gear (``"a"``, ``"b"``) to its root stress (MPa), Lewis form factor and equivalent tooth
+    count per pose; ``tangential_N`` and ``normal_N`` are the tooth loads they come from."""
+
+    tangential_N: np.ndarray
+    normal_N: np.ndarray
+    lewis: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]
+    hertz_MPa: np.ndarray
+
+
+def tooth_stresses(pair: GearPair, torque_b: np.ndarray, motion: Motion, face_mm: float,
+                   material: Material) -> ToothStresses:
+    """Lewis root bending and Hertz contact of one gear pair at every pose, under the torque on gear b.
 
     At each pose the pitch point lies on the line of centres, ``r_a = a i / (1 + i)`` from axis a (``i`` the
     instantaneous ratio); the local radius of curvature of each pitch curve there makes the equivalent
     spur gear (``z_eq = 2 rho / m``) whose Lewis form factor the tooth gets, and the two radii (times
     sin phi) are the involute flanks' radii for Hertz. A concave stretch takes the rack's form factor
-    and bears as a concave surface.
+    and bears as a concave surface. The Hertz stress does not depend on the module (only on the pitch
+    curves, the load and the face width): a larger module relieves the root, never the contact.
     """
-    face = min((p.thickness_mm for p in parts if p.gear == pair.name), default=None)
-    if face is None:
-        return []
     xa = motion.relative_angle(pair.body_a, pair.carrier)
     xb = motion.relative_angle(pair.body_b, pair.carrier)
     ratio = np.abs(np.asarray(pair.law(xa, 1), dtype=np.float64))
@@ -365,30 +376,47 @@ def gear_findings(pair: GearPair, torque_b: np.ndarray, mechanism: Mechanism, mo
     contact_b = r_b[:, None] * np.column_stack([np.cos(math.pi - xb), np.sin(math.pi - xb)])
     rho_a = local_radius(pair.pitch_a, contact_a)
     rho_b = local_radius(pair.pitch_b, contact_b)
-    found = []
+    lewis = {}
     for gear, rho in (("a", rho_a), ("b", rho_b)):
         with np.errstate(divide="ignore", invalid="ignore"):
             teeth = np.where(np.isfinite(rho) & (rho > 0), 2.0 * rho / pair.module, np.inf)
         y = np.asarray(gear_teeth.lewis_form_factor(teeth), dtype=np.float64)
-        sigma = np.asarray(gear_teeth.lewis_bending_stress(ft, pair.module, face, y), dtype=np.float64)
-        i = int(np.argmax(sigma))
-        body = pair.body_a if gear == "a" else pair.body_b
-        name = next((p.name for p in parts if p.body == body and p.gear == pair.name), body)
-        found.append(Finding(name, f"gear {pair.name} tooth root (Lewis, Y {y[i]:.3f}, z_eq {teeth[i]:.1f})",
-                                       "gear", float(sigma[i]), material.flexural_MPa, i,
-                                       f"{ft[i]:.1f} N tangential", "a larger module (gears.module) or a thicker plate",
-                                       sigma))
+        sigma = np.asarray(gear_teeth.lewis_bending_stress(ft, pair.module, face_mm, y), dtype=np.float64)
+        lewis[gear] = (sigma, y, teeth)
     fn = ft / math.cos(phi)
     flat = 1e9  # a straight pitch stretch: a flat flank for Hertz
     r1, r2 = gear_teeth.involute_contact_radii(np.where(np.isfinite(rho_a), rho_a, flat),
                                            np.where(np.isfinite(rho_b), rho_b, flat), phi)
-    hertz = np.asarray(gear_teeth.hertz_line_contact_stress(fn, face, r1, r2, material.modulus_MPa, material.poisson,
-                                                        material.modulus_MPa, material.poisson), dtype=np.float64)
+    hertz = np.asarray(gear_teeth.hertz_line_contact_stress(fn, face_mm, r1, r2, material.modulus_MPa,
+                                                        material.poisson, material.modulus_MPa, material.poisson),
+                       dtype=np.float64)
+    return ToothStresses(ft, fn, lewis, hertz)
+
+
+def gear_findings(pair: GearPair, torque_b: np.ndarray, mechanism: Mechanism, motion: Motion, parts: list[Part],
+                  material: Material) -> list[Finding]:
+    """Lewis root bending and Hertz contact of one gear pair (:func:`tooth_stresses`) as findings, the face
+    width the thinnest of the pair's parts."""
+    face = min((p.thickness_mm for p in parts if p.gear == pair.name), default=None)
+    if face is None:
+        return []
+    stresses = tooth_stresses(pair, torque_b, motion, face, material)
+    ft, fn = stresses.tangential_N, stresses.normal_N
+    found = []
+    for gear in ("a", "b"):
+        sigma, y, teeth = stresses.lewis[gear]
+        i = int(np.argmax(sigma))
+        body = pair.body_a if gear == "a" else pair.body_b
+        name = next((p.name for p in parts if p.body == body and p.gear == pair.name), body)
+        found.append(Finding(name, f"gear {pair.name} tooth root (Lewis, Y {y[i]:.3f}, z_eq {teeth[i]:.1f})",
+                             "gear", float(sigma[i]), material.flexural_MPa, i, f"{ft[i]:.1f} N tangential",
+                             "a larger module (gears.module_mm) or a thicker plate", sigma))
+    hertz = stresses.hertz_MPa
     i = int(np.argmax(hertz))
     name = next((p.name for p in parts if p.gear == pair.name), pair.name)
     found.append(Finding(name, f"gear {pair.name} tooth contact (Hertz)", "gear", float(hertz[i]),
-                                   material.compressive_MPa, i, f"{fn[i]:.1f} N normal",
-                                   "a larger module or a thicker plate", hertz))
+                         material.compressive_MPa, i, f"{fn[i]:.1f} N normal",
+                         "a thicker plate or a lighter load (the contact stress does not depend on the module)", hertz))
     return found
 
 
