@@ -84,6 +84,34 @@ def legend(ax: Any, *args: Any, fontsize: float | None = None, **kwargs: Any) ->
     return ax.legend(*args, fontsize=size, **kwargs)
 
 
+def legend_below(fig: Any, ax: Any, axes_height_in: float, columns: int = 2, **kwargs: Any) -> Any:
+    """A legend of ``ax``'s series in ``columns`` columns under it, the figure grown to hold it.
+
+    Long entries (a part, its feature and its Kt) keep their whole text at :data:`MIN_LEGEND_PT`, which a
+    legend beside the axes cut at the figure's edge. Sets the figure's height and the axes' margins.
+
+    Parameters
+    ----------
+    fig, ax
+        The figure and its one axes.
+    axes_height_in : float
+        Height of the axes with its title and tick labels (inches).
+    columns : int
+    **kwargs
+        As :func:`legend`.
+    """
+    handles, labels = ax.get_legend_handles_labels()
+    rows = -(-len(handles) // max(1, columns))
+    legend_in = 0.15 + 0.17 * rows  # 8 pt rows
+    height = axes_height_in + legend_in
+    width = fig.get_size_inches()[0]
+    fig.set_size_inches(width, height)
+    fig.subplots_adjust(left=0.8 / width, right=1.0 - 0.25 / width, bottom=(legend_in + 0.5) / height,
+                        top=1.0 - 0.4 / height)
+    return legend(fig, handles, labels, loc="lower center", ncol=columns, frameon=False,
+                  bbox_to_anchor=(0.5, 0.0), **kwargs)
+
+
 def _is_grey(rgba: Sequence[float]) -> bool:
     return max(rgba[:3]) - min(rgba[:3]) < 0.02
 

@@ -120,7 +120,8 @@ def test_strength_plot_gives_each_of_twelve_parts_its_own_colour():
     from fabricate.strength.plots import MAX_PARTS, strength_figure
 
     x = np.linspace(0.0, 360.0, 50)
-    findings = [Finding(part=f"part_{k:02d}", feature="net section", kind="link", stress_MPa=1.0 + k,
+    feature = "section at hole G1+G1r: N -20.0 N, M -254 N·mm (Kt 2.23)"  # as long as the plot's entries get
+    findings = [Finding(part=f"part_{k:02d}", feature=feature, kind="link", stress_MPa=1.0 + k,
                         allowable_MPa=40.0, pose=0, load="design", fix="", curve=(1.0 + k) * np.sin(np.radians(x)) ** 2)
                 for k in range(14)]
     result = StrengthResult(findings=findings, statics=None, min_safety_factor=2.0, inputs=x)
@@ -130,6 +131,10 @@ def test_strength_plot_gives_each_of_twelve_parts_its_own_colour():
     assert len(colours) == MAX_PARTS + 1  # the parts drawn and the limit line
     assert len(set(colours[:MAX_PARTS])) == MAX_PARTS  # root and tip no longer both blue
     assert figure_problems(fig) == []
+    # every entry whole: the legend inside the figure (beside the axes it ran past the right edge)
+    fig.canvas.draw()
+    box = (fig.legends[0] if fig.legends else ax.get_legend()).get_window_extent()
+    assert box.x0 >= 0 and box.y0 >= 0 and box.x1 <= fig.bbox.x1 and box.y1 <= fig.bbox.y1
     assert png_bytes(strength_figure(result, "deg")) == png_bytes(strength_figure(result, "deg"))
 
 

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from fabricate.checks.interference import InterferenceResult
-from fabricate.plotting import figure, legend, png_bytes, series_styles
+from fabricate.plotting import figure, legend_below, png_bytes, series_styles
 
 #: Pairs drawn: the closest ones (the others are in the report's table).
 MAX_PAIRS = 12
@@ -64,7 +64,6 @@ def clearance_figure(result: InterferenceResult, max_pairs: int = MAX_PAIRS) -> 
     ax.set_ylim(-0.05 * top, 1.05 * top)
     ax.set_title(f"Clearance over the motion ({len(x)} poses, {len(result.pairs)} pairs)")
     ax.grid(True, alpha=0.3)
-    legend(ax, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
-    # fixed margins (tight_layout would draw the figure twice)
-    fig.subplots_adjust(left=0.07, right=0.7, bottom=0.11, top=0.92)
+    # under the axes in two columns, each entry whole (fixed margins: tight_layout would draw the figure twice)
+    legend_below(fig, ax, 4.0)
     return fig

@@ -76,9 +76,10 @@ def pair_figure(pair: GearPair, x_a: float) -> Any:
     for ax in (ax1, ax2):
         ax.set_xlabel("x (mm)")
         ax.tick_params(labelsize=7)
-    legend(ax1, loc="upper left", framealpha=0.8)
-    legend(ax2, loc="upper left", framealpha=0.8)
-    fig.subplots_adjust(left=0.06, right=0.98, bottom=0.12, top=0.92, wspace=0.15)
+    # one legend for both panels, under them (inside, it hid teeth of the zoom)
+    handles, labels = ax1.get_legend_handles_labels()
+    legend(fig, handles, labels, loc="lower center", ncol=len(handles), frameon=False)
+    fig.subplots_adjust(left=0.06, right=0.98, bottom=0.16, top=0.92, wspace=0.15)
     return fig
 
 

@@ -198,7 +198,8 @@ def motion_gif(parts: Sequence[Part], motion: Motion, frames: int = 24, size_px:
         return [(round(float(a), 2), round(float(b), 2)) for a, b in zip(x, y, strict=True)]
 
     # a fixed palette: index 0 white, 1 outline grey, 2.. the layer colours (no per-frame quantising)
-    palette = [255, 255, 255, 40, 40, 40] + [c for rgb in PALETTE for c in rgb]
+    # (the first ten colours always, so a GIF of up to ten parts keeps the bytes it had with a 10-colour palette)
+    palette = [255, 255, 255, 40, 40, 40] + [c for rgb in PALETTE[:max(10, len(parts))] for c in rgb]
     palette += [0] * (768 - len(palette))
     images = []
     for i in indices:

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from fabricate.plotting import figure, legend, png_bytes, series_styles
+from fabricate.plotting import figure, legend_below, png_bytes, series_styles
 from fabricate.strength.check import StrengthResult
 
 #: Parts drawn: the most loaded ones (the rest are in report.md's table).
@@ -33,10 +33,9 @@ def strength_figure(result: StrengthResult, input_unit: str, max_parts: int = MA
     ax.set_title("Strength over the motion: governing stress of each part")
     ax.set_ylim(bottom=0.0)
     ax.grid(True, lw=0.3)
-    legend(ax, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
-    # fixed margins (tight_layout would draw the figure twice); the legend's 70-character entries need the
-    # right third of the figure at 8 pt
-    fig.subplots_adjust(left=0.07, right=0.6, bottom=0.11, top=0.92)
+    # under the axes in two columns: entries of 70 characters at 8 pt, whole (fixed margins: tight_layout
+    # would draw the figure twice)
+    legend_below(fig, ax, 4.0)
     return fig
 
 
