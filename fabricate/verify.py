@@ -255,7 +255,7 @@ def _rebuild(folder: OutputFolder, report: Mapping[str, Any], raw: bytes, progre
     from fabricate.export.step import step_available
     from fabricate.pipeline import OptionalOutputs, run_build, run_synth
     from fabricate.process import ProcessOverride
-    from fabricate.spec import design_from_text
+    from fabricate.design import design_from_text
 
     text = report.get("template_text")
     design_info = report.get("design", {})
