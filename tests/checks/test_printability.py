@@ -599,3 +599,44 @@ def test_a_part_fits_if_some_turn_on_the_plate_fits(sla_process, size, fits_area
     every turn); 150 x 10 is longer than the diagonal."""
     result = check_printability([box_part("p", size, angle_deg=17.0)], sla_process, margin_mm=4.0)
     assert result.passed is fits_area and result.parts[0].fits is fits_area
+
+
+@pytest.mark.slow
+def test_the_gripper_palm_on_the_sl1s_fails_naming_it():
+    """Issue 26's reproduction: the gripper built for the SL1S (--printer prusa_sl1s) exits 1, the palm named
+    with its size and the printer's area and margin, and no plate holds a part outside its bed."""
+    from fabricate.design import load_design
+    from fabricate.pipeline import run_build
+
+    outcome = run_build(load_design("gripper_compliant", None, "prusa_sl1s"))
+    assert outcome.exit_code == 1
+    assert ("printability: palm (129.9 × 45.1 × 12 mm) does not fit the prusa_sl1s build volume 127 × 80 × 150 mm "
+            "inside its 4 mm margin (119 × 72 mm usable, at any rotation on the plate)") in outcome.failures
+    palm = next(p for p in outcome.report["parts"] if p["name"] == "palm")
+    assert palm["plate"]["fits"] is False
+    assert all(p["plate"]["fits"] for p in outcome.report["parts"] if p["name"] != "palm")
+
+
+@pytest.mark.slow
+def test_the_gripper_palm_on_every_sla_preset_fits_or_is_named(shipped_build):
+    """On each SLA preset the palm either fits at some turn inside the plate margin (and the check passes it)
+    or the check names it with the preset's area."""
+    from fabricate.catalogue.printers import printers_for
+    from fabricate.design import load_design
+    from fabricate.export.layout import fitting_angle
+
+    outcome = shipped_build("gripper_compliant")
+    palm = next(p for p in outcome.partset.parts if p.name == "palm")
+    margin = outcome.design.parts.plate_spacing_mm
+    verdicts = {}
+    for name in printers_for("sla"):
+        process = load_design("gripper_compliant", None, name).process
+        result = check_printability([palm], process, margin_mm=margin)
+        usable = (process.build_volume_mm[0] - 2 * margin, process.build_volume_mm[1] - 2 * margin)
+        fits_area = fitting_angle(palm.polygons(process.chord_tolerance_mm)[0], *usable) is not None
+        assert result.passed is fits_area
+        if not fits_area:
+            assert result.failures[0].startswith(f"printability: palm (129.9 × 45.1 × 12 mm) does not fit the {name} "
+                                                 "build volume")
+        verdicts[name] = fits_area
+    assert verdicts["prusa_sl1s"] is False and verdicts["elegoo_saturn_3"] is True
