@@ -154,6 +154,7 @@ def figure_problems(fig: Any) -> list[str]:
     - an axes with unlabelled curves in two or more colours (other than greys) and no legend: a multi-curve
       plot a reader cannot decode.
     """
+    import numpy as np
     from matplotlib.colors import to_rgba
     from matplotlib.lines import Line2D
 
@@ -178,7 +179,8 @@ def figure_problems(fig: Any) -> list[str]:
                 problems.append(f"axes {k}: {styles[style]!r} and {label!r} are drawn alike")
             styles.setdefault(style, label)
         unlabelled = {tuple(round(c, 3) for c in to_rgba(line.get_color())) for line in ax.get_lines()
-                      if isinstance(line, Line2D) and line.get_label().startswith("_") and len(line.get_xdata()) > 2}
+                      if isinstance(line, Line2D) and str(line.get_label()).startswith("_")
+                      and np.size(line.get_xdata()) > 2}
         coloured = {c for c in unlabelled if not _is_grey(c)}
         if len(coloured) >= 2 and not entries and ax.get_legend() is None and not fig.legends:
             problems.append(f"axes {k}: {len(coloured)} colours of curves and no legend")
