@@ -49,7 +49,7 @@ from fabricate.planar import inverse_transform_points, rotation
 
 if TYPE_CHECKING:
     from fabricate.catalogue.actuators import Actuator
-    from fabricate.checks.interference import SweepItem
+    from fabricate.checks.items import SweepItem
     from fabricate.drive.spec import ActuatorSpec
     from fabricate.parts.build import PartSet
     from fabricate.process import ProcessSpec
@@ -231,7 +231,7 @@ def attach_actuator(design: Any, mechanism: Mechanism, motion: Motion, partset: 
 
 def sweep_items(partset: Any) -> list[SweepItem]:
     """The actuator's solids as interference-sweep items of kind ``"actuator"`` (none without an actuator)."""
-    from fabricate.checks.interference import SweepItem
+    from fabricate.checks.items import SweepItem
 
     placed: PlacedActuator | None = getattr(partset, "actuator", None)
     if placed is None:

@@ -58,7 +58,7 @@ from fabricate.mechanism import Mechanism, Motion, Revolute
 from fabricate.parts.model import Hole, Part, circle_polygon
 
 if TYPE_CHECKING:
-    from fabricate.checks.interference import SweepItem
+    from fabricate.checks.items import SweepItem
     from fabricate.parts.bom import Pin
     from fabricate.process import ProcessSpec
 
@@ -579,7 +579,7 @@ def spring_sweep_items(springs: Sequence[PlacedSpring], chord_tolerance_mm: floa
     body. The coil's end bears on the plate it sits on (kind ``spacer``: touching is its job, an overlap is
     not); the legs share the anchor name with the coil (they are its wire: they touch it, never overlap).
     """
-    from fabricate.checks.interference import SweepItem
+    from fabricate.checks.items import SweepItem
 
     items: list[SweepItem] = []
     tol = chord_tolerance_mm

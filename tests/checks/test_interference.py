@@ -24,13 +24,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from fabricate.checks.distance import Outline, RelativePoses, planar_clearance
-from fabricate.checks.interference import (
-    OVERLAP_SAMPLES,
-    PinSolid,
-    naive_interference,
-    pins_from_parts_layer,
-    sweep_interference,
-)
+from fabricate.checks.interference import OVERLAP_SAMPLES, naive_interference, sweep_interference
+from fabricate.checks.items import PinSolid, pins_from_parts_layer
 from fabricate.mechanism import Motion
 from fabricate.parts.model import BulgePath, Hole, Part
 from fabricate.planar import transform_points
@@ -256,7 +251,7 @@ def test_pins_from_holes_one_per_shared_joint_through_every_part():
     (ties by name), on that part's hole centre, with the holes' nominal pin diameter (also 1 mm and
     below), from the lowest bottom face to the highest top face. A pin hole on one body only (M, listed
     first) is a mounting hole and makes no pin, nor do screw holes (pin diameter 0) on two bodies."""
-    from fabricate.checks.interference import pins_from_holes
+    from fabricate.checks.items import pins_from_holes
 
     parts = [
         box_part("L", "a", (20.0, 6.0), 1.0, 2.0, holes=(Hole("M", np.array([-5.0, 0.0]), 2.5, 2.0),
@@ -300,7 +295,7 @@ def test_spacer_items_are_rings_of_the_spacers_not_modelled_as_parts():
     within the chord tolerance, on the spacer's centre) from z to z + length on their body. Skipped: a
     spacer already modelled as a spacer part (that body, that joint) and a zero-length one; kept: a
     0.3 mm washer. A second tube of the same name gets its list index appended."""
-    from fabricate.checks.interference import spacer_items
+    from fabricate.checks.items import spacer_items
     from fabricate.planar import polygon_area
 
     modelled = Part("sleeve", "b", BulgePath.polyline(np.array([[-2.0, -2.0], [2.0, -2.0], [2.0, 2.0], [-2.0, 2.0]])),

@@ -9,7 +9,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from fabricate.checks.interference import SweepItem, sweep_interference
+from fabricate.checks.interference import sweep_interference
+from fabricate.checks.items import SweepItem
 from fabricate.parts.build import build_parts
 from fabricate.parts.spec import PartsSpec
 

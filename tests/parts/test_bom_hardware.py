@@ -222,7 +222,7 @@ def test_shipped_pins_hardware_and_holes(template, shipped_build):
 def test_interference_proof_sees_the_standard_pins_and_their_end_pieces(four_bar, laser_process):
     """The proof sweeps each pin over its own length (stack and clip ends), and each clip and washer on its end
     as a ring where it stands; a pin shortened to its stack would leave the clips floating."""
-    from fabricate.checks.interference import pin_items, pins_from_parts_layer, spacer_items
+    from fabricate.checks.items import pin_items, pins_from_parts_layer, spacer_items
     from tests.parts.test_build import design_for
 
     partset = build_parts(design_for(laser_process, PartsSpec()), four_bar, four_bar.sweep(61), [])
