@@ -18,6 +18,7 @@ from fabricate.drive import geometry as geo
 from fabricate.drive.mount import MountPlacement
 from fabricate.drive.parts import (
     BODY_ROLES,
+    ROTARY,
     Fastener,
     PlacedActuator,
     body_part,
@@ -52,6 +53,58 @@ def driver_joint(mechanism: Mechanism, driver: Driver) -> str:
                                            f"{driver.reference!r}, joined by {len(found)} revolute joints; "
                                            "an actuator needs exactly one axis")
     return found[0]
+
+
+def motor_top_mm(entry: Actuator, thickness_mm: float) -> float:
+    """Height (mm) above a shaft motor's output face of what stands toward the stack: the output's base, the
+    mount plate (``thickness_mm``) and the heads of screws into the motor's tapped holes."""
+    plate0 = geo.mount_plate_z(entry)
+    top = max(geo.output_base_z(entry), plate0 + thickness_mm)
+    tapped = [h.thread for h in entry.mounting_holes or () if h.thread in ISO4762]
+    if tapped:  # screws into the motor's tapped holes: their heads on the plate, toward the stack
+        top = max(top, plate0 + thickness_mm + max(ISO4762[s].head_h_mm for s in tapped))
+    return top
+
+
+def replaced_joint(design: Any, mechanism: Mechanism) -> str | None:
+    """The joint whose pin a rotary actuator's output replaces (its driver's), or None (no rotary actuator, or
+    one that does not resolve)."""
+    spec = getattr(design, "actuator", None)
+    if spec is None:
+        return None
+    try:
+        entry = spec.entry()
+    except SpecError:
+        return None
+    if spec.driver >= len(mechanism.drivers) or entry.kind not in ROTARY:
+        return None
+    driver = mechanism.drivers[spec.driver]
+    return driver_joint(mechanism, driver) if driver.kind == "angle" else None
+
+
+def output_depth(design: Any, mechanism: Mechanism) -> tuple[str, float] | None:
+    """How deep in the stack the driven part of a shaft (or bare spline) output may lie: (driven body, mm from
+    the stack's outer face to the part's near face) for which the output still reaches half way into the part
+    with the motor and its plate clear of the stack (:meth:`RotaryPlacement._face`); the layer order keeps the
+    driven part there (:func:`~fabricate.parts.layers.order_layers`). None for a horn (flush with the driven
+    part), a pushing actuator or no actuator, and where the design's actuator does not resolve (the drive
+    stage says why)."""
+    spec = getattr(design, "actuator", None)
+    if spec is None:
+        return None
+    try:
+        entry = spec.entry()
+    except SpecError:
+        return None
+    if spec.driver >= len(mechanism.drivers) or entry.kind not in ROTARY or entry.horn is not None:
+        return None
+    driver = mechanism.drivers[spec.driver]
+    output = entry.shaft if entry.shaft is not None else entry.spline
+    if driver.kind != "angle" or output is None:
+        return None
+    process = design.process
+    t = float(process.thickness_mm)
+    return driver.body, float(output.length_mm) - float(process.layer_gap_mm) - motor_top_mm(entry, t) - 0.5 * t
 
 
 class RotaryPlacement(MountPlacement):
@@ -96,21 +149,27 @@ class RotaryPlacement(MountPlacement):
             seat1 = geo.horn_seat_z(entry)[1]
             return z_d + t_d + seat1 if flip else z_d - seat1
         shaft = self._shaft()
-        plate0 = geo.mount_plate_z(entry)
-        top = max(geo.output_base_z(entry), plate0 + t)
-        tapped = [h.thread for h in entry.mounting_holes or () if h.thread in ISO4762]
-        if tapped:  # screws into the motor's tapped holes: their heads on the plate, toward the stack
-            top = max(top, plate0 + t + max(ISO4762[s].head_h_mm for s in tapped))
+        top = motor_top_mm(entry, t)
         gap = float(self.process.layer_gap_mm)
         lo = min(p.z_mm for p in self.ps.parts)
         hi = max(p.z_mm + p.thickness_mm for p in self.ps.parts)
-        if flip:
-            z_face = max(z_d + shaft.length_mm, hi + gap + top)
-            short = z_face - shaft.length_mm > z_d + 0.5 * t_d + 1e-9
-        else:
-            z_face = min(z_d + t_d - shaft.length_mm, lo - gap - top)
-            short = z_face + shaft.length_mm < z_d + 0.5 * t_d - 1e-9
-        return math.inf if short else z_face
+        # a pin's end (its clip, washers) sticking out of the stack within the body's reach: the motor clears it
+        corners = [np.hypot(x, y) for b in entry.body or () for x in (b.x0, b.x1) for y in (b.y0, b.y1)]
+        reach = max(corners, default=0.0) + self.c
+        at = shapely.Point(*self.mechanism.body(self.ground).point(self.joint))
+        near = [(z0, z1) for geom, z0, z1 in self._pin_obstacles() if geom.distance(at) < reach]
+        # clear of those where the shaft still reaches (else only of the parts: the interference proof names the
+        # pin end the motor meets)
+        for lo_, hi_ in ((min([lo] + [z0 for z0, _ in near]), max([hi] + [z1 for _, z1 in near])), (lo, hi)):
+            if flip:
+                z_face = max(z_d + shaft.length_mm, hi_ + gap + top)
+                short = z_face - shaft.length_mm > z_d + 0.5 * t_d + 1e-9
+            else:
+                z_face = min(z_d + t_d - shaft.length_mm, lo_ - gap - top)
+                short = z_face + shaft.length_mm < z_d + 0.5 * t_d - 1e-9
+            if not short:
+                return z_face
+        return math.inf
 
     def _horn_layout(self, thickness_mm: float) -> tuple[float, str, float, Screw, tuple[MountHole, ...]]:
         """The horn's interface on a driven part ``thickness_mm`` thick: hub bore (nominal), screw size, pilot

@@ -11,7 +11,8 @@ deterministic).
 from __future__ import annotations
 
 import itertools
-from collections.abc import Mapping, Sequence
+import math
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import shapely
@@ -195,27 +196,144 @@ def pin_crossings(outlines: Mapping[str, np.ndarray], world_poses: Mapping[str, 
     return out
 
 
-def order_layers(layers: Mapping[str, int], crossings: Sequence[tuple[str, str, str]],
-                 max_layers: int = 7) -> dict[str, int]:
-    """Renumber the layers (keeping who shares a layer) so no body sits between the layers of a pin it
-    passes over.
+def pin_neighbours(pins: Sequence[tuple[np.ndarray, str]], world_poses: Mapping[str, np.ndarray],
+                   within_mm: float) -> list[tuple[int, int]]:
+    """Pairs of pins that come within ``within_mm`` of each other (centre to centre) anywhere over the motion.
 
-    Every permutation of up to ``max_layers`` layers is tried; the first with the fewest violations wins
-    (the identity first, so a colouring that already works is kept).
+    Parameters
+    ----------
+    pins : sequence of ((2,) centre in the body's coordinates, body)
+    world_poses : Mapping[str, (k, 3) array]
+        Each body's world poses over the motion.
+    within_mm : float
+
+    Returns
+    -------
+    list of (int, int)
+        Indices into ``pins``, the lower first.
+    """
+    k = len(next(iter(world_poses.values()))) if world_poses else 0
+    pick = np.unique(np.linspace(0, max(k - 1, 0), min(k, MAX_CONFLICT_POSES)).round().astype(int))
+    paths = []
+    for centre, body in pins:
+        pose = np.asarray(world_poses[body], dtype=np.float64)[pick]
+        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+        paths.append(np.column_stack([centre[0] * c - centre[1] * s + pose[:, 0],
+                                      centre[0] * s + centre[1] * c + pose[:, 1]]))
+    out = []
+    for i, j in itertools.combinations(range(len(pins)), 2):
+        rel = paths[i] - paths[j]
+        # the pins move at most this far apart between samples
+        margin = 0.5 * float(np.max(np.hypot(*np.diff(rel, axis=0).T))) if len(rel) > 1 else 0.0
+        if float(np.min(np.hypot(rel[:, 0], rel[:, 1]))) - margin < within_mm:
+            out.append((i, j))
+    return out
+
+
+#: The layer order tries at most this many arrangements for one number of layers.
+MAX_ARRANGEMENTS = 400_000
+#: What a driven part out of its motor shaft's reach counts in the layer order (a collision counts 1).
+OUT_OF_REACH = 1000
+
+
+def order_layers(layers: Mapping[str, int], crossings: Sequence[tuple[str, str, str]],
+                 max_layers: int = 7, *, pins: Sequence[tuple[str, ...]] = (),
+                 end_crossings: Sequence[tuple[int, str]] = (), pin_pairs: Sequence[tuple[int, int]] = (),
+                 end_reach: Callable[[float], float] | None = None, thickness_mm: float = 1.0,
+                 gap_mm: float = 0.0, spare_layers: int = 0, outer: Sequence[tuple[str, float]] = ()
+                 ) -> dict[str, int]:
+    """Renumber the layers (keeping who shares a layer) so no body sits between the layers of a pin it
+    passes over, nor where a pin's end sticks out of its stack.
+
+    Every arrangement of the layers is tried, the identity first (so a colouring that already works is
+    kept): first with no empty layer, then with up to ``spare_layers`` empty layers among them, while some
+    arrangement still has a violation. The first with the fewest violations wins (fewest layers on a tie).
+
+    A pin whose retention sticks out of its stack (a clip and its washers, or a bonded cap: ``end_reach``)
+    takes the room beyond each end face at its position: a body that passes over the pin (``end_crossings``)
+    may not lie there, nor may another pin near it (``pin_pairs``) reach there with its stack or its own
+    ends. An empty layer gives such an end its room.
+
+    Parameters
+    ----------
+    layers : Mapping[str, int]
+        The colouring (:func:`assign_layers`).
+    crossings : sequence of (body a, body b, body c)
+        ``c`` passes over the spacer of the pin of ``a`` and ``b`` (:func:`pin_crossings`).
+    max_layers : int
+        No arrangement is searched beyond this many layers (nor is one of more colours reordered).
+    pins : sequence of tuple of str
+        Each pin's bodies (the stack runs from the lowest of their layers to the highest).
+    end_crossings : sequence of (int, str)
+        (pin index, body) the body passes over the pin's end (its retention hardware).
+    pin_pairs : sequence of (int, int)
+        Pins whose stacks or ends come near each other (:func:`pin_neighbours`).
+    end_reach : callable, optional
+        Stack length (mm) -> how far (mm) the pin and its retention reach beyond each end face; none: 0.
+    thickness_mm, gap_mm : float
+        Layer thickness and the gap between layers (:func:`layer_z`).
+    spare_layers : int
+        At most this many empty layers may be put among the bodies' layers.
+    outer : sequence of (str, float)
+        (body, depth mm): the body's part lies at most this deep under the stack's bottom or top face (a motor's
+        short shaft reaches it from outside the stack; :data:`OUT_OF_REACH` violations if not), and at most that
+        less how far the pins' ends stick out there (one violation if not: the motor meets a pin's end).
+
+    Returns
+    -------
+    dict[str, int]
     """
     count = 1 + max(layers.values(), default=0)
-    if not crossings or count > max_layers:
+    ends = end_reach is not None and bool(pins) and bool(end_crossings or pin_pairs)
+    if (not crossings and not ends and not outer) or count > max_layers:
         return dict(layers)
-
-    def violations(perm: tuple[int, ...]) -> int:
-        bad = 0
+    pitch = thickness_mm + gap_mm
+    eps = 1e-6
+    best: tuple[int, np.ndarray] | None = None
+    for extra in range(0, spare_layers + 1 if ends else 1):
+        slots = count + extra
+        if slots > max_layers or math.perm(slots, count) > MAX_ARRANGEMENTS:
+            break
+        perms = np.array(list(itertools.permutations(range(slots), count)), dtype=np.int64).reshape(-1, count)
+        if extra:  # an empty layer at the bottom or top is no arrangement of its own (one fewer layers, moved)
+            perms = perms[(perms.min(axis=1) == 0) & (perms.max(axis=1) == slots - 1)]
+        bad = np.zeros(len(perms), dtype=np.int64)
+        reach_of = np.array([end_reach(s * pitch + thickness_mm) if end_reach is not None else 0.0
+                             for s in range(slots)])
+        stuck_out = float(np.max(reach_of))
+        for body, depth in outer:
+            zc = perms[:, layers[body]] * pitch
+            top = (perms.max(axis=1) - perms[:, layers[body]]) * pitch
+            # out of the shaft's reach the design cannot be built: that outweighs any collision
+            bad += OUT_OF_REACH * ((zc > depth + eps) & (top > depth + eps))
+            bad += (zc > depth - stuck_out + eps) & (top > depth - stuck_out + eps)
         for a, b, c in crossings:
-            lo, hi = sorted((perm[layers[a]], perm[layers[b]]))
-            bad += lo < perm[layers[c]] < hi
-        return bad
-
-    best = min(itertools.permutations(range(count)), key=violations)
-    return {name: best[layer] for name, layer in layers.items()}
+            pa, pb, pc = perms[:, layers[a]], perms[:, layers[b]], perms[:, layers[c]]
+            bad += (np.minimum(pa, pb) < pc) & (pc < np.maximum(pa, pb))
+        if ends:
+            lo = np.stack([perms[:, [layers[b] for b in bodies]].min(axis=1) for bodies in pins], axis=1)
+            hi = np.stack([perms[:, [layers[b] for b in bodies]].max(axis=1) for bodies in pins], axis=1)
+            z0, z1 = lo * pitch, hi * pitch + thickness_mm
+            reach = reach_of[hi - lo]
+            for i, body in end_crossings:
+                zc = perms[:, layers[body]] * pitch
+                below = (zc < z0[:, i]) & (zc + thickness_mm > z0[:, i] - reach[:, i] + eps)
+                above = (zc >= z1[:, i] - eps) & (zc < z1[:, i] + reach[:, i] - eps)
+                bad += (reach[:, i] > eps) & (below | above)
+            for i, j in pin_pairs:
+                for p, q in ((i, j), (j, i)):
+                    # the ends of p against all of q (its stack and its ends)
+                    q0, q1 = z0[:, q] - reach[:, q], z1[:, q] + reach[:, q]
+                    hit_bottom = (z0[:, p] - reach[:, p] < q1 - eps) & (q0 < z0[:, p] - eps)
+                    hit_top = (z1[:, p] < q1 - eps) & (q0 < z1[:, p] + reach[:, p] - eps)
+                    bad += (reach[:, p] > eps) & (hit_bottom | hit_top)
+        k = int(np.argmin(bad))
+        if best is None or int(bad[k]) < best[0]:
+            best = (int(bad[k]), perms[k])
+        if best[0] == 0:
+            break
+    assert best is not None
+    return {name: int(best[1][layer]) for name, layer in layers.items()}
 
 
 def layer_z(layer: int, thickness_mm: float, gap_mm: float) -> float:

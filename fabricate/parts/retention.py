@@ -48,6 +48,7 @@ from fabricate.catalogue.hardware import (
     e_clip,
     fill_gap,
     pin_lengths,
+    washers_for_shaft,
 )
 from fabricate.errors import SpecError
 from fabricate.process import ProcessSpec
@@ -256,6 +257,35 @@ def plan_pin(joint: str, process: ProcessSpec, stack_z_mm: tuple[float, float], 
         return PinPlan(joint, d, scheme, "", choice, (z0, z1), 2.0 * cap, (end, end))
     except SpecError as exc:
         raise SpecError("process.pin_diameter_mm", f"pin {joint}: {exc.message}") from None
+
+
+def end_reach_mm(process: ProcessSpec, stack_mm: float) -> float:
+    """How far (mm) a pin on a stack ``stack_mm`` long, with what its retention puts on its ends (washers and
+    a clip, or a cap), reaches beyond each end face: what the layer order keeps clear
+    (:func:`~fabricate.parts.layers.order_layers`). 0 for a press fit (its pin ends inside the stack, or
+    sticks out only where no layer lies) and where no standard pin covers the stack (a rod cut to it)."""
+    if process.retention == "press":
+        return 0.0
+    try:
+        plan = plan_pin("", process, (0.0, float(stack_mm)))
+    except SpecError:
+        return 0.0
+    return max(max(e.protrusion_mm, e.cap_mm) for e in plan.ends)
+
+
+def end_radius_mm(process: ProcessSpec) -> float:
+    """Radius (mm) of what a pin's retention puts on its ends: the largest of the clip and the washers a pin of
+    the profile takes, or the cap; 0 for a press fit."""
+    d = float(process.pin_diameter_mm)
+    if process.retention == "clip":
+        try:
+            ring = e_clip(d).ring_od_mm
+        except SpecError:
+            return 0.0
+        return 0.5 * max([ring] + [w.d2_mm for w in washers_for_shaft(d)])
+    if process.retention == "cap":
+        return 0.5 * (hole_size(process, d, "running").modelled_mm + 2.0 * max(process.min_wall_mm, 0.5 * d))
+    return 0.0
 
 
 def _washers(d: float, gap: float) -> tuple[Washer, ...]:

@@ -906,7 +906,7 @@ def test_printed_spacers_on_one_compound_pin_are_numbered_bottom_up(sla_process,
     import fabricate.parts.build as build
 
     forced = {"ground": 0, "coupler": 1, "crank": 2, "rocker": 3, "flap": 4}
-    monkeypatch.setattr(build, "order_layers", lambda layers, crossings: dict(forced))
+    monkeypatch.setattr(build, "order_layers", lambda layers, crossings, **_: dict(forced))
     mech = flapped_four_bar()
     partset = build_parts(design_for(sla_process), mech, mech.sweep(13), [])
     assert partset.layers == forced
