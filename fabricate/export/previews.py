@@ -23,6 +23,10 @@ if TYPE_CHECKING:
 #: Part colours (RGB 0-255): the shared distinct palette (its first ten are matplotlib's tab10, as before).
 PALETTE = palette_rgb255(len(DISTINCT_HEX))
 
+#: Parts the motion GIF draws as outlines: the actuator's mount plate lies over the mechanism, and filled it
+#: hid the gears, links and standoffs under it in every frame.
+SEE_THROUGH_ROLES = ("mount",)
+
 #: Outline tolerance (mm) for pictures.
 PREVIEW_CHORD_MM = 0.05
 
@@ -210,7 +214,11 @@ def motion_gif(parts: Sequence[Part], motion: Motion, frames: int = 24, size_px:
         for part, outline, holes in shapes:
             pose = body_poses.get(part.body, np.zeros(3))
             colour = 2 + part_colour[part.name]
-            draw.polygon(pixels(transform_points(pose, outline)), fill=colour, outline=1)
+            ring = pixels(transform_points(pose, outline))
+            if part.role in SEE_THROUGH_ROLES:  # its outline only: a filled mount plate hid the parts under it
+                draw.line([*ring, ring[0]], fill=colour, width=2)
+                continue
+            draw.polygon(ring, fill=colour, outline=1)
             for centre, radius in holes:
                 if radius > 0:
                     (cx, cy), = pixels(transform_points(pose, centre)[None, :])
