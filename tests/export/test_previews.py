@@ -119,18 +119,21 @@ def test_every_picture_of_a_build_is_readable(shipped_build, drawn, name):
 
 
 @pytest.mark.slow
-def test_strength_and_drive_plots_of_a_build_are_readable(monkeypatch, drawn):
-    """The strength plot with its 12 most loaded parts and the drive plot, as a real build draws them (the
-    pictures drawn in this process, FABRICATE_SERIAL, so each figure can be looked at)."""
-    from fabricate.design import load_design
-    from fabricate.pipeline import run_build
+def test_strength_and_drive_plots_of_a_build_are_readable(shipped_build, drawn):
+    """The strength plot with its 12 most loaded parts and the drive plot of jansen_leg, from the checks as
+    the build runs them."""
+    from fabricate.drive.check import run_drive
+    from fabricate.drive.plots import drive_plot
+    from fabricate.strength.check import run_strength
+    from fabricate.strength.plots import strength_plot
 
-    monkeypatch.setenv("FABRICATE_SERIAL", "1")
-    outcome = run_build(load_design("jansen_leg"))
-    titles = {fig.axes[0].get_title(): fig for fig in drawn if fig.axes}
-    strength = titles["Strength over the motion: governing stress of each part"]
-    colours = plotting.series_colours(strength.axes[0])
+    outcome = shipped_build("jansen_leg")
+    design, partset, motion, synthesis = outcome.design, outcome.partset, outcome.motion, outcome.synthesis
+    strength = run_strength(design, partset, synthesis.mechanism, motion, outcome.gear_pairs, synthesis.parts)
+    assert strength_plot(strength, synthesis.mechanism.input_unit) == outcome.files["plots/strength.png"]
+    drive = run_drive(design, synthesis.mechanism, motion, synthesis.parts, strength, copies=partset.copies)
+    assert drive_plot(drive) == outcome.files["plots/drive.png"]
+    strength_fig, drive_fig = drawn
+    colours = plotting.series_colours(strength_fig.axes[0])
     assert len(colours) == 13 and len(set(colours)) == 13  # 12 parts and the limit, no two alike
-    assert any(t.startswith("Drive:") for t in titles)
-    assert {k: p for k, fig in enumerate(drawn) if (p := plotting.figure_problems(fig))} == {}
-    assert outcome.files["plots/strength.png"].startswith(b"\x89PNG")
+    assert plotting.figure_problems(strength_fig) == [] and plotting.figure_problems(drive_fig) == []
