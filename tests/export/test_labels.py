@@ -11,6 +11,8 @@ import ezdxf
 import numpy as np
 import pytest
 import shapely
+from ezdxf import bbox
+from ezdxf import path as dxf_path
 
 from fabricate.export.dxf import DxfStyle, cut_file_problems, part_dxf, sheet_dxf, sheet_layout
 from fabricate.export.labels import (
@@ -160,3 +162,76 @@ def test_cut_file_problems_names_text_borders_open_paths_and_repeated_lines():
     assert "TEXT on ENGRAVE" in problems and "LWPOLYLINE on SHEET" in problems
     assert "an open path" in problems and "LINE on CUT: not a closed contour" in problems
     assert "CIRCLE on CUT and CIRCLE on CUT touch, cross or repeat" in problems
+
+
+PONOKO = (("P1", 181.0, 181.0), ("P2", 384.0, 384.0), ("P3", 790.0, 384.0))
+
+
+def test_each_sheet_is_the_smallest_standard_sheet_that_holds_its_parts():
+    from fabricate.export.dxf import sized_sheets
+    from fabricate.export.layout import fits
+
+    few = [bar(f"l{k}", length=60.0, width=10.0) for k in range(3)]
+    placements, sheets = sized_sheets(few, 0.2, PONOKO, (790.0, 384.0), 5.0, 3.0)
+    assert [(s.name, s.size_mm) for s in sheets] == [("P1", (181.0, 181.0))]
+    assert all(fits(pl, (181.0, 181.0), 5.0) for pl in placements)
+    assert sheets[0].part_area_mm2 == pytest.approx(sum(p.area_mm2() for p in few))
+    assert sheets[0].utilisation == pytest.approx(sheets[0].part_area_mm2 / 181.0 ** 2)
+    # 40 bars 70 mm long do not fit a P1 (their area alone is larger), they do a P2
+    many = [bar(f"l{k}", length=70.0, width=10.0) for k in range(40)]
+    assert sum(p.area_mm2() for p in many) > 171.0 ** 2
+    _, sheets = sized_sheets(many, 0.2, PONOKO, (790.0, 384.0), 5.0, 3.0)
+    assert [s.name for s in sheets] == ["P2"] and sheets[0].parts == tuple(p.name for p in many)
+    # more than the largest holds: full largest sheets, the rest on the smallest that holds it
+    lots = [bar(f"l{k}", length=300.0, width=40.0) for k in range(13)]
+    placements, sheets = sized_sheets(lots, 0.2, PONOKO, (790.0, 384.0), 5.0, 3.0)
+    assert [s.name for s in sheets][:-1] == ["P3"] * (len(sheets) - 1) and sheets[-1].name in ("P2", "P3")
+    assert sum(len(s.parts) for s in sheets) == len(lots)
+    for pl in placements:
+        assert fits(pl, sheets[pl.sheet].size_mm, 5.0)
+    # a stock larger than the bed is never used; with none, the bed is the sheet
+    _, sheets = sized_sheets(few, 0.2, (("huge", 2000.0, 2000.0),), (600.0, 400.0), 5.0, 3.0)
+    assert [(s.name, s.size_mm) for s in sheets] == [("bed", (600.0, 400.0))]
+
+
+def assert_shop_ready(out, report, process) -> None:
+    """A laser build's folder as a shop gets it (called on every shipped template's ``--process laser`` build by
+    tests/test_process_override.py): no text anywhere, nothing on CUT but part contours, none repeated or
+    touching, every part labelled (name or number, matching the report) or listed unlabelled, and each sheet the
+    stock it names, holding its parts, its utilisation their area over its own."""
+    cut = report["cut"]
+    labels = {row["part"]: row for row in cut["labels"]}
+    assert sorted(labels) == sorted(p["name"] for p in report["parts"])
+    assert sorted(cut["unlabelled"]) == sorted(n for n, row in labels.items() if row["text"] is None)
+    assert len({row["number"] for row in labels.values()}) == len(labels)  # the key is one-to-one
+    stock = {name: (w, h) for name, w, h in process.sheets}
+    files = [f for f in report["files"] if f.startswith("cut/")]
+    for rel in files:
+        data = (out / rel).read_bytes()
+        if rel.endswith(".svg"):
+            assert b"<text" not in data, rel
+            continue
+        assert cut_file_problems(data) == [], rel
+        msp = _read(data)
+        if rel.startswith("cut/sheet_"):
+            continue
+        row = labels[rel[len("cut/"):-len(".dxf")]]
+        engraved = msp.query('LWPOLYLINE[layer=="ENGRAVE"]')
+        assert bool(engraved) == (row["text"] is not None), rel
+        if row["text"] is not None:  # the outline is the text the report names, inside the part
+            outline = max((shapely.Polygon([(v.x, v.y) for v in dxf_path.make_path(e).flattening(0.01)])
+                           for e in msp.query('LWPOLYLINE[layer=="CUT"]')), key=lambda g: g.area)
+            assert all(outline.contains(shapely.Polygon(np.array(e.get_points("xy")))) for e in engraved), rel
+            svg = (out / rel.replace(".dxf", ".svg")).read_text()
+            assert f"<title>{row['text']}</title></path>" in svg, rel
+    areas = {p["name"]: p["area_mm2"] for p in report["parts"]}
+    for sheet in cut["sheets"]:
+        w, h = sheet["size_mm"]
+        assert sorted((w, h)) == sorted(stock[sheet["stock"]]) if stock else sheet["stock"] == "bed"
+        assert sheet["part_area_mm2"] == pytest.approx(sum(areas[n] for n in sheet["parts"]), abs=0.01)
+        assert sheet["utilisation"] == pytest.approx(sheet["part_area_mm2"] / (w * h), abs=1e-4)
+        msp = _read((out / sheet["file"]).read_bytes())
+        box = bbox.extents(msp.query('*[layer=="CUT"]'))
+        assert min(box.extmin.x, box.extmin.y) >= 0.0 and box.extmax.x <= w and box.extmax.y <= h, sheet["file"]
+    assert report["interference"]["shop"]["parts_checked"] == len(report["parts"])
+
