@@ -429,7 +429,7 @@ def cut_file_problems(data: bytes) -> list[str]:
         elif layer not in ("CUT", "ENGRAVE"):
             problems.append(f"{where}: a layer that is neither a cut nor an engraving")
         elif kind == "LWPOLYLINE":
-            if not e.closed:
+            if not getattr(e, "closed", False):
                 problems.append(f"{where}: an open path")
             elif layer == "CUT":
                 ring = shapely.LinearRing([(v.x, v.y) for v in dxf_path.make_path(e).flattening(0.001)])
