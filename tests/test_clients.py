@@ -100,20 +100,19 @@ def test_librecad_draws_dimension_text_at_least_2_5_mm(tmp_path, shipped_build):
 
 # -- PrusaSlicer: every plate on its printer's bed -------------------------------------------------------------
 def _prusaslicer_config(printer: Printer, first_layer_mm: float) -> str:
-    """A PrusaSlicer config of the preset's bed and height (SLA: the exposure area at 10 px/mm, no supports or
-    pad, which would grow the print past the plate; FDM: 0.4 mm nozzle, solid infill), with the profile's
-    first-layer compensation."""
+    """A PrusaSlicer config of the preset's bed and height (SLA: the exposure area at 4 px/mm and 0.1 mm layers,
+    enough to tell whether a plate fits, no supports or pad, which would grow the print past the plate; FDM: a
+    0.4 mm nozzle, 0.3 mm layers, sparse infill), with the profile's first-layer compensation."""
     x, y, z = printer.build_volume_mm
     lines = [f"bed_shape = 0x0,{x:g}x0,{x:g}x{y:g},0x{y:g}", f"max_print_height = {z:g}",
              f"elefant_foot_compensation = {first_layer_mm:g}"]
     if printer.technique == "sla":
         lines += ["printer_technology = SLA", f"display_width = {x:g}", f"display_height = {y:g}",
-                  f"display_pixels_x = {round(10 * x)}", f"display_pixels_y = {round(10 * y)}",
-                  "display_orientation = landscape", "supports_enable = 0", "pad_enable = 0", "layer_height = 0.05"]
+                  f"display_pixels_x = {round(4 * x)}", f"display_pixels_y = {round(4 * y)}",
+                  "display_orientation = landscape", "supports_enable = 0", "pad_enable = 0", "layer_height = 0.1"]
     else:
-        lines += ["printer_technology = FFF", "nozzle_diameter = 0.4", "filament_diameter = 1.75", "layer_height = 0.2",
-                  "first_layer_height = 0.2", "perimeters = 2", "fill_density = 100%", "fill_pattern = rectilinear",
-                  "skirts = 0"]
+        lines += ["printer_technology = FFF", "nozzle_diameter = 0.4", "filament_diameter = 1.75", "layer_height = 0.3",
+                  "first_layer_height = 0.3", "perimeters = 2", "fill_density = 15%", "skirts = 0"]
     return "\n".join(lines) + "\n"
 
 
