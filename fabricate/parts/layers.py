@@ -5,7 +5,10 @@ frame of the other at every sampled pose (the relative swept plan view) and the 
 the two outlines is compared with the clearance. Bodies joined by a pin always conflict (their bosses
 share the pin). Bodies carrying meshing gears are merged into one group first (their teeth must lie in
 one plane) and the groups are coloured greedily (DSATUR, ties broken by body order so it is
-deterministic).
+deterministic). The colours are then put in order (:func:`order_layers`): no body between the two layers of a
+pin it passes over; where a pin's retention sticks out of its stack (a clip and its washers, or a cap), no
+body that passes over the pin's end and no pin near it in the room beyond the end face, with empty layers put
+in where no order of the colours gives that room; a motor's short shaft's driven part near a face of the stack.
 """
 
 from __future__ import annotations
