@@ -221,6 +221,9 @@ def _parser() -> argparse.ArgumentParser:
         cmd.add_argument("--process", metavar="sla|laser|PATH",
                          help="make it with this process profile instead of the template's (the template's "
                               "pin diameter is kept)")
+        cmd.add_argument("--printer", metavar="NAME",
+                         help="print on this printer preset (prusa_sl1s, prusa_mk4, ...: fabricate/catalogue/"
+                              "printers.py): its build volume replaces the profile's and the template's")
     w = sub.add_parser("sweep", help="many designs from one template on Dask: tables, plots, the best built",
                        description="Run a design-space sweep: a spec (TOML with [sweep], [vary], [set]) or a "
                                    "template with --vary. Writes sweep.csv, sweep.parquet, plots/ and best/.")
@@ -272,7 +275,7 @@ def _summary(report: dict, out: Path | None, failures: list[str] | None = None) 
 
 def _output_holding(path: Path) -> Path | None:
     """The nearest of ``path`` and its parents that is a fabricate output folder (it has our report.json)."""
-    from fabricate.output import previous_output
+    from fabricate.output_read import previous_output
 
     for folder in (path, *path.parents):
         if previous_output(folder) is not None:
@@ -315,7 +318,7 @@ def _build(args: argparse.Namespace) -> int:
     from fabricate.pipeline import run_build, run_synth
     from fabricate.process import shipped_profiles
 
-    design = load_design(args.template, args.process)
+    design = load_design(args.template, args.process, args.printer)
     stage = args.command
     target = args.output or _default_output(design.name, Path(design.template), stage)
     # inputs the build reads: never inside the folder replaced, even with --force
@@ -347,13 +350,15 @@ def _check(args: argparse.Namespace) -> int:
                 raise SpecError(args.target, "no such folder or template: 'check' takes a folder written by "
                                              "'fabricate build' or a template (a file, or a name from "
                                              "'fabricate list'), and neither exists") from None
-        outcome = run_build(load_design(args.target, args.process), _progress(args.quiet))
+        outcome = run_build(load_design(args.target, args.process, args.printer), _progress(args.quiet))
         _summary(outcome.report, None)
         return outcome.exit_code
     from fabricate.verify import verify_output
 
     if args.process:
         raise SpecError("--process", "a folder is checked with the process it was built with (see its report)")
+    if args.printer:
+        raise SpecError("--printer", "a folder is checked with the printer it was built for (see its report)")
 
     problems, report = verify_output(target, _progress(args.quiet))
     if report is None:

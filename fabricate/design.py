@@ -26,11 +26,13 @@ from fabricate.templates import find_template, parse_toml, read_text
 GENERIC_SECTIONS = ("design", "process", "checks", "gears", "parts", "load", "actuator")
 
 
-def load_design(path: str | Path, process: str | ProcessOverride | None = None) -> DesignSpec:
+def load_design(path: str | Path, process: str | ProcessOverride | None = None,
+                printer: str | None = None) -> DesignSpec:
     """Load and validate a template file (a path, or a shipped template's name) into a :class:`DesignSpec`.
 
     ``process`` (``--process``: ``"sla"``, ``"laser"``, a profile file or a :class:`ProcessOverride`)
-    replaces the template's process profile.
+    replaces the template's process profile; ``printer`` (``--printer``: a preset of
+    :mod:`fabricate.catalogue.printers`) the printer of the profile and the template.
 
     Raises
     ------
@@ -38,7 +40,11 @@ def load_design(path: str | Path, process: str | ProcessOverride | None = None) 
         On the first invalid field, naming its path.
     """
     path = find_template(path)
-    if isinstance(process, str):
+    if printer is not None:
+        source = process.source if isinstance(process, ProcessOverride) else process
+        process = (ProcessOverride(process.source, process.text, printer) if isinstance(process, ProcessOverride)
+                   else process_override(source, printer))
+    elif isinstance(process, str):
         process = process_override(process)
     return design_from_text(read_text(path), path, process)
 

@@ -119,9 +119,16 @@ def design_section(design: DesignSpec, stage: str) -> dict[str, Any]:
     section: dict[str, Any] = {"name": design.name, "kind": design.kind, "template": Path(design.template).name,
                "fabricate_version": __version__, "description": design.description,
                "process": design.process.name, "stage": stage}
+    if design.process.printer:  # the printer the plates are packed for (fabricate.catalogue.printers)
+        from fabricate.catalogue.printers import printer
+
+        section["printer"] = {**printer(design.process.printer).report(),
+                              "first_layer_compensation_mm": design.process.first_layer_compensation_mm}
     if design.process_override is not None:  # --process: check rebuilds with the same profile
         section["process_override"] = {"source": design.process_override.source,
                                        "text": design.process_override.text}
+        if design.process_override.printer:  # --printer
+            section["process_override"]["printer"] = design.process_override.printer
     return section
 
 
@@ -312,9 +319,12 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
 def _make_gears(run: BuildRun) -> None:
     """One cut, checked gear pair per gear coupling: report.json's ``gears``."""
     from fabricate.gears import build_gear_pairs
+    from fabricate.gears.auto import module_limits
 
     run.enter("gears")
-    run.gear_pairs = build_gear_pairs(run.mechanism, run.design.gears, run.design.process.chord_tolerance_mm)
+    # gears.module_mm = "auto": the smallest standard module the process makes and the load allows
+    run.gear_pairs = build_gear_pairs(run.mechanism, run.design.gears, run.design.process.chord_tolerance_mm,
+                                      lambda: module_limits(run.design, run.mechanism, run.motion, run.synthesis.parts))
     run.report["gears"] = [pair.report() for pair in run.gear_pairs]
 
 
@@ -389,7 +399,7 @@ def _export(run: BuildRun, with_step: bool) -> None:
     run.enter("exports")
     assert run.partset is not None  # the parts stage ran
     exported, parts_report = export_all(run.design, run.partset, run.mechanism, run.motion, previews=False,
-                                        step=False, with_step=with_step)
+                                        step=False, with_step=with_step, sections=run.report)
     run.files.update(exported)
     run.report["parts"] = parts_report
     run.report["bom"] = list(getattr(run.partset, "bom", []))

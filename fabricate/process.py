@@ -401,11 +401,13 @@ def _build_volume(t: Table, template: Table, cli_printer: str, template_fields: 
 
     name = _printer_name(t, template, cli_printer, template_fields)
     if not name:
-        return tuple(t.array("build_volume_mm", shape=(3,), positive=True, max=10000.0).tolist())
+        x, y, z = (float(v) for v in t.array("build_volume_mm", shape=(3,), positive=True, max=10000.0))
+        return x, y, z
     if t.has("build_volume_mm"):  # validated, then replaced by the printer's
         t.array("build_volume_mm", shape=(3,), positive=True, max=10000.0)
     field = "--printer" if cli_printer else t.field("printer")
-    return tuple(float(v) for v in printer(name, field).build_volume_mm)
+    x, y, z = (float(v) for v in printer(name, field).build_volume_mm)
+    return x, y, z
 
 
 def _check_printer(spec: ProcessSpec, field: str) -> None:
@@ -456,7 +458,10 @@ def _interference(t: Table, material: Material | None, name: str, key: str) -> f
 
 def _sheets(t: Table) -> tuple[tuple[str, float, float], ...]:
     """``[sheets]``: ``NAME = [width, height]`` (mm) of each standard stock sheet, smallest area first."""
-    sizes = [(key, *(float(v) for v in t.array(key, shape=(2,), positive=True, max=10000.0))) for key in t.data]
+    sizes: list[tuple[str, float, float]] = []
+    for key in t.data:
+        width, height = (float(v) for v in t.array(key, shape=(2,), positive=True, max=10000.0))
+        sizes.append((key, width, height))
     return tuple(sorted(sizes, key=lambda s: (s[1] * s[2], s[1], s[0])))
 
 

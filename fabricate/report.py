@@ -155,6 +155,10 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
                       [[p.get("name"), p.get("process"), p.get("layer"), p.get("volume_mm3"),
                         ", ".join(f"{h['joint']}: {h['diameter_mm']:.3f}" for h in p.get("holes", [])),
                         p.get("stl"), p.get("dxf")] for p in parts]) + [""]
+    if report.get("cut"):  # a laser build: its sheets, their utilisation, the part-number key and labels
+        from fabricate.export.labels import cut_markdown
+
+        out += cut_markdown(report["cut"])
     assembly = report.get("assembly", {})
     if assembly.get("steps") or assembly.get("guide"):
         out += ["## Assembly", ""]

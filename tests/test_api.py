@@ -144,7 +144,7 @@ def test_build_takes_a_process_like_the_cli(monkeypatch):
         assert seen[-1].template_text == design.template_text
     fabricate.build(design)
     assert seen[-1] is design
-    with pytest.raises(fabricate.SpecError, match="--process: expected sla, laser or a process profile file"):
+    with pytest.raises(fabricate.SpecError, match="--process: expected sla, fdm, laser or a process profile file"):
         fabricate.build(design, process="cnc")
 
 

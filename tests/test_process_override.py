@@ -44,14 +44,18 @@ def test_every_template_builds_for_the_laser_or_names_what_it_cannot_make(templa
         assert failures and all(isinstance(f, str) and ":" in f for f in failures)
     # the design's own pin survives the override; everything else is the laser's
     laser = load_design(template, "laser").process
-    assert laser.kerf_mm == pytest.approx(0.2) and laser.build_volume_mm[:2] == (600.0, 400.0)
+    assert laser.kerf_mm == pytest.approx(0.2) and laser.build_volume_mm[:2] == (790.0, 384.0)
     own = read_toml(TEMPLATE_DIR / f"{template}.toml").get("process", {}).get("pin_diameter_mm")
     assert laser.pin_diameter_mm == (own if own is not None else 3.0)  # else the laser profile's 3 mm
+    # the files a shop takes as sent: no text, only part contours cut, every part labelled or listed, sheets sized
+    from tests.export.test_labels import assert_shop_ready
+
+    assert_shop_ready(out, report, laser)
 
 
 def test_a_bad_process_is_named(tmp_path, capsys):
     assert main(["build", "gear_pair_elliptic", "--process", "waterjet", "-o", str(tmp_path / "o")]) == 2
-    assert "--process: expected sla, laser or a process profile file" in capsys.readouterr().err
+    assert "--process: expected sla, fdm, laser or a process profile file" in capsys.readouterr().err
     profile = tmp_path / "mine.toml"
     profile.write_text((TEMPLATE_DIR / "process_laser.toml").read_text().replace('"#ff0000"', '"red"'))
     assert main(["build", "gear_pair_elliptic", "--process", str(profile), "-o", str(tmp_path / "o")]) == 2
@@ -64,7 +68,7 @@ def test_check_rebuilds_with_the_process_it_was_built_with(tmp_path, capsys):
     profile = tmp_path / "thick.toml"
     profile.write_text((TEMPLATE_DIR / "process_laser.toml").read_text()
                        .replace("thickness_mm = 3.0", "thickness_mm = 4.0")
-                       .replace("build_volume_mm = [600.0, 400.0, 3.0]", "build_volume_mm = [600.0, 400.0, 4.0]"))
+                       .replace("build_volume_mm = [790.0, 384.0, 3.0]", "build_volume_mm = [790.0, 384.0, 4.0]"))
     out = tmp_path / "out"
     code = main(["build", "gear_pair_elliptic", "--process", str(profile), "-o", str(out), "-q"])
     assert code in (0, 1)
@@ -121,6 +125,25 @@ def test_segment_arcs_give_openscad_the_reported_areas(tmp_path):
         # prints 6 significant digits (1e-4 mm here) and its holes are 720-gons
         bound = (tol + 1e-4) * perimeter + 2e-5 * part["area_mm2"]
         assert abs(_even_odd_area(faces) - part["area_mm2"]) <= bound, part["name"]
+    # the files sent to the shop: each part's cut path and each sheet at the area report.json gives (kerf
+    # applied), read as sent (every layer: no "Unsupported DXF Entity 'TEXT'", the labels are outlines)
+    cut = [(f"cut/{p['name']}.dxf", p["cut_area_mm2"]) for p in report["parts"]]
+    cut += [(s["file"], s["cut_area_mm2"]) for s in report["cut"]["sheets"]]
+    for rel, area in cut:
+        scad = tmp_path / "cut.scad"
+        scad.write_text(f'$fn = 720; import("{out / rel}");\n')
+        run = subprocess.run(["openscad", "-o", str(tmp_path / "all.dxf"), str(scad)], capture_output=True,
+                             text=True, timeout=120)
+        assert run.returncode == 0 and "ERROR" not in run.stderr and "Unsupported" not in run.stderr, run.stderr
+        scad.write_text(f'$fn = 720; import("{out / rel}", layer="CUT");\n')
+        run = subprocess.run(["openscad", "-o", str(tmp_path / "cut.dxf"), str(scad)], capture_output=True,
+                             text=True, timeout=120)
+        assert run.returncode == 0 and "WARNING" not in run.stderr, run.stderr
+        lines = [((e.dxf.start.x, e.dxf.start.y), (e.dxf.end.x, e.dxf.end.y))
+                 for e in ezdxf.readfile(tmp_path / "cut.dxf").modelspace() if e.dxftype() == "LINE"]
+        faces = list(shapely.ops.polygonize(shapely.MultiLineString(lines)))
+        perimeter = sum(f.exterior.length for f in faces)
+        assert abs(_even_odd_area(faces) - area) <= (tol + 1e-4) * perimeter + 2e-5 * area, rel
 
 
 # -- Step 13: a process is what it can do (technique, layout), never its name -----------------------------------

@@ -155,11 +155,21 @@ def run_checks(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motio
         meshes = tuple(check_gear_meshes(gear_pairs, motion))
         if not sweep.pairs:
             not_checked.append({"check": "interference", "reason": NO_PAIRS})
-    printable = check_printability(parts, process, gear_pairs, pins)
+    # the free border the plate / sheet layout keeps (export._Making): a part must fit inside it (a design
+    # without a [parts] spec, as unit tests build, keeps none)
+    layout = getattr(design, "parts", None)
+    margin = 0.0 if layout is None else (layout.sheet_margin_mm if process.layout == "sheet"
+                                         else layout.plate_spacing_mm)
+    printable = check_printability(parts, process, gear_pairs, pins, margin_mm=float(margin))
+    from fabricate.checks.shop import check_shop
+
+    shop = check_shop(parts, process)  # a cut process: the shop's rules (None for a printer)
     failures = sweep.failures()
     for mesh in meshes:
         failures += list(mesh.failures)
     failures += list(printable.failures)
+    if shop is not None:
+        failures += list(shop.failures)
     interference = sweep.report()
     skipped = next((e["reason"] for e in not_checked if e["check"] == "interference"), None)
     interference["passed"] = None if skipped is not None else sweep.passed
@@ -167,5 +177,7 @@ def run_checks(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motio
         interference["reason"] = skipped
     interference["gear_mesh"] = [m.report() for m in meshes]
     interference["printability"] = printable.report()
+    if shop is not None:
+        interference["shop"] = shop.report()
     return CheckReport(interference=interference, failures=failures, passed=not failures, sweep=sweep,
                        gear_mesh=meshes, printability=printable, not_checked=tuple(not_checked))

@@ -179,11 +179,11 @@ def pack(outlines: Sequence[np.ndarray], area_mm: tuple[float, float], margin_mm
     bins: list[list[tuple[float, float, float, float]]] = []  # free rectangles (x, y, w, h) of each bin
     placements: dict[int, Placement] = {}
     for i in order:
-        spot = None
+        spot: tuple[int, float, float, tuple[float, np.ndarray, np.ndarray]] | None = None
         for k, free in enumerate(bins):
-            spot = _best_fit(free, options[i], spacing_mm)
-            if spot is not None:
-                spot = (k, *spot)
+            fit = _best_fit(free, options[i], spacing_mm)
+            if fit is not None:
+                spot = (k, *fit)
                 break
         if spot is None:
             bins.append([(0.0, 0.0, bin_w, bin_h)])

@@ -15,7 +15,7 @@ from typing import Any, cast
 import numpy as np
 import trimesh
 
-from fabricate.export.layout import Placement, shelf_pack
+from fabricate.export.layout import Placement, pack
 from fabricate.parts.model import Part
 from fabricate.parts.solids import mesh_arrays, part_solid, posed
 
@@ -173,10 +173,11 @@ def plate_layout(parts: Sequence[Part], cache: SolidCache, build_area_mm: tuple[
     """Placements of parts on the SLA build plate (x, y of the build volume).
 
     Parts are measured by the vertices of the meshes that are printed, so a placement's box is the
-    printed part's box (a coarser outline could leave the mesh a sagitta outside the margin).
+    printed part's box (a coarser outline could leave the mesh a sagitta outside the margin); they are packed
+    densely (:func:`fabricate.export.layout.pack`), the spacing kept at the plate's edge too.
     """
     outlines = [cache.flat_mesh(p)[0][:, :2] for p in parts]
-    return shelf_pack(outlines, build_area_mm, margin_mm=spacing_mm, spacing_mm=spacing_mm)
+    return pack(outlines, build_area_mm, margin_mm=spacing_mm, spacing_mm=spacing_mm)
 
 
 def plate_stl(meshes: Sequence[tuple[np.ndarray, np.ndarray]]) -> bytes:

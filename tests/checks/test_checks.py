@@ -94,9 +94,11 @@ class Recorder:
     def __init__(self, result):
         self.result = result
         self.args: list[tuple] = []
+        self.kwargs: list[dict] = []
 
-    def __call__(self, *args):
+    def __call__(self, *args, **kwargs):
         self.args.append(args)
+        self.kwargs.append(kwargs)
         return self.result
 
 
@@ -258,6 +260,7 @@ def test_failures_of_all_three_checks_are_gathered_in_order(sla_process, monkeyp
     ((parts, process, pairs, pins),) = printing.args
     assert parts == tuple(partset.parts) and process is sla_process and pairs is gear_pairs
     assert pins == (pin,)
+    assert printing.kwargs == [{"margin_mm": 0.0}]  # a design without [parts]: no plate margin
 
 
 def test_gear_mesh_failures_alone_fail_the_build(sla_process, monkeypatch):
