@@ -56,10 +56,17 @@ from fabricate.parts.bom import (
     with_sources,
 )
 from fabricate.parts.features import pad_segment, slider_guides
-from fabricate.parts.layers import assign_layers, conflict_graph, layer_z, order_layers, pin_crossings
+from fabricate.parts.layers import (
+    assign_layers,
+    conflict_graph,
+    layer_z,
+    order_layers,
+    pin_crossings,
+    pin_neighbours,
+)
 from fabricate.parts.model import BulgePath, Hole, Part, circle_polygon
 from fabricate.parts.profiles import circle_hull, fuse_polygons
-from fabricate.parts.retention import cap_parts, choose_holder, hole_size, retain_pins
+from fabricate.parts.retention import cap_parts, choose_holder, end_radius_mm, end_reach_mm, hole_size, retain_pins
 from fabricate.parts.spec import PartsSpec
 from fabricate.parts.springs import PlacedSpring, place_springs, with_spring_rows
 from fabricate.planar import rotation
@@ -271,7 +278,7 @@ def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_p
     _add_gears(drawing, mechanism, gear_pairs, sizes.hub_mm, tol)
     outlines = _outlines(drawing, mechanism, motion, sizes, parts_spec, process)
     layers = _layers(outlines, drawing.holes, pin_joints, mechanism, motion, gear_pairs, sizes.boss_radius_mm,
-                     process.running_clearance_mm)
+                     design)
     pin_joints = _press_fits(drawing, pin_joints, layers, sizes, process, mechanism.ground)
 
     parts = _body_parts(drawing, mechanism, outlines, layers, process)
@@ -440,13 +447,16 @@ def _outlines(drawing: _Drawing, mechanism: Mechanism, motion: Motion, sizes: Si
 
 def _layers(outlines: Mapping[str, BulgePath], holes: Mapping[str, Sequence[Hole]],
             pin_joints: Sequence[tuple[str, tuple[str, ...]]], mechanism: Mechanism, motion: Motion,
-            gear_pairs: Sequence[GearPair], radius: float, clearance_mm: float) -> dict[str, int]:
+            gear_pairs: Sequence[GearPair], radius: float, design: DesignSpec) -> dict[str, int]:
     """Body name -> layer (see :mod:`fabricate.parts.layers`).
 
     Bodies that come within the clearance of each other anywhere over the motion, or share a pin, get
     different layers; meshing gears share one. The layers are then ordered so that no body sweeps over a
-    pin between the two layers it joins (a spacer fills the skipped layers there).
+    pin between the two layers it joins (a spacer fills the skipped layers there), nor over a clip's or cap's
+    pin end beyond its stack, and a motor's short shaft reaches its driven part.
     """
+    process = design.process
+    clearance_mm = process.running_clearance_mm
     coarse = {n: p.polygon(CONFLICT_CHORD_MM) for n, p in outlines.items()}
     holes_at = {(body, h.joint): h.centre for body, hs in holes.items() for h in hs}
     poses = {n: motion.pose(n) for n in mechanism.body_names}
@@ -458,7 +468,27 @@ def _layers(outlines: Mapping[str, BulgePath], holes: Mapping[str, Sequence[Hole
     crossings = pin_crossings(coarse, poses, [(holes_at[(a, name)], a, b) for name, bodies in pin_joints
                                               for i, a in enumerate(bodies) for b in bodies[i + 1:]],
                               radius, clearance_mm + CONFLICT_CHORD_MM)
-    return order_layers(layers, crossings)
+    from fabricate.drive.rotary import output_depth, replaced_joint  # the drive sits above the parts layer
+
+    depth = output_depth(design, mechanism)
+    outer = [depth] if depth is not None else []
+    end_r = end_radius_mm(process)
+    if end_r <= 0.0:
+        return order_layers(layers, crossings, outer=outer, thickness_mm=process.thickness_mm,
+                            gap_mm=process.layer_gap_mm)
+    # a clip's or cap's pin sticks out of its stack: the bodies that pass over its ends and the pins near it
+    # keep off the room beyond its end faces (an empty layer gives it that room); the pin a motor's output
+    # replaces is not built
+    gone = replaced_joint(design, mechanism)
+    kept = [(name, bodies) for name, bodies in pin_joints if gone not in name.split("+")]
+    at = [(holes_at[(bodies[0], name)], bodies[0]) for name, bodies in kept]
+    over = [(i, c) for i, ((centre, a), (_, bodies)) in enumerate(zip(at, kept, strict=True))
+            for _, _, c in pin_crossings(coarse, poses, [(centre, a, a)], max(radius, end_r),
+                                         clearance_mm + CONFLICT_CHORD_MM) if c not in bodies]
+    return order_layers(layers, crossings, pins=[tuple(bodies) for _, bodies in kept], end_crossings=over,
+                        pin_pairs=pin_neighbours(at, poses, 2.0 * end_r + clearance_mm),
+                        end_reach=lambda stack: end_reach_mm(process, stack), thickness_mm=process.thickness_mm,
+                        gap_mm=process.layer_gap_mm, spare_layers=3, outer=outer)
 
 
 def _body_parts(drawing: _Drawing, mechanism: Mechanism, outlines: Mapping[str, BulgePath],
