@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     from fabricate.checks import CheckReport
     from fabricate.drive.check import DriveResult
     from fabricate.gears.pair import GearPair
-    from fabricate.parts.build import PartSet
+    from fabricate.parts.partset import PartSet
     from fabricate.strength.check import StrengthResult
 
 Progress = Callable[[str], None]

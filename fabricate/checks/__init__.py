@@ -29,7 +29,7 @@ from fabricate.mechanism import Mechanism, Motion
 
 if TYPE_CHECKING:
     from fabricate.gears.pair import GearPair
-    from fabricate.parts.build import PartSet
+    from fabricate.parts.partset import PartSet
     from fabricate.spec import DesignSpec
 
 __all__ = ["CheckReport", "run_checks", "sweep_interference", "check_gear_mesh", "check_printability"]

@@ -15,7 +15,7 @@ import shapely.ops
 
 from fabricate.catalogue.hardware import ISO4762, screw
 from fabricate.drive import geometry as geo
-from fabricate.drive.parts import MOUNT_PART, Fastener, Standoff, fit_hole, screw_size
+from fabricate.drive.records import MOUNT_PART, Fastener, Standoff, fit_hole, screw_size
 from fabricate.parts.model import BulgePath, Hole, Part
 from fabricate.parts.profiles import circle_hull
 from fabricate.planar import rotation
@@ -23,7 +23,7 @@ from fabricate.planar import rotation
 if TYPE_CHECKING:
     from fabricate.catalogue.actuators import Actuator
     from fabricate.mechanism import Mechanism, Motion
-    from fabricate.parts.build import PartSet
+    from fabricate.parts.partset import PartSet
     from fabricate.process import ProcessSpec
 
 
@@ -126,7 +126,7 @@ class MountPlacement:
         clear of the actuator (body, output) and of every part moving between the plate and the ground; else
         two new holes (``standoff_1``, ``standoff_2``), as far apart as the ground part's free material allows;
         none if it has none."""
-        from fabricate.parts.build import swept_region
+        from fabricate.parts.partset import swept_region
 
         entry, c = self.entry, self.c
         nominal = float(self.design.parts.mounting_hole_mm) + 2.0 * c
@@ -210,7 +210,7 @@ class MountPlacement:
         """Two standoff sites off the ground part, each on an arm the ground part grows to reach it (in its own
         layer, clear of what moves there): the sites nearest the ground part that clear ``keep_out``, at least
         three standoffs apart. Sets :attr:`ground_arms`; [] when no site is found."""
-        from fabricate.parts.build import swept_region
+        from fabricate.parts.partset import swept_region
 
         if self.ground != self.mechanism.ground:
             return []
@@ -257,7 +257,7 @@ class MountPlacement:
     def _mount(self, place: geo.Placement, ground: Part, flip: bool
                ) -> tuple[Part, list[Fastener], list[Standoff], list[Part], list[geo.Solid]]:
         """The mount plate on the actuator's flange, its screws, and the standoffs to the ground part."""
-        from fabricate.parts.build import SlottedPart, safe_name
+        from fabricate.parts.partset import SlottedPart, safe_name
 
         entry, process, tol = self.entry, self.process, self.tol
         t = float(process.thickness_mm)

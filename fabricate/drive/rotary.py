@@ -15,20 +15,9 @@ from fabricate.catalogue.actuators import Hole as MountHole
 from fabricate.catalogue.actuators import Shaft
 from fabricate.catalogue.hardware import ISO4762, ISO7089, Screw
 from fabricate.drive import geometry as geo
+from fabricate.drive.editing import body_part, bom_without, fuse_pad, with_changes
 from fabricate.drive.mount import MountPlacement
-from fabricate.drive.parts import (
-    BODY_ROLES,
-    ROTARY,
-    Fastener,
-    PlacedActuator,
-    body_part,
-    bom_without,
-    fit_hole,
-    fuse_pad,
-    purchased_row,
-    screw_row,
-    with_changes,
-)
+from fabricate.drive.records import BODY_ROLES, ROTARY, Fastener, PlacedActuator, fit_hole, purchased_row, screw_row
 from fabricate.errors import SpecError
 from fabricate.mechanism import Driver, Mechanism, Motion, Revolute
 from fabricate.parts.model import BulgePath, Hole, Part
@@ -37,7 +26,7 @@ from fabricate.planar import inverse_transform_points, rotation
 
 if TYPE_CHECKING:
     from fabricate.catalogue.actuators import Actuator
-    from fabricate.parts.build import PartSet
+    from fabricate.parts.partset import PartSet
     from fabricate.process import ProcessSpec
 
 
@@ -424,7 +413,7 @@ class RotaryPlacement(MountPlacement):
                 item = f"standoff tube {s.inner_diameter_mm:.3g}/{s.outer_diameter_mm:.3g} x {s.length_mm:.2f} mm"
                 tubes[item] = tubes.get(item, 0) + ps.copies
         bom += [purchased_row(item, qty, "actuator mount standoff, cut to length") for item, qty in tubes.items()]
-        from fabricate.parts.build import overlapping_cuts
+        from fabricate.parts.partset import overlapping_cuts
 
         warnings = tuple(ps.warnings) + tuple(w for w in overlapping_cuts([new_driven, new_ground, mount])
                                               if w not in ps.warnings)

@@ -36,8 +36,8 @@ if TYPE_CHECKING:  # ezdxf loads with fabricate.export.dxf: only when a DXF is m
     from fabricate.export.stl import SolidCache
     from fabricate.mechanism import Mechanism, Motion
     from fabricate.parts.assembly import PinStack
-    from fabricate.parts.build import PartSet
     from fabricate.parts.model import Part
+    from fabricate.parts.partset import PartSet
     from fabricate.spec import DesignSpec
 
 #: bom.csv's leading columns; any other key of the report's BOM rows follows, sorted by name.

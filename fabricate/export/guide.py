@@ -20,7 +20,7 @@ from fabricate.parts.assembly import GuideStep
 
 if TYPE_CHECKING:
     from fabricate.mechanism import Motion
-    from fabricate.parts.build import PartSet
+    from fabricate.parts.partset import PartSet
 
 #: Picture size (inches at :data:`DPI`): 360 × 270 px.
 SIZE_IN = (3.6, 2.7)

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from fabricate.parts.build import PartSet
+    from fabricate.parts.partset import PartSet
 
 #: mm -> m
 MM = 1e-3

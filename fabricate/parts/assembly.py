@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from fabricate.parts.build import PartSet
+    from fabricate.parts.partset import PartSet
 
 
 @dataclass(frozen=True)

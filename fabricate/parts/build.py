@@ -35,9 +35,8 @@ spacers (SLA: printed parts when at least a layer thick) and standard washers fi
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -47,7 +46,6 @@ from fabricate.errors import GeometryError, SpecError
 from fabricate.hints import PadHint, PartHints
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
 from fabricate.parts.bom import (
-    Pin,
     Spacer,
     bill_of_materials,
     mounting_rows,
@@ -65,102 +63,24 @@ from fabricate.parts.layers import (
     pin_neighbours,
 )
 from fabricate.parts.model import BulgePath, Hole, Part, circle_polygon
+from fabricate.parts.partset import (
+    CONFLICT_CHORD_MM,
+    PartSet,
+    SlottedPart,
+    overlapping_cuts,
+    safe_name,
+    swept_region,
+)
 from fabricate.parts.profiles import circle_hull, fuse_polygons
 from fabricate.parts.retention import cap_parts, choose_holder, end_radius_mm, end_reach_mm, hole_size, retain_pins
 from fabricate.parts.spec import PartsSpec
-from fabricate.parts.springs import PlacedSpring, place_springs, with_spring_rows
+from fabricate.parts.springs import place_springs, with_spring_rows
 from fabricate.planar import rotation
 from fabricate.process import ProcessSpec
 
 if TYPE_CHECKING:  # the gears and the design sit above the parts layer
-    from fabricate.drive.parts import PlacedActuator
     from fabricate.gears.pair import GearPair
     from fabricate.spec import DesignSpec
-
-#: Chord tolerance (mm) of the coarse outlines used only for the layer conflict test.
-CONFLICT_CHORD_MM = 0.05
-
-
-@dataclass(frozen=True)
-class SlottedPart(Part):
-    """A part with slots (stadium-shaped through cuts, e.g. the guide slot of a push rod) besides holes.
-
-    Attributes
-    ----------
-    slots : tuple of BulgePath
-        Counter-clockwise slot contours in body coordinates; cut through the plate.
-    """
-
-    slots: tuple[BulgePath, ...] = ()
-
-    def polygons(self, chord_tolerance_mm: float) -> list[np.ndarray]:
-        rings = super().polygons(chord_tolerance_mm)
-        for slot in self.slots:
-            ring = slot.polygon(chord_tolerance_mm)
-            rings.append(ring[::-1] if slot.area() > 0 else ring)
-        return rings
-
-    def area_mm2(self) -> float:
-        return super().area_mm2() - sum(abs(s.area()) for s in self.slots)
-
-
-@dataclass(frozen=True)
-class PartSet:
-    """All parts of one mechanism and how they go together.
-
-    Attributes
-    ----------
-    parts : tuple of Part
-        Body parts (one per body) then printed spacers.
-    bom : list of dict
-        Bill of materials rows (JSON-ready): pins, spacers, washers, springs, purchased items.
-    pins : tuple of Pin
-    spacers : tuple of Spacer
-    layers : dict[str, int]
-        Body name -> layer index.
-    process : str
-        The process's name (a label: :class:`~fabricate.process.ProcessSpec` says what it can do).
-    chord_tolerance_mm : float
-        Polygonisation tolerance for meshes.
-    copies : int
-        Identical copies of the mechanism (BOM quantities already multiplied).
-    hints : PartHints
-        The synthesis hints used.
-    warnings : tuple of str
-        Geometry the mechanism forces but nobody can make: holes that run into each other (their
-        centres closer than their radii). Parts are still built; the report should carry these.
-    actuator : PlacedActuator or None
-        What drives the design, as placed (:mod:`fabricate.drive.parts`); None without ``[actuator]``.
-    springs : tuple of PlacedSpring
-        The torsion springs, sized and placed on their pins (:mod:`fabricate.parts.springs`).
-    """
-
-    parts: tuple[Part, ...]
-    bom: list[dict[str, Any]]
-    pins: tuple[Pin, ...]
-    spacers: tuple[Spacer, ...]
-    layers: dict[str, int]
-    process: str
-    chord_tolerance_mm: float
-    thickness_mm: float
-    layer_gap_mm: float
-    kerf_mm: float
-    copies: int = 1
-    hints: PartHints = field(default_factory=PartHints)
-    warnings: tuple[str, ...] = ()
-    actuator: PlacedActuator | None = None
-    springs: tuple[PlacedSpring, ...] = ()
-
-    def part(self, name: str) -> Part:
-        for p in self.parts:
-            if p.name == name:
-                return p
-        raise KeyError(name)
-
-    def body_parts(self) -> tuple[Part, ...]:
-        """Parts that move with a body (spacers excluded)."""
-        return tuple(p for p in self.parts if p.role != "spacer")
-
 
 @dataclass(frozen=True)
 class Sizes:
@@ -203,11 +123,6 @@ def derive_sizes(process: ProcessSpec, parts: PartsSpec, hints: PartHints,
                  mount_boss_radius_mm=mount / 2.0 + wall, hub_mm=max(hub, hole + 2.0 * process.min_wall_mm),
                  hole_nominal_mm=running.nominal_mm, press_hole_mm=press.modelled_mm,
                  press_nominal_mm=press.nominal_mm, mount_nominal_mm=mounting.nominal_mm)
-
-
-def safe_name(name: str) -> str:
-    """A file-name-safe part name."""
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._") or "part"
 
 
 def gear_outline_in_body(mechanism: Mechanism, pair: GearPair, side: str) -> tuple[str, str, np.ndarray]:
@@ -557,24 +472,6 @@ def _check_pin_webs(parts: Sequence[Part], process: ProcessSpec) -> None:
                                     f"{process.min_wall_mm:g} mm); {limit}")
 
 
-def overlapping_cuts(parts: Sequence[Part]) -> list[str]:
-    """Holes of one part that run into each other or into a slot (the plate would fall apart there)."""
-    found = []
-    for part in parts:
-        holes = list(part.holes)
-        for i, a in enumerate(holes):
-            for b in holes[i + 1:]:
-                gap = float(np.hypot(*(np.asarray(a.centre) - b.centre))) - 0.5 * (a.diameter_mm + b.diameter_mm)
-                if gap < 0:
-                    found.append(f"part {part.name}: holes {a.joint} and {b.joint} overlap by {-gap:.3f} mm; "
-                                 "move the joints apart or use a smaller pin")
-            for slot in getattr(part, "slots", ()):
-                ring = shapely.Polygon(slot.polygon(0.01))
-                if ring.distance(shapely.Point(a.centre)) < 0.5 * a.diameter_mm:
-                    found.append(f"part {part.name}: hole {a.joint} runs into a guide slot")
-    return found
-
-
 def merge_coincident_pins(pin_joints: Sequence[tuple[str, tuple[str, ...]]],
                           pin_holes: Sequence[tuple[str, str, np.ndarray]]
                           ) -> tuple[list[tuple[str, tuple[str, ...]]], list[tuple[str, str, np.ndarray]]]:
@@ -619,17 +516,6 @@ def merge_coincident_pins(pin_joints: Sequence[tuple[str, tuple[str, ...]]],
             done.add(pin_body)
             holes_out.append((pin_body[0], body, centre))
     return [(name, tuple(bodies)) for name, bodies in merged.items()], holes_out
-
-
-def swept_region(outlines: Mapping[str, BulgePath], motion: Motion, poses: int = 90) -> Any:
-    """Plan-view region (shapely geometry, ground coordinates) swept by the given bodies over the motion."""
-    pick = np.unique(np.linspace(0, len(motion.inputs) - 1, min(poses, len(motion.inputs))).round().astype(int))
-    shapes = []
-    for body, path in outlines.items():
-        outline = path.polygon(CONFLICT_CHORD_MM)
-        for pose in motion.pose(body)[pick]:
-            shapes.append(shapely.Polygon(outline @ rotation(pose[2]).T + pose[:2]))
-    return shapely.union_all(shapes) if shapes else shapely.Polygon()
 
 
 def _add_mounting(mechanism: Mechanism, motion: Motion, ground: str,

@@ -48,7 +48,7 @@ from fabricate.strength.statics import BodyTorque, DriverEffort, PointForce, Sta
 if TYPE_CHECKING:
     from fabricate.gears.pair import GearPair
     from fabricate.hints import PartHints
-    from fabricate.parts.build import PartSet
+    from fabricate.parts.partset import PartSet
     from fabricate.spec import DesignSpec
     from fabricate.strength.spec import LoadSpec
 

@@ -23,7 +23,7 @@ from fabricate.strength.check import run_strength
 if TYPE_CHECKING:
     from fabricate.gears.pair import GearPair
     from fabricate.hints import PartHints
-    from fabricate.parts.build import PartSet
+    from fabricate.parts.partset import PartSet
     from fabricate.spec import DesignSpec
 
 #: Width resolution of the search (mm).

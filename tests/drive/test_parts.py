@@ -20,7 +20,8 @@ import trimesh
 from fabricate.catalogue.actuators import NEMA17, SG90
 from fabricate.checks.interference import sweep_interference
 from fabricate.drive import geometry as geo
-from fabricate.drive.parts import MOUNT_PART, attach_actuator, sweep_items
+from fabricate.drive.parts import attach_actuator, sweep_items
+from fabricate.drive.records import MOUNT_PART
 from fabricate.drive.spec import ActuatorSpec
 from fabricate.errors import SpecError
 from fabricate.export.stl import SolidCache, part_stl

@@ -26,8 +26,8 @@ from fabricate.export.stl import (
     plate_layout,
     validate_stl,
 )
-from fabricate.parts.build import SlottedPart
 from fabricate.parts.model import BulgePath, Hole
+from fabricate.parts.partset import SlottedPart
 from tests.interference_fixtures import slot_outline, slot_part
 
 KERF = 0.2

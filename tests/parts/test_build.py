@@ -24,24 +24,21 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fabricate.catalogue.hardware import ISO8734_LENGTHS_MM
+from fabricate.catalogue.pins import ISO8734_LENGTHS_MM
 from fabricate.errors import GeometryError, SpecError
 from fabricate.hints import PadHint, PartHints, PurchasedItem, SpringHint
 from fabricate.mechanism import Body, Driver, GearCoupling, LinearLaw, Mechanism, Revolute, Slider
 from fabricate.parts.build import (
-    CONFLICT_CHORD_MM,
-    SlottedPart,
     _check_pin_webs,
     build_parts,
     derive_sizes,
     gear_outline_in_body,
     merge_coincident_pins,
-    overlapping_cuts,
-    swept_region,
 )
 from fabricate.parts.features import _guide_spacing, _segment_distance, pad_segment
 from fabricate.parts.layers import assign_layers
 from fabricate.parts.model import BulgePath, Hole, Part
+from fabricate.parts.partset import CONFLICT_CHORD_MM, SlottedPart, overlapping_cuts, swept_region
 from fabricate.parts.profiles import circle_hull, fuse_polygons, offset_path
 from fabricate.parts.spec import PartsSpec, parse_parts_spec
 from fabricate.planar import polygon_area, relative_poses, rotation, transform_points
