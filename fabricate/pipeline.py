@@ -393,7 +393,7 @@ def _export(run: BuildRun, with_step: bool) -> None:
     from fabricate.export.guide import guide_markdown, guide_steps
     from fabricate.parts.assembly import assembly_steps, guide_report, pin_stacks, stacks_report
     from fabricate.parts.retention import hardware_report
-    from fabricate.parts.springs import springs_report
+    from fabricate.parts.spring_rows import springs_report
     from fabricate.synthesis.linkage.exact import mechanism_toml
 
     run.enter("exports")

@@ -145,7 +145,7 @@ def run_checks(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motio
             not_checked.append({"check": "gear mesh", "reason": NO_POSES})
     else:
         from fabricate.drive.parts import sweep_items as actuator_items
-        from fabricate.parts.springs import spring_sweep_items
+        from fabricate.parts.spring_rows import spring_sweep_items
 
         sweep = sweep_interference(parts, motion, chord_tolerance_mm=process.chord_tolerance_mm,
                                    min_clearance_mm=float(required), pins=pins or None,

@@ -74,7 +74,8 @@ from fabricate.parts.partset import (
 from fabricate.parts.profiles import circle_hull, fuse_polygons
 from fabricate.parts.retention import cap_parts, choose_holder, end_radius_mm, end_reach_mm, hole_size, retain_pins
 from fabricate.parts.spec import PartsSpec
-from fabricate.parts.springs import place_springs, with_spring_rows
+from fabricate.parts.spring_rows import with_spring_rows
+from fabricate.parts.springs import place_springs
 from fabricate.planar import rotation
 from fabricate.process import ProcessSpec
 

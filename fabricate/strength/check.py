@@ -33,7 +33,7 @@ import numpy as np
 
 from fabricate.errors import GeometryError
 from fabricate.mechanism import Mechanism, Motion, Revolute, Slider
-from fabricate.parts.springs import spring_failures
+from fabricate.parts.spring_rows import spring_failures
 from fabricate.planar import rotation
 from fabricate.strength.features import (
     FeatureLoads,

@@ -17,7 +17,8 @@ import shapely
 from fabricate.hints import SpringHint
 from fabricate.parts.build import build_parts
 from fabricate.parts.spec import PartsSpec
-from fabricate.parts.springs import place_springs, spring_bom_rows, spring_failures, with_spring_rows
+from fabricate.parts.spring_rows import spring_bom_rows, spring_failures, with_spring_rows
+from fabricate.parts.springs import place_springs
 from tests.conftest import make_four_bar
 
 #: Music wire A228 modulus by diameter (Shigley 9th ed. Table 10-5), written out again: d < 0.032 in
