@@ -93,7 +93,8 @@ class Finger:
     def __init__(self, build: Any) -> None:
         import mujoco
 
-        from fabricate.export.mjcf import driver_targets, kinematic_tree, spring_joints
+        from fabricate.export.mjcf import spring_joints
+        from fabricate.export.mjcf_tree import driver_targets, kinematic_tree
 
         self.build = build
         self.model = load_with_can(build)
@@ -124,7 +125,7 @@ class Finger:
         there (the tip is left free)."""
         import mujoco
 
-        from fabricate.export.mjcf import joint_coordinates
+        from fabricate.export.mjcf_tree import joint_coordinates
 
         coordinates = joint_coordinates(self.build.motion.mechanism, self.build.motion, self.tree)
         for name, values in coordinates.items():

@@ -2,10 +2,11 @@
 
 An output folder (``-o``) may be new, empty, or a previous fabricate output; anything else is refused
 before any work is done unless the user passes ``--force``. A previous output is recognised by its
-``report.json`` (a regular file: a link, FIFO or device of that name is not read) and must hold nothing but
-the files that report lists, so a note the user dropped into a build folder is never deleted silently. A
-file or symbolic link given as the folder, the current folder (or one holding it) and a folder holding an
-input of the command (the template, the process profile) are refused even with ``--force``.
+``report.json`` (a regular file: a link, FIFO or device of that name is not read; see
+:mod:`fabricate.output_read`) and must hold nothing but the files that report lists, so a note the user
+dropped into a build folder is never deleted silently. A file or symbolic link given as the folder, the
+current folder (or one holding it) and a folder holding an input of the command (the template, the process
+profile) are refused even with ``--force``.
 
 Writing goes into a temporary sibling ``.NAME.fabricate-XXXXXXXXXXXXXXXX.tmp`` (16 random hex digits) which
 is swapped with the old folder in one atomic step (``renameat2(RENAME_EXCHANGE)`` on Linux; elsewhere two
@@ -27,7 +28,6 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import errno
-import json
 import os
 import re
 import secrets
@@ -42,25 +42,19 @@ from pathlib import Path
 from typing import Any
 
 from fabricate.errors import SpecError
+from fabricate.output_read import CLOEXEC, NOFOLLOW, NONBLOCK, REPORT, foreign_entries, not_regular, previous_output
 
 try:  # POSIX advisory locks; elsewhere writers are not serialised (documented in the README)
     import fcntl
 except ImportError:  # pragma: no cover - Windows
     fcntl = None  # type: ignore[assignment]
 
-REPORT = "report.json"
-#: Largest report.json read from an existing folder to decide whether it is a fabricate output (a linkage at
-#: every documented bound writes a few MB); a larger one is not taken for a fabricate output.
-MAX_REPORT_BYTES = 64 * 2**20
 #: Random hex digits in a temporary sibling's name (fixed, so the name before them is unambiguous).
 _TOKEN_HEX = 16
 #: Room a sibling's name needs beyond the folder's own name: ".", ".fabricate-", the digits, ".tmp".
 _SIBLING_EXTRA = 1 + len(".fabricate-") + _TOKEN_HEX + len(".tmp")
 _SIBLING = re.compile(rf"\.(?P<name>.+)\.fabricate-(?P<token>[0-9a-f]{{{_TOKEN_HEX}}})\.(?P<kind>tmp|old)", re.S)
 _RECORD = re.compile(rf"(?P<token>[0-9a-f]{{{_TOKEN_HEX}}})(?: (?P<dev>[0-9]+) (?P<ino>[0-9]+))?")
-_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
-_NONBLOCK = getattr(os, "O_NONBLOCK", 0)
-_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
 
 Identity = tuple[int, int]
 
@@ -92,88 +86,6 @@ def _identity(path: Path) -> Identity | None:
     except FileNotFoundError:
         return None
     return st.st_dev, st.st_ino
-
-
-def read_regular(path: Path, limit: int) -> bytes | None:
-    """The bytes of ``path`` if it is a regular file of at most ``limit`` bytes, else None.
-
-    A symbolic link, FIFO, device or socket is never opened for reading, so this never blocks: the path is
-    checked with ``lstat``, then opened non-blocking without following a link and checked again on the
-    open descriptor (it may have been swapped in between).
-    """
-    try:
-        before = os.lstat(path)
-        if not stat.S_ISREG(before.st_mode) or before.st_size > limit:
-            return None
-        fd = os.open(path, os.O_RDONLY | _NOFOLLOW | _NONBLOCK | _CLOEXEC)
-    except OSError:
-        return None
-    try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode) or (st.st_dev, st.st_ino) != (before.st_dev, before.st_ino):
-            return None
-        chunks: list[bytes] = []
-        total = 0
-        while total <= limit:  # bounded even if the file grows while it is read
-            chunk = os.read(fd, min(1 << 20, limit + 1 - total))
-            if not chunk:
-                return b"".join(chunks)
-            chunks.append(chunk)
-            total += len(chunk)
-        return None
-    except OSError:
-        return None
-    finally:
-        os.close(fd)
-
-
-def _not_regular(path: Path) -> str:
-    """What ``path`` is if it exists but is not a regular file ("a FIFO"), else ""."""
-    try:
-        mode = os.lstat(path).st_mode
-    except OSError:
-        return ""
-    kinds = ((stat.S_ISLNK, "a symbolic link"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISSOCK, "a socket"),
-             (stat.S_ISCHR, "a device"), (stat.S_ISBLK, "a device"), (stat.S_ISDIR, "a folder"))
-    return next((what for test, what in kinds if test(mode)), "")
-
-
-def previous_output(directory: Path) -> dict[str, Any] | None:
-    """The report of a fabricate output folder, or None when ``directory`` is not one (its report.json is
-    missing, not a regular file, larger than :data:`MAX_REPORT_BYTES` or not a fabricate report)."""
-    data = read_regular(Path(directory) / REPORT, MAX_REPORT_BYTES)
-    if data is None:
-        return None
-    try:
-        report = json.loads(data.decode("utf-8"))
-    except (ValueError, RecursionError):
-        return None
-    if not isinstance(report, dict) or not isinstance(report.get("design"), dict) \
-            or "fabricate_version" not in report["design"] or not isinstance(report.get("files"), list):
-        return None
-    return report
-
-
-def _written_by(report: Mapping[str, Any]) -> set[str]:
-    listed = {str(p) for p in report.get("files", [])}
-    listed |= {str(m.get("path")) for m in report.get("manifest", []) if isinstance(m, dict)}
-    return listed | {REPORT}
-
-
-def foreign_entries(directory: Path, report: Mapping[str, Any]) -> list[str]:
-    """Files under ``directory`` (relative POSIX paths) that its report does not list, sorted."""
-    listed = _written_by(report)
-    found = []
-    for root, dirs, names in os.walk(directory):
-        dirs.sort()
-        for name in sorted(names):
-            rel = (Path(root) / name).relative_to(directory).as_posix()
-            if rel not in listed:
-                found.append(rel)
-        for name in dirs:
-            if os.path.islink(os.path.join(root, name)):  # os.walk does not enter it: it is foreign
-                found.append((Path(root) / name).relative_to(directory).as_posix())
-    return found
 
 
 def _name_max(existing: Path) -> int:
@@ -258,7 +170,7 @@ def _check_replaceable(out: Path, force: bool, stage: str) -> None:
         return
     report = previous_output(out)
     if report is None:
-        odd = _not_regular(out / REPORT)
+        odd = not_regular(out / REPORT)
         if odd:
             raise _refuse(out, f"holds a report.json that is {odd}, not one fabricate wrote (it is never opened); "
                                "choose a new or empty folder, or pass --force to replace it")
@@ -332,7 +244,7 @@ def _locked(parent: Path, name: str) -> Iterator[_Lock]:
         return
     while True:
         try:  # never through a link, never blocking on a FIFO someone named like the lock
-            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_APPEND | _NOFOLLOW | _NONBLOCK | _CLOEXEC, 0o644)
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_APPEND | NOFOLLOW | NONBLOCK | CLOEXEC, 0o644)
         except OSError as exc:
             if exc.errno not in (errno.ELOOP, errno.EISDIR, errno.ENXIO):
                 raise

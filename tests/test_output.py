@@ -20,12 +20,12 @@ from fabricate.output import (
     LeftAloneWarning,
     check_output_dir,
     parse_sibling,
-    previous_output,
     remove_leftovers,
     sibling_name,
     write_atomically,
     write_output,
 )
+from fabricate.output_read import previous_output
 from fabricate.pipeline import manifest
 
 FAST = "gear_pair_elliptic"  # the quickest shipped template to build
@@ -505,7 +505,8 @@ FIFO_CHILD = """
 import json, sys
 from pathlib import Path
 from fabricate.errors import SpecError
-from fabricate.output import check_output_dir, previous_output, write_output
+from fabricate.output import check_output_dir, write_output
+from fabricate.output_read import previous_output
 from tests.test_output import fake_output
 out = Path(sys.argv[1])
 print(json.dumps(previous_output(out)))

@@ -2,7 +2,8 @@
 pin, washers and retainers that make up its stack.
 
 Pure functions of the process profile (:class:`~fabricate.process.ProcessSpec`) and the catalogue
-(:mod:`fabricate.catalogue.hardware`); nothing here places parts or draws.
+(:mod:`fabricate.catalogue.pins`, :mod:`~fabricate.catalogue.hardware`, :mod:`~fabricate.catalogue.clips`);
+nothing here places parts or draws.
 
 Fits
 ----
@@ -40,16 +41,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from fabricate.catalogue.hardware import (
-    PinChoice,
-    RetainingRing,
-    Washer,
-    dowel_pin,
-    e_clip,
-    fill_gap,
-    pin_lengths,
-    washers_for_shaft,
-)
+from fabricate.catalogue.clips import RetainingRing, e_clip
+from fabricate.catalogue.hardware import Washer, fill_gap, washers_for_shaft
+from fabricate.catalogue.pins import PinChoice, dowel_pin, pin_lengths
 from fabricate.errors import SpecError
 from fabricate.process import ProcessSpec
 

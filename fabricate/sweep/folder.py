@@ -103,7 +103,7 @@ def prepare_folder(out: Path, spec: SweepSpec, protect: Sequence[Path] = ()) -> 
     if not marker.is_file():
         raise SpecError(str(out), f"holds files fabricate did not write ({', '.join(entries[:3])}"
                                   f"{', ...' if len(entries) > 3 else ''}); choose a new or empty folder")
-    from fabricate.output import read_regular
+    from fabricate.output_read import read_regular
 
     data = read_regular(marker, MAX_RECORD_BYTES)
     if data is None:

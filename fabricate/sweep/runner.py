@@ -405,7 +405,8 @@ def _best(spec: SweepSpec, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 def _build_best(client: Any, spec: SweepSpec, best: list[dict[str, Any]], out: Path, say: Progress,
                 protect: Sequence[Path] = ()) -> None:
     """Build the best points in full on the cluster and write each as a normal build output folder."""
-    from fabricate.output import MAX_REPORT_BYTES, read_regular, write_output
+    from fabricate.output import write_output
+    from fabricate.output_read import MAX_REPORT_BYTES, read_regular
     from fabricate.sweep.task import point_text
 
     parts = spec.field_parts()

@@ -13,16 +13,28 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fabricate.catalogue import CATALOGUE, actuator, dowel_pin, e_clip, screw, shim_ring, tendon, torsion_spring
+from fabricate.catalogue import (
+    CATALOGUE,
+    actuator,
+    clips,
+    dowel_pin,
+    e_clip,
+    pins,
+    screw,
+    shim_ring,
+    tendon,
+    torsion_spring,
+)
 from fabricate.catalogue import actuators as act_mod
 from fabricate.catalogue import hardware as hw
 from fabricate.catalogue import springs as sp
 from fabricate.errors import SpecError
 
 CATALOGUE_DIR = Path(act_mod.__file__).parent
-MODULES = ("_units.py", "actuators.py", "hardware.py", "springs.py")
+MODULES = ("_units.py", "actuators.py", "clips.py", "designations.py", "hardware.py", "pins.py", "springs.py",
+           "tables.py")
 #: Module-level names that are numerical tolerances, not catalogue data.
-NOT_DATA = {"_EPS"}
+NOT_DATA = {"EPS"}
 
 
 # --- every number has its source -------------------------------------------------------------------------
@@ -164,7 +176,7 @@ PIN_DIAMETERS = (1.5, 2.0, 2.5, 3.0, 4.0, 5.0)
 @pytest.mark.parametrize("standard", ["ISO 8734", "ISO 2338"])
 @pytest.mark.parametrize("d", PIN_DIAMETERS)
 def test_dowel_pin_picks_the_next_series_length(d, standard):
-    series = hw.pin_lengths(d, standard)
+    series = pins.pin_lengths(d, standard)
     assert len(series) >= 5 and list(series) == sorted(series)
     lo, hi = series[0], series[-1]
     for need in [0.5, lo, lo + 0.01, *(0.5 * (a + b) for a, b in zip(series, series[1:], strict=False)), hi]:
@@ -251,7 +263,7 @@ def test_washers_and_shims():
 
 
 def test_e_clip_table_joins_up_and_each_pin_gets_a_groove_it_can_hold():
-    rows = sorted(hw.DIN6799.items())
+    rows = sorted(clips.DIN6799.items())
     for (_, a), (_, b) in zip(rows, rows[1:], strict=False):
         assert a[0] < b[0] and b[0] <= a[1]                     # ranges ascend and leave no gap
     for d in PIN_DIAMETERS:

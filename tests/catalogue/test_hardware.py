@@ -8,7 +8,9 @@ import math
 
 import pytest
 
+from fabricate.catalogue import clips, pins
 from fabricate.catalogue import hardware as hw
+from fabricate.catalogue.designations import parse_designation
 from fabricate.errors import SpecError
 
 # --- ISO 7089 / DIN 125-A washers -------------------------------------------------------------------------
@@ -26,7 +28,7 @@ def test_iso7089_covers_m16_to_m8_as_a_monotone_series():
         assert a[0] < b[0] and a[1] < b[1] and a[2] <= b[2]
     for size in sizes:
         w = hw.washer(size)
-        assert hw.parse_designation(w.designation) == w == hw.parse_designation(w.alt_designation)
+        assert parse_designation(w.designation) == w == parse_designation(w.alt_designation)
 
 
 # --- fill_gap ----------------------------------------------------------------------------------------------
@@ -84,10 +86,10 @@ def test_din988_shims_are_named_d1_x_d2_x_h_and_read_back():
         for h in thicknesses:
             ring = hw.shim_ring(d1, h)
             assert ring.designation == f"DIN 988 {d1:g} × {d2:g} × {h:g}"
-            assert hw.parse_designation(ring.designation) == ring
-            assert hw.parse_designation(f"DIN 988 {d1:g} x {d2:g} x {h:g}".replace(".", ",")) == ring
+            assert parse_designation(ring.designation) == ring
+            assert parse_designation(f"DIN 988 {d1:g} x {d2:g} x {h:g}".replace(".", ",")) == ring
     with pytest.raises(SpecError):
-        hw.parse_designation("DIN 988 3 × 7 × 0.5")                 # the 3 mm ring is 6 mm outside
+        parse_designation("DIN 988 3 × 7 × 0.5")                 # the 3 mm ring is 6 mm outside
 
 
 # --- nuts and screws ---------------------------------------------------------------------------------------
@@ -99,7 +101,7 @@ def test_iso4032_nuts_are_hexagons_growing_with_the_thread():
     prev = None
     for size in sizes:
         n = hw.nut(size)
-        assert n.designation == f"ISO 4032 {size}" and hw.parse_designation(n.designation) == n
+        assert n.designation == f"ISO 4032 {size}" and parse_designation(n.designation) == n
         # across corners of a regular hexagon is s / cos 30°; the standard's e min sits just under it
         assert n.s_mm < n.e_mm <= n.s_mm / math.cos(math.radians(30)) + 1e-9
         assert float(size[1:]) < n.s_mm and 0 < n.m_mm < n.s_mm
@@ -117,19 +119,19 @@ def test_screw_and_nut_engages_the_whole_nut(size):
         s, n = hw.screw_and_nut(size, clamp)
         assert s.length_mm >= clamp + n.m_mm and s.engagement_mm >= n.m_mm
         assert s.length_mm in hw.ISO4762_LENGTHS_MM
-        assert hw.parse_designation(s.designation).length_mm == s.length_mm
+        assert parse_designation(s.designation).length_mm == s.length_mm
 
 
 # --- clevis pins and split pins ------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("d", sorted(hw.ISO2341))
+@pytest.mark.parametrize("d", sorted(pins.ISO2341))
 def test_clevis_pin_grip_covers_the_stack_and_takes_its_split_pin(d):
-    dk, dl, _, _, k, le = hw.ISO2341[d]
-    lo, hi = hw.ISO2341_RANGE_MM[d]
-    series = [v for v in hw.ISO2341_LENGTHS_MM if lo <= v <= hi]
+    dk, dl, _, _, k, le = pins.ISO2341[d]
+    lo, hi = pins.ISO2341_RANGE_MM[d]
+    series = [v for v in pins.ISO2341_LENGTHS_MM if lo <= v <= hi]
     for grip in (1.0, 4.5, 9.2, series[-1] - le - dl / 2):
-        pin = hw.clevis_pin(d, grip)
+        pin = pins.clevis_pin(d, grip)
         assert pin.length_mm in series
         assert pin.grip_mm == pytest.approx(pin.length_mm - le - dl / 2) and pin.grip_mm >= grip - 1e-9
         shorter = [v for v in series if v < pin.length_mm]
@@ -137,27 +139,27 @@ def test_clevis_pin_grip_covers_the_stack_and_takes_its_split_pin(d):
         assert pin.protrusion_mm == pytest.approx(le + dl / 2) and pin.head_d_mm == dk > d
         sp = pin.split_pin
         assert sp.size_mm == dl and sp.length_mm >= d and sp.wire_d_mm < dl   # fits its hole, spans the pin
-        assert sp.length_mm in hw.ISO1234_LENGTHS_MM
+        assert sp.length_mm in pins.ISO1234_LENGTHS_MM
         assert pin.designation == f"ISO 2341-B {d:g} × {pin.length_mm:g}"
-        assert hw.parse_designation(pin.designation) == pin
-        assert hw.parse_designation(sp.designation) == sp
+        assert parse_designation(pin.designation) == pin
+        assert parse_designation(sp.designation) == sp
     with pytest.raises(SpecError) as err:
-        hw.clevis_pin(d, series[-1])
+        pins.clevis_pin(d, series[-1])
     assert err.value.path == "min_grip_mm"
 
 
 def test_clevis_pin_refuses_a_diameter_iso_2341_lacks():
     with pytest.raises(SpecError) as err:
-        hw.clevis_pin(2.0, 10.0)                                    # ISO 2341 starts at 3 mm
+        pins.clevis_pin(2.0, 10.0)                                    # ISO 2341 starts at 3 mm
     assert err.value.path == "diameter_mm"
-    assert hw.clevis_pin(3, 9.2).designation == "ISO 2341-B 3 × 12"   # 12 - 1.6 - 0.4 = 10 >= 9.2
+    assert pins.clevis_pin(3, 9.2).designation == "ISO 2341-B 3 × 12"   # 12 - 1.6 - 0.4 = 10 >= 9.2
 
 
 @pytest.mark.parametrize("d", [2.0, 2.5, 3.0, 4.0, 5.0])
 def test_grooved_pin_leaves_room_for_a_clip_at_each_face(d):
     for stack in (3.0, 7.4, 12.0):
-        g = hw.grooved_pin(d, stack)
-        series = hw.pin_lengths(d, "ISO 2338")
+        g = clips.grooved_pin(d, stack)
+        series = pins.pin_lengths(d, "ISO 2338")
         need = stack + 2 * (g.clip.groove_w_mm + g.clip.edge_margin_mm)
         assert g.pin.length_mm in series and g.pin.length_mm >= need
         assert all(v < need for v in series if v < g.pin.length_mm)        # the shortest that does
@@ -172,23 +174,23 @@ def test_grooved_pin_leaves_room_for_a_clip_at_each_face(d):
 
 
 def test_every_designation_names_its_record():
-    records = [hw.dowel_pin(d, n) for d in (1.5, 2, 3) for n in (8.0, 12.3, 15.6)]
+    records = [pins.dowel_pin(d, n) for d in (1.5, 2, 3) for n in (8.0, 12.3, 15.6)]
     records += [hw.screw(size, clamp, 3.0, std) for std in ("ISO 4762", "ISO 7380") for size in ("M3", "M4")
                 for clamp in (2.0, 7.0)]
-    records += [hw.e_clip(d) for d in (2.0, 2.5, 3.0, 4.0)]
-    records += [hw.split_pin(s, 10) for s in hw.ISO1234]
+    records += [clips.e_clip(d) for d in (2.0, 2.5, 3.0, 4.0)]
+    records += [pins.split_pin(s, 10) for s in pins.ISO1234]
     records += [hw.pin_washer(d) for d in hw.ISO8738]
     for r in records:
-        back = hw.parse_designation(r.designation)
+        back = parse_designation(r.designation)
         assert back.designation == r.designation
         if isinstance(r, hw.Screw):
             assert (back.length_mm, back.head_d_mm) == (r.length_mm, r.head_d_mm)
         else:
             assert back == r
-    assert hw.e_clip(3.0).designation == "DIN 6799 1.9"
-    assert hw.parse_designation("ISO 8734 2 × 20") == ("ISO 8734 2 × 20", 20.0)
+    assert clips.e_clip(3.0).designation == "DIN 6799 1.9"
+    assert parse_designation("ISO 8734 2 × 20") == ("ISO 8734 2 × 20", 20.0)
     for bad in ("ISO 8734 2 × 21", "ISO 4762 M3 × 13", "ISO 7089 7", "DIN 6799 1.3", "ISO 2341-B 3 × 7",
                 "ISO 1234 0.8 × 7", "M3 washer", "ISO 4032 M7"):
         with pytest.raises(SpecError) as err:
-            hw.parse_designation(bad)
+            parse_designation(bad)
         assert err.value.path == "designation"

@@ -21,7 +21,8 @@ import numpy as np
 import pytest
 
 from fabricate.export.mass import mesh_mass_properties, stl_triangles
-from fabricate.export.mjcf import activate_gear_segments, driver_targets, joint_coordinates, kinematic_tree
+from fabricate.export.mjcf import activate_gear_segments
+from fabricate.export.mjcf_tree import driver_targets, joint_coordinates, kinematic_tree
 from fabricate.mechanism import Body, Driver, GearCoupling, Mechanism, Revolute
 from fabricate.pipeline import BuildOutcome
 
@@ -261,7 +262,7 @@ def test_kinematic_tree_of_a_four_bar_closes_one_pin_and_holds_the_driver(four_b
 
 
 def test_gear_fit_is_one_exact_quartic_for_a_quartic_law_and_segments_a_full_turn_law() -> None:
-    from fabricate.export.mjcf import GEAR_FIT_TOLERANCE_RAD, fit_gear
+    from fabricate.export.mjcf_tree import GEAR_FIT_TOLERANCE_RAD, fit_gear
     from fabricate.mechanism import LinearLaw
 
     linear = _gear_train(LinearLaw(-1.5, 0.2), 60.0)

@@ -22,7 +22,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from fabricate.catalogue.hardware import PinChoice, parse_designation, pin_lengths
+from fabricate.catalogue.designations import parse_designation
+from fabricate.catalogue.pins import PinChoice, pin_lengths
 from fabricate.parts.build import build_parts
 from fabricate.parts.retention import SHORT_OF_END
 from fabricate.parts.spec import PartsSpec

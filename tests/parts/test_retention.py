@@ -7,7 +7,8 @@ import dataclasses
 
 import pytest
 
-from fabricate.catalogue.hardware import ISO2338_LENGTHS_MM, ISO8734_LENGTHS_MM, e_clip, pin_lengths
+from fabricate.catalogue.clips import e_clip
+from fabricate.catalogue.pins import ISO2338_LENGTHS_MM, ISO8734_LENGTHS_MM, pin_lengths
 from fabricate.errors import SpecError
 from fabricate.parts.retention import (
     SHORT_OF_END,
