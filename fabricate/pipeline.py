@@ -392,7 +392,7 @@ def _export(run: BuildRun, with_step: bool) -> None:
     from fabricate.export import assembly_csv, export_all, motion_csv
     from fabricate.export.guide import guide_markdown, guide_steps
     from fabricate.parts.assembly import assembly_steps, guide_report, pin_stacks, stacks_report
-    from fabricate.parts.retention import hardware_report
+    from fabricate.parts.hardware_report import hardware_report
     from fabricate.parts.spring_rows import springs_report
     from fabricate.synthesis.linkage.exact import mechanism_toml
 

@@ -174,7 +174,7 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
         keys = list(dict.fromkeys(k for row in bom for k in row))
         out += _table(keys, [[row.get(k, "") for k in keys] for row in bom]) + [""]
     if report.get("hardware"):
-        from fabricate.parts.retention import hardware_markdown
+        from fabricate.parts.hardware_report import hardware_markdown
 
         out += hardware_markdown(report["hardware"])
     strength = report.get("strength", {})
