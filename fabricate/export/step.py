@@ -28,7 +28,8 @@ from typing import Any
 import numpy as np
 
 from fabricate.errors import GeometryError
-from fabricate.export.step_read import StepSolid, read_step, step_problems
+from fabricate.export.step_curves import clean_path, profile_pieces, spline_edges
+from fabricate.export.step_read import DESCRIPTION, StepSolid, read_step, step_problems
 from fabricate.parts.model import BulgePath, Part
 
 __all__ = ["StepSolid", "assembly_step", "part_shape", "part_step", "read_step", "step_available", "step_files",
@@ -45,6 +46,7 @@ VOLUME_REL_TOL = 1e-9
 
 #: Shortest edge kept (mm): a repeated vertex in a profile would make a zero-length edge, which OCCT refuses.
 _MIN_EDGE_MM = 1e-9
+
 
 
 @contextlib.contextmanager
@@ -113,11 +115,13 @@ def _arc_circle(p0: np.ndarray, p1: np.ndarray, bulge: float) -> Any:
     return gp_Circ(frame, radius)
 
 
-def _path_wire(path: BulgePath, counter_clockwise: bool, what: str) -> Any:
-    """A closed wire of the path's lines and true arcs, turned to the asked orientation.
+def _path_wire(path: BulgePath, counter_clockwise: bool, what: str, chord_tolerance_mm: float) -> Any:
+    """A closed wire of the path's lines, true arcs and B-spline runs, turned to the asked orientation.
 
-    Vertices are made once and shared by the edges meeting there, so the wire closes exactly (no
-    tolerance-based vertex matching).
+    The path is split by :func:`fabricate.export.step_curves.profile_pieces`: its arcs and the polygonised
+    circles in it become circular edges, smooth runs of short lines (gear flanks) a few B-splines each (see
+    :func:`~fabricate.export.step_curves.spline_edges`). Vertices are made once and shared by the edges
+    meeting there, so the wire closes exactly (no tolerance-based vertex matching).
     """
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
 
@@ -127,26 +131,32 @@ def _path_wire(path: BulgePath, counter_clockwise: bool, what: str) -> Any:
         # the reversed path visits the vertices backwards; each arc keeps its circle with the opposite sense
         vertices = vertices[::-1]
         bulges = -np.roll(bulges[::-1], -1)
-    n = len(vertices)
-    keep = [i for i in range(n) if float(np.hypot(*(vertices[(i + 1) % n] - vertices[i]))) > _MIN_EDGE_MM]
-    if len(keep) < 2 or (len(keep) == 2 and not np.any(bulges[keep])):
-        raise GeometryError(f"{what}: degenerate profile of {len(keep)} edges")
     # a dropped (zero-length) segment merges its two vertices: keep the first of each run
-    points = [vertices[i] for i in keep]
-    made = [_vertex(p) for p in points]
+    vertices, bulges = clean_path(vertices, bulges, _MIN_EDGE_MM)
+    if len(vertices) < 2 or (len(vertices) == 2 and not np.any(bulges)):
+        raise GeometryError(f"{what}: degenerate profile of {len(vertices)} edges")
+    made: dict[int, Any] = {}
+
+    def vertex(index: int) -> Any:
+        if index not in made:
+            made[index] = _vertex(vertices[index])
+        return made[index]
+
     wire = BRepBuilderAPI_MakeWire()
-    for k, i in enumerate(keep):
-        j = (k + 1) % len(keep)
-        p0, p1, b = points[k], points[j], float(bulges[i])
-        if b != 0.0:
-            edge = BRepBuilderAPI_MakeEdge(_arc_circle(p0, p1, b), made[k], made[j])
+    for piece in profile_pieces(vertices, bulges):
+        if piece.kind == "spline":
+            edges = spline_edges(piece.points, piece.start, len(vertices), vertex, chord_tolerance_mm)
+        elif piece.kind == "arc":
+            edges = [BRepBuilderAPI_MakeEdge(_arc_circle(vertices[piece.start], vertices[piece.end], piece.bulge),
+                                             vertex(piece.start), vertex(piece.end))]
         else:
-            edge = BRepBuilderAPI_MakeEdge(made[k], made[j])
-        if not edge.IsDone():
-            raise GeometryError(f"{what}: edge {i} of the profile could not be made")
-        wire.Add(edge.Edge())
-        if not wire.IsDone():
-            raise GeometryError(f"{what}: edge {i} does not continue the profile")
+            edges = [BRepBuilderAPI_MakeEdge(vertex(piece.start), vertex(piece.end))]
+        for edge in edges:
+            if not edge.IsDone():
+                raise GeometryError(f"{what}: edge from vertex {piece.start} of the profile could not be made")
+            wire.Add(edge.Edge())
+            if not wire.IsDone():
+                raise GeometryError(f"{what}: the edge from vertex {piece.start} does not continue the profile")
     return wire.Wire()
 
 
@@ -207,14 +217,14 @@ def _solid(part: Part, chord_tolerance_mm: float, z_mm: float, what: str) -> Any
 
     if not part.thickness_mm > 0:
         raise GeometryError(f"{what}: thickness {part.thickness_mm} mm")
-    outer = _path_wire(part.outline, True, what)
+    outer = _path_wire(part.outline, True, what, chord_tolerance_mm)
     face_maker = BRepBuilderAPI_MakeFace(outer, True)
     if not face_maker.IsDone():
         raise GeometryError(f"{what}: the outline is not a planar face")
     for hole in part.holes:
         face_maker.Add(_circle_wire(np.asarray(hole.centre, dtype=np.float64), hole.diameter_mm))
     for slot in getattr(part, "slots", ()):
-        face_maker.Add(_path_wire(slot, False, what))
+        face_maker.Add(_path_wire(slot, False, what, chord_tolerance_mm))
     face = face_maker.Face()
     # the face is what can be wrong (a hole or slot crossing the outline or each other, a self-touching
     # outline); a prism of a valid planar face along its normal is valid by construction, and checking the
@@ -236,15 +246,28 @@ def _solid(part: Part, chord_tolerance_mm: float, z_mm: float, what: str) -> Any
     if not explorer.More():
         raise GeometryError(f"{what}: the extrusion is not a solid")
     solid = _downcast("Solid", explorer.Current())
-    # the solid must hold the report's volume (exact area with arcs, minus holes and slots, times thickness)
+    # the solid must hold the part's volume (its path's area with arcs, minus holes and slots, times the
+    # thickness), but where curves replaced a polygon's chords: each within the chord tolerance of them
     volume, expected = _volume(solid), part.volume_mm3()
-    if not abs(volume - expected) <= VOLUME_REL_TOL * abs(expected):
+    if not abs(volume - expected) <= VOLUME_REL_TOL * abs(expected) + volume_band_mm3(part, chord_tolerance_mm):
         raise GeometryError(f"{what}: volume {volume:.6f} mm^3, the part's is {expected:.6f} mm^3")
     if z_mm:
         lift = gp_Trsf()
         lift.SetTranslation(gp_Vec(0.0, 0.0, float(z_mm)))
         solid = _downcast("Solid", BRepBuilderAPI_Transform(solid, lift, True).Shape())
     return solid
+
+
+def volume_band_mm3(part: Part, chord_tolerance_mm: float) -> float:
+    """How far the solid's volume may lie from the part's (:meth:`Part.volume_mm3`, its polygon's where the
+    path is one): the chord tolerance times the thickness times the length of the straight segments of
+    outline and slots, which arcs and splines within that tolerance of them may replace."""
+    length = 0.0
+    for path in (part.outline, *getattr(part, "slots", ())):
+        v = np.asarray(path.vertices, dtype=np.float64)
+        chords = np.hypot(*(np.roll(v, -1, axis=0) - v).T)
+        length += float(chords[np.asarray(path.bulges) == 0.0].sum())
+    return chord_tolerance_mm * part.thickness_mm * length
 
 
 def _downcast(kind: str, shape: Any) -> Any:
@@ -304,7 +327,7 @@ _OCCURRENCE_ENTITY = re.compile(rb"NEXT_ASSEMBLY_USAGE_OCCURRENCE\(.*?\);", re.D
 _CONTINUATION = re.compile(rb"\r?\n[ \t]*")
 
 
-def _write(document: Any, title: str) -> bytes:
+def _write(document: Any, title: str, chord_tolerance_mm: float) -> bytes:
     """The XCAF document as STEP AP214 bytes with a fixed header (see module docstring)."""
     from OCP.Interface import Interface_Static
     from OCP.STEPCAFControl import STEPCAFControl_Writer
@@ -328,7 +351,7 @@ def _write(document: Any, title: str) -> bytes:
         with _quiet_occt():
             if not writer.Transfer(document, STEPControl_AsIs):
                 raise GeometryError(f"{title}: STEP transfer failed")
-            _fix_header(writer.ChangeWriter().Model(), title)
+            _fix_header(writer.ChangeWriter().Model(), title, chord_tolerance_mm)
             status = writer.Write(path)
         with open(path, "rb") as handle:
             data = handle.read()
@@ -345,13 +368,15 @@ def _write(document: Any, title: str) -> bytes:
     return _fixed_file_name(data, title)
 
 
-def _fix_header(model: Any, title: str) -> None:
-    """Header entities with fixed values (name, time stamp, author, organisation, systems)."""
+def _fix_header(model: Any, title: str, chord_tolerance_mm: float) -> None:
+    """Header entities with fixed values (name, time stamp, author, organisation, systems), and a description
+    stating the chord tolerance its curves keep to (:data:`fabricate.export.step_read.DESCRIPTION`)."""
     from OCP.APIHeaderSection import APIHeaderSection_MakeHeader
     from OCP.TCollection import TCollection_HAsciiString
 
     header = APIHeaderSection_MakeHeader(model)
     header.SetName(TCollection_HAsciiString(title))
+    header.SetDescriptionValue(1, TCollection_HAsciiString(DESCRIPTION.format(tolerance=chord_tolerance_mm)))
     header.SetTimeStamp(TCollection_HAsciiString(HEADER_TIME_STAMP))
     header.SetAuthorValue(1, TCollection_HAsciiString(""))
     header.SetOrganizationValue(1, TCollection_HAsciiString(""))
@@ -403,7 +428,7 @@ def part_step(part: Part, chord_tolerance_mm: float, shape: Any = None) -> bytes
     document, tool = _xcaf_document()
     label = tool.AddShape(shape if shape is not None else part_shape(part, chord_tolerance_mm), False)
     _set_name(label, part.name)
-    return _write(document, part.name)
+    return _write(document, part.name, chord_tolerance_mm)
 
 
 def assembly_step(parts: Sequence[Part], poses: Mapping[str, np.ndarray], chord_tolerance_mm: float,
@@ -441,7 +466,7 @@ def assembly_step(parts: Sequence[Part], poses: Mapping[str, np.ndarray], chord_
         component = tool.AddComponent(assembly, label, _pose_location(pose, part.z_mm))
         _set_name(component, part.name)
     tool.UpdateAssemblies()
-    return _write(document, title)
+    return _write(document, title, chord_tolerance_mm)
 
 
 def step_files(parts: Sequence[Part], poses: Mapping[str, np.ndarray], chord_tolerance_mm: float,

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import tempfile
 from collections.abc import Mapping
 from typing import Any, NamedTuple
@@ -17,6 +18,12 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from fabricate.errors import GeometryError
+
+#: The writer's FILE_DESCRIPTION: arcs and splines that replaced a polygon's chords (gear flanks, fused
+#: hubs) stand within the build's chord tolerance of them, so the solid's volume may differ from the report's
+#: (the polygon's) by that tolerance times the area of its curved side faces, and no more.
+DESCRIPTION = "fabricate: curves within {tolerance:.6g} mm of the part's polygon"
+_DESCRIBED_TOLERANCE = re.compile(rb"FILE_DESCRIPTION\s*\(\s*\(\s*'fabricate: curves within ([0-9.eE+-]+) mm")
 
 
 class StepSolid(NamedTuple):
@@ -37,6 +44,10 @@ class StepSolid(NamedTuple):
         Partial cylindrical faces (outline and slot arcs).
     bounds : (2, 3) float64 array
         Tight axis-aligned bounding box (min, max) in mm, in the file's world frame (posed for an assembly).
+    curved_area_mm2 : float
+        Area of the faces that are neither planes nor holes (arcs, B-spline flanks).
+    n_faces : int
+        Every face of the solid.
     """
 
     name: str
@@ -45,6 +56,8 @@ class StepSolid(NamedTuple):
     valid: bool
     n_arc_faces: int
     bounds: np.ndarray
+    curved_area_mm2: float = 0.0
+    n_faces: int = 0
 
 
 
@@ -142,8 +155,10 @@ def _measure(shape: Any, name: str) -> list[StepSolid]:
     from OCP.BRepAdaptor import BRepAdaptor_Surface
     from OCP.BRepBndLib import BRepBndLib
     from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.BRepGProp import BRepGProp
     from OCP.BRepTools import BRepTools
-    from OCP.GeomAbs import GeomAbs_Cylinder
+    from OCP.GeomAbs import GeomAbs_Cylinder, GeomAbs_Plane
+    from OCP.GProp import GProp_GProps
     from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
 
@@ -153,23 +168,30 @@ def _measure(shape: Any, name: str) -> list[StepSolid]:
     explorer = TopExp_Explorer(shape, TopAbs_SOLID)
     while explorer.More():
         solid = _downcast("Solid", explorer.Current())
-        full = partial = 0
+        full = partial = count = 0
+        curved = 0.0
         faces = TopExp_Explorer(solid, TopAbs_FACE)
         while faces.More():
             face = _downcast("Face", faces.Current())
-            if BRepAdaptor_Surface(face).GetType() == GeomAbs_Cylinder:
+            kind = BRepAdaptor_Surface(face).GetType()
+            count += 1
+            hole = False
+            if kind == GeomAbs_Cylinder:
                 u0, u1, _, _ = BRepTools.UVBounds_s(face)
                 # a hole's wall goes once round its axis; an outline arc covers less than a turn
-                if u1 - u0 > 2.0 * math.pi - 1e-9:
-                    full += 1
-                else:
-                    partial += 1
+                hole = u1 - u0 > 2.0 * math.pi - 1e-9
+                full, partial = full + hole, partial + (not hole)
+            if kind != GeomAbs_Plane and not hole:
+                props = GProp_GProps()
+                BRepGProp.SurfaceProperties_s(face, props)
+                curved += float(props.Mass())
             faces.Next()
         box = Bnd_Box()
         BRepBndLib.AddOptimal_s(solid, box, False, False)
         low, high = box.CornerMin(), box.CornerMax()
         solids.append(StepSolid(name, _volume(solid), full, bool(BRepCheck_Analyzer(solid).IsValid()), partial,
-                                np.array([[low.X(), low.Y(), low.Z()], [high.X(), high.Y(), high.Z()]])))
+                                np.array([[low.X(), low.Y(), low.Z()], [high.X(), high.Y(), high.Z()]]), curved,
+                                count))
         explorer.Next()
     return solids
 
@@ -186,7 +208,9 @@ def step_problems(data: bytes, expected: Mapping[str, tuple[float, int]] | None 
         Part name -> (volume mm^3, number of holes), in file order: one entry for a part file, every
         part for ``assembly.step``. Without it only readability and validity are checked.
     rel_tol : float
-        Relative volume tolerance.
+        Relative volume tolerance, to which the chord tolerance the file states (:data:`DESCRIPTION`) times
+        the area of its curved side faces is added: the report's volume is the polygon's, which those curves
+        replaced within that tolerance.
 
     Returns
     -------
@@ -197,6 +221,8 @@ def step_problems(data: bytes, expected: Mapping[str, tuple[float, int]] | None 
         solids = read_step(data)
     except GeometryError as exc:
         return [str(exc)]
+    stated = _DESCRIBED_TOLERANCE.search(data[:4096])
+    tolerance = float(stated.group(1)) if stated else 0.0
     problems = [f"solid {s.name or '?'}: not a valid solid" for s in solids if not s.valid]
     if not solids:
         problems.append("no solid")
@@ -207,7 +233,7 @@ def step_problems(data: bytes, expected: Mapping[str, tuple[float, int]] | None 
         return problems + [f"solids {names} differ from the report's parts {list(expected)}"]
     for solid in solids:
         volume, holes = expected[solid.name]
-        if not abs(solid.volume_mm3 - volume) <= rel_tol * abs(volume):
+        if not abs(solid.volume_mm3 - volume) <= rel_tol * abs(volume) + tolerance * solid.curved_area_mm2:
             problems.append(f"solid {solid.name}: volume {solid.volume_mm3:.4f} mm^3, the report says {volume:.4f}")
         if solid.n_cylindrical_faces != holes:
             problems.append(f"solid {solid.name}: {solid.n_cylindrical_faces} hole cylinders, the report says {holes}")

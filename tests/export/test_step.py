@@ -3,12 +3,13 @@
 What is asserted, per shipped template, on the files the pipeline produces:
 
 - every ``parts/NAME.step`` holds one valid solid named NAME whose volume equals the part's exact volume
-  (``part.volume_mm3()``, the report's ``volume_mm3``) within 1e-6 relative. That holds for gear parts
-  too: their flanks reach the part model already polygonised to the chord tolerance (short lines), the
-  STEP keeps those lines, so the solid is the report's polygon exactly; the flanks are within the chord
-  tolerance of the involute-approximated tooth by construction of the polygonisation, not of the STEP;
+  (``part.volume_mm3()``, the report's ``volume_mm3``) within 1e-6 relative where its profile is lines and
+  arcs. A fused profile (gear teeth, hubs, pads) reaches the part model as a polygon within the chord
+  tolerance of its curves; the STEP puts the curves back (true arcs, B-spline flanks: see
+  tests/export/test_step_curves.py), so its volume may differ from the polygon's by the chord tolerance
+  times its curved side area, and no more;
 - full cylinders (a face going once round its axis) = holes, one each; partial cylinders = arc segments
-  of the outline and the slots (true circular edges, not facets);
+  of the outline and the slots (true circular edges, not facets), and the polygonised arcs recognised;
 - ``assembly.step`` holds one solid per part, named as the part, and each solid's bounding box equals
   the posed mesh's in ``assembly.3mf`` within the chord tolerance (the mesh is inscribed in the arcs, so
   a B-rep box may be larger by at most the sagitta) plus 1e-5 mm for the mesh's float32 rounding;
@@ -41,6 +42,7 @@ from fabricate.export.step import (  # noqa: E402
     step_available,
     step_problems,
 )
+from fabricate.export.step_curves import SPLINE_FIT_FACTOR  # noqa: E402
 from fabricate.export.stl import read_3mf  # noqa: E402
 from fabricate.parts.model import BulgePath, Hole, Part  # noqa: E402
 from fabricate.templates import shipped_templates  # noqa: E402
@@ -79,15 +81,18 @@ def test_every_part_step_is_a_valid_solid_with_the_report_volume_and_hole_cylind
         solid = solids[0]
         assert solid.valid, f"{name}/{part.name}: invalid solid"
         assert solid.name == part.name
-        assert solid.volume_mm3 == pytest.approx(part.volume_mm3(), rel=VOLUME_REL_TOL)
-        assert solid.volume_mm3 == pytest.approx(entry["volume_mm3"], rel=VOLUME_REL_TOL, abs=1e-4)
+        band = outcome.partset.chord_tolerance_mm * solid.curved_area_mm2 if not part.outline.bulges.any() else 0.0
+        assert abs(solid.volume_mm3 - part.volume_mm3()) <= VOLUME_REL_TOL * part.volume_mm3() + band
+        assert abs(solid.volume_mm3 - entry["volume_mm3"]) <= VOLUME_REL_TOL * part.volume_mm3() + band + 1e-4
         assert solid.n_cylindrical_faces == len(part.holes), f"{name}/{part.name}"
         arcs = int(np.count_nonzero(part.outline.bulges)) + sum(
             int(np.count_nonzero(slot.bulges)) for slot in getattr(part, "slots", ()))
-        assert solid.n_arc_faces == arcs, f"{name}/{part.name}: arcs not kept as circular edges"
-        # lying on z = 0 in its own coordinates, like its STL
-        assert solid.bounds[0, 2] == pytest.approx(0.0, abs=1e-7)
-        assert solid.bounds[1, 2] == pytest.approx(part.thickness_mm, abs=1e-7)
+        assert solid.n_arc_faces >= arcs, f"{name}/{part.name}: arcs not kept as circular edges"
+        if not part.outline.bulges.any() and len(part.outline.vertices) > 12:  # a fused profile: few faces
+            assert solid.n_faces < len(part.outline.vertices) / 2, f"{name}/{part.name}: {solid.n_faces} faces"
+        # lying on z = 0 in its own coordinates, like its STL (a box round curved faces adds their 1e-7 mm)
+        assert solid.bounds[0, 2] == pytest.approx(0.0, abs=2e-7)
+        assert solid.bounds[1, 2] == pytest.approx(part.thickness_mm, abs=2e-7)
 
 
 @pytest.mark.slow
@@ -101,13 +106,15 @@ def test_assembly_step_has_one_named_solid_per_part_where_the_3mf_puts_it(build)
     assert not problems
     for part, solid in zip(parts, solids, strict=True):
         assert solid.valid
-        assert solid.volume_mm3 == pytest.approx(part.volume_mm3(), rel=VOLUME_REL_TOL)
+        band = tolerance * solid.curved_area_mm2 if not part.outline.bulges.any() else 0.0
+        assert abs(solid.volume_mm3 - part.volume_mm3()) <= VOLUME_REL_TOL * part.volume_mm3() + band
         assert solid.n_cylindrical_faces == len(part.holes)
         mesh_bounds = np.asarray(meshes[part.name].bounds)
         # the mesh is inscribed in the exact arcs: the B-rep box contains it, larger by at most a sagitta;
-        # MESH_ROUNDING_MM covers the mesh's own rounding
-        assert np.all(solid.bounds[0] <= mesh_bounds[0] + MESH_ROUNDING_MM), f"{name}/{part.name}"
-        assert np.all(solid.bounds[1] >= mesh_bounds[1] - MESH_ROUNDING_MM), f"{name}/{part.name}"
+        # MESH_ROUNDING_MM covers the mesh's own rounding, a flank spline may pass inside a vertex by its fit
+        slack = MESH_ROUNDING_MM + SPLINE_FIT_FACTOR * tolerance
+        assert np.all(solid.bounds[0] <= mesh_bounds[0] + slack), f"{name}/{part.name}"
+        assert np.all(solid.bounds[1] >= mesh_bounds[1] - slack), f"{name}/{part.name}"
         assert np.allclose(solid.bounds, mesh_bounds, atol=tolerance + MESH_ROUNDING_MM), f"{name}/{part.name}"
         assert solid.bounds[0, 2] == pytest.approx(part.z_mm, abs=1e-6)
 
