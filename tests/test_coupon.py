@@ -145,6 +145,14 @@ def test_coupon_cli_writes_the_files_from_a_profile_copy(tmp_path, monkeypatch):
     assert main(["init", "--process", "sla"]) == 0
     assert main(["coupon", "--process", "my_sla.toml", "-o", "c"]) == 0
     assert sorted(p.name for p in (tmp_path / "c").iterdir()) == ["README.md", "coupon.3mf", "coupon.stl"]
+    # the loop: a measured compensation edited into the copy is what the next coupon (and build) uses
+    copy = tmp_path / "my_sla.toml"
+    text = copy.read_text()
+    assert "hole_compensation_mm = 0.2 " in text
+    copy.write_text(text.replace("hole_compensation_mm = 0.2 ", "hole_compensation_mm = 0.35"))
+    edited = make_coupon(coupon_process(str(copy)))
+    assert edited.process.hole_compensation_mm == 0.35
+    assert all(abs(f.modelled_mm - f.nominal_mm - 0.35) < 1e-12 for f in edited.features)
 
 
 @pytest.mark.parametrize("argv", [["coupon", "--process", "nope", "-o", "out"],
