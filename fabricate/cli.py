@@ -1,4 +1,4 @@
-"""Command line: ``fabricate build|synth|check|sweep|list|init``.
+"""Command line: ``fabricate build|synth|check|sweep|list|init|coupon``.
 
 Exit codes: 0 all checks pass; 1 the design fails a check (files are written, the report says why);
 2 invalid input or usage (nothing is written); 3 an internal error (a bug: please report it with the
@@ -200,7 +200,7 @@ def _progress(quiet: bool):
 
 def _parser() -> argparse.ArgumentParser:
     p = _Parser(prog="fabricate", description="Turn a template into a prototype to make: fabricate "
-                                              "build|synth|check|sweep|list|init.", epilog=HELP_EPILOG)
+                                              "build|synth|check|sweep|list|init|coupon.", epilog=HELP_EPILOG)
     p.add_argument("--version", action="version", version=f"fabricate {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     b = sub.add_parser("build", help="the whole pipeline into an output folder")
@@ -248,10 +248,24 @@ def _parser() -> argparse.ArgumentParser:
                                                      "or an earlier run of the same sweep, which is resumed")
     w.add_argument("-q", "--quiet", action="store_true", help=QUIET_HELP)
     sub.add_parser("list", help="templates shipped")
-    i = sub.add_parser("init", help="write an editable copy of a shipped template into the current folder")
-    i.add_argument("name", help="name of the new design (writes NAME.toml)")
+    i = sub.add_parser("init", help="write an editable copy of a shipped template (or, with --process, of a "
+                                     "process profile) into the current folder")
+    i.add_argument("name", nargs="?", help="name of the new design (writes NAME.toml)")
     i.add_argument("--from", dest="source", default=DEFAULT_TEMPLATE,
                    help=f"template to copy (default {DEFAULT_TEMPLATE})")
+    i.add_argument("--process", metavar="sla|fdm|laser",
+                   help="copy this shipped process profile instead (default file my_<process>.toml); edit it "
+                        "and build with --process FILE")
+    i.add_argument("-o", "--output", type=Path, help="the profile copy's file (with --process)")
+    k = sub.add_parser("coupon", help="a calibration coupon for a process: pin holes press to loose, a rack at "
+                                      "the process's module, a kerf comb for a laser; README.md says what to "
+                                      "measure and which profile field it sets")
+    k.add_argument("--process", required=True, metavar="sla|fdm|laser|PATH",
+                   help="the process profile (a shipped name or a profile file, e.g. one 'init --process' wrote)")
+    k.add_argument("--printer", metavar="NAME", help="print on this printer preset (the coupon must fit it)")
+    k.add_argument("-o", "--output", type=Path,
+                   help="output folder (default outputs/coupon_<process>/): new or empty")
+    k.add_argument("--force", action="store_true", help="replace an output folder that holds other files")
     return p
 
 
@@ -481,6 +495,12 @@ def _init(args: argparse.Namespace) -> int:
     from fabricate.design import design_from_text
     from fabricate.templates import find_template, read_text
 
+    if args.process is not None:
+        return _init_process(args)
+    if args.output is not None:
+        raise SpecError("-o", "names the profile copy of 'init --process'; a design copy is NAME.toml")
+    if args.name is None:
+        raise SpecError("NAME", "expected the new design's name (or --process to copy a process profile)")
     name = args.name[:-5] if args.name.endswith(".toml") else args.name
     if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}", name):
         raise SpecError("NAME", f"expected a plain design name (letters, digits, _ . -), got \"{args.name}\"")
@@ -502,6 +522,47 @@ def _init(args: argparse.Namespace) -> int:
         raise SpecError(str(target), f"cannot be written: {exc.strerror}") from exc
     print(f"wrote {target.name} (from {source.name}); build it with: fabricate build {target.name}")
     return EXIT_OK
+
+
+def _init_process(args: argparse.Namespace) -> int:
+    """``init --process P [-o FILE]``: the shipped profile's text under a header saying how to use it."""
+    from fabricate.coupon import profile_copy
+
+    if args.name is not None:
+        raise SpecError("NAME", "init --process writes a process profile: name its file with -o, not NAME")
+    target = args.output if args.output is not None else Path(f"my_{args.process}.toml")
+    text = profile_copy(args.process, target)
+    try:
+        with open(target, "x", encoding="utf-8") as fh:
+            fh.write(text)
+    except FileExistsError as exc:
+        raise SpecError(str(target), "exists already; init never overwrites a file") from exc
+    except OSError as exc:
+        raise SpecError(str(target), f"cannot be written: {exc.strerror}") from exc
+    print(f"wrote {target} (from the shipped {args.process} profile); calibrate it with: fabricate coupon "
+          f"--process {target}; build with: fabricate build TEMPLATE --process {target}")
+    return EXIT_OK
+
+
+def _coupon(args: argparse.Namespace) -> int:
+    from fabricate.coupon import coupon_files, coupon_process
+    from fabricate.output import check_output_dir, write_output
+
+    process = coupon_process(args.process, args.printer)
+    target = args.output or Path("outputs") / f"coupon_{process.name}"
+    protect = {} if args.process in _shipped_profiles() else {Path(args.process): "the process profile in use"}
+    out = check_output_dir(target, force=args.force, protect=protect)
+    files = coupon_files(process, str(args.process))
+    write_output(files, out, force=args.force, protect=protect, warn=lambda msg: _say(f"fabricate: warning: {msg}"))
+    args.written = out
+    print(f"coupon {process.name}: {', '.join(sorted(files))} -> {out} (README.md says what to measure)")
+    return EXIT_OK
+
+
+def _shipped_profiles() -> tuple[str, ...]:
+    from fabricate.process import shipped_profiles
+
+    return shipped_profiles()
 
 
 def _text(exc: BaseException) -> str:
@@ -542,6 +603,8 @@ def _run(argv: list[str] | None, received: list[int]) -> int:
             return _list()
         if args.command == "init":
             return _init(args)
+        if args.command == "coupon":
+            return _coupon(args)
         if args.command == "check":
             return _check(args)
         if args.command == "sweep":
