@@ -38,7 +38,7 @@ from typing import Any
 
 from fabricate.errors import FabricateError, SpecError
 from fabricate.export import copy_name
-from fabricate.output import REPORT, foreign_entries
+from fabricate.output_read import REPORT, foreign_entries
 from fabricate.report_schema import schema_errors, version_problem
 from fabricate.verify_files import OutputFolder, Unreadable, parse_problems, reject_constant, same_bytes
 
@@ -252,10 +252,10 @@ def _folder_step_files(folder: OutputFolder, report: Mapping[str, Any]) -> dict[
 
 def _rebuild(folder: OutputFolder, report: Mapping[str, Any], raw: bytes, progress: Callable[[str], None],
              notes: list[str]) -> tuple[list[str], dict[str, Any] | None]:
+    from fabricate.design import design_from_text
     from fabricate.export.step import step_available
     from fabricate.pipeline import OptionalOutputs, run_build, run_synth
     from fabricate.process import ProcessOverride
-    from fabricate.design import design_from_text
 
     text = report.get("template_text")
     design_info = report.get("design", {})
@@ -265,7 +265,8 @@ def _rebuild(folder: OutputFolder, report: Mapping[str, Any], raw: bytes, progre
     try:
         process = None
         if isinstance(override, dict):
-            process = ProcessOverride(str(override.get("source")), str(override.get("text")))
+            process = ProcessOverride(str(override.get("source")), str(override.get("text")),
+                                      str(override.get("printer") or ""))
         design = design_from_text(text, str(design_info.get("template") or "template.toml"), process)
     except SpecError as exc:
         return [f"{REPORT}: the embedded template is not valid: {exc}"], None

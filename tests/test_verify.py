@@ -19,10 +19,10 @@ import pytest
 import trimesh
 
 from fabricate.cli import main
+from fabricate.design import load_design
 from fabricate.output import write_output
 from fabricate.pipeline import run_build
 from fabricate.report_schema import SCHEMA_VERSION
-from fabricate.design import load_design
 from fabricate.templates import TEMPLATE_DIR
 
 FAST = "gear_pair_elliptic"

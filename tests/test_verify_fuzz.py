@@ -23,9 +23,9 @@ from typing import Any
 import pytest
 
 from fabricate.cli import main
+from fabricate.design import load_design
 from fabricate.output import write_output
 from fabricate.pipeline import run_build
-from fabricate.design import load_design
 
 FAST = "gear_pair_elliptic"
 #: Cases of each kind: ~0.1-0.3 s each once the module's build and first parse are done.
