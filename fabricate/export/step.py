@@ -2,12 +2,15 @@
 
 Mechanical CAD (SolidWorks, Fusion, Onshape, FreeCAD) wants solids, not meshes: every part becomes a
 planar face bounded by its exact profile (lines, true circular arcs for bulges, full circles for holes,
-slots as inner wires) extruded by its thickness. Gear flanks arrive already polygonised to the chord
-tolerance (short lines), so they stay lines here and the solid's volume is the report's exactly.
+slots as inner wires) extruded by its thickness. A profile fused with polygons (gear teeth, hubs, pads)
+arrives as a polygon within the chord tolerance of its curves; :mod:`fabricate.export.step_curves` puts
+them back: polygonised circles as true arcs, gear flanks as a few smooth B-spline faces per tooth. Such a
+solid's volume differs from the report's (the polygon's) by at most the chord tolerance times its curved
+side area, which the file states (:mod:`fabricate.export.step_read`); elsewhere it is the report's exactly.
 
-This is the only module importing OCP (the optional extra ``cad``: the ``cadquery-ocp-novtk`` wheel). It
-is imported lazily, inside the functions, so the package works without it; :func:`step_available`
-says whether it is there.
+This module, :mod:`~fabricate.export.step_curves` and :mod:`~fabricate.export.step_read` are the only ones
+importing OCP (the optional extra ``cad``: the ``cadquery-ocp-novtk`` wheel). It is imported lazily, inside
+the functions, so the package works without it; :func:`step_available` says whether it is there.
 
 Encoders return bytes and are deterministic: OCP writes files only, so each encoder writes into a private
 temporary folder, reads the file back and deletes it; the header's time stamp, author, organisation and
@@ -179,9 +182,9 @@ def part_shape(part: Part, chord_tolerance_mm: float, z_mm: float = 0.0) -> Any:
         Outline (lines and arcs, CCW or CW: turned CCW here), holes (full circles) and, for parts that
         have them, ``slots`` (closed bulge paths cut through the plate); mm in body coordinates.
     chord_tolerance_mm : float
-        The build's chord tolerance (mm). The B-rep keeps arcs and circles exact, so it does not shape the
-        solid; it bounds the tolerance handed to OCCT's shape fixing (a tenth of it) and names the gear
-        flank accuracy, which was fixed when the flanks were polygonised.
+        The build's chord tolerance (mm): how far the polygon of a fused profile is from its curves, so how
+        far the arcs and B-splines put back may stand from the polygon (and the solid's volume from the
+        part's); a tenth of it is the tolerance handed to OCCT's shape fixing.
     z_mm : float
         Height of the bottom face: 0 for the part's own file, ``part.z_mm`` for an assembly.
 
