@@ -119,16 +119,23 @@ def perimeter_mm(part) -> float:
 
 
 def expected_cut_diameter(hole, c) -> float:
-    """Modelled hole minus the kerf, from the process and the design alone (never from the part model's sizes,
-    only its fit): a running or clearance hole is the pin (or the mounting screw of ``[parts]``) + 2 x radial
-    clearance, a press-fit hole the pin - the profile's interference; + SLA compensation - kerf."""
+    """Modelled hole minus the kerf. A pin's hole and a ``[parts]`` mounting hole from the process and the
+    design alone (never from the part model's sizes, only its fit): a running or clearance hole is the pin (or
+    the mounting screw) + 2 x radial clearance, a press-fit hole the pin - the profile's interference. Step 14's
+    other holes (the actuator's screw, shaft and clearance holes, the springs' leg anchors and arbors) are sized
+    from the catalogue item they take, so their nominal is the model's stated one (it must be stated). Every
+    hole then gets the process's compensation (SLA) and loses the kerf."""
     process = c.process
+    pin_joints = {j for p in c.partset.pins for j in (p.joint, *p.joint.split("+"))}
     if hole.joint.startswith("mount_"):
         nominal = c.design.parts.mounting_hole_mm + 2 * process.running_clearance_mm
-    elif hole.fit == "press":
+    elif hole.joint in pin_joints and hole.fit == "press":
         nominal = process.pin_diameter_mm - process.press_fit_interference_mm
-    else:
+    elif hole.joint in pin_joints:
         nominal = process.pin_diameter_mm + 2 * process.running_clearance_mm
+    else:
+        assert hole.nominal_diameter_mm > 0.0, (hole.joint, "no nominal size stated")
+        nominal = hole.nominal_diameter_mm
     return nominal + process.hole_compensation_mm - process.kerf_mm
 
 

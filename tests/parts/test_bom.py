@@ -84,22 +84,63 @@ def test_printed_spacers_are_parts_not_hardware(gripper):
 @pytest.mark.slow
 @pytest.mark.parametrize("which", ["gripper", "five_bar_laser"])
 def test_each_pin_stack_fills_its_pin_exactly(which, request):
+    """Each stack's items cover its pin's span where the pin is: from face to face of the stack (report.json's
+    hardware: the pin's ends less its stated protrusions), without an overlap, a gap only where no standard
+    washer is that thin (axial play). Beyond a face only the retention's end items (the hardware's ``ends``,
+    on the pin's protrusion) and a spring (on the pin's extension, or on its printed arbor where it reaches
+    past the pin's end). A pressed pin short of a face ends inside the part there."""
+    from fabricate.parts.retention import fill_layer_gap
+
     outcome = request.getfixturevalue(which)
     stacks = outcome.report["assembly"]["pins"]
-    assert {s["pin"] for s in stacks} == {p.joint for p in outcome.partset.pins}
+    hardware = {p["pin"]: p for p in outcome.report["hardware"]["pins"]}
+    assert {s["pin"] for s in stacks} == {p.joint for p in outcome.partset.pins} == set(hardware)
     by_name = {p.name: p for p in outcome.partset.parts}
     for stack in stacks:
+        pin = hardware[stack["pin"]]
+        assert stack["length_mm"] == pytest.approx(pin["length_mm"], abs=1e-9)
+        ends = (stack["z_mm"], stack["z_mm"] + stack["length_mm"])  # the pin's own ends
+        faces = (ends[0] + pin["protrusion_mm"][0], ends[0] + pin["protrusion_mm"][0] + pin["stack_mm"])
+        assert faces[1] + pin["protrusion_mm"][1] == pytest.approx(ends[1], abs=1e-9)
         items = stack["stack"]
-        # bottom to top without a gap or an overlap, from the pin's bottom to its top
-        assert items[0]["z_mm"][0] == pytest.approx(stack["z_mm"], abs=1e-9)
-        assert items[-1]["z_mm"][1] == pytest.approx(stack["z_mm"] + stack["length_mm"], abs=1e-9)
-        for below, above in zip(items, items[1:], strict=False):
-            assert above["z_mm"][0] == pytest.approx(below["z_mm"][1], abs=1e-9)
+        inside = [i for i in items if faces[0] - 1e-9 <= i["z_mm"][0] and i["z_mm"][1] <= faces[1] + 1e-9]
+        # the stack: bottom face to top face, no overlap, a gap only where no standard washer fits
+        assert inside[0]["z_mm"][0] == pytest.approx(faces[0], abs=1e-9)
+        assert inside[-1]["z_mm"][1] == pytest.approx(faces[1], abs=1e-9)
+        for below, above in zip(inside, inside[1:], strict=False):
+            gap = above["z_mm"][0] - below["z_mm"][1]
+            assert gap >= -1e-9, (stack["pin"], below, above)
+            assert gap <= 1e-9 or fill_layer_gap(pin["diameter_mm"], gap) == (), (stack["pin"], below, above)
+        for side, sign in ((0, -1.0), (1, 1.0)):
+            face = faces[side]
+            if pin["protrusion_mm"][side] < 0.0:  # a pressed pin short of this face: it ends inside the part there
+                (at_face,) = [i for i in inside if abs(i["z_mm"][side] - face) < 1e-9]
+                assert at_face["kind"] == "part"
+                assert at_face["z_mm"][1] - at_face["z_mm"][0] > -pin["protrusion_mm"][side]
+            beyond = sorted((i for i in items if sign * (i["z_mm"][1 - side] - face) >= -1e-9 and i not in inside),
+                            key=lambda i: sign * i["z_mm"][0])
+            # the retention's end items, face outwards, each on the pin's protrusion
+            retained = [i for i in beyond if i["kind"] in ("clip", "washer")]
+            assert [i["item"] for i in retained] == pin["ends"][side], stack["pin"]
+            for i in retained:
+                assert min(ends) - 1e-9 <= i["z_mm"][0] and i["z_mm"][1] <= max(ends) + 1e-9
+            for spring in (i for i in beyond if i["kind"] == "spring"):
+                assert min(abs(spring["z_mm"][0] - face), abs(spring["z_mm"][1] - face)) < 1e-9  # on the face
+                past_pin = spring["z_mm"][0] < ends[0] - 1e-9 or spring["z_mm"][1] > ends[1] + 1e-9
+                arbors = [i for i in beyond if i["kind"] == "part" and i["z_mm"] == spring["z_mm"]
+                          and any(h.joint == f"arbor_{stack['pin']}" for h in by_name[i["item"]].holes)]
+                assert arbors or not past_pin, (stack["pin"], spring)  # past the pin's end: on its arbor
+            assert {i["kind"] for i in beyond} <= {"clip", "washer", "spring", "part"}
         for item in items:
             if item["kind"] == "part":
                 part = by_name[item["item"].removesuffix(" (in its slot)")]  # a real part, at its own height
-                assert item["z_mm"] == pytest.approx([part.z_mm, part.z_mm + part.thickness_mm], abs=1e-9)
-                on_hole = bool({h.joint for h in part.holes} & set(stack["pin"].split("+")))
+                # report.json rounds heights to 1e-6 mm (an arbor stands at a computed, not a round, height)
+                assert item["z_mm"] == pytest.approx([part.z_mm, part.z_mm + part.thickness_mm], abs=1e-6)
+                holes = {h.joint for h in part.holes}
+                if f"arbor_{stack['pin']}" in holes:
+                    assert item not in inside  # a spring's arbor stands beyond the stack's face
+                    continue
+                on_hole = bool(holes & set(stack["pin"].split("+")))
                 assert on_hole != item["item"].endswith("(in its slot)")  # a hole, or else its slot
                 assert on_hole or part.slots
     csv_rows = list(csv.DictReader(io.StringIO(outcome.files["assembly.csv"].decode())))
