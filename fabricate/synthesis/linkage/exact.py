@@ -47,7 +47,7 @@ if TYPE_CHECKING:
 #: Samples of a law written approximately (a law of a kind this file cannot write exactly).
 SAMPLED_LAW_POINTS = 2001
 #: Generic tables of the design copied into the template as they were written.
-GENERIC_TABLES = ("process", "gears", "parts", "checks", "load")
+GENERIC_TABLES = ("process", "gears", "parts", "checks", "load", "actuator")
 
 
 # -- writing -----------------------------------------------------------------------------------------

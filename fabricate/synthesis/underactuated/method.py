@@ -57,10 +57,14 @@ def synthesise(design: DesignSpec) -> SynthesisResult:
     springs = tuple(SpringHint(f"G{i + 1}", float(spec.spring_rates[i] * np.pi / 180.0),
                                float(np.degrees(spec.spring_preloads[i])), spec.spring_legs,
                                "return spring, opens the joint against its stop") for i in range(d.n))
+    # the push rod's drive: a template's [actuator] places it (its BOM row, the drive check), so only without one
+    # does the synthesis name what to buy; never both, which listed two drives per copy
+    drive = () if design.actuator is not None else (
+        PurchasedItem(f"linear actuator, stroke >= {spec.stroke:.0f} mm, force >= {spec.push_force:.0f} N", 1,
+                      "drives the push rod"),)
     parts = PartHints(
         springs=springs,
-        purchased=(PurchasedItem(f"linear actuator, stroke >= {spec.stroke:.0f} mm, force >= {spec.push_force:.0f} N",
-                                 1, "drives the push rod"),),
+        purchased=drive,
         tip_point="tip",
         pads={f"phalanx{d.n}": PadHint("tip", float(0.5 * d.thickness))},
     )
