@@ -264,7 +264,8 @@ def content_problems(rel: str, data: bytes, expected: Any) -> list[str]:
     if suffix in (".png", ".gif"):
         return _image_problems(data)
     if suffix == ".step":
-        from fabricate.export.step import step_available, step_problems
+        from fabricate.export.step import step_available
+        from fabricate.export.step_read import step_problems
 
         return step_problems(data, expected) if step_available() else []
     if suffix == ".svg":

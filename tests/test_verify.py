@@ -72,9 +72,9 @@ def _one_step_reading_per_file(monkeypatch):
     kept by content hash. A changed STEP file has another hash and is read for real."""
     import hashlib
 
-    import fabricate.export.step as step
+    import fabricate.export.step_read as step_read
 
-    real = step.step_problems
+    real = step_read.step_problems
 
     def cached(data, expected=None, rel_tol=1e-6):
         key = (hashlib.sha256(data).hexdigest(), tuple(sorted((expected or {}).items())), rel_tol)
@@ -82,7 +82,7 @@ def _one_step_reading_per_file(monkeypatch):
             _STEP_VERDICTS[key] = real(data, expected, rel_tol)
         return list(_STEP_VERDICTS[key])
 
-    monkeypatch.setattr(step, "step_problems", cached)
+    monkeypatch.setattr(step_read, "step_problems", cached)
 
 
 @pytest.fixture

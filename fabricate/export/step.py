@@ -19,24 +19,22 @@ originating system are set to fixed values (a rebuild gives the same bytes).
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import math
 import os
 import re
 import tempfile
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from fabricate.errors import GeometryError
+from fabricate.export.occt import DESCRIPTION, downcast, quiet_occt, shape_volume, xcaf_document
 from fabricate.export.step_curves import clean_path, profile_pieces, spline_edges
-from fabricate.export.step_read import DESCRIPTION, StepSolid, read_step, step_problems
 from fabricate.parts.model import BulgePath, Part
 
-__all__ = ["StepSolid", "assembly_step", "part_shape", "part_step", "read_step", "step_available", "step_files",
-           "step_problems"]
+__all__ = ["assembly_step", "part_shape", "part_step", "step_available", "step_files"]
 
 #: Fixed header values: STEP's FILE_NAME carries a time stamp and who wrote it; a rebuild must give the
 #: same bytes, so none of it may depend on the clock, the user or the OCCT build.
@@ -50,24 +48,6 @@ VOLUME_REL_TOL = 1e-9
 #: Shortest edge kept (mm): a repeated vertex in a profile would make a zero-length edge, which OCCT refuses.
 _MIN_EDGE_MM = 1e-9
 
-
-
-@contextlib.contextmanager
-def _quiet_occt() -> Iterator[None]:
-    """OCCT's default messenger prints transfer statistics to stdout; a build writes nothing there
-    (``-q``), so every printer is held at failures only while we read or write, then restored."""
-    from OCP.Message import Message, Message_Fail
-
-    printers = Message.DefaultMessenger_s().Printers()
-    saved = [printers.Value(k) for k in range(1, printers.Length() + 1)]
-    levels = [printer.GetTraceLevel() for printer in saved]
-    for printer in saved:
-        printer.SetTraceLevel(Message_Fail)
-    try:
-        yield
-    finally:
-        for printer, level in zip(saved, levels, strict=True):
-            printer.SetTraceLevel(level)
 
 
 @functools.lru_cache(maxsize=1)
@@ -248,16 +228,16 @@ def _solid(part: Part, chord_tolerance_mm: float, z_mm: float, what: str) -> Any
     explorer = TopExp_Explorer(prism.Shape(), TopAbs_SOLID)
     if not explorer.More():
         raise GeometryError(f"{what}: the extrusion is not a solid")
-    solid = _downcast("Solid", explorer.Current())
+    solid = downcast("Solid", explorer.Current())
     # the solid must hold the part's volume (its path's area with arcs, minus holes and slots, times the
     # thickness), but where curves replaced a polygon's chords: each within the chord tolerance of them
-    volume, expected = _volume(solid), part.volume_mm3()
+    volume, expected = shape_volume(solid), part.volume_mm3()
     if not abs(volume - expected) <= VOLUME_REL_TOL * abs(expected) + volume_band_mm3(part, chord_tolerance_mm):
         raise GeometryError(f"{what}: volume {volume:.6f} mm^3, the part's is {expected:.6f} mm^3")
     if z_mm:
         lift = gp_Trsf()
         lift.SetTranslation(gp_Vec(0.0, 0.0, float(z_mm)))
-        solid = _downcast("Solid", BRepBuilderAPI_Transform(solid, lift, True).Shape())
+        solid = downcast("Solid", BRepBuilderAPI_Transform(solid, lift, True).Shape())
     return solid
 
 
@@ -273,24 +253,6 @@ def volume_band_mm3(part: Part, chord_tolerance_mm: float) -> float:
     return chord_tolerance_mm * part.thickness_mm * length
 
 
-def _downcast(kind: str, shape: Any) -> Any:
-    """``TopoDS.Solid`` / ``TopoDS.Face`` of a shape: a namespace function in OCP 8, a static method
-    (``Solid_s``) in OCP 7."""
-    from OCP import TopoDS as topods_module
-
-    caster = topods_module.TopoDS
-    return getattr(caster, kind)(shape) if hasattr(caster, kind) else getattr(caster, f"{kind}_s")(shape)
-
-
-def _volume(shape: Any) -> float:
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
-    props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape, props)
-    return float(props.Mass())
-
-
 def _pose_location(pose: np.ndarray, z_mm: float) -> Any:
     """TopLoc_Location of a planar body pose (x mm, y mm, theta rad) lifted to ``z_mm``; the same motion
     as :func:`fabricate.planar.pose_matrix` applies to the meshes."""
@@ -304,15 +266,6 @@ def _pose_location(pose: np.ndarray, z_mm: float) -> Any:
 
 
 # ----------------------------------------------------------------------------------------------- writing
-
-
-def _xcaf_document() -> tuple[Any, Any]:
-    from OCP.TCollection import TCollection_ExtendedString
-    from OCP.TDocStd import TDocStd_Document
-    from OCP.XCAFDoc import XCAFDoc_DocumentTool
-
-    document = TDocStd_Document(TCollection_ExtendedString("XmlXCAF"))
-    return document, XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
 
 
 def _set_name(label: Any, name: str) -> None:
@@ -351,7 +304,7 @@ def _write(document: Any, title: str, chord_tolerance_mm: float) -> bytes:
     folder = tempfile.mkdtemp(prefix="fabricate-step-")
     path = os.path.join(folder, "out.step")
     try:
-        with _quiet_occt():
+        with quiet_occt():
             if not writer.Transfer(document, STEPControl_AsIs):
                 raise GeometryError(f"{title}: STEP transfer failed")
             _fix_header(writer.ChangeWriter().Model(), title, chord_tolerance_mm)
@@ -428,7 +381,7 @@ def part_step(part: Part, chord_tolerance_mm: float, shape: Any = None) -> bytes
     bytes
         One named solid (product name = part name); deterministic.
     """
-    document, tool = _xcaf_document()
+    document, tool = xcaf_document()
     label = tool.AddShape(shape if shape is not None else part_shape(part, chord_tolerance_mm), False)
     _set_name(label, part.name)
     return _write(document, part.name, chord_tolerance_mm)
@@ -458,7 +411,7 @@ def assembly_step(parts: Sequence[Part], poses: Mapping[str, np.ndarray], chord_
         Deterministic STEP text.
     """
     shapes = shapes or {}
-    document, tool = _xcaf_document()
+    document, tool = xcaf_document()
     assembly = tool.NewShape()
     _set_name(assembly, title)
     for part in parts:

@@ -1,9 +1,8 @@
 """Reading STEP files back (through OCP): every solid named, measured and checked against the report.
 
-The other half of :mod:`fabricate.export.step` (which re-exports :func:`read_step`, :func:`step_problems` and
-:class:`StepSolid`): the exporter builds and writes solids, this module reads a file as a CAD program would
-and says what it holds. OCP is imported inside the functions, like the writer's, so the package imports
-without the optional extra ``cad``.
+The other half of :mod:`fabricate.export.step`: the exporter builds and writes solids, this module reads a
+file as a CAD program would and says what it holds. OCP is imported inside the functions, like the
+writer's, so the package imports without the optional extra ``cad``.
 """
 
 from __future__ import annotations
@@ -18,11 +17,8 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from fabricate.errors import GeometryError
+from fabricate.export.occt import downcast, quiet_occt, shape_volume, xcaf_document
 
-#: The writer's FILE_DESCRIPTION: arcs and splines that replaced a polygon's chords (gear flanks, fused
-#: hubs) stand within the build's chord tolerance of them, so the solid's volume may differ from the report's
-#: (the polygon's) by that tolerance times the area of its curved side faces, and no more.
-DESCRIPTION = "fabricate: curves within {tolerance:.6g} mm of the part's polygon"
 _DESCRIBED_TOLERANCE = re.compile(rb"FILE_DESCRIPTION\s*\(\s*\(\s*'fabricate: curves within ([0-9.eE+-]+) mm")
 
 
@@ -83,9 +79,8 @@ def read_step(data: bytes) -> list[StepSolid]:
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPCAFControl import STEPCAFControl_Reader
 
-    from fabricate.export.step import _quiet_occt, _xcaf_document
 
-    document, tool = _xcaf_document()
+    document, tool = xcaf_document()
     folder = tempfile.mkdtemp(prefix="fabricate-step-")
     path = os.path.join(folder, "in.step")
     try:
@@ -93,7 +88,7 @@ def read_step(data: bytes) -> list[StepSolid]:
             handle.write(data)
         reader = STEPCAFControl_Reader()
         reader.SetNameMode(True)
-        with _quiet_occt():
+        with quiet_occt():
             status = reader.ReadFile(path)
             if status != IFSelect_RetDone:
                 raise GeometryError(f"STEP not readable (reader status {status})")
@@ -162,17 +157,16 @@ def _measure(shape: Any, name: str) -> list[StepSolid]:
     from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
 
-    from fabricate.export.step import _downcast, _volume
 
     solids = []
     explorer = TopExp_Explorer(shape, TopAbs_SOLID)
     while explorer.More():
-        solid = _downcast("Solid", explorer.Current())
+        solid = downcast("Solid", explorer.Current())
         full = partial = count = 0
         curved = 0.0
         faces = TopExp_Explorer(solid, TopAbs_FACE)
         while faces.More():
-            face = _downcast("Face", faces.Current())
+            face = downcast("Face", faces.Current())
             kind = BRepAdaptor_Surface(face).GetType()
             count += 1
             hole = False
@@ -189,7 +183,7 @@ def _measure(shape: Any, name: str) -> list[StepSolid]:
         box = Bnd_Box()
         BRepBndLib.AddOptimal_s(solid, box, False, False)
         low, high = box.CornerMin(), box.CornerMax()
-        solids.append(StepSolid(name, _volume(solid), full, bool(BRepCheck_Analyzer(solid).IsValid()), partial,
+        solids.append(StepSolid(name, shape_volume(solid), full, bool(BRepCheck_Analyzer(solid).IsValid()), partial,
                                 np.array([[low.X(), low.Y(), low.Z()], [high.X(), high.Y(), high.Z()]]), curved,
                                 count))
         explorer.Next()

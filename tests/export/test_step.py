@@ -38,11 +38,10 @@ from fabricate.export.step import (  # noqa: E402
     assembly_step,
     part_shape,
     part_step,
-    read_step,
     step_available,
-    step_problems,
 )
 from fabricate.export.step_curves import SPLINE_FIT_FACTOR  # noqa: E402
+from fabricate.export.step_read import read_step, step_problems  # noqa: E402
 from fabricate.export.stl import read_3mf  # noqa: E402
 from fabricate.parts.model import BulgePath, Hole, Part  # noqa: E402
 from fabricate.templates import shipped_templates  # noqa: E402

@@ -22,8 +22,9 @@ import shapely
 
 pytest.importorskip("OCP")
 
-from fabricate.export.step import part_shape, part_step, read_step, step_problems  # noqa: E402
+from fabricate.export.step import part_shape, part_step  # noqa: E402
 from fabricate.export.step_curves import SPLINE_FIT_FACTOR, profile_pieces  # noqa: E402
+from fabricate.export.step_read import read_step, step_problems
 from fabricate.parts.model import BulgePath, Hole, Part  # noqa: E402
 from fabricate.parts.profiles import circle_hull  # noqa: E402
 from fabricate.planar import polygon_area  # noqa: E402
@@ -82,12 +83,12 @@ def edge_samples(shape) -> shapely.STRtree:
     from OCP.TopAbs import TopAbs_EDGE
     from OCP.TopExp import TopExp_Explorer
 
-    from fabricate.export.step import _downcast
+    from fabricate.export.occt import downcast
 
     lines = []
     explorer = TopExp_Explorer(shape, TopAbs_EDGE)
     while explorer.More():
-        curve = BRepAdaptor_Curve(_downcast("Edge", explorer.Current()))
+        curve = BRepAdaptor_Curve(downcast("Edge", explorer.Current()))
         ts = np.linspace(curve.FirstParameter(), curve.LastParameter(), 100)
         points = np.array([[curve.Value(t).X(), curve.Value(t).Y(), curve.Value(t).Z()] for t in ts])
         if np.all(np.abs(points[:, 2]) < 1e-9):
