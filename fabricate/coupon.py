@@ -146,7 +146,8 @@ def _rack_edge(module: float, x0: float, x1: float) -> np.ndarray:
     edge = np.concatenate(rows)
     # points repeated where a run meets the flat ends
     keep = np.concatenate([[True], np.any(np.diff(edge, axis=0) != 0.0, axis=1)])
-    return edge[keep]
+    kept: np.ndarray = edge[keep]
+    return kept
 
 
 def _label(text: str, height: float, centre: tuple[float, float]) -> Label:
