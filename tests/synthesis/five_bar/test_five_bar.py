@@ -62,7 +62,7 @@ def test_template_loads_through_load_design():
 
     design = load_design(TEMPLATE)
     assert design.kind == "five_bar_ncg"
-    assert design.gears.module_mm is None  # "auto": the smallest standard module the process makes (0.45 on SLA)
+    assert design.gears.module_mm == 0.5
     assert design.checks.sweep_poses == 360
 
 
