@@ -59,7 +59,7 @@ def synthesise(design: DesignSpec) -> SynthesisResult:
                                "return spring, opens the joint against its stop") for i in range(d.n))
     # the push rod's drive: a template's [actuator] places it (its BOM row, the drive check), so only without one
     # does the synthesis name what to buy; never both, which listed two drives per copy
-    drive = () if getattr(design, "actuator", None) is not None else (
+    drive = () if design.actuator is not None else (
         PurchasedItem(f"linear actuator, stroke >= {spec.stroke:.0f} mm, force >= {spec.push_force:.0f} N", 1,
                       "drives the push rod"),)
     parts = PartHints(

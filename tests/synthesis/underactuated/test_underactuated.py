@@ -116,7 +116,7 @@ def test_stroke_grows_with_every_joint_at_the_open_pose():
 
 
 def test_closing_on_cylinder_sequence_and_forces():
-    res = ua.synthesise(types.SimpleNamespace(method=SPEC, name="finger"))
+    res = ua.synthesise(types.SimpleNamespace(method=SPEC, name="finger", actuator=None))
     rep = res.report
     assert rep["contact_sequence"] == DATA["contact_sequence"]
     assert np.allclose(rep["contact_strokes_mm"], DATA["contact_strokes_mm"], atol=DATA["stroke_tolerance_mm"])
@@ -233,7 +233,7 @@ def test_events_located_and_driver_laws_match_a_dense_solve():
     """Contacts and stop releases between stroke samples are located (not snapped to the 0.375 mm grid)
     and the drivers, split at them, follow a 601-sample solve (0.025 mm grid, events not located: an
     independent reference whose contact strokes are late by at most one step)."""
-    res = ua.synthesise(types.SimpleNamespace(method=SPEC, name="finger"))
+    res = ua.synthesise(types.SimpleNamespace(method=SPEC, name="finger", actuator=None))
     motion = res.data["motion"]
     dense = closing_motion(SPEC, samples=601, locate_events=False)
     step = SPEC.stroke / 600
