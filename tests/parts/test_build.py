@@ -1233,6 +1233,14 @@ def test_pad_hint_adds_fingertip(four_bar, sla_process):
                     PartHints(pads={"coupler": PadHint("Z", 6.0)}))
 
 
+def test_pad_hint_without_a_radius_is_a_boss_disc(four_bar, sla_process):
+    # PadHint.radius_mm None: the boss radius, and at a joint point that boss is already there
+    plain = build_parts(design_for(sla_process), four_bar, four_bar.sweep(11), [])
+    padded = build_parts(design_for(sla_process), four_bar, four_bar.sweep(11), [],
+                         PartHints(pads={"coupler": PadHint("B")}))
+    assert padded.part("coupler").area_mm2() == pytest.approx(plain.part("coupler").area_mm2(), rel=1e-12)
+
+
 # -- gears fused to bodies ----------------------------------------------------------------------
 
 def spur_like(radius: float, teeth: int, depth: float, n: int = 720) -> np.ndarray:
