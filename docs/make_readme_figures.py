@@ -66,7 +66,9 @@ def failed_checks(reason: str) -> list[str]:
     if re.search(r"(^|; )strength: ", reason):
         found.append("strength")
     rest = re.sub(r"gear \w+: undercut:[^;]*(; use module[^;]*)?", "", reason)
-    rest = re.sub(r"strength: [^;]*(; a larger module or a thicker plate)?", "", rest)
+    # a strength failure's own fix clause: "a larger module or a thicker plate" (Lewis), "a thicker plate or a
+    # lighter load (...)" (Hertz, since the module choice): not another check
+    rest = re.sub(r"strength: [^;]*(; a (larger module|thicker plate)[^;]*)?", "", rest)
     if rest.strip("; "):
         found.append("other")
     return found
