@@ -200,6 +200,11 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
         journal.close()
         if draw:
             print(file=sys.stderr)
+    if interrupted:
+        # a stop can land between a row's journal write and its count: the journal is what a resume reads, so
+        # the record counts what it holds (the same rows the resume will call "done earlier")
+        done = {pid: row for pid, row in read_journal(out, spec).items()
+                if pid in by_id and row["exit_code"] != EXIT_INTERNAL}
     rows = [done[pid] for pid in ids if pid in done]
     try:
         _write_results(out, spec, rows)
