@@ -55,9 +55,9 @@ def motor_top_mm(entry: Actuator, thickness_mm: float) -> float:
     return top
 
 
-def replaced_joint(design: Any, mechanism: Mechanism) -> str | None:
-    """The joint whose pin a rotary actuator's output replaces (its driver's), or None (no rotary actuator, or
-    one that does not resolve)."""
+def _rotary_drive(design: Any, mechanism: Mechanism) -> tuple[Actuator, Driver] | None:
+    """The design's rotary actuator and the driver it drives, or None (no actuator, a pushing one, or one that
+    does not resolve: the drive stage says why)."""
     spec = getattr(design, "actuator", None)
     if spec is None:
         return None
@@ -67,7 +67,16 @@ def replaced_joint(design: Any, mechanism: Mechanism) -> str | None:
         return None
     if spec.driver >= len(mechanism.drivers) or entry.kind not in ROTARY:
         return None
-    driver = mechanism.drivers[spec.driver]
+    return entry, mechanism.drivers[spec.driver]
+
+
+def replaced_joint(design: Any, mechanism: Mechanism) -> str | None:
+    """The joint whose pin a rotary actuator's output replaces (its driver's), or None (no rotary actuator, or
+    one that does not resolve)."""
+    found = _rotary_drive(design, mechanism)
+    if found is None:
+        return None
+    _, driver = found
     return driver_joint(mechanism, driver) if driver.kind == "angle" else None
 
 
@@ -78,16 +87,10 @@ def output_depth(design: Any, mechanism: Mechanism) -> tuple[str, float] | None:
     driven part there (:func:`~fabricate.parts.layers.order_layers`). None for a horn (flush with the driven
     part), a pushing actuator or no actuator, and where the design's actuator does not resolve (the drive
     stage says why)."""
-    spec = getattr(design, "actuator", None)
-    if spec is None:
+    found = _rotary_drive(design, mechanism)
+    if found is None or found[0].horn is not None:
         return None
-    try:
-        entry = spec.entry()
-    except SpecError:
-        return None
-    if spec.driver >= len(mechanism.drivers) or entry.kind not in ROTARY or entry.horn is not None:
-        return None
-    driver = mechanism.drivers[spec.driver]
+    entry, driver = found
     output = entry.shaft if entry.shaft is not None else entry.spline
     if driver.kind != "angle" or output is None:
         return None
