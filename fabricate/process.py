@@ -207,6 +207,9 @@ class ProcessSpec:
         the template's own).
     printer_technique : str
         The technique of the printers the profile serves (``"sla"``, ``"fdm"``, "" for none).
+    stock_thickness_mm : tuple of float
+        The sheet thicknesses a cut process's shop stocks, ascending (``stock_thickness_mm``; () when not given):
+        a template's own ``thickness_mm`` among them survives ``--process`` (see :func:`_keeps_thickness`).
     first_layer_compensation_mm : float
         How far the first layer spreads (see the module docstring); 0 when the process has no such effect.
     """
@@ -239,6 +242,7 @@ class ProcessSpec:
     printer_technique: str = ""
     first_layer_compensation_mm: float = 0.0
     sheets: tuple[tuple[str, float, float], ...] = ()  # [sheets]: standard stock (name, w, h), smallest first
+    stock_thickness_mm: tuple[float, ...] = ()  # the sheet thicknesses a cut process stocks (--process keeps these)
     shop: tuple[tuple[str, float], ...] = ()  # [shop]: the cut shop's rules (fabricate.checks.shop)
 
     def part_material(self) -> Material | None:
@@ -295,8 +299,31 @@ def process_override(name_or_path: str | Path | None, printer: str | None = None
 
 
 #: Fields a template keeps when --process replaces its profile: which dowel pins the design uses is a
-#: choice of the design, everything else (clearances, kerf, sheet, thickness) belongs to the process.
+#: choice of the design, everything else (clearances, kerf, sheet) belongs to the process; the plate thickness is
+#: kept where the new process makes it (:func:`_keeps_thickness`).
 DESIGN_PROCESS_FIELDS = ("pin_diameter_mm",)
+
+
+def _keeps_thickness(base: Mapping[str, object], value: object) -> bool:
+    """Whether a template's own ``thickness_mm`` stays when ``--process`` replaces its profile with ``base``.
+
+    A template sets its plate thickness for strength (its gear contact, its hinges), a choice of the design as
+    long as the new process can make it: an additive process prints any plate thickness (its printer's height is
+    checked with the parts), a cut process only the stock it lists (``stock_thickness_mm``; a profile without the
+    list cuts its own thickness only). A sheet kept at another stock is that thick (``build_volume_mm[2]``), and the
+    profile's ``[shop]`` numbers, which are its own stock's, give way to the shop check's half the stock.
+    """
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        return False  # validated (and refused) as the profile's field would be
+    technique = base.get("technique")
+    method = base.get("method")
+    if technique is None and isinstance(method, str) and method in shipped_profiles():
+        technique = read_toml(TEMPLATE_DIR / f"process_{method}.toml").get("technique")
+    if technique == "additive":
+        return True
+    stock = base.get("stock_thickness_mm")
+    return isinstance(stock, list) and any(isinstance(t, (int, float)) and abs(float(t) - float(value)) <= 1e-9
+                                           for t in stock)
 
 
 def parse_process(table: Table, override: ProcessOverride | None = None) -> ProcessSpec:
@@ -324,6 +351,15 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
             table._used.add(key)
             if override is None or key in DESIGN_PROCESS_FIELDS:
                 merged[key] = table.data[key]
+    if override is not None and "thickness_mm" in table.data and _keeps_thickness(base, table.data["thickness_mm"]):
+        merged["thickness_mm"] = table.data["thickness_mm"]
+        volume = base.get("build_volume_mm")
+        if base.get("layout") == "sheet" and isinstance(volume, list) and len(volume) == 3:
+            merged["build_volume_mm"] = [*volume[:2], table.data["thickness_mm"]]  # a sheet is the stock it is cut from
+        if base.get("thickness_mm") != table.data["thickness_mm"]:
+            # the profile's [shop] numbers are its own stock's: at another stock the shop check takes its rule of
+            # half the stock thickness (fabricate.checks.shop)
+            merged.pop("shop", None)
     t = Table(merged, path)
     name = t.string("method", profile) if override is None else t.string("method")
     if not _PROCESS_NAME.fullmatch(name):
@@ -368,6 +404,7 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
         printer_technique=_capability(t, "printer_technique", name, PRINTER_TECHNIQUES, fallback=""),
         first_layer_compensation_mm=t.number("first_layer_compensation_mm", 0.0, min=0.0, max=2.0),
         sheets=_sheets(t.table("sheets", {})),
+        stock_thickness_mm=_stock(t),
         shop=_shop(t.table("shop", {})),
     )
     t.finish()
@@ -463,6 +500,16 @@ def _sheets(t: Table) -> tuple[tuple[str, float, float], ...]:
         width, height = (float(v) for v in t.array(key, shape=(2,), positive=True, max=10000.0))
         sizes.append((key, width, height))
     return tuple(sorted(sizes, key=lambda s: (s[1] * s[2], s[1], s[0])))
+
+
+def _stock(t: Table) -> tuple[float, ...]:
+    """``stock_thickness_mm``: the sheet thicknesses (mm) the cut shop stocks, ascending; () when not given."""
+    if not t.has("stock_thickness_mm"):
+        return ()
+    values = t.array("stock_thickness_mm", shape=(None,), positive=True, max=100.0)
+    if len(values) == 0:
+        raise SpecError(t.field("stock_thickness_mm"), "expected at least one thickness (or leave the field out)")
+    return tuple(sorted({float(v) for v in values}))
 
 
 #: ``[shop]`` rules (mm) a cut part is checked against (fabricate.checks.shop).

@@ -243,3 +243,37 @@ def test_what_is_made_follows_the_capabilities_not_the_name(four_bar, laser_proc
     hole = derive_sizes(thick_cut, PartsSpec(), PartHints()).hole_mm
     assert derive_sizes(thick_cut, PartsSpec(), PartHints()).boss_radius_mm == pytest.approx(hole / 2 + 5.0)
     assert derive_sizes(thick_printed, PartsSpec(), PartHints()).boss_radius_mm == pytest.approx(hole / 2 + 3.0)
+
+
+@pytest.mark.parametrize(("template", "process", "thickness"), [
+    ("finger_five_bar_ncg", "laser", 6.0),  # 6 mm acrylic is a stock the laser profile names
+    ("gripper_compliant", "laser", 3.0),  # 12 mm is not: the laser's own 3 mm sheet
+    ("finger_five_bar_ncg", "fdm", 6.0),  # a printer prints any plate thickness
+    ("gripper_compliant", "fdm", 12.0),
+    ("jansen_leg", "laser", 3.0),  # the template gives none: the profile's
+])
+def test_process_keeps_the_templates_thickness_where_the_process_makes_it(template, process, thickness):
+    spec = load_design(template, process).process
+    assert spec.thickness_mm == thickness
+    shipped = read_toml(TEMPLATE_DIR / f"process_{process}.toml")
+    if spec.layout == "sheet":
+        # the sheet is the stock it is cut from; the profile's shop numbers are its own 3 mm stock's
+        assert spec.build_volume_mm == (790.0, 384.0, thickness)
+        assert spec.stock_thickness_mm == (3.0, 6.0) and thickness in spec.stock_thickness_mm
+        from fabricate.checks.shop import ShopRules
+
+        rules = ShopRules.of(spec)
+        expected = (shipped["shop"]["min_hole_mm"] if thickness == shipped["thickness_mm"] else 0.5 * thickness)
+        assert (rules.min_hole_mm, rules.min_web_mm, rules.min_hole_edge_mm) == (expected,) * 3
+    else:
+        assert spec.build_volume_mm[2] >= thickness
+
+
+def test_a_cut_profile_without_stock_keeps_only_its_own_thickness():
+    text = (TEMPLATE_DIR / "process_laser.toml").read_text()
+    text = text.replace("stock_thickness_mm = [3.0, 6.0]", "")
+    spec = parse_process(Table({"profile": "sla", "thickness_mm": 6.0}, "process"), ProcessOverride("mine.toml", text))
+    assert spec.thickness_mm == 3.0 and spec.stock_thickness_mm == ()
+    bad = text.replace("thickness_mm = 3.0 ", "stock_thickness_mm = []\nthickness_mm = 3.0 ")
+    with pytest.raises(SpecError, match="at least one thickness"):
+        parse_process(Table({}, "process"), ProcessOverride("bad.toml", bad))

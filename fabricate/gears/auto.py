@@ -24,12 +24,22 @@ A closed pair's perimeters must hold whole teeth: a candidate module becomes the
 closes the law, and the module the pitch curves then give (``perimeter_a / (pi z_a)``, within a few per cent
 of the candidate) is the one judged and built; the report gives both.
 
+The pressure angle: a template that fixes it (``pressure_angle_deg = 20``) gets the modules scanned at that angle.
+Left out, or ``"auto"``, with the module chosen, the modules are scanned at 20 deg and, only when none passes
+there, at 22.5 and then 25 deg (:data:`fabricate.gears.spec.STANDARD_PRESSURE_ANGLES_DEG`, the full-depth systems
+of Shigley's Table 13-1); the first angle with a passing module is taken. A larger angle narrows the tooth tip
+(the rack's tip land ``pi m / 2 - 2 h_a m tan alpha``) but lowers the undercut limit (``~ h_a m / sin^2 alpha``),
+so on fixed pitch curves it opens a window of modules a fine process's tip land closes at 20 deg; and it lowers
+the Hertz contact pressure as ``1 / sqrt(sin 2 alpha)`` (5 % from 20 to 22.5 deg, 8 % to 25 deg). The Lewis form
+factors are the 20 deg table's at every angle: a larger angle's thicker root makes them conservative.
+
 When no candidate passes, the pair is built with the largest module whose only faults are the process's and the
-load's (tip land, strength), the one closest to passing, and :meth:`GearPair.failures` names what no standard
-module satisfies (the build exits 1). When only the Hertz contact fails, at every module, the smallest module
-passing the rest is built. The scan stops at the first undercut module or the first the pitch curves cannot hold
-(every larger one fails the same way), and a module whose rack tooth is already too narrow at the tip is rejected
-without cutting it when the pitch curves are convex, so a choice cuts a handful of candidates (seconds).
+load's (tip land, strength), the one closest to passing, and :meth:`GearPair.failures` names what no standard module
+satisfies (the build exits 1); with an automatic angle, at each angle tried. When only the Hertz contact fails, at
+every module, the smallest module passing the rest is built. The scan stops at the first undercut module or the
+first the pitch curves cannot hold (every larger one fails the same way), and a module whose rack tooth is already
+too narrow at the tip is rejected without cutting it when the pitch curves are convex, so a choice cuts a handful of
+candidates (seconds).
 """
 
 from __future__ import annotations
@@ -200,6 +210,12 @@ def choose_module(make: Callable[[GearSpec], GearPair], spec: GearSpec, limits: 
                   convex: bool = False) -> tuple[GearPair, dict[str, Any]]:
     """The pair cut with the smallest standard module that passes :func:`judge`, and the choice for the report.
 
+    With an automatic pressure angle (``spec.pressure_angle_candidates``) the modules are scanned at each
+    standard angle in turn (20, 22.5, 25 deg) and the first angle at which one passes is taken: 20 deg is the
+    standard basic rack, and a larger angle is what a gear designer turns to when the window between the tip
+    land (narrower teeth tips at a larger angle) and the undercut (a larger angle allows a larger module on the
+    same pitch curves) holds no module, or to lower the contact stress (``sigma_H^2 ~ 1 / sin 2 alpha``).
+
     Parameters
     ----------
     make : callable
@@ -223,10 +239,83 @@ def choose_module(make: Callable[[GearSpec], GearPair], spec: GearSpec, limits: 
     SpecError
         No standard module can be cut on these pitch curves at all (naming ``gears.module_mm``).
     """
+    angles = spec.pressure_angle_candidates
+    if not angles:
+        scan = _scan(make, spec, limits, convex)
+        if not scan.pairs:
+            assert scan.first_error is not None  # every candidate raised
+            raise SpecError("gears.module_mm", f"no standard module ({SERIES_NAME}) can be cut on these pitch "
+                                               f"curves; the smallest: {scan.first_error.message}")
+        return _choice(scan, limits)
+    scans = []
+    for degrees, dedendum, fillet in angles:
+        at = replace(spec, pressure_angle_deg=degrees, dedendum=dedendum, root_fillet=fillet,
+                     pressure_angle_candidates=())
+        scans.append(_scan(make, at, limits, convex))
+        if scans[-1].found:
+            break
+    cut = [sc for sc in scans if sc.pairs]
+    if not cut:
+        first = scans[0].first_error
+        assert first is not None  # every candidate at every angle raised
+        raise SpecError("gears.module_mm", f"no standard module ({SERIES_NAME}) can be cut on these pitch curves at "
+                                           f"any pressure angle; the smallest: {first.message}")
+    # none passing: of the angles whose closest module fails only the contact stress (no module helps it), the
+    # largest (the lowest contact stress); else the standard 20 deg's closest
+    only_contact = [sc for sc in cut if {k for k, _ in _closest(sc.verdicts).reasons} <= {"hertz"}]
+    built = scans[-1] if scans[-1].found else (only_contact[-1] if only_contact else cut[0])
+    pair, choice = _choice(built, limits)
+    choice["pressure_angle_deg"] = built.degrees
+    choice["pressure_angle"] = {"mode": "auto", "candidates_deg": [a for a, _, _ in angles],
+                                "tried_deg": [sc.degrees for sc in scans], "source": ANGLE_SOURCE}
+    choice["rejected"] = [dict(v.report(), pressure_angle_deg=sc.degrees) for sc in scans for v in sc.verdicts
+                          if not v.passed]
+    if not built.found:
+        contact = all(_contact_everywhere(sc.verdicts) for sc in cut)
+        words = [f"at {sc.degrees:g} deg: " + (_limits_words(sc.verdicts, contact=not contact) or "no other limit")
+                 for sc in cut]
+        if contact:  # one reason for every angle, worded once at the angle that comes closest
+            best = cut[-1].verdicts
+            words.insert(0, "the Hertz contact fails at every module and angle (the contact stress does not depend "
+                            f"on the module: thicker plates or a lighter load), least at {cut[-1].degrees:g} deg: "
+                            + next(w for v in best for k, w in v.reasons if k == "hertz"))
+        choice["unsatisfied"] = (f"no standard module ({SERIES_NAME}) at pressure angle "
+                                 f"{_angles_words([sc.degrees for sc in scans])} deg satisfies the process and the "
+                                 f"load: {'; '.join(words)}; built with module {float(pair.module):.4g} mm at "
+                                 f"{built.degrees:g} deg")
+    return pair, choice
+
+
+#: Where the automatic pressure angles come from (report.json's ``module_choice.pressure_angle.source``).
+ANGLE_SOURCE = ("full-depth systems 20, 22.5, 25 deg of Shigley's Mechanical Engineering Design Table 13-1; "
+                "20 deg is ISO 53's basic rack")
+
+
+def _angles_words(degrees: list[float]) -> str:
+    words = [f"{d:g}" for d in degrees]
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " or " + words[-1]
+
+
+@dataclass(frozen=True)
+class _Scan:
+    """The standard modules tried at one pressure angle, in order, and the pairs cut."""
+
+    degrees: float
+    verdicts: list[Verdict]
+    pairs: dict[float, GearPair]
+    first_error: SpecError | None
+
+    @property
+    def found(self) -> bool:
+        return bool(self.verdicts) and self.verdicts[-1].passed
+
+
+def _scan(make: Callable[[GearSpec], GearPair], spec: GearSpec, limits: ModuleLimits, convex: bool) -> _Scan:
+    """Every standard module, smallest first, cut with ``spec``'s pressure angle and judged, up to the first that
+    passes (or the first undercut one, or the first the pitch curves cannot hold once one could be cut)."""
     verdicts: list[Verdict] = []
     pairs: dict[float, GearPair] = {}
     first_error: SpecError | None = None
-    chosen: GearPair | None = None
     for module in standard_modules():
         bound = rack_tip_land_mm(module, spec)
         if convex and bound < limits.min_feature_mm - 1e-9:
@@ -248,32 +337,31 @@ def choose_module(make: Callable[[GearSpec], GearPair], spec: GearSpec, limits: 
         verdicts.append(Verdict(module, float(pair.module), reasons))
         pairs[module] = pair
         if not reasons:
-            chosen = pair
             break
         if any(kind == "undercut" for kind, _ in reasons):
             break  # the undercut limit grows with the module, the pitch curvature does not: every larger one is
-    if chosen is None:
-        if not pairs:
-            assert first_error is not None  # every candidate raised
-            raise SpecError("gears.module_mm", f"no standard module ({SERIES_NAME}) can be cut on these pitch "
-                                               f"curves; the smallest: {first_error.message}")
-        chosen = pairs[_fallback(verdicts)]
-    found = verdicts[-1].passed
+    return _Scan(float(spec.pressure_angle_deg), verdicts, pairs, first_error)
+
+
+def _choice(scan: _Scan, limits: ModuleLimits) -> tuple[GearPair, dict[str, Any]]:
+    """The pair one scan builds (its passing module, else :func:`_closest`) and report.json's choice."""
+    verdicts = scan.verdicts
+    chosen = scan.pairs[verdicts[-1].module_mm] if scan.found else scan.pairs[_closest(verdicts).module_mm]
     choice: dict[str, Any] = {
         "mode": "auto",
         "series": SERIES_NAME,
-        "found": found,
-        "chosen_module_mm": verdicts[-1].module_mm if found else None,
+        "found": scan.found,
+        "chosen_module_mm": verdicts[-1].module_mm if scan.found else None,
         "built_module_mm": round(float(chosen.module), 6),
         "criteria": _criteria(limits),
         "rejected": [v.report() for v in verdicts if not v.passed],
     }
-    if not found:
+    if not scan.found:
         choice["unsatisfied"] = _unsatisfied(verdicts, float(chosen.module))
     return chosen, choice
 
 
-def _fallback(verdicts: list[Verdict]) -> float:
+def _closest(verdicts: list[Verdict]) -> Verdict:
     """The module to build when none passes.
 
     The smallest that fails nothing but a fault every candidate has (the Hertz contact, which no module changes);
@@ -283,9 +371,9 @@ def _fallback(verdicts: list[Verdict]) -> float:
     everywhere = {"hertz"} if all(any(k == "hertz" for k, _ in v.reasons) for v in cut) else set()
     only = [v for v in cut if {k for k, _ in v.reasons} <= everywhere]
     if only:
-        return only[0].module_mm
+        return only[0]
     closest = [v for v in cut if {k for k, _ in v.reasons} <= _PROCESS_KINDS]
-    return (closest[-1] if closest else cut[0]).module_mm
+    return closest[-1] if closest else cut[0]
 
 
 def _criteria(limits: ModuleLimits) -> dict[str, Any]:
@@ -301,6 +389,19 @@ def _criteria(limits: ModuleLimits) -> dict[str, Any]:
 
 def _unsatisfied(verdicts: list[Verdict], built: float) -> str:
     """What no standard module satisfies, in words: per criterion the candidate that shows its limit."""
+    return (f"no standard module ({SERIES_NAME}) satisfies the process and the load: " + _limits_words(verdicts)
+            + f"; built with module {built:.4g} mm")
+
+
+def _contact_everywhere(verdicts: list[Verdict]) -> bool:
+    """Every module of one scan that was cut fails the Hertz contact."""
+    cut = [v for v in verdicts if v.built_mm is not None]
+    return bool(cut) and all(any(k == "hertz" for k, _ in v.reasons) for v in cut)
+
+
+def _limits_words(verdicts: list[Verdict], contact: bool = True) -> str:
+    """Per criterion the candidate of one scan that shows its limit (see :func:`_unsatisfied`); ``contact``: with
+    the Hertz contact where it fails at every module."""
     parts = []
     cut = [v for v in verdicts if v.built_mm is not None]
     for kind in ("tip_land", "lewis"):  # a lower bound on the module: the largest that still fails
@@ -315,9 +416,8 @@ def _unsatisfied(verdicts: list[Verdict], built: float) -> str:
             v = failing[0]
             parts.append(f"m = {v.module_mm:g}: {next(w for k, w in v.reasons if k == kind)}")
     hertz = [v for v in cut if any(k == "hertz" for k, _ in v.reasons)]
-    if hertz and len(hertz) == len(cut):
+    if contact and hertz and len(hertz) == len(cut):
         words = next(w for k, w in hertz[-1].reasons if k == "hertz")
         parts.append(f"at every module (the contact stress does not depend on it: thicker plates or a lighter "
                      f"load): {words}")
-    return (f"no standard module ({SERIES_NAME}) satisfies the process and the load: " + "; ".join(parts)
-            + f"; built with module {built:.4g} mm")
+    return "; ".join(parts)

@@ -400,8 +400,8 @@ def build_gear_pairs(mechanism: Mechanism, spec: GearSpec, chord_tolerance_mm: f
         convex = _convex(g.law, float(np.hypot(*d)), g.working_range)
         scanned, choice = choose_module(lambda s: make(replace(s, compare_methods=False), False), spec, known[0],
                                         convex=convex)
-        assert scanned.spec.module_mm is not None  # every candidate is cut with its module fixed
-        full = make(replace(spec, module_mm=scanned.spec.module_mm), True)
+        assert scanned.spec.module_mm is not None  # every candidate is cut with its module (and angle) fixed
+        full = make(replace(scanned.spec, compare_methods=spec.compare_methods), True)
         pairs.append(replace(full, module_choice=choice))
     return pairs
 

@@ -12,7 +12,10 @@ Keys (all optional)
                          (DIN 780-1 series 1 and 2) whose teeth the process makes and the load allows
                          (:mod:`fabricate.gears.auto`); a closed pair given ``teeth`` takes the module its tooth
                          count and centre distance give instead.
-``pressure_angle_deg``   float in [10, 35], default 20. Pressure angle of the generating rack. Above about
+``pressure_angle_deg``   float in [10, 35], or ``"auto"``; default 20, or ``"auto"`` when the module is chosen
+                         (``module_mm`` auto and no ``teeth``). ``"auto"``: the first of the standard full-depth
+                         systems 20, 22.5, 25 degrees (:data:`STANDARD_PRESSURE_ANGLES_DEG`) at which a standard
+                         module passes (:mod:`fabricate.gears.auto`). Pressure angle of the generating rack. Above about
                          22 degrees the default root fillet no longer fits the rack's tooth space and
                          is reduced to the largest that does (above about 31 degrees also the default
                          dedendum); a ``root_fillet`` or ``dedendum`` given explicitly that does not fit
@@ -65,6 +68,10 @@ from fabricate.table import Table
 METHODS = ("exact", "approx")
 #: Smallest module: finer teeth than no process resolves (SLA min feature 0.3 mm) only cost time.
 MIN_MODULE_MM = 0.05
+#: Pressure angles an automatic one is chosen from, preferred first: the full-depth spur-gear systems of Shigley's
+#: *Mechanical Engineering Design* (Budynas & Nisbett, 9th ed.) Table 13-1 (20, 22.5, 25 deg, addendum 1 m,
+#: dedendum 1.25 m); 20 deg is ISO 53:1998's basic rack, 25 deg AGMA 201.02's other full-depth system.
+STANDARD_PRESSURE_ANGLES_DEG = (20.0, 22.5, 25.0)
 
 
 @dataclass(frozen=True)
@@ -115,6 +122,9 @@ class GearSpec:
     min_teeth: int = 8
     bore_mm: float | None = None
     hub_diameter_mm: float | None = None
+    #: ``pressure_angle_deg = "auto"``: the candidates (angle deg, dedendum, root fillet), each with the rack
+    #: proportions that fit at it, preferred first; () when the angle is fixed
+    pressure_angle_candidates: tuple[tuple[float, float, float], ...] = ()
 
     @property
     def pressure_angle(self) -> float:
@@ -126,13 +136,17 @@ class GearSpec:
         return self.module_mm if self.module_mm is not None else float(default_mm)
 
 
-def parse_gear_spec(table: Table) -> GearSpec:
+def parse_gear_spec(table: Table, retarget: bool = False) -> GearSpec:
     """Read the ``[gears]`` table (an empty table gives the defaults).
 
     Parameters
     ----------
     table : Table
         The ``[gears]`` table, ``{}`` when absent.
+    retarget : bool
+        The design is built for another process than its template's (``--process``): a ``module_mm`` and a
+        ``pressure_angle_deg`` the template fixes for its own process are chosen again (``"auto"``), except a
+        module that, with ``teeth``, fixes the geometry of a closed pair.
 
     Returns
     -------
@@ -148,7 +162,13 @@ def parse_gear_spec(table: Table) -> GearSpec:
     if table.has("module_mm") and isinstance(table.raw("module_mm"), str) and not auto:
         raise SpecError(table.field("module_mm"), f'expected a module in mm or "auto", got "{table.raw("module_mm")}"')
     module = None if auto else table.number("module_mm", None, min=MIN_MODULE_MM, max=50.0)
-    pressure = table.number("pressure_angle_deg", 20.0, min=10.0, max=35.0)
+    if retarget and auto is False and table.has("module_mm") and not table.has("teeth"):
+        module = None  # --process: a module that only sizes the teeth is chosen again for the new process
+    angle_auto = table.has("pressure_angle_deg") and table.raw("pressure_angle_deg") == "auto"
+    if table.has("pressure_angle_deg") and isinstance(table.raw("pressure_angle_deg"), str) and not angle_auto:
+        raise SpecError(table.field("pressure_angle_deg"),
+                        f'expected an angle in degrees or "auto", got "{table.raw("pressure_angle_deg")}"')
+    pressure = 20.0 if angle_auto else table.number("pressure_angle_deg", 20.0, min=10.0, max=35.0)
     addendum = table.number("addendum", 1.0, min=0.3, max=1.5)
     dedendum = table.number("dedendum", 1.25, min=0.5, max=2.0)
     fillet = table.number("root_fillet", 0.38, min=0.0, max=0.5)
@@ -173,6 +193,14 @@ def parse_gear_spec(table: Table) -> GearSpec:
         raise SpecError(table.field("dedendum"),
                         f"dedendum {dedendum:g} m must exceed addendum {addendum:g} m (tip clearance); "
                         f"use dedendum >= {addendum + 0.25:g}")
+    chosen = module is None and teeth is None
+    if angle_auto and not chosen:
+        raise SpecError(table.field("pressure_angle_deg"), '"auto" is chosen together with the module: set '
+                                                           'module_mm = "auto" (without teeth) or give an angle')
+    candidates: tuple[tuple[float, float, float], ...] = ()
+    if chosen and (angle_auto or not table.has("pressure_angle_deg") or retarget):
+        candidates = _angle_candidates(table, addendum, dedendum, fillet)
+        pressure = candidates[0][0]
     dedendum, fillet = _fit_rack(table, pressure, addendum, dedendum, fillet)
     if hub is not None and bore is not None and hub <= bore:
         raise SpecError(table.field("hub_diameter_mm"),
@@ -184,7 +212,22 @@ def parse_gear_spec(table: Table) -> GearSpec:
     return GearSpec(module_mm=module, pressure_angle_deg=pressure, addendum=addendum, dedendum=dedendum,
                     root_fillet=fillet, backlash_mm=backlash, method=method, compare_methods=compare,
                     spare_teeth=spare, mesh_steps=steps, closed=closed, teeth=teeth, min_teeth=min_teeth,
-                    bore_mm=bore, hub_diameter_mm=hub)
+                    bore_mm=bore, hub_diameter_mm=hub, pressure_angle_candidates=candidates)
+
+
+def _angle_candidates(table: Table, addendum: float, dedendum: float,
+                      fillet: float) -> tuple[tuple[float, float, float], ...]:
+    """The standard pressure angles an automatic one is chosen from, each with the dedendum and root fillet cut
+    at it (:func:`_fit_rack`); an angle at which a dedendum or fillet the template gives does not fit is left out
+    (20 deg, the first, must fit: its error is the template's)."""
+    out = []
+    for k, angle in enumerate(STANDARD_PRESSURE_ANGLES_DEG):
+        try:
+            out.append((angle, *_fit_rack(table, angle, addendum, dedendum, fillet)))
+        except SpecError:
+            if k == 0:
+                raise
+    return tuple(out)
 
 
 def _fit_rack(table: Table, pressure_deg: float, addendum: float, dedendum: float,
