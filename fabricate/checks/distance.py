@@ -29,9 +29,16 @@ import shapely
 
 from fabricate.planar import polygon_area, relative_poses
 
-#: Largest number of posed outline vertices built at once by :func:`planar_clearance` (about 0.3 GB
-#: of shapely geometry at ~150 bytes per vertex).
-POSED_VERTICES_PER_CHUNK = 2_000_000
+#: Largest number of posed outline vertices held at once by :func:`planar_clearance` and :func:`overlap_areas`
+#: (shapely geometry takes ~150 bytes a vertex: about 10 MB). The poses are streamed through in chunks of this
+#: many vertices, so the memory of a sweep does not grow with its poses (a 400-vertex outline: 164 poses a
+#: chunk; the chunk's shapely calls cost far less than its per-pose distances, so a smaller chunk costs no time).
+POSED_VERTICES_PER_CHUNK = 65_536
+
+
+def poses_per_chunk(outline: Outline) -> int:
+    """Poses of ``outline`` posed at once within :data:`POSED_VERTICES_PER_CHUNK` vertices (at least one)."""
+    return max(1, POSED_VERTICES_PER_CHUNK // max(1, len(outline.vertices)))
 
 
 @dataclass(frozen=True)
@@ -132,42 +139,41 @@ def planar_clearance(a: Outline, b: Outline, rel: RelativePoses, search_mm: floa
         the boundaries touch; ``-inf`` where the interiors overlap.
     """
     n = len(rel.q)
-    # every posed copy of B is a shapely polygon held at once: pose in chunks of at most
-    # POSED_VERTICES_PER_CHUNK vertices so memory stays bounded for any number of poses (a chunk
-    # boundary only drops the distance guess of one pose, which is retried at full size anyway)
-    chunk = max(1, POSED_VERTICES_PER_CHUNK // max(1, len(b.vertices)))
-    if n > chunk:
-        return np.concatenate([planar_clearance(a, b, RelativePoses(rel.q[i:i + chunk]), search_mm)
-                               for i in range(0, n, chunk)])
     out = np.full(n, np.inf)
     if n == 0:
         return out
-    polys = b.posed(rel)
-    meets = shapely.intersects(a.polygon, polys)
-    if np.any(meets):
-        idx = np.nonzero(meets)[0]
-        touching = shapely.touches(a.polygon, polys[idx])
-        out[idx] = np.where(touching, 0.0, -math.inf)
-    rest = np.nonzero(~meets)[0]
-    if len(rest) == 0:
-        return out
     # poses follow each other closely: the previous distance plus the largest point displacement
     # since then bounds this one, and a window that small is much cheaper (retried at full size
-    # when the guess proves too small)
+    # when the guess proves too small); the displacements are of the whole run, and the guess carries
+    # over from one chunk to the next, so the values do not depend on the chunk size
     centre = rel.apply(b.centre[None, :])[:, 0]
     step = np.hypot(*np.diff(centre, axis=0).T) + np.abs(np.diff(rel.q[:, 2])) * b.radius
     moved = np.concatenate([[math.inf], step])
-    bb = shapely.bounds(polys)
     previous, previous_index = math.inf, -2
-    for i in rest:
-        guess = previous + moved[i] + 1e-9 if previous_index == i - 1 else math.inf
-        tried = guess < search_mm
-        d = _clipped_distance(a, polys[i], bb[i], guess) if tried else math.inf
-        if not (tried and d <= guess):  # no guess, or the guess was too short
-            d = _clipped_distance(a, polys[i], bb[i], search_mm)
-        if d <= search_mm:
-            out[i] = d
-        previous, previous_index = d, int(i)
+    chunk = poses_per_chunk(b)
+    # the posed copies of B are shapely polygons held at once: pose them a chunk at a time so memory stays
+    # bounded for any number of poses
+    for lo in range(0, n, chunk):
+        polys = b.posed(RelativePoses(rel.q[lo:lo + chunk]))
+        meets = shapely.intersects(a.polygon, polys)
+        if np.any(meets):
+            idx = np.nonzero(meets)[0]
+            touching = shapely.touches(a.polygon, polys[idx])
+            out[lo + idx] = np.where(touching, 0.0, -math.inf)
+        rest = np.nonzero(~meets)[0]
+        if len(rest) == 0:
+            continue
+        bb = shapely.bounds(polys)
+        for k in rest:
+            i = lo + int(k)
+            guess = previous + moved[i] + 1e-9 if previous_index == i - 1 else math.inf
+            tried = guess < search_mm
+            d = _clipped_distance(a, polys[k], bb[k], guess) if tried else math.inf
+            if not (tried and d <= guess):  # no guess, or the guess was too short
+                d = _clipped_distance(a, polys[k], bb[k], search_mm)
+            if d <= search_mm:
+                out[i] = d
+            previous, previous_index = d, i
     return out
 
 
@@ -196,7 +202,7 @@ def _clipped_distance(a: Outline, poly_b: shapely.Polygon, bounds_b: np.ndarray,
 
 def overlap_areas(a: Outline, b: Outline, rel: RelativePoses) -> np.ndarray:
     """Area (mm^2) of the overlap of ``a`` and ``b`` posed by each of ``rel`` (n,)."""
-    chunk = max(1, POSED_VERTICES_PER_CHUNK // max(1, len(b.vertices)))  # bounded memory, as above
+    chunk = poses_per_chunk(b)  # bounded memory, as above (each pose's area is its own)
     return np.concatenate([
         np.asarray(shapely.area(shapely.intersection(a.polygon, b.posed(RelativePoses(rel.q[i:i + chunk])))),
                    dtype=np.float64)

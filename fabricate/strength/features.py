@@ -420,6 +420,10 @@ def gear_findings(pair: GearPair, torque_b: np.ndarray, mechanism: Mechanism, mo
     return found
 
 
+#: Point-vertex pairs :func:`local_radius` compares at once (about 16 MB of differences).
+NEAREST_VALUES_PER_CHUNK = 1_000_000
+
+
 def local_radius(points: np.ndarray, at: np.ndarray) -> np.ndarray:
     """Signed radius of curvature (mm; positive where the curve turns with its own sense, i.e. convex) of a
     pitch polyline at the vertex nearest each point of ``at`` (n, 2); inf where it is straight."""
@@ -432,6 +436,11 @@ def local_radius(points: np.ndarray, at: np.ndarray) -> np.ndarray:
         radius = np.where(cross != 0.0, sense * ab * bc * ca / (2.0 * cross), np.inf)
     # an open curve's end vertices have no neighbour on one side: take their inner neighbour's value
     radius[0], radius[-1] = radius[1], radius[-2]
-    nearest = np.argmin(np.sum((p[None, :, :] - at[:, None, :]) ** 2, axis=2), axis=1)
+    # the nearest vertex of a few points at a time: all at once is an (n, vertices, 2) array, 0.24 GB at 5000
+    # poses of a 3000-vertex pitch curve (each row's argmin is its own, so the chunk size changes nothing)
+    at = np.asarray(at, dtype=np.float64).reshape(-1, 2)
+    chunk = max(1, NEAREST_VALUES_PER_CHUNK // max(1, len(p)))
+    nearest = np.concatenate([np.argmin(np.sum((p[None, :, :] - at[i:i + chunk, None, :]) ** 2, axis=2), axis=1)
+                              for i in range(0, len(at), chunk)] or [np.zeros(0, dtype=np.intp)])
     nearest_radius: np.ndarray = radius[nearest]
     return nearest_radius

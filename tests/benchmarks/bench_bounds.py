@@ -310,11 +310,98 @@ def run(kind: str, work: Path, blas: int) -> dict[str, Any]:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+#: Run in its own process by ``--poses-memory``: builds a template's inputs up to the parts, then runs each stage
+#: that goes through every pose (the motion sweep again, the exports with motion.csv and the MJCF model, the
+#: interference proof, the gear mesh check, the strength statics and findings) with the peak resident memory reset
+#: before it (Linux ``/proc/self/clear_refs``, after glibc's ``malloc_trim``); prints each stage's peak (VmHWM)
+#: and the resident memory it started from (MB). The interference proof and the gear mesh check are measured
+#: inside ``run_checks`` by wrapping them.
+STAGE_PEAKS = """
+import ctypes, json, sys
+import fabricate.checks as checks
+from fabricate.design import design_from_text
+from fabricate.pipeline import (BuildRun, _synthesis_stage, _make_gears, _make_parts, _check, _check_strength,
+                                _export, _record_optional_outputs, OptionalOutputs)
+from fabricate.bounds import blas_threads
+
+def status(key):
+    with open("/proc/self/status") as f:
+        return next(float(line.split()[1]) / 1024.0 for line in f if line.startswith(key + ":"))
+
+out = {}
+
+def measured(name, fn):
+    def run(*args, **kwargs):
+        ctypes.CDLL("libc.so.6").malloc_trim(0)  # what earlier stages freed goes back: the start is what lives
+        start = status("VmRSS")
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")  # VmHWM := VmRSS
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            out[name] = {"start_mb": start, "peak_mb": status("VmHWM")}
+    return run
+
+checks.sweep_interference = measured("interference", checks.sweep_interference)
+checks.check_gear_meshes = measured("gear mesh", checks.check_gear_meshes)
+with blas_threads():
+    design = design_from_text(open(sys.argv[1]).read(), "t.toml")
+    result, report, motion, failures = _synthesis_stage(design, lambda s: None, "build")
+    measured("motion sweep", result.mechanism.sweep)(design.checks.sweep_poses)
+    run = BuildRun(design, result, motion, report, lambda s: None, OptionalOutputs(step=False))
+    _make_gears(run)
+    _make_parts(run)
+    measured("exports", _export)(run, _record_optional_outputs(run))
+    _check(run)
+    measured("strength", _check_strength)(run)
+print(json.dumps(out))
+"""
+
+#: ``--poses-memory``: the templates and pose counts whose stage peaks are compared.
+POSES_MEMORY_TEMPLATES = ("finger_five_bar_ncg", "linkage_stephenson")
+POSES_MEMORY_COUNTS = (360, bounds.MAX_SWEEP_POSES)
+POSES_MEMORY_STAGES = ("motion sweep", "exports", "interference", "gear mesh", "strength")
+
+
+def poses_memory(templates: tuple[str, ...] = POSES_MEMORY_TEMPLATES,
+                 counts: tuple[int, ...] = POSES_MEMORY_COUNTS) -> None:
+    """Peak memory of the stages that go through every pose against the number of poses: each template at each
+    count in a fresh process (:data:`STAGE_PEAKS`); prints each stage's peak and its ratio to the first count's
+    (the interference proof and the strength sweep stream their poses in chunks: within 1.3x from 360 to 5000)."""
+    print(f"{'template':22s} {'stage':13s} " + " ".join(f"{f'{n} poses MB':>15s}" for n in counts)
+          + f" {'ratio':>6s}   (peak RSS in the stage; in brackets its growth over the RSS it started from)")
+    with tempfile.TemporaryDirectory(prefix="bench_poses_") as tmp:
+        for name in templates:
+            peaks: dict[int, dict[str, Any]] = {}
+            for n in counts:
+                data = parse_toml((TEMPLATE_DIR / f"{name}.toml").read_text(encoding="utf-8"), name)
+                data.setdefault("checks", {})["sweep_poses"] = n
+                path = Path(tmp) / f"{name}_{n}.toml"
+                path.write_text(toml_text(data), encoding="utf-8")
+                env = {**os.environ, "FABRICATE_SERIAL": "1", "OPENBLAS_NUM_THREADS": "1"}
+                out = subprocess.run([sys.executable, "-c", STAGE_PEAKS, str(path)], capture_output=True, text=True,
+                                     check=True, env=env)
+                peaks[n] = json.loads(out.stdout.strip().splitlines()[-1])
+            for stage in POSES_MEMORY_STAGES:
+                if any(stage not in peaks[n] for n in counts):
+                    continue  # no gear pair: no gear mesh check
+                cells = [f"{p['peak_mb']:6.0f} ({p['peak_mb'] - p['start_mb']:+6.0f})"
+                         for p in (peaks[n][stage] for n in counts)]
+                ratio = peaks[counts[-1]][stage]["peak_mb"] / peaks[counts[0]][stage]["peak_mb"]
+                print(f"{name:22s} {stage:13s} " + " ".join(f"{c:>15s}" for c in cells) + f" {ratio:6.2f}",
+                      flush=True)
+
+
 def main(argv: list[str]) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--blas", choices=("1", "2", "both"), default="both")
+    parser.add_argument("--poses-memory", action="store_true",
+                        help="peak memory of the interference and strength sweeps at 360 and the most poses")
     parser.add_argument("kinds", nargs="*", metavar="kind", help=f"of {', '.join([*WORST, *GENERATED])}")
     args = parser.parse_args(argv)
+    if args.poses_memory:
+        poses_memory(tuple(args.kinds) or POSES_MEMORY_TEMPLATES)
+        return
     kinds = args.kinds or [*WORST, *GENERATED]
     unknown = [k for k in kinds if k not in WORST and k not in GENERATED]
     if unknown:

@@ -1024,3 +1024,43 @@ def test_clipped_distance_equals_plain_distance(x, y, theta, search):
         assert d == pytest.approx(reference, abs=1e-9)
     else:
         assert d == math.inf
+
+
+# -- the poses streamed in chunks (issue 27, item 5) -----------------------------------------------------
+@pytest.mark.parametrize("layers", [None, "coupler_on_ground_layer"])
+def test_a_sweep_streamed_seven_poses_at_a_time_equals_the_sweep_all_at_once(monkeypatch, four_bar_motion, layers):
+    """The posed outlines are held a chunk of poses at a time (memory flat in the poses): seven poses a chunk
+    gives every pair's clearance per pose, exactness, minimum and its pose, kernel gap, colliding poses and
+    overlap volumes exactly (not approximately) as all 360 at once, for the clear four-bar and the colliding
+    one; and no call posed more than seven copies at once."""
+    import fabricate.checks.distance as distance
+
+    mech, motion = four_bar_motion
+    parts = four_bar_parts(mech, **({} if layers is None else {"layers": EXPECTED[layers]["layers"]}))
+
+    def sweep(chunk: int) -> tuple[object, int]:
+        held = [0]
+        posed = Outline.posed
+
+        def spy(self: Outline, rel: RelativePoses) -> np.ndarray:
+            held[0] = max(held[0], len(rel.q))
+            return posed(self, rel)
+
+        monkeypatch.setattr(distance, "poses_per_chunk", lambda outline: chunk)
+        monkeypatch.setattr(Outline, "posed", spy)
+        result = sweep_interference(parts, motion, chord_tolerance_mm=CHORD_TOL, min_clearance_mm=0.25)
+        monkeypatch.undo()
+        return result, held[0]
+
+    whole, held_whole = sweep(10 ** 9)
+    chunked, held_chunked = sweep(7)
+    assert held_whole > 100 and held_chunked == 7  # the near poses of a pair: up to all 360 at once
+    assert (layers is None) == (not whole.collisions)
+    assert len(chunked.pairs) == len(whole.pairs) > 0
+    for a, b in zip(whole.pairs, chunked.pairs, strict=True):
+        for name in ("a", "b", "relation", "z_gap_mm", "required_mm", "min_clearance_mm", "min_index",
+                     "kernel_gap_mm", "max_overlap_mm3", "max_overlap_index"):
+            assert getattr(a, name) == getattr(b, name), (a.a, a.b, name)
+        for name in ("clearance", "exact", "collision_indices", "overlap_indices", "overlap_mm3"):
+            np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    assert json.dumps(whole.report()) == json.dumps(chunked.report())

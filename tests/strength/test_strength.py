@@ -370,3 +370,57 @@ def test_an_unloaded_part_has_a_null_safety_factor_not_inf():
     rows = {p["name"]: p for p in result.report()["parts"]}
     assert rows["idle"]["min_safety_factor"] is None and rows["busy"]["min_safety_factor"] == 5.0
     assert result.passed is True and result.report()["passed"] is True
+
+
+# -- the poses streamed in chunks (issue 27, item 5) -----------------------------------------------------
+
+def test_local_radius_a_point_at_a_time_equals_all_at_once(monkeypatch):
+    """The nearest pitch vertex is found for a few contact points at a time (memory flat in the poses): one
+    point a chunk gives exactly the radii of all at once, each row its own nearest vertex."""
+    import fabricate.strength.features as features
+
+    t = np.linspace(0.0, 2.0 * np.pi, 801)[:-1]
+    curve = np.column_stack([20.0 * np.cos(t), 12.0 * np.sin(t)])
+    probe = np.random.default_rng(7).uniform(-25.0, 25.0, (301, 2))
+    whole = features.local_radius(curve, probe)
+    monkeypatch.setattr(features, "NEAREST_VALUES_PER_CHUNK", 1)
+    one = features.local_radius(curve, probe)
+    np.testing.assert_array_equal(one, whole)
+    assert len(np.unique(whole)) > 50  # the probes land on many different vertices
+    assert features.local_radius(curve, np.zeros((0, 2))).shape == (0,)
+
+
+def test_strength_streamed_seven_poses_at_a_time_equals_all_at_once(monkeypatch):
+    """The elliptic gear pair's strength check (statics, pins, holes, links, gear teeth) over 120 poses with the
+    gear contact's nearest pitch vertices found seven poses at a time: every finding (stress, pose, curve) and
+    the joint force curves exactly as all poses at once."""
+    import fabricate.strength.features as features
+    from fabricate.design import load_design
+    from fabricate.gears import build_gear_pairs
+    from fabricate.parts.build import build_parts
+    from fabricate.pipeline import synthesise
+    from fabricate.strength.check import run_strength
+
+    design = load_design("gear_pair_elliptic")
+    synthesis = synthesise(design)
+    mech = synthesis.mechanism
+    motion = mech.sweep(120)
+    gear_pairs = build_gear_pairs(mech, design.gears, design.process.chord_tolerance_mm)
+    partset = build_parts(design, mech, motion, gear_pairs, synthesis.parts)
+
+    def strength():
+        return run_strength(design, partset, mech, motion, gear_pairs, synthesis.parts)
+
+    whole = strength()
+    vertices = max(len(p) for pair in gear_pairs for p in (pair.pitch_a, pair.pitch_b))
+    monkeypatch.setattr(features, "NEAREST_VALUES_PER_CHUNK", 7 * vertices)
+    chunked = strength()
+    assert [f.kind for f in whole.findings].count("gear") > 0
+    assert len(chunked.findings) == len(whole.findings)
+    for a, b in zip(whole.findings, chunked.findings, strict=True):
+        assert (a.part, a.feature, a.stress_MPa, a.pose) == (b.part, b.feature, b.stress_MPa, b.pose)
+        np.testing.assert_array_equal(a.curve, b.curve)
+    assert whole.curves.keys() == chunked.curves.keys()
+    for key in whole.curves:
+        np.testing.assert_array_equal(whole.curves[key], chunked.curves[key])
+    assert json.dumps(whole.report()) == json.dumps(chunked.report())
