@@ -164,7 +164,6 @@ def code_fingerprint() -> str:
         return _fingerprint
     import platform
     import time
-    from importlib import metadata
 
     import fabricate
     from fabricate.templates import TEMPLATE_DIR
@@ -173,14 +172,43 @@ def code_fingerprint() -> str:
     digest = hashlib.sha256()
     digest.update(f"fabricate {fabricate.__version__}\npython {sys.version}\n{platform.machine()}\n"
                   f"pickle {PICKLE_PROTOCOL}\n".encode())
+    versions = installed_versions()
     for name in LIBRARIES:
+        digest.update(f"{name} {versions.get(_normal(name), '-')}\n".encode())
+    digest.update(source_digest((Path(fabricate.__file__).resolve().parent, Path(TEMPLATE_DIR).resolve())).encode())
+    _fingerprint = digest.hexdigest()
+    fingerprint_seconds = time.perf_counter() - start
+    return _fingerprint
+
+
+def _normal(name: str) -> str:
+    return name.lower().replace("-", "_").replace(".", "_")
+
+
+def installed_versions() -> dict[str, str]:
+    """``{normalised distribution name: version}`` of every distribution on ``sys.path``, from the names of
+    their ``.dist-info``/``.egg-info`` folders (the first on the path wins, as for imports). One directory listing
+    per path entry: ``importlib.metadata.version`` took ~10 ms a library on a busy machine."""
+    found: dict[str, str] = {}
+    for entry in sys.path:
         try:
-            version = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            version = "-"
-        digest.update(f"{name} {version}\n".encode())
-    package = Path(fabricate.__file__).resolve().parent
-    for root in (package, Path(TEMPLATE_DIR).resolve()):
+            names = os.listdir(entry or ".")
+        except OSError:
+            continue
+        for name in names:
+            stem, dot, suffix = name.rpartition(".")
+            if not dot or suffix not in ("dist-info", "egg-info") or "-" not in stem:
+                continue
+            dist, _, version = stem.partition("-")
+            found.setdefault(_normal(dist), version.partition("-")[0])
+    return found
+
+
+def source_digest(roots: tuple[Path, ...]) -> str:
+    """sha256 of every ``.py``/``.json``/``.toml`` file under ``roots`` (each file's path under its root and its
+    content's sha256, in sorted order; ``__pycache__`` left out). A missing root counts as empty."""
+    digest = hashlib.sha256()
+    for root in roots:
         if not root.is_dir():
             continue
         files = sorted(p for p in root.rglob("*") if p.suffix in SOURCE_SUFFIXES and "__pycache__" not in p.parts
@@ -188,9 +216,7 @@ def code_fingerprint() -> str:
         for path in files:
             digest.update(f"{root.name}/{path.relative_to(root).as_posix()}\n".encode())
             digest.update(hashlib.sha256(path.read_bytes()).digest())
-    _fingerprint = digest.hexdigest()
-    fingerprint_seconds = time.perf_counter() - start
-    return _fingerprint
+    return digest.hexdigest()
 
 
 def canonical(value: Any) -> str:
@@ -481,9 +507,11 @@ def exports_key(design: DesignSpec, with_step: bool) -> tuple[Any, ...]:
 
 
 def checks_key(design: DesignSpec) -> tuple[Any, ...]:
-    """Interference, gear mesh and printability (``pipeline._check``): the part set and gear pairs, ``checks``
-    (clearance, poses), ``process`` and ``parts`` (plate layout)."""
-    return (parts_key(design), design.checks)
+    """Interference, gear mesh and printability (``pipeline._check``) and the clearance plot: the part set and
+    gear pairs, ``checks.min_clearance_mm`` (``sweep_poses`` is the motion's, in the synthesis key), ``process``
+    and ``parts`` (the plate layout; in the part set's key). Not ``checks.min_safety_factor`` (strength's) or
+    ``[load]``."""
+    return (parts_key(design), design.checks.min_clearance_mm)
 
 
 def pictures_key(design: DesignSpec, job: str, extra: Any = None) -> tuple[Any, ...]:
@@ -494,3 +522,62 @@ def pictures_key(design: DesignSpec, job: str, extra: Any = None) -> tuple[Any, 
     if job == "gear_pictures":
         return (gears_key(design),)
     return (parts_key(design), extra)
+
+
+def strength_key(design: DesignSpec) -> tuple[Any, ...]:
+    """The strength check (``pipeline._check_strength``) and its plot: the part set (with its gear pairs and the
+    synthesis' hints), ``load`` and ``checks.min_safety_factor``; ``process`` (materials) is in the part set's
+    key already."""
+    return (parts_key(design), design.load, design.checks.min_safety_factor)
+
+
+class SynthesisFigures:
+    """A synthesis result's ``figures`` that can be pickled: the method's own drawing function where this process
+    has it, else the figures stored under the synthesis' key, else (evicted) the synthesis run again for them.
+
+    A method's figures are a closure over its intermediate results (not picklable); a cached result carries this
+    in its place, and the figures themselves are the ``synthesis_plots`` entry.
+    """
+
+    def __init__(self, design: DesignSpec, draw: Callable[[], dict[str, bytes]] | None = None) -> None:
+        self.design = design
+        self._draw = draw
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {"design": self.design}  # the closure stays in the process that made it
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.design = state["design"]
+        self._draw = None
+
+    def __call__(self) -> dict[str, bytes]:
+        return cached("synthesis_plots", synthesis_key(self.design), self._figures)
+
+    def _figures(self) -> dict[str, bytes]:
+        if self._draw is not None:
+            return self._draw()
+        from fabricate.kinds import KINDS
+
+        figures: dict[str, bytes] = KINDS[self.design.kind].synthesise(self.design).figures()
+        return figures
+
+
+def storable_synthesis(result: Any, design: DesignSpec) -> Any:
+    """``result`` (a :class:`~fabricate.synthesis.base.SynthesisResult`) with :class:`SynthesisFigures` in place
+    of its figures closure when the cache is on, so it can be stored; unchanged when it is off."""
+    if not enabled():
+        return result
+    return dataclasses.replace(result, figures=SynthesisFigures(design, result.figures))
+
+
+def sizing_key(design: DesignSpec) -> tuple[Any, ...]:
+    """``parts.link_width_mm = "auto"`` (``pipeline._size_links``): the gear pairs, and every section the parts
+    and the strength check read (it builds parts at each width tried and checks their strength)."""
+    return (gears_key(design), design.parts, design.process, design.load, design.checks, design.actuator,
+            design.name, design.kind)
+
+
+def drive_key(design: DesignSpec) -> tuple[Any, ...]:
+    """The drive check's plot (``pipeline._plots``): the strength check's inputs (its statics) and ``actuator``
+    (the rating and margin drawn)."""
+    return (strength_key(design), design.actuator)
