@@ -13,6 +13,12 @@ The output folder holds:
 
 A re-run into the same folder skips the points whose rows are done (exit codes 0, 1, 2; a point that hit
 an internal error or lost its worker every time is run again).
+
+Points are sent in the order of their synthesis group (:func:`fabricate.sweep.task.synthesis_group`: the points
+that differ only in fields synthesis does not read, one after the other), and each worker process keeps the
+stage results of its points in memory (:mod:`fabricate.cache`'s in-process layer) for as long as it lives: a
+``--stage build`` sweep over ``[process]``, ``[parts]``, ``[load]`` or ``[checks]`` fields synthesises each
+group once per worker instead of once per point.
 """
 
 from __future__ import annotations
@@ -32,7 +38,7 @@ from typing import Any
 from fabricate.errors import SpecError
 from fabricate.sweep.folder import JOURNAL, SWEEP_JSON, Journal, prepare_folder, read_journal, sweep_record, write_file
 from fabricate.sweep.spec import SweepSpec
-from fabricate.sweep.task import EXIT_INTERNAL, build_point, run_batch
+from fabricate.sweep.task import EXIT_INTERNAL, build_point, run_batch, synthesis_group, warm
 
 #: Results are rewritten at most this often while a sweep runs (and always at its end).
 FLUSH_SECONDS = 5.0
@@ -71,6 +77,9 @@ class SweepOutcome:
     workers: int = 0
     tasks: int = 0
     notes: list[str] = field(default_factory=list)
+    #: Seconds from the first task sent to the last row received (the points' own wall time: no cluster start-up,
+    #: tables, plots or best builds).
+    points_seconds: float = 0.0
 
 
 # -- Dask ----------------------------------------------------------------------------------------------------
@@ -134,7 +143,7 @@ def _counts(rows: Mapping[str, Mapping[str, Any]]) -> dict[str, int]:
 
 def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, scheduler: str | None = None,
               quiet: bool = False, progress_bar: bool | None = None, log: Progress | None = None,
-              protect: Sequence[Path] = ()) -> SweepOutcome:
+              protect: Sequence[Path] = (), cache: bool | None = None) -> SweepOutcome:
     """Run every point of ``spec`` not done yet in ``out``, then write the tables, plots and best builds.
 
     Parameters
@@ -153,6 +162,10 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
         Draw the progress bar on stderr (default: when stderr is a terminal).
     protect : sequence of Path
         The sweep's input files (spec, template): ``out`` may not be or hold one.
+    cache : bool, optional
+        Let each worker reuse stage results across its points, in its memory only (never the disk cache). Default:
+        whether :mod:`fabricate.cache` is on here (:func:`fabricate.cache.use_cache`; the command line turns it on
+        unless ``--no-cache``). The rows are the same either way.
     """
     if workers is not None:  # before anything is written: the cores and the memory bound the local processes
         from fabricate.bounds import check_workers
@@ -171,11 +184,17 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     say = log or (lambda msg: None if quiet else print(msg, file=sys.stderr, flush=True))
     draw = (not quiet) and (sys.stderr.isatty() if progress_bar is None else progress_bar)
 
-    todo = deque((i, points[i], ids[i]) for i in range(len(points)) if ids[i] not in done)
+    if cache is None:
+        from fabricate.cache import enabled
+
+        cache = enabled()
+    order = group_order(spec.field_parts(), points, [i for i in range(len(points)) if ids[i] not in done])
+    todo = deque((i, points[i], ids[i]) for i in order)
     start = time.perf_counter()
     client = cluster = None
     interrupted = False
     n_workers = tasks = 0
+    points_seconds = 0.0
     if todo:  # a cluster that cannot be had is a usage error: nothing is written
         client, cluster = connect(workers, scheduler)
         try:
@@ -191,7 +210,10 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
             say(f"sweep {spec.name}: {len(points)} points ({resumed} done earlier), stage {spec.stage}, "
                 f"{n_workers} Dask worker{'s' if n_workers != 1 else ''}"
                 f"{' at ' + scheduler if scheduler else ' (local cluster)'}")
-            tasks = _run_points(client, spec, todo, done, journal, out, start, resumed, len(points), draw, say)
+            began = time.perf_counter()
+            tasks = _run_points(client, spec, todo, done, journal, out, start, resumed, len(points), draw, say,
+                                cache)
+            points_seconds = time.perf_counter() - began
         elif not quiet:
             say(f"sweep {spec.name}: all {len(points)} points done earlier; writing the results")
     except KeyboardInterrupt:
@@ -214,7 +236,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
             if best:
                 if client is None:
                     client, cluster = connect(workers, scheduler)
-                _build_best(client, spec, best, out, say, protect)
+                _build_best(client, spec, best, out, say, protect, cache)
         counts = _counts(done)
         complete = len(rows) == len(points)
         notes = _notes(spec, rows)
@@ -231,7 +253,17 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     code = 130 if interrupted else (1 if counts.get(str(EXIT_INTERNAL)) else 0)
     return SweepOutcome(exit_code=code, out=out, total=len(points), done=len(rows), resumed=resumed,
                         counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers,
-                        tasks=tasks, notes=notes)
+                        tasks=tasks, notes=notes, points_seconds=points_seconds)
+
+
+def group_order(fields: Sequence[tuple[str, Sequence[str | int]]], points: Sequence[Mapping[str, Any]],
+                indices: Sequence[int]) -> list[int]:
+    """``indices`` with the points of one synthesis group (:func:`fabricate.sweep.task.synthesis_group`) one after
+    the other, groups in the order of their lowest index, each group's points in index order: a worker's cache
+    then synthesises a group once, however the grid orders its fields."""
+    groups: dict[str, int] = {}
+    return sorted(sorted(indices),
+                  key=lambda i: (groups.setdefault(synthesis_group(fields, points[i]), len(groups)), i))
 
 
 def _json(data: Any) -> bytes:
@@ -266,12 +298,17 @@ def _close(client: Any, cluster: Any) -> None:
 
 
 def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[str, Any]], journal: Journal,
-                out: Path, start: float, resumed: int, total: int, draw: bool, say: Progress) -> int:
+                out: Path, start: float, resumed: int, total: int, draw: bool, say: Progress,
+                cache: bool = False) -> int:
     """Submit batches, keep about two per worker in flight, and record rows as tasks finish. Returns the
     number of tasks submitted."""
     from distributed import as_completed
 
     base, parts, metrics = spec.base, spec.field_parts(), list(spec.metrics)
+    try:  # every worker imports the pipeline now, side by side, instead of in its first point
+        client.run(warm)
+    except Exception:  # noqa: BLE001 - a worker that cannot run it will show why in its first point
+        pass
     # the base template and metrics go to the cluster once; every task refers to them
     shared = client.scatter([base, parts, metrics], broadcast=True, hash=False)
     batch_size = 1  # the first tasks measure a point's time; later batches aim at spec.batch_seconds
@@ -294,7 +331,7 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
     def submit(batch: list[tuple[int, Any, str]]) -> None:
         nonlocal submitted
         submitted += 1
-        fut = client.submit(run_batch, batch, shared[0], shared[1], spec.stage, shared[2], pure=False,
+        fut = client.submit(run_batch, batch, shared[0], shared[1], spec.stage, shared[2], cache, pure=False,
                             retries=TASK_RETRIES)
         in_flight[fut] = batch
         queue.add(fut)
@@ -408,7 +445,7 @@ def _best(spec: SweepSpec, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 def _build_best(client: Any, spec: SweepSpec, best: list[dict[str, Any]], out: Path, say: Progress,
-                protect: Sequence[Path] = ()) -> None:
+                protect: Sequence[Path] = (), cache: bool = False) -> None:
     """Build the best points in full on the cluster and write each as a normal build output folder."""
     from fabricate.output import write_output
     from fabricate.output_read import MAX_REPORT_BYTES, read_regular
@@ -432,8 +469,8 @@ def _build_best(client: Any, spec: SweepSpec, best: list[dict[str, Any]], out: P
     if not wanted:
         return
     say(f"building the best {len(best)} point{'s' if len(best) != 1 else ''} in full")
-    futures = [client.submit(build_point, entry["values"], spec.base, parts, pure=False, retries=TASK_RETRIES)
-               for entry, _ in wanted]
+    futures = [client.submit(build_point, entry["values"], spec.base, parts, cache, pure=False,
+                             retries=TASK_RETRIES) for entry, _ in wanted]
     for (entry, folder), fut in zip(wanted, futures, strict=True):
         code, reason, files = fut.result()
         entry["build_exit_code"] = code

@@ -3,6 +3,12 @@
 A point is a template like any other: it is validated, synthesised (``stage = "synth"``) or built in full
 (``"build"``), and its report's metrics are read. Whatever happens, the point becomes a row; a bad point is a
 row with its exit code and reason, never an exception out of the task.
+
+Points that differ only in fields synthesis does not read (:func:`synthesis_group`) share its result: a batch
+runs with the in-process layer of the stage cache (:mod:`fabricate.cache`, never its disk layer), which lives as
+long as the worker process, so a worker synthesises each group once, and a build sweep's later stages are
+reused too wherever their own inputs agree (a point that only changes ``[load]`` re-runs the strength check
+alone). The runner sends a group's points one after the other.
 """
 
 from __future__ import annotations
@@ -19,6 +25,37 @@ from fabricate.sweep.paths import Metric
 
 #: Exit codes of a row, as the CLI's: 0 passes, 1 fails a check, 2 invalid or infeasible, 3 internal error.
 EXIT_OK, EXIT_FAILED, EXIT_INVALID, EXIT_INTERNAL = 0, 1, 2, 3
+
+#: Template tables synthesis never reads (:func:`fabricate.cache.synthesis_key`): a point that varies only fields
+#: in these (and ``[checks]`` but its ``sweep_poses``) shares the synthesis of the other points of its group.
+NOT_SYNTHESIS_TABLES = frozenset({"process", "parts", "load"})
+
+
+def synthesis_group(fields: Sequence[tuple[str, Sequence[str | int]]], values: Mapping[str, Any]) -> str:
+    """The values of a point's varied fields that synthesis may read, as a text: points with the same text share
+    their synthesis (and its swept motion).
+
+    A scheduling hint only: the cache's own key (:func:`fabricate.cache.synthesis_key`, of the validated design)
+    decides what is reused, so a field taken for one that synthesis reads when it does not costs a synthesis,
+    never a wrong result. ``[process]``, ``[parts]``, ``[load]``, ``[checks]`` (but ``sweep_poses``) and
+    ``design.description`` are the fields it does not read.
+    """
+    read = []
+    for path, parts in fields:
+        top = str(parts[0]) if parts else ""
+        second = str(parts[1]) if len(parts) > 1 else ""
+        if top in NOT_SYNTHESIS_TABLES or (top == "checks" and second != "sweep_poses") \
+                or (top == "design" and second == "description"):
+            continue
+        read.append([path, values[path]])
+    return json.dumps(read, sort_keys=True, default=str)
+
+
+def warm() -> None:
+    """Import what a point runs (a Dask worker does once, at start-up, rather than in its first point)."""
+    import fabricate.design  # noqa: F401
+    import fabricate.pipeline  # noqa: F401
+    import fabricate.report  # noqa: F401
 
 
 def point_text(base: Mapping[str, Any], fields: Sequence[tuple[str, Sequence[str | int]]],
@@ -93,22 +130,31 @@ def run_point(index: int, values: Mapping[str, Any], pid: str, base: Mapping[str
 
 def run_batch(points: Sequence[tuple[int, Mapping[str, Any], str]], base: Mapping[str, Any],
               fields: Sequence[tuple[str, Sequence[str | int]]], stage: str,
-              metrics: Sequence[Metric]) -> list[dict[str, Any]]:
+              metrics: Sequence[Metric], cache: bool = False) -> list[dict[str, Any]]:
     """Rows of several points ``(index, values, id)``, run one after the other in this process (one Dask
     task).
 
     Plots that a build would draw in a forked child are drawn in this process: a Dask worker runs one task
-    per core already.
+    per core already. With ``cache``, stage results are kept in this process's memory (never on disk) and
+    reused by this and later batches of the same process wherever a stage's inputs are the same.
     """
+    from fabricate.cache import use_cache
+
     os.environ.setdefault("FABRICATE_SERIAL", "1")
-    return [run_point(i, values, pid, base, fields, stage, metrics) for i, values, pid in points]
+    with use_cache(cache, disk=False):
+        return [run_point(i, values, pid, base, fields, stage, metrics) for i, values, pid in points]
 
 
 def build_point(values: Mapping[str, Any], base: Mapping[str, Any],
-                fields: Sequence[tuple[str, Sequence[str | int]]]) -> tuple[int, str, dict[str, bytes]]:
-    """A point built in full (the sweep's best points): exit code, reason and every output file."""
+                fields: Sequence[tuple[str, Sequence[str | int]]],
+                cache: bool = False) -> tuple[int, str, dict[str, bytes]]:
+    """A point built in full (the sweep's best points): exit code, reason and every output file (a build
+    sweep's worker may still hold its stages, with ``cache``)."""
+    from fabricate.cache import use_cache
+
     os.environ.setdefault("FABRICATE_SERIAL", "1")
-    code, reason, _report, outcome = evaluate(point_text(base, fields, values), "build")
+    with use_cache(cache, disk=False):
+        code, reason, _report, outcome = evaluate(point_text(base, fields, values), "build")
     return code, reason, (dict(outcome.files) if outcome is not None else {})
 
 

@@ -21,3 +21,81 @@ def test_a_checked_point_has_no_reason_and_a_synth_point_no_not_checked_note() -
     assert report is not None and report["strength"]["passed"] is True
     code, reason, _, _ = evaluate(dumps(_tables(load=True)), "synth")
     assert (code, reason) == (EXIT_OK, "")
+
+
+# -- points that share a synthesis (issue 27, item 4) -----------------------------------------------------
+
+def test_synthesis_group_ignores_only_the_fields_synthesis_does_not_read() -> None:
+    from fabricate.sweep.task import synthesis_group
+
+    fields = [("load.torque_Nmm", ("load", "torque_Nmm")), ("process.thickness_mm", ("process", "thickness_mm")),
+              ("parts.link_width_mm", ("parts", "link_width_mm")),
+              ("checks.min_clearance_mm", ("checks", "min_clearance_mm")),
+              ("design.description", ("design", "description"))]
+    a = dict(zip((f for f, _ in fields), (150.0, 3.0, 6.0, 0.3, "x"), strict=True))
+    b = dict(zip((f for f, _ in fields), (90.0, 4.0, 7.0, 0.4, "y"), strict=True))
+    assert synthesis_group(fields, a) == synthesis_group(fields, b)
+    for path, parts in (("gear_pair.eccentricity", ("gear_pair", "eccentricity")),
+                        ("checks.sweep_poses", ("checks", "sweep_poses")), ("gears.module_mm", ("gears", "module_mm")),
+                        ("finger.lengths_mm[0]", ("finger", "lengths_mm", 0)), ("design.name", ("design", "name"))):
+        grown = [*fields, (path, parts)]
+        assert synthesis_group(grown, {**a, path: 1}) != synthesis_group(grown, {**a, path: 2}), path
+        assert synthesis_group(grown, {**a, path: 1}) == synthesis_group(grown, {**b, path: 1}), path
+
+
+def test_a_grid_is_sent_group_by_group_whatever_its_field_order() -> None:
+    """The grid's last field varies fastest: with the synthesis field last, its points would alternate between
+    groups; sent in group order, each group's points follow each other (in index order), groups in the order of
+    their first point, and every point is sent once."""
+    from fabricate.sweep.runner import group_order
+    from fabricate.sweep.spec import sweep_from_tables
+
+    spec = sweep_from_tables({
+        "sweep": {"template": "gear_pair_elliptic", "stage": "build", "metrics": ["synthesis.center_distance_mm"]},
+        "vary": {"load.torque_Nmm": [50.0, 100.0, 150.0], "gear_pair.eccentricity": [0.1, 0.2]}})
+    points = spec.points()
+    assert [p["gear_pair.eccentricity"] for p in points] == [0.1, 0.2] * 3
+    order = group_order(spec.field_parts(), points, [5, 0, 1, 2, 3, 4])
+    assert order == [0, 2, 4, 1, 3, 5]
+    assert [points[i]["gear_pair.eccentricity"] for i in order] == [0.1] * 3 + [0.2] * 3
+
+
+def test_a_build_sweep_synthesises_a_shared_synthesis_once_and_gives_the_same_rows(monkeypatch) -> None:
+    """Two build points of the Stephenson six-bar that differ only in [load]: in one batch with the cache it is
+    synthesised once (the second point's synthesis is a cache hit); the second point's row (exit code, reason,
+    metrics) is the same as its build on its own without the cache, and the two points' metrics differ (the
+    load is read)."""
+    import fabricate.pipeline as pipeline
+    from fabricate import cache
+    from fabricate.sweep.spec import sweep_from_tables
+    from fabricate.sweep.task import run_batch
+
+    spec = sweep_from_tables({
+        "sweep": {"template": "linkage_stephenson", "stage": "build",
+                  "metrics": ["interference.min_clearance_mm", "min(strength.parts[*].min_safety_factor)"]},
+        "vary": {"load.torque_Nmm": [60.0, 150.0]}, "set": {"checks.sweep_poses": 60}})
+    batch = [(i, values, spec.point_id(values)) for i, values in enumerate(spec.points())]
+    calls = []
+    synthesise = pipeline.synthesise
+
+    def spy(design, *args, **kwargs):
+        calls.append(design.load.torque_Nmm)
+        return synthesise(design, *args, **kwargs)
+
+    monkeypatch.setattr(pipeline, "synthesise", spy)
+    cache.clear_memory()
+    before = dict(cache.stats.get("synthesis", {"hits": 0, "misses": 0}))
+    shared = run_batch(batch, spec.base, spec.field_parts(), spec.stage, list(spec.metrics), cache=True)
+    after = cache.stats["synthesis"]
+    assert calls == [60.0]
+    assert (after["misses"] - before.get("misses", 0), after["hits"] - before.get("hits", 0)) == (1, 1)
+    cache.clear_memory()
+    # the first point's row above was built from nothing (the memory layer was empty): the second is the one
+    # that reused a result, so it is the one built again on its own
+    (separate,) = run_batch(batch[1:], spec.base, spec.field_parts(), spec.stage, list(spec.metrics), cache=False)
+    assert calls == [60.0, 150.0]
+    assert not cache.enabled()  # the batch's switch is restored
+    shared[1].pop("seconds"), separate.pop("seconds")
+    assert shared[1] == separate
+    name = "min(strength.parts[*].min_safety_factor)"
+    assert shared[0][name] > shared[1][name] > 0.0
