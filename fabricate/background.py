@@ -2,7 +2,8 @@
 
 The pipeline's pictures take as long as everything else, so :class:`Background` draws them on the second
 core; whatever happens to the child (no ``fork``, a daemon process, a crash, a kill), the caller gets the
-same bytes, computed here if need be.
+same bytes, computed here if need be. :func:`run_isolated` runs one call in a fresh interpreter instead, for
+work whose imports are large and needed nowhere else (the STEP writer's OCP).
 """
 
 from __future__ import annotations
@@ -135,3 +136,68 @@ class Background:
             self._process.join()
             self._conn.close()
             self._process = None
+
+
+def run_isolated(module: str, function: str, *args: Any) -> Any:
+    """``module.function(*args)`` run in a fresh Python process; its result (arguments and result pickled).
+
+    A forked child carries its parent's resident memory (every kernel's libraries, a build's arrays) on top
+    of what it imports itself; a fresh interpreter holds only what the call imports. That keeps OCP (220 MB
+    resident once imported) out of every process that holds the rest of a build. The result is the call's
+    own either way: where the process cannot start, dies or the call raises, it runs again here (and raises
+    here, if it does).
+
+    Parameters
+    ----------
+    module, function : str
+        Where the function is (``"fabricate.export.step"``, ``"step_files"``): it must be importable by name
+        in a new process; this copy of fabricate is put first on its path.
+    *args
+        Picklable arguments.
+    """
+    import importlib
+    import pickle
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    payload = pickle.dumps((module, function, args), protocol=pickle.HIGHEST_PROTOCOL)
+    root = str(Path(__file__).resolve().parents[1])
+    code = (f"import sys; sys.path.insert(0, {root!r}); "
+            "from fabricate.background import _isolated_main; _isolated_main()")
+    try:
+        proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                stderr=subprocess.DEVNULL)
+    except OSError:  # no process now (EAGAIN, ENOMEM): the call runs here
+        proc = None
+    if proc is not None:
+        try:
+            out, _ = proc.communicate(payload)
+        except BaseException:  # a stop signal while waiting: nothing is left to wait for
+            proc.kill()
+            proc.wait()
+            raise
+        if proc.returncode == 0:
+            try:
+                ok, value = pickle.loads(out)
+            except Exception:  # noqa: BLE001 - a truncated or unreadable answer: redo it here
+                ok = False
+            if ok:
+                return value
+    return getattr(importlib.import_module(module), function)(*args)
+
+
+def _isolated_main() -> None:
+    """The fresh process of :func:`run_isolated`: the call from stdin, ``(ok, result)`` to stdout."""
+    import importlib
+    import pickle
+    import sys
+
+    _die_with_parent(os.getppid())
+    module, function, args = pickle.loads(sys.stdin.buffer.read())
+    try:
+        answer = (True, getattr(importlib.import_module(module), function)(*args))
+    except Exception as exc:  # noqa: BLE001 - the caller runs it again and raises there
+        answer = (False, repr(exc))
+    sys.stdout.buffer.write(pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL))
+    sys.stdout.buffer.flush()

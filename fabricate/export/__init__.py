@@ -374,11 +374,14 @@ def copy_name(name: str, index: int, copies: int) -> str:
 
 def export_step(design: DesignSpec, partset: PartSet, motion: Motion) -> dict[str, bytes]:
     """``parts/NAME.step`` and ``assembly.step`` (B-rep solids, first pose); empty without OCP."""
-    from fabricate.export.step import step_available, step_files
+    from fabricate.background import run_isolated
+    from fabricate.export.step import step_available
 
     if not step_available():
         return {}
-    return step_files(list(partset.parts), motion.poses_at(0), partset.chord_tolerance_mm, title=design.name)
+    # in a fresh process: OCP's 220 MB stay out of the processes holding the rest of the build
+    return run_isolated("fabricate.export.step", "step_files", list(partset.parts), motion.poses_at(0),
+                        partset.chord_tolerance_mm, design.name)
 
 
 #: What a build says when the optional ``cad`` extra is missing.

@@ -15,7 +15,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import ConvexHull
 
 from fabricate.planar import rotation
 
@@ -54,6 +53,8 @@ def best_angle(points: np.ndarray, steps: int = 180) -> float:
     """
     pts = np.asarray(points, dtype=np.float64)
     if len(pts) > 3:
+        from scipy.spatial import ConvexHull  # here: the STEP worker imports this package without needing it
+
         pts = pts[ConvexHull(pts).vertices]  # the box of the hull is the box of the part
     angles = math.pi * np.arange(steps) / steps
     c, s = np.cos(angles), np.sin(angles)
@@ -73,6 +74,8 @@ def fitting_angle(points: np.ndarray, width: float, height: float, steps: int = 
     """
     pts = np.asarray(points, dtype=np.float64)
     if len(pts) > 3:
+        from scipy.spatial import ConvexHull
+
         pts = pts[ConvexHull(pts).vertices]
     angle = best_angle(pts)
     w, h = _box(pts, angle)

@@ -20,6 +20,7 @@ originating system are set to fixed values (a rebuild gives the same bytes).
 from __future__ import annotations
 
 import functools
+import importlib.util
 import math
 import os
 import re
@@ -29,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from fabricate.errors import GeometryError
+from fabricate.errors import FabricateError, GeometryError
 from fabricate.export.occt import DESCRIPTION, downcast, quiet_occt, shape_volume, xcaf_document
 from fabricate.export.step_curves import clean_path, profile_pieces, spline_edges
 from fabricate.parts.model import BulgePath, Part
@@ -52,19 +53,39 @@ _MIN_EDGE_MM = 1e-9
 
 @functools.lru_cache(maxsize=1)
 def step_available() -> bool:
-    """Whether OCP (the optional extra ``cad``) can be imported, so STEP files can be written."""
+    """Whether OCP (the optional extra ``cad``) is installed, so STEP files can be written.
+
+    Found by its import spec, not imported: importing OCP takes about 0.9 s and 220 MB, which a build's main
+    process does not need (its STEP files are written by the picture child, where :func:`step_files` imports
+    it). An OCP that is found but does not import fails there, named (:func:`_import_ocp`).
+    """
+    try:
+        return importlib.util.find_spec("OCP") is not None
+    except (ImportError, ValueError):  # a finder refusing it (ModuleNotFoundError), a module without __spec__
+        return False
+
+
+def _import_ocp() -> None:
+    """Import OCP's STEP writer (the slow part: its one extension module), or say why it does not import.
+
+    Raises
+    ------
+    FabricateError
+        OCP is installed (:func:`step_available`) but its import fails: a broken ``cad`` extra.
+    KeyboardInterrupt
+        A Ctrl-C landing in the import: pybind11 reports any exception during a module's init as an
+        ImportError, and a Ctrl-C must stay a Ctrl-C, not become a broken install.
+    """
     try:
         import OCP.STEPCAFControl  # noqa: F401
     except ImportError as exc:
-        # pybind11 reports any exception during a module's init as an ImportError: a Ctrl-C that lands in
-        # this (slow) import must stay a Ctrl-C, not become "OCP is not installed" (and be cached as such)
         cause = exc.__cause__ or exc.__context__
         while cause is not None:
             if isinstance(cause, KeyboardInterrupt):
                 raise cause from None
             cause = cause.__cause__ or cause.__context__
-        return False
-    return True
+        raise FabricateError(f"OCP (the 'cad' extra) is installed but does not import ({exc}): reinstall it "
+                             "(pip install 'fabricate[cad]') or uninstall it to build without STEP") from exc
 
 
 # ---------------------------------------------------------------------------------------------- building
@@ -435,6 +456,7 @@ def step_files(parts: Sequence[Part], poses: Mapping[str, np.ndarray], chord_tol
     dict[str, bytes]
         Path relative to the output folder -> content.
     """
+    _import_ocp()
     shapes = {part.name: part_shape(part, chord_tolerance_mm) for part in parts}
     files = {f"parts/{part.name}.step": part_step(part, chord_tolerance_mm, shapes[part.name]) for part in parts}
     files["assembly.step"] = assembly_step(parts, poses, chord_tolerance_mm, title, shapes)
