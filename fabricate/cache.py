@@ -70,6 +70,16 @@ LIBRARIES = ("numpy", "scipy", "shapely", "trimesh", "manifold3d", "ezdxf", "mat
 SOURCE_SUFFIXES = (".py", ".json", ".toml")
 
 _lock = threading.RLock()
+
+
+def _new_lock() -> None:
+    # a forked child (the build's picture child) must not inherit the lock held by another thread of its parent
+    global _lock
+    _lock = threading.RLock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_new_lock)
 _enabled = False
 _disk = True
 _memory: OrderedDict[str, bytes] = OrderedDict()
