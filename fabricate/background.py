@@ -15,10 +15,53 @@ from collections.abc import Callable
 from typing import Any
 
 
+class _Threaded:
+    """A job that :func:`_run_jobs` starts in a thread of its own before the others (:func:`in_thread`)."""
+
+    def __init__(self, job: Callable[[], dict[str, bytes]]) -> None:
+        self.job = job
+
+    def __call__(self) -> dict[str, bytes]:
+        return self.job()
+
+
+def in_thread(job: Callable[[], dict[str, bytes]]) -> Callable[[], dict[str, bytes]]:
+    """Mark ``job`` to run in a thread beside the other jobs, started first.
+
+    For a job that mostly waits on another process (:func:`run_isolated`: the STEP files), so that the
+    pictures are drawn meanwhile instead of after it. Its files still come in the job's place in the list;
+    its exception is raised once the other jobs are done.
+    """
+    return _Threaded(job)
+
+
 def _run_jobs(jobs: list[Callable[[], dict[str, bytes]]]) -> dict[str, bytes]:
+    import threading
+
+    answers: dict[int, tuple[bool, Any]] = {}
+
+    def run(k: int, job: Callable[[], dict[str, bytes]]) -> None:
+        try:
+            answers[k] = (True, job())
+        except BaseException as exc:  # noqa: BLE001 - raised in the caller's thread, in the job's turn
+            answers[k] = (False, exc)
+
+    # daemon: a job raising first ends the caller; the thread's own process (if any) dies with it
+    threads = {k: threading.Thread(target=run, args=(k, job), daemon=True)
+               for k, job in enumerate(jobs) if isinstance(job, _Threaded)}
+    for thread in threads.values():
+        thread.start()
+    for k, job in enumerate(jobs):
+        if k not in threads:
+            answers[k] = (True, job())
+    for k, thread in threads.items():
+        thread.join()
+        ok, value = answers[k]
+        if not ok:
+            raise value
     files: dict[str, bytes] = {}
-    for job in jobs:
-        files.update(job())
+    for k in range(len(jobs)):  # in the jobs' order, whichever finished first
+        files.update(answers[k][1])
     return files
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import colorsys
 import io
+import sys
 from collections.abc import Sequence
 from typing import Any
 
@@ -224,13 +225,17 @@ def png_bytes(fig: Any, dpi: float | None = None) -> bytes:
     Parameters
     ----------
     fig : matplotlib.figure.Figure
-        A pyplot-managed or standalone figure.
+        A standalone figure (:func:`figure`) or a pyplot-managed one.
     dpi : float, optional
         Resolution; the figure's own when omitted.
     """
     buffer = io.BytesIO()
     _savefig(fig, buffer, dpi if dpi is not None else fig.dpi)
-    pyplot().close(fig)
+    # only pyplot keeps a figure alive (a standalone one is freed with its last reference): importing pyplot
+    # just to close it cost every build its import
+    plt = sys.modules.get("matplotlib.pyplot")
+    if plt is not None:
+        plt.close(fig)
     return buffer.getvalue()
 
 

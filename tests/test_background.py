@@ -43,3 +43,32 @@ def test_run_isolated_runs_here_when_no_process_starts(monkeypatch):
     monkeypatch.setattr(subprocess, "Popen", no_process)
     pid, value = run_isolated("tests.test_background", "_pid_and_value", 9.0)
     assert pid == os.getpid() and value == 3.0
+
+
+def test_in_thread_jobs_run_beside_the_others_and_keep_their_place():
+    import threading
+
+    from fabricate.background import _run_jobs, in_thread
+
+    later_job_ran = threading.Event()
+
+    def waits_for_the_later_job() -> dict[str, bytes]:
+        # run one after the other, this job would wait for a job after it: it must already be running
+        return {"b": b"1" if later_job_ran.wait(timeout=120) else b"0"}
+
+    def later() -> dict[str, bytes]:
+        later_job_ran.set()
+        return {"c": b"c"}
+
+    files = _run_jobs([lambda: {"a": b"a"}, in_thread(waits_for_the_later_job), later])
+    assert files == {"a": b"a", "b": b"1", "c": b"c"} and list(files) == ["a", "b", "c"]
+
+
+def test_in_thread_job_raises_its_error_in_its_turn():
+    from fabricate.background import _run_jobs, in_thread
+
+    def broken() -> dict[str, bytes]:
+        raise ValueError("no STEP")
+
+    with pytest.raises(ValueError, match="no STEP"):
+        _run_jobs([lambda: {"a": b"a"}, in_thread(broken)])

@@ -74,6 +74,11 @@ def _polar_tables(table: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
 #: geometry at the peak, measured 0.2 MB per step for 30-tooth gears of ~14000 vertices).
 MESH_VERTICES_PER_CHUNK = 4_000_000
 
+#: Posed flank points of gear a held at once by :func:`free_play` within :func:`mesh_check`: about 150 bytes
+#: each across its temporaries (the finger's 720 steps in one piece peaked at 175 MB; 100000 points hold
+#: ~15 MB). Chunking changes no value: every step is computed on its own.
+MESH_FLANK_POINTS_PER_CHUNK = 100_000
+
 
 def flank_reach(pair: GearPair) -> float:
     """Half-width of the window of rack flanks :func:`free_play` compares, mm along the pitch line.
@@ -143,13 +148,33 @@ def free_play(pair: GearPair, x_a: np.ndarray, return_contacts: bool = False) ->
         Only with ``return_contacts``: driving flank pairs within :data:`CONTACT_TOLERANCE_RAD` of
         the closest one (their mean is the contact ratio); 0 where no driving pair is in mesh.
     """
+    return _free_play(pair, x_a, _flank_tables(pair), return_contacts)
+
+
+def _flank_tables(pair: GearPair) -> tuple[np.ndarray, ...]:
+    """What :func:`free_play` compares, independent of the steps: both gears' padded flank tables and gear
+    b's polar search table (made once per mesh check, not once per chunk of steps)."""
+    table_a, present_a, off_a = _pad_flanks(pair.cut_a.flanks)
+    table_b, present_b, off_b = _pad_flanks(pair.cut_b.flanks)
+    key_b, phi_b, range_b = _polar_tables(table_b)
+    return table_a, present_a, off_a, table_b, present_b, off_b, key_b, phi_b, range_b
+
+
+def _flank_points_per_step(pair: GearPair) -> int:
+    """Gear a's flank points :func:`free_play` poses at each step: the flanks in its window times the longest."""
+    p = np.pi * pair.module
+    count = int(np.ceil(2 * flank_reach(pair) / (p / 2))) + 1
+    return count * max((len(v) for v in pair.cut_a.flanks.values()), default=1)
+
+
+def _free_play(pair: GearPair, x_a: np.ndarray, tables: tuple[np.ndarray, ...], return_contacts: bool
+               ) -> tuple[np.ndarray, ...]:
+    """:func:`free_play` with its flank tables made (:func:`_flank_tables`)."""
     pitch = pair.pitch_model
     p = np.pi * pair.module
     s = pitch.s_of_x(x_a)
     theta_b = np.asarray(pair.law(x_a), dtype=np.float64)
-    table_a, present_a, off_a = _pad_flanks(pair.cut_a.flanks)
-    table_b, present_b, off_b = _pad_flanks(pair.cut_b.flanks)
-    key_b, phi_b, range_b = _polar_tables(table_b)
+    table_a, present_a, off_a, table_b, present_b, off_b, key_b, phi_b, range_b = tables
     reach = flank_reach(pair)
     j_lo = np.ceil((s - reach - pair.rack_origin + p / 4) / (p / 2)).astype(np.int64)
     count = int(np.ceil(2 * reach / (p / 2))) + 1  # the flanks from s - reach to s + reach
@@ -256,7 +281,9 @@ def mesh_check(pair: GearPair, x_a_values: np.ndarray | None = None, steps: int 
     # memory stays bounded whatever mesh_steps and the tooth count are (the values are per step)
     vertices = len(pair.outline_a) + len(pair.outline_b)
     chunk = max(1, MESH_VERTICES_PER_CHUNK // max(1, vertices))
-    parts = [free_play(pair, x[i:i + chunk], return_contacts=True) for i in range(0, len(x), chunk)]
+    flank_chunk = max(1, MESH_FLANK_POINTS_PER_CHUNK // max(1, _flank_points_per_step(pair)))
+    tables = _flank_tables(pair) if len(x) else ()
+    parts = [_free_play(pair, x[i:i + flank_chunk], tables, True) for i in range(0, len(x), flank_chunk)]
     plus, minus, contacts = (np.concatenate([part[k] for part in parts]) if parts else np.zeros(0)
                              for k in range(3))
     r_b = pair.pitch_model.radii(x, "b")[0]

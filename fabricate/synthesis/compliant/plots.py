@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fabricate.plotting import legend, palette, png_bytes, pyplot
+from fabricate.plotting import figure, legend, palette, png_bytes
 
 
 def _png(fig) -> bytes:
@@ -13,13 +13,14 @@ def _png(fig) -> bytes:
 
 def compliant_figures(spec, path, grasp, motion, optimum) -> dict[str, bytes]:
     """``{file name: PNG bytes}``: grasp_force.png (Fig 3) and closing.png (finger poses)."""
-    plt = pyplot()
+    from matplotlib.patches import Circle
 
     from fabricate.synthesis.compliant.model import finger_state, grasp_force_curve
 
     out: dict[str, bytes] = {}
     strokes, f_static, f_hover = grasp_force_curve(path, spec.springs, spec.load.mu)
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig = figure((6, 4), 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax = fig.subplots()
     static_colour, hover_colour = palette(2)
     ax.plot(strokes, f_static, color=static_colour, label="static load F_n1 (eqs 3-4)")
     ax.plot(strokes, f_hover, "--", color=hover_colour, label="hover F_n (eqs 5-6)")
@@ -36,7 +37,8 @@ def compliant_figures(spec, path, grasp, motion, optimum) -> dict[str, bytes]:
     legend(ax, loc="upper left")
     out["grasp_force.png"] = _png(fig)
 
-    fig, ax = plt.subplots(figsize=(5, 6))
+    fig = figure((5, 6), 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax = fig.subplots()
     g = spec.geometry
     # one colour per pose (palette order, not the pose's index: two indices ten apart shared a colour), named
     # by its stroke in the legend
@@ -46,7 +48,7 @@ def compliant_figures(spec, path, grasp, motion, optimum) -> dict[str, bytes]:
         pts = np.array([[0.0, 0.0], st.B, st.C, st.D, st.E, st.M])
         ax.plot(pts[:5, 0], pts[:5, 1], "-o", ms=3, color=colour, label=f"stroke {motion.strokes[k]:.1f} mm")
         ax.plot(pts[4:, 0], pts[4:, 1], ":", color=colour)
-        circ = plt.Circle(st.pad_centre, g.r, fill=False, lw=0.5, color=colour)
+        circ = Circle(st.pad_centre, g.r, fill=False, lw=0.5, color=colour)
         ax.add_patch(circ)
     wall = spec.load.radius - g.l1
     ax.axvline(wall, color="k", lw=1.5)

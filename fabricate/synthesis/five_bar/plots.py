@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from fabricate.plotting import legend, png_bytes, pyplot
+from fabricate.plotting import figure, legend, png_bytes
 
 #: Figure size (inches) and resolution shared by every plot.
 FIGSIZE = (6.4, 4.8)
@@ -39,8 +39,8 @@ def _branch_lines(ax: Any, points: np.ndarray, branch: np.ndarray, mask: np.ndar
 
 def hinge_curves_png(data: Any) -> bytes:
     """Fig 8: the A- and B-curves at the first pose with the finger and the chosen hinges."""
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=FIGSIZE)
+    fig = figure(FIGSIZE, 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax = fig.subplots()
     dom, t = data.domain, data.targets
     every = np.ones(len(dom.status), dtype=bool)
     _branch_lines(ax, dom.a, dom.family.branch, every, color="tab:blue", lw=0.8, label="hinge A curve")
@@ -64,8 +64,8 @@ def hinge_curves_png(data: Any) -> bytes:
 
 def feasible_domain_png(data: Any) -> bytes:
     """Fig 9: the feasible parts of the hinge curves inside the limits box for A."""
-    plt = pyplot()
-    fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(FIGSIZE[0] * 1.5, FIGSIZE[1]))
+    fig = figure((FIGSIZE[0] * 1.5, FIGSIZE[1]), 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax_a, ax_b = fig.subplots(1, 2)
     dom, spec = data.domain, data.spec
     ok = dom.feasible
     for ax, points, name, colour in ((ax_a, dom.a, "A", "tab:blue"), (ax_b, dom.b, "B", "tab:red")):
@@ -94,9 +94,9 @@ def feasible_domain_png(data: Any) -> bytes:
 
 def gear_ratio_png(data: Any) -> bytes:
     """Fig 10: transmission ratio and pitch radii over the working range."""
-    plt = pyplot()
     law = data.dyad.law
-    fig, (ax_i, ax_r) = plt.subplots(2, 1, figsize=FIGSIZE, sharex=True)
+    fig = figure(FIGSIZE, 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax_i, ax_r = fig.subplots(2, 1, sharex=True)
     x = np.degrees(law.x)
     ax_i.plot(x, law.ratio, "b-", label="i = -dx_b/dx_a")
     ax_i.plot(np.degrees(law.knots_a), -law.law(law.knots_a, 1), "ko", ms=4, label="poses")
@@ -113,8 +113,8 @@ def gear_ratio_png(data: Any) -> bytes:
 
 def trajectory_png(data: Any) -> bytes:
     """Fig 12: fingertip trajectory of the solved mechanism with the target poses."""
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=FIGSIZE)
+    fig = figure(FIGSIZE, 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax = fig.subplots()
     t, motion = data.targets, data.motion
     tip = motion.point("P", "distal")
     ax.plot(tip[:, 0], tip[:, 1], "b-", lw=1.2, label="fingertip P (mechanism)")

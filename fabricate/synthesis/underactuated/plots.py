@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fabricate.plotting import legend, palette, png_bytes, pyplot
+from fabricate.plotting import figure, legend, palette, png_bytes
 
 
 def _png(fig) -> bytes:
@@ -13,14 +13,15 @@ def _png(fig) -> bytes:
 
 def closing_figures(spec, motion, free, final) -> dict[str, bytes]:
     """``{file name: PNG bytes}``: closing.png (poses on the object), joint_angles.png."""
-    plt = pyplot()
+    from matplotlib.patches import Circle
 
     from fabricate.synthesis.underactuated.model import finger_pose
 
     d = spec.design
     out: dict[str, bytes] = {}
-    fig, ax = plt.subplots(figsize=(6, 5))
-    ax.add_patch(plt.Circle(spec.cylinder_centre, spec.cylinder_radius, color="0.85"))
+    fig = figure((6, 5), 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax = fig.subplots()
+    ax.add_patch(Circle(spec.cylinder_centre, spec.cylinder_radius, color="0.85"))
     # one colour per pose (palette order: pose indices ten apart shared a colour), named by its stroke
     shown = np.linspace(0, len(motion.strokes) - 1, 5).astype(int)
     for k, colour in zip(shown, palette(len(shown)), strict=True):
@@ -41,7 +42,8 @@ def closing_figures(spec, motion, free, final) -> dict[str, bytes]:
     legend(ax, loc="best", framealpha=0.85)
     out["closing.png"] = _png(fig)
 
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig = figure((6, 4), 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax = fig.subplots()
     # a joint's colour is shared by its two curves (solid on the object, dashed free): distinct per joint
     for i, colour in enumerate(palette(d.n)):
         ax.plot(motion.strokes, np.degrees(motion.q[:, i]), color=colour, label=f"joint {i + 1}, on object")

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fabricate.plotting import legend, png_bytes, pyplot
+from fabricate.plotting import figure, legend, png_bytes
 from fabricate.synthesis.watt_six_bar.burmester import CubicCurve, grid_in_range, sample_curve
 
 _BRANCH_COLOURS = ("tab:blue", "tab:orange", "tab:green")
@@ -43,11 +43,11 @@ def _draw_box(ax, box: np.ndarray, name: str, colour: str = "0.3") -> None:
 
 def plot_curve_d(spec, region, choice) -> bytes:
     """C_d and C_e (whole curves near the boxes), the feasible segments of C_d and the chosen d, e."""
-    plt = pyplot()
     one = region.stage_one
     box_d, box_e = spec.box("d"), spec.box("e")
     view = _view([box_d, box_e])
-    fig, ax = plt.subplots(figsize=(8.0, 6.0))
+    fig = figure((8.0, 6.0), 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax = fig.subplots()
     _draw_curve(ax, one.curve_d, view, "C_d", 0.05)
     sample_e = sample_curve(one.curve_e, grid_in_range(view[0], view[1], 0.05)).points()
     ax.plot(sample_e[..., 0].ravel(), sample_e[..., 1].ravel(), ".", ms=0.8, color="0.6", label="C_e")
@@ -78,11 +78,11 @@ def plot_curve_d0(spec, finger, choice) -> bytes:
     """C_d0 and C_f for the chosen dyad d-e, with the boxes and the chosen d0, f."""
     from fabricate.synthesis.watt_six_bar.region import stage_two_curves
 
-    plt = pyplot()
     curve_d0, curve_f = stage_two_curves(finger, choice.d, choice.e)
     box_d0, box_f = spec.box("d0"), spec.box("f")
     view = _view([box_d0, box_f])
-    fig, ax = plt.subplots(figsize=(8.0, 6.0))
+    fig = figure((8.0, 6.0), 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax = fig.subplots()
     _draw_curve(ax, curve_d0, view, "C_d0", 0.05)
     sample_f = sample_curve(curve_f, grid_in_range(view[0], view[1], 0.05)).points()
     ax.plot(sample_f[..., 0].ravel(), sample_f[..., 1].ravel(), ".", ms=0.8, color="0.6", label="C_f")
@@ -103,8 +103,8 @@ def plot_curve_d0(spec, finger, choice) -> bytes:
 
 def plot_region(spec, region, refined, choice) -> bytes:
     """The solution region (d_x, d0_x) coloured by K; K > limit grey, circuit defects hollow."""
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(8.0, 6.0))
+    fig = figure((8.0, 6.0), 100)  # matplotlib's default dpi, as pyplot's figures had
+    ax = fig.subplots()
     finite = np.isfinite(region.K)
     over = finite & (region.K > spec.k_max)
     ax.plot(region.d[over, 0], region.d0[over, 0], ",", color="0.75", label=f"K > {spec.k_max:g}")
