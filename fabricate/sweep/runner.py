@@ -199,6 +199,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
         client, cluster = connect(workers, scheduler)
         try:
             n_workers = _wait_for_workers(client, scheduler)
+            _warm(client)
         except BaseException:
             _close(client, cluster)
             raise
@@ -282,6 +283,14 @@ def _wait_for_workers(client: Any, scheduler: str | None) -> int:
         time.sleep(0.2)
 
 
+def _warm(client: Any) -> None:
+    """Every worker imports the pipeline now, side by side, instead of in its first point."""
+    try:
+        client.run(warm)
+    except Exception:  # noqa: BLE001 - a worker that cannot run it will show why in its first point
+        pass
+
+
 def _takes_n_workers(client: Any) -> bool:
     import inspect
 
@@ -305,10 +314,6 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
     from distributed import as_completed
 
     base, parts, metrics = spec.base, spec.field_parts(), list(spec.metrics)
-    try:  # every worker imports the pipeline now, side by side, instead of in its first point
-        client.run(warm)
-    except Exception:  # noqa: BLE001 - a worker that cannot run it will show why in its first point
-        pass
     # the base template and metrics go to the cluster once; every task refers to them
     shared = client.scatter([base, parts, metrics], broadcast=True, hash=False)
     batch_size = 1  # the first tasks measure a point's time; later batches aim at spec.batch_seconds

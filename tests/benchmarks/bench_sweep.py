@@ -1,62 +1,76 @@
-"""Sweep throughput on Dask: points per second with 1 and 2 local workers (their ratio) and the per-task
-overhead, side by side in one run.
+"""Sweep throughput on Dask: points per second per worker with 1 and 2 local workers, for a synthesis sweep and a
+build sweep, side by side in one run.
 
     pip install -e ".[test]"          # dask distributed and pyarrow are in the test extra (and the sweep one)
-    python tests/benchmarks/bench_sweep.py [--points 48] [--stage synth|build]
+    python tests/benchmarks/bench_sweep.py [--stage synth|build|both] [--points N] [--overhead]
 
-The sweep varies the elliptic gear pair's eccentricity (``gear_pair_elliptic``). Rows:
+The sweeps vary the elliptic gear pair's eccentricity (``gear_pair_elliptic``, 60 poses): every point has its own
+synthesis. Rows, for each stage:
 
 - in-process: the points run one after the other in this process (``run_point``), no Dask: the floor;
-- Dask, 1 worker / 2 workers: ``run_sweep`` on a LocalCluster (cluster start-up and result writing
-  included, as a user sees it); the ratio is the speed-up of the second worker;
-- per-point overhead of a one-point task: (Dask 1 worker with batch 1 - in-process) / points;
-- a no-op task's round trip: ``client.submit`` + ``result`` of a function that returns at once.
+- Dask, 1 worker / 2 workers: ``run_sweep`` on a LocalCluster. ``points/s`` counts the points' own wall time
+  (``SweepOutcome.points_seconds``: first task sent to last row received, the workers already started and
+  imported); ``command s`` is the whole call as a user sees it (cluster start-up, tables, plots included);
+  ``main CPU s`` is this process's CPU in it (the scheduler, the client, the tables: taken from the workers'
+  cores). The ratio is the second worker's speed-up of the points' rate;
+- with ``--overhead``: a one-point-per-task sweep on one worker (the per-task cost) and a no-op task's round trip.
+
+Each row also prints the 1-minute load average when it ended: on a machine shared with other work, a second
+worker only helps if a second core is free.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
+#: Default points per stage (a synthesis point takes ~0.2 s, a build point of 60 poses ~1.5 s on an idle core).
+DEFAULT_POINTS = {"synth": 48, "build": 16}
 
-def _spec(points: int, stage: str, batch_seconds: float):
+
+def _spec(points: int, stage: str, batch_seconds: float) -> Any:
     import numpy as np
 
     from fabricate.sweep.spec import sweep_from_tables
 
+    metrics = ["synthesis.center_distance_mm"] + (["interference.min_clearance_mm"] if stage == "build" else [])
     return sweep_from_tables({
         "sweep": {"template": "gear_pair_elliptic", "stage": stage, "name": "bench",
-                  "metrics": ["synthesis.center_distance_mm"], "batch_seconds": batch_seconds},
+                  "metrics": metrics, "batch_seconds": batch_seconds},
         "vary": {"gear_pair.eccentricity": [float(e) for e in np.round(np.linspace(0.05, 0.45, points), 6)]},
         "set": {"checks.sweep_poses": 60},
     })
 
 
-def _in_process(spec) -> float:
-    from fabricate.sweep.task import run_point
+def _in_process(spec: Any) -> float:
+    from fabricate.sweep.task import run_batch
 
+    points = [(i, values, spec.point_id(values)) for i, values in enumerate(spec.points())]
     start = time.perf_counter()
-    for i, values in enumerate(spec.points()):
-        run_point(i, values, spec.point_id(values), spec.base, spec.field_parts(), spec.stage, list(spec.metrics))
+    run_batch(points, spec.base, spec.field_parts(), spec.stage, list(spec.metrics))
     return time.perf_counter() - start
 
 
-def _dask(spec, workers: int) -> float:
+def _dask(spec: Any, workers: int) -> tuple[float, float, float]:
+    """(the points' own seconds, the whole call's seconds, this process's CPU seconds: the scheduler, the client
+    and the tables it writes, which take a core's share from the workers)."""
     from fabricate.sweep.runner import run_sweep
 
     with tempfile.TemporaryDirectory() as tmp:
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         outcome = run_sweep(spec, Path(tmp) / "out", workers=workers, quiet=True)
-        elapsed = time.perf_counter() - start
-    assert outcome.exit_code == 0 and outcome.done == outcome.total
-    return elapsed
+        elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu
+    assert outcome.exit_code == 0 and outcome.done == outcome.total, outcome
+    return outcome.points_seconds, elapsed, cpu
 
 
 def _noop_round_trip(n: int = 200) -> float:
@@ -73,34 +87,54 @@ def _noop_round_trip(n: int = 200) -> float:
     return statistics.median(times)
 
 
+def _load() -> str:
+    try:
+        return f"{os.getloadavg()[0]:.1f}"
+    except OSError:
+        return "?"
+
+
+def bench_stage(stage: str, n: int, overhead: bool) -> list[tuple[str, float, float, float, float, str, str]]:
+    """Rows ``(run, points' seconds, whole call's seconds, main process CPU seconds, points/s per worker, ratio,
+    load)`` of one stage."""
+    _in_process(_spec(2, stage, 1.0))  # warm this process's imports
+    batched = _spec(n, stage, 1.0)
+    rows = []
+    cpu = time.process_time()
+    serial = _in_process(batched)
+    rows.append(("in-process, one after the other", serial, serial, time.process_time() - cpu, n / serial, "",
+                 _load()))
+    one, one_all, one_cpu = _dask(batched, 1)
+    rows.append(("Dask LocalCluster, 1 worker", one, one_all, one_cpu, n / one, f"{serial / one:.2f} x in-process",
+                 _load()))
+    two, two_all, two_cpu = _dask(batched, 2)
+    rows.append(("Dask LocalCluster, 2 workers", two, two_all, two_cpu, n / two / 2,
+                 f"**{one / two:.2f} x 1 worker** (command {one_all / two_all:.2f} x)", _load()))
+    if overhead:
+        single, single_all, single_cpu = _dask(_spec(n, stage, 0.001), 1)  # one point per task
+        rows.append(("Dask, 1 worker, 1 point per task", single, single_all, single_cpu, n / single,
+                     f"{(single - one) / n * 1000:.1f} ms a task over batched", _load()))
+    return rows
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--points", type=int, default=48)
-    parser.add_argument("--stage", choices=("synth", "build"), default="synth")
+    parser.add_argument("--stage", choices=("synth", "build", "both"), default="both")
+    parser.add_argument("--points", type=int, help=f"points of each sweep (default {DEFAULT_POINTS})")
+    parser.add_argument("--overhead", action="store_true", help="also the per-task cost and a no-op round trip")
     args = parser.parse_args(argv)
-    batched = _spec(args.points, args.stage, 1.0)
-    single = _spec(args.points, args.stage, 0.01)  # one point per task (a point takes ~0.2 s)
-    _in_process(_spec(2, args.stage, 1.0))  # warm the imports and caches of this process
-    serial = _in_process(batched)
-    one = _dask(batched, 1)
-    two = _dask(batched, 2)
-    one_single = _dask(single, 1)
-    noop = _noop_round_trip()
-    n = args.points
-    rows = [
-        ("in-process, one after the other", serial, n / serial, ""),
-        ("Dask LocalCluster, 1 worker (batched ~1 s)", one, n / one, f"{serial / one:.2f} x in-process"),
-        ("Dask LocalCluster, 2 workers (batched ~1 s)", two, n / two, f"{one / two:.2f} x 1 worker"),
-        ("Dask LocalCluster, 1 worker, 1 point per task", one_single, n / one_single,
-         f"{one_single / one:.2f} x batched time"),
-    ]
-    print(f"sweep of {n} points (gear_pair_elliptic, stage {args.stage}); wall times include cluster start-up\n")
-    print("| run | wall s | points/s | ratio |\n|---|---:|---:|---|")
-    for name, seconds, rate, ratio in rows:
-        print(f"| {name} | {seconds:.2f} | {rate:.2f} | {ratio} |")
-    print(f"\nper-point overhead of one-point tasks over in-process: {(one_single - serial) / n * 1000:.1f} ms "
-          f"(cluster start-up included, spread over {n} points)")
-    print(f"no-op task round trip (submit + result, median of 200): {noop * 1000:.2f} ms")
+    stages = ("synth", "build") if args.stage == "both" else (args.stage,)
+    print(f"cores available: {len(os.sched_getaffinity(0)) if hasattr(os, 'sched_getaffinity') else os.cpu_count()}"
+          f", load average before: {_load()}\n")
+    print("| stage | points | run | points' s | command s | main CPU s | points/s per worker | ratio | load after |\n"
+          "|---|---:|---|---:|---:|---:|---:|---|---:|")
+    for stage in stages:
+        n = args.points or DEFAULT_POINTS[stage]
+        for name, seconds, whole, cpu, rate, ratio, load in bench_stage(stage, n, args.overhead):
+            print(f"| {stage} | {n} | {name} | {seconds:.2f} | {whole:.2f} | {cpu:.2f} | {rate:.2f} | {ratio} "
+                  f"| {load} |", flush=True)
+    if args.overhead:
+        print(f"\nno-op task round trip (submit + result, median of 200): {_noop_round_trip() * 1000:.2f} ms")
     return 0
 
 
