@@ -38,7 +38,7 @@ from typing import Any
 from fabricate.errors import SpecError
 from fabricate.sweep.folder import JOURNAL, SWEEP_JSON, Journal, prepare_folder, read_journal, sweep_record, write_file
 from fabricate.sweep.spec import SweepSpec
-from fabricate.sweep.task import EXIT_INTERNAL, build_point, run_batch, synthesis_group, warm
+from fabricate.sweep.task import EXIT_INTERNAL, build_point, peak_rss_mb, run_batch, synthesis_group, warm
 
 #: Results are rewritten at most this often while a sweep runs (and always at its end).
 FLUSH_SECONDS = 5.0
@@ -80,6 +80,9 @@ class SweepOutcome:
     #: Seconds from the first task sent to the last row received (the points' own wall time: no cluster start-up,
     #: tables, plots or best builds).
     points_seconds: float = 0.0
+    #: Largest peak resident memory of a worker process (MB; 0 when unknown): its imports, its points and the
+    #: stage results it keeps (see :data:`fabricate.bounds.WORKER_MB`).
+    worker_peak_mb: float = 0.0
 
 
 # -- Dask ----------------------------------------------------------------------------------------------------
@@ -250,11 +253,12 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
         interrupted = True
         counts, best, notes = _counts(done), [], []
     finally:
+        worker_peak = _worker_peak_mb(client) if client is not None and not interrupted else 0.0
         _close(client, cluster)
     code = 130 if interrupted else (1 if counts.get(str(EXIT_INTERNAL)) else 0)
     return SweepOutcome(exit_code=code, out=out, total=len(points), done=len(rows), resumed=resumed,
                         counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers,
-                        tasks=tasks, notes=notes, points_seconds=points_seconds)
+                        tasks=tasks, notes=notes, points_seconds=points_seconds, worker_peak_mb=worker_peak)
 
 
 def group_order(fields: Sequence[tuple[str, Sequence[str | int]]], points: Sequence[Mapping[str, Any]],
@@ -289,6 +293,15 @@ def _warm(client: Any) -> None:
         client.run(warm)
     except Exception:  # noqa: BLE001 - a worker that cannot run it will show why in its first point
         pass
+
+
+def _worker_peak_mb(client: Any) -> float:
+    """The largest peak resident memory of the cluster's workers (MB), 0 when they cannot say."""
+    try:
+        peaks = client.run(peak_rss_mb)
+        return max((float(v) for v in peaks.values()), default=0.0)
+    except Exception:  # noqa: BLE001 - a figure for benchmarks, never a reason to fail a finished sweep
+        return 0.0
 
 
 def _takes_n_workers(client: Any) -> bool:

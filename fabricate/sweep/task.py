@@ -17,6 +17,7 @@ import copy
 import json
 import math
 import os
+import sys
 import time
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -49,6 +50,16 @@ def synthesis_group(fields: Sequence[tuple[str, Sequence[str | int]]], values: M
             continue
         read.append([path, values[path]])
     return json.dumps(read, sort_keys=True, default=str)
+
+
+def peak_rss_mb() -> float:
+    """This process's peak resident memory (MB; 0 where the platform does not say)."""
+    try:
+        import resource
+    except ImportError:  # Windows
+        return 0.0
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / 1024.0 if sys.platform != "darwin" else peak / 1024.0 / 1024.0  # kB on Linux, bytes on macOS
 
 
 def warm() -> None:

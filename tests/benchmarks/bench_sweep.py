@@ -33,6 +33,8 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
+#: Each Dask run's largest worker peak memory, printed at the end.
+PEAKS: list[str] = []
 #: Default points per stage (a synthesis point takes ~0.2 s, a build point of 60 poses ~1.5 s on an idle core).
 DEFAULT_POINTS = {"synth": 48, "build": 16}
 
@@ -62,7 +64,7 @@ def _in_process(spec: Any) -> float:
 
 def _dask(spec: Any, workers: int) -> tuple[float, float, float]:
     """(the points' own seconds, the whole call's seconds, this process's CPU seconds: the scheduler, the client
-    and the tables it writes, which take a core's share from the workers)."""
+    and the tables it writes, which take a core's share from the workers). Prints the workers' peak memory."""
     from fabricate.sweep.runner import run_sweep
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -70,6 +72,7 @@ def _dask(spec: Any, workers: int) -> tuple[float, float, float]:
         outcome = run_sweep(spec, Path(tmp) / "out", workers=workers, quiet=True)
         elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu
     assert outcome.exit_code == 0 and outcome.done == outcome.total, outcome
+    PEAKS.append(f"{spec.stage}, {workers} worker{'s' if workers > 1 else ''}: {outcome.worker_peak_mb:.0f} MB")
     return outcome.points_seconds, elapsed, cpu
 
 
@@ -133,6 +136,7 @@ def main(argv: list[str] | None = None) -> int:
         for name, seconds, whole, cpu, rate, ratio, load in bench_stage(stage, n, args.overhead):
             print(f"| {stage} | {n} | {name} | {seconds:.2f} | {whole:.2f} | {cpu:.2f} | {rate:.2f} | {ratio} "
                   f"| {load} |", flush=True)
+    print(f"\nworkers' peak resident memory: {'; '.join(PEAKS)}")
     if args.overhead:
         print(f"\nno-op task round trip (submit + result, median of 200): {_noop_round_trip() * 1000:.2f} ms")
     return 0
