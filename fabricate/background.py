@@ -164,6 +164,9 @@ class Background:
             self._conn.close()
             self._process.join()
             self._process = None
+            # the child's workers (run_isolated) are this process's children: reaped here, their time and
+            # memory are the build's (the child is gone, so an unused one reads the end of its input)
+            _reap_handed(kill=False)
             if ok:
                 return payload
         return _run_jobs(self.jobs)
@@ -179,6 +182,70 @@ class Background:
             self._process.join()
             self._conn.close()
             self._process = None
+            _reap_handed(kill=True)
+
+
+def _reap_handed(kill: bool) -> None:
+    """Wait for (or kill) the workers handed to a forked child (:func:`prestart`)."""
+    while _HANDED:
+        proc = _HANDED.pop()
+        if kill:
+            with contextlib.suppress(OSError):
+                proc.kill()
+        proc.wait()
+
+
+#: Started workers of :func:`run_isolated` waiting for a call, by module: ``(process, pid of its starter)``.
+_WARM: dict[str, tuple[Any, int]] = {}
+#: Workers handed to a forked child, kept here until they end (so they are reaped, not warned about).
+_HANDED: list[Any] = []
+
+
+def _start_worker(preload: str = "", warm_up: str = "") -> Any:
+    """A fresh interpreter running :func:`_isolated_main` (pipes to and from it), or None if none starts."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = str(Path(__file__).resolve().parents[1])
+    code = (f"import sys; sys.path.insert(0, {root!r}); "
+            f"from fabricate.background import _isolated_main; _isolated_main({preload!r}, {warm_up!r})")
+    try:
+        return subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                stderr=subprocess.DEVNULL)
+    except OSError:  # no process now (EAGAIN, ENOMEM)
+        return None
+
+
+def prestart(module: str, warm_up: str = "") -> None:
+    """Start the worker of the next :func:`run_isolated` call into ``module`` now: it imports ``module`` and
+    calls its ``warm_up()`` (e.g. importing OCP) on a core the caller leaves idle, then waits for the call.
+
+    At most one waits per module and process. A fork hands it to the child (:class:`Background`'s, which
+    makes the call): the parent lets go of it, so it is never used twice. Unused, it ends when every process
+    holding its pipe has ended, or with the process that started it.
+    """
+    _HANDED[:] = [proc for proc in _HANDED if proc.poll() is None]
+    entry = _WARM.get(module)
+    if entry is not None and entry[1] == os.getpid() and entry[0].poll() is None:
+        return
+    proc = _start_worker(module, warm_up)
+    if proc is not None:
+        _WARM[module] = (proc, os.getpid())
+
+
+def _hand_over() -> None:
+    """After a fork, in the parent: the waiting workers are the child's now (their pipes closed here)."""
+    for proc, _ in _WARM.values():
+        for pipe in (proc.stdin, proc.stdout):
+            with contextlib.suppress(OSError):
+                pipe.close()
+        _HANDED.append(proc)
+    _WARM.clear()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_parent=_hand_over)
 
 
 def run_isolated(module: str, function: str, *args: Any) -> Any:
@@ -186,9 +253,9 @@ def run_isolated(module: str, function: str, *args: Any) -> Any:
 
     A forked child carries its parent's resident memory (every kernel's libraries, a build's arrays) on top
     of what it imports itself; a fresh interpreter holds only what the call imports. That keeps OCP (220 MB
-    resident once imported) out of every process that holds the rest of a build. The result is the call's
-    own either way: where the process cannot start, dies or the call raises, it runs again here (and raises
-    here, if it does).
+    resident once imported) out of every process that holds the rest of a build. The worker
+    :func:`prestart` started is used where there is one. The result is the call's own either way: where the
+    process cannot start, dies or the call raises, it runs again here (and raises here, if it does).
 
     Parameters
     ----------
@@ -199,48 +266,73 @@ def run_isolated(module: str, function: str, *args: Any) -> Any:
         Picklable arguments.
     """
     import importlib
-    import pickle
-    import subprocess
-    import sys
-    from pathlib import Path
 
-    payload = pickle.dumps((module, function, args), protocol=pickle.HIGHEST_PROTOCOL)
-    root = str(Path(__file__).resolve().parents[1])
-    code = (f"import sys; sys.path.insert(0, {root!r}); "
-            "from fabricate.background import _isolated_main; _isolated_main()")
-    try:
-        proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                stderr=subprocess.DEVNULL)
-    except OSError:  # no process now (EAGAIN, ENOMEM): the call runs here
-        proc = None
-    if proc is not None:
-        try:
-            out, _ = proc.communicate(payload)
-        except BaseException:  # a stop signal while waiting: nothing is left to wait for
-            proc.kill()
-            proc.wait()
-            raise
-        if proc.returncode == 0:
-            try:
-                ok, value = pickle.loads(out)
-            except Exception:  # noqa: BLE001 - a truncated or unreadable answer: redo it here
-                ok = False
-            if ok:
-                return value
+    entry = _WARM.pop(module, None)
+    for proc in ([entry[0]] if entry is not None else []) + [None]:
+        proc = proc if proc is not None else _start_worker()
+        if proc is None:
+            break
+        ok, value = _call(proc, module, function, args)
+        if ok:
+            return value
+        if ok is False:  # the call raised: it raises here too
+            break
     return getattr(importlib.import_module(module), function)(*args)
 
 
-def _isolated_main() -> None:
-    """The fresh process of :func:`run_isolated`: the call from stdin, ``(ok, result)`` to stdout."""
+def _call(proc: Any, module: str, function: str, args: tuple[Any, ...]) -> tuple[bool | None, Any]:
+    """One call through worker ``proc``: ``(True, result)``; ``(False, None)`` where the call raised; ``(None,
+    None)`` where the worker was lost (gone, killed, or not the one this call was sent to)."""
+    import pickle
+    import struct
+
+    nonce = os.urandom(8)  # its answer carries it: never another call's answer (a worker is used once)
+    payload = pickle.dumps((nonce, module, function, args), protocol=pickle.HIGHEST_PROTOCOL)
+    try:
+        try:
+            proc.stdin.write(struct.pack("<Q", len(payload)) + payload)
+            proc.stdin.close()
+            out = proc.stdout.read()
+        finally:
+            for pipe in (proc.stdin, proc.stdout):
+                with contextlib.suppress(OSError):
+                    pipe.close()
+            proc.wait()  # after a fork: not this process's child (ECHILD), which Popen takes as ended
+    except (OSError, ValueError):  # a worker gone (EPIPE) or its pipe closed: another one, or here
+        return None, None
+    except BaseException:  # a stop signal while waiting: nothing is left to wait for
+        with contextlib.suppress(OSError):
+            proc.kill()
+        raise
+    try:
+        answer_nonce, ok, value = pickle.loads(out)
+    except Exception:  # noqa: BLE001 - a truncated or unreadable answer (the worker died): redo it
+        return None, None
+    return (bool(ok), value) if answer_nonce == nonce else (None, None)
+
+
+def _isolated_main(preload: str = "", warm_up: str = "") -> None:
+    """The fresh process of :func:`run_isolated`: ``preload`` imported (and its ``warm_up()`` called), then
+    one call from stdin (length-prefixed: its pipe may stay open in other processes), its answer to stdout."""
     import importlib
     import pickle
+    import struct
     import sys
 
     _die_with_parent(os.getppid())
-    module, function, args = pickle.loads(sys.stdin.buffer.read())
+    if preload:
+        with contextlib.suppress(Exception):  # a failing warm-up fails the call itself, where it is reported
+            loaded = importlib.import_module(preload)
+            if warm_up:
+                getattr(loaded, warm_up)()
+    head = sys.stdin.buffer.read(8)
+    if len(head) < 8:  # every caller let go of it: nothing to do
+        return
+    payload = sys.stdin.buffer.read(struct.unpack("<Q", head)[0])
+    nonce, module, function, args = pickle.loads(payload)
     try:
-        answer = (True, getattr(importlib.import_module(module), function)(*args))
+        answer = (nonce, True, getattr(importlib.import_module(module), function)(*args))
     except Exception as exc:  # noqa: BLE001 - the caller runs it again and raises there
-        answer = (False, repr(exc))
+        answer = (nonce, False, repr(exc))
     sys.stdout.buffer.write(pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL))
     sys.stdout.buffer.flush()

@@ -72,3 +72,40 @@ def test_in_thread_job_raises_its_error_in_its_turn():
 
     with pytest.raises(ValueError, match="no STEP"):
         _run_jobs([lambda: {"a": b"a"}, in_thread(broken)])
+
+
+def test_prestarted_worker_serves_the_next_call():
+    from fabricate import background
+
+    background.prestart("tests.test_background")
+    worker = background._WARM["tests.test_background"][0]
+    pid, value = run_isolated("tests.test_background", "_pid_and_value", 4.0)
+    assert pid == worker.pid and value == 2.0
+    assert "tests.test_background" not in background._WARM  # used once
+    pid, _ = run_isolated("tests.test_background", "_pid_and_value", 4.0)
+    assert pid not in (worker.pid, os.getpid())  # the next call starts its own
+
+
+def test_a_fork_hands_the_prestarted_worker_to_the_child():
+    import pickle
+
+    from fabricate import background
+
+    background.prestart("tests.test_background")
+    worker = background._WARM["tests.test_background"][0]
+    read, write = os.pipe()
+    child = os.fork()
+    if child == 0:  # the child makes the call, through the worker it was handed
+        try:
+            os.close(read)
+            os.write(write, pickle.dumps(run_isolated("tests.test_background", "_pid_and_value", 16.0)))
+        finally:
+            os._exit(0)
+    os.close(write)
+    assert background._WARM == {}  # the parent let go of it
+    with os.fdopen(read, "rb") as answer:
+        pid, value = pickle.loads(answer.read())
+    os.waitpid(child, 0)
+    assert pid == worker.pid and value == 4.0
+    background._reap_handed(kill=False)
+    assert worker.returncode == 0  # the parent reaped it: its time and memory are counted as the caller's

@@ -372,6 +372,16 @@ def copy_name(name: str, index: int, copies: int) -> str:
     return name if copies == 1 else f"{name} ({index + 1} of {copies})"
 
 
+def prestart_step() -> None:
+    """Start the STEP worker now, where OCP is installed: it imports OCP (about 1 s) on a core the build
+    leaves idle, and :func:`export_step` finds it ready (:func:`fabricate.background.prestart`)."""
+    from fabricate.background import prestart
+    from fabricate.export.step import step_available
+
+    if step_available():
+        prestart("fabricate.export.step", "_import_ocp")
+
+
 def export_step(design: DesignSpec, partset: PartSet, motion: Motion) -> dict[str, bytes]:
     """``parts/NAME.step`` and ``assembly.step`` (B-rep solids, first pose); empty without OCP."""
     from fabricate.background import run_isolated

@@ -6,11 +6,11 @@
 
 What it measures, in one run:
 
-- **whole-process builds**: ``python -m fabricate build T -o TMP --force -q`` as a user runs it (the pictures'
-  forked child included), medians of ``--runs`` runs for the default template (``finger_five_bar_ncg``) and of
-  ``--other-runs`` for the others, after one warm-up run of the default template. Wall time, CPU time (user +
-  sys of the build and its children, from ``os.wait4``) and peak memory (``ru_maxrss``: the largest single
-  process, the build or its picture child);
+- **whole-process builds**: ``python -m fabricate build T -o TMP --force -q`` as a user runs it (its
+  picture child and STEP worker included; ``FABRICATE_NO_CACHE=1``: every run a cold build), medians of
+  ``--runs`` runs for the default template (``finger_five_bar_ncg``) and of ``--other-runs`` for the others,
+  after one warm-up run of the default template. Wall time, CPU time (user + sys of the build and its
+  children, from ``os.wait4``) and peak memory (``ru_maxrss``: the largest single process of the build);
 - **the import floor** in the same rounds: a process that only imports what a build cannot do without
   (:data:`FLOOR_MODULES`; with the ``cad`` extra also :data:`STEP_MODULES`), and each build's ratio to it
   (the median of the per-round ratios, so the machine's drift cancels);
@@ -21,8 +21,10 @@ What it measures, in one run:
   (synthesis, sweep, gears, parts, exports, checks, strength, drive, plots) timestamped with wall and CPU
   clocks, the STEP probe and each picture job wrapped, with ``FABRICATE_SERIAL=1`` so the pictures run in
   that process and every stage's CPU is counted once (the stages add up to a serial build; the whole-process
-  rows are the real, parallel one). Peak memory per stage is the process's resident high-water mark over
-  that stage (``/proc/self/clear_refs`` resets it at each mark; Linux only);
+  rows are the real, parallel one). CPU includes the processes a stage waited for (the STEP worker, which
+  a build starts early: all its CPU is in the STEP row). Peak memory per stage is the process's resident
+  high-water mark over that stage (``/proc/self/clear_refs`` resets it at each mark; Linux only), or the
+  STEP worker's where that is larger;
 - ``--vs PATH``: the same builds on another checkout's code (``PYTHONPATH=PATH``), run alternately with this
   checkout's (A B A B ...), and the ratio A/B (median of the pairs).
 
@@ -99,6 +101,7 @@ def _env(code: Path, install: str, blocker: Path, extra: dict[str, str] | None =
     paths = [str(code)] if install == "cad" else [str(blocker), str(code)]
     env["PYTHONPATH"] = os.pathsep.join(paths + ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
     env["MPLBACKEND"] = "Agg"
+    env["FABRICATE_NO_CACHE"] = "1"  # every run a cold build: a stage cache (fabricate/cache.py) must not serve it
     env.pop("FABRICATE_SERIAL", None)
     env.update(extra or {})
     return env
@@ -121,17 +124,8 @@ def _floor_argv(install: str) -> list[str]:
             + "".join(f"import {m}\n" for m in modules)]
 
 
-def _build_argv(template: str, out: Path, no_cache: bool) -> list[str]:
-    argv = [sys.executable, "-m", "fabricate", "build", template, "-o", str(out), "--force", "-q"]
-    return argv + (["--no-cache"] if no_cache else [])
-
-
-def _has_no_cache(code: Path) -> bool:
-    """Whether ``code``'s CLI has ``--no-cache`` (a stage cache must not serve the benchmark's repeats)."""
-    env = _env(code, "cad", Path("."))
-    text = subprocess.run([sys.executable, "-m", "fabricate", "build", "--help"], env=env, capture_output=True,
-                          text=True, check=False).stdout
-    return "--no-cache" in text
+def _build_argv(template: str, out: Path) -> list[str]:
+    return [sys.executable, "-m", "fabricate", "build", template, "-o", str(out), "--force", "-q"]
 
 
 def ocp_installed() -> bool:
@@ -256,7 +250,7 @@ class _Clock:
 
 
 def _stages_in_child(template: str, code: Path, install: str, blocker: Path, cwd: Path) -> dict | None:
-    env = _env(code, install, blocker, {"FABRICATE_SERIAL": "1", "FABRICATE_NO_CACHE": "1"})
+    env = _env(code, install, blocker, {"FABRICATE_SERIAL": "1"})
     proc = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--stage-profile", template], env=env,
                           cwd=cwd, capture_output=True, text=True, check=False)
     if proc.returncode != 0:
@@ -292,7 +286,6 @@ def measure(templates: Sequence[str], installs: Sequence[str], runs: int, other_
     blocker.mkdir(exist_ok=True)
     (blocker / "sitecustomize.py").write_text(_NO_OCP, encoding="utf-8")
     codes = {"A": ROOT} | ({"B": vs} if vs is not None else {})
-    no_cache = {k: _has_no_cache(c) for k, c in codes.items()}
     floors = {install: Series() for install in installs}
     rows: list[Row] = []
     for template in templates:
@@ -307,8 +300,7 @@ def measure(templates: Sequence[str], installs: Sequence[str], runs: int, other_
                     row.floor.samples.append(floor)
                     floors[install].samples.append(floor)
                 for key, code in codes.items():
-                    sample = _run(_build_argv(template, work / f"out_{key}", no_cache[key]),
-                                  _env(code, install, blocker), work)
+                    sample = _run(_build_argv(template, work / f"out_{key}"), _env(code, install, blocker), work)
                     if counted:
                         (row.a if key == "A" else row.b).samples.append(sample)
             log(f"  {template} {install}: A {row.a.median('wall'):.2f} s"
@@ -348,8 +340,8 @@ def print_tables(rows: list[Row], floors: dict[str, Series], profiles: dict, vs:
     p()
     p("### Whole-process builds (`fabricate build T -o DIR --force -q`)")
     p()
-    head = "| template | install | runs | wall s | CPU s | peak MB | x floor |"
-    rule = "|---|---|---|---|---|---|---|"
+    head = "| template | install | runs | wall s | CPU s | peak MB | x floor | x floor CPU |"
+    rule = "|---|---|---|---|---|---|---|---|"
     if vs is not None:
         head += " before: wall s | CPU s | peak MB | x floor | now / before |"
         rule += "---|---|---|---|---|"
@@ -362,7 +354,7 @@ def print_tables(rows: list[Row], floors: dict[str, Series], profiles: dict, vs:
             ",".join(str(s.code) for s in row.a.samples + row.b.samples) + ")"
         line = (f"| {row.template}{fail} | {row.install} | {len(row.a.samples)} | {_fmt(row.a.median('wall'))} | "
                 f"{_fmt(row.a.median('cpu'))} | {_fmt(row.a.median('rss_mb'), 0)} | "
-                f"{_fmt(_ratio(row.a, row.floor))} |")
+                f"{_fmt(_ratio(row.a, row.floor))} | {_fmt(_ratio(row.a, row.floor, 'cpu'))} |")
         if vs is not None and row.b.samples:
             line += (f" {_fmt(row.b.median('wall'))} | {_fmt(row.b.median('cpu'))} | "
                      f"{_fmt(row.b.median('rss_mb'), 0)} | {_fmt(_ratio(row.b, row.floor))} | "
@@ -370,7 +362,8 @@ def print_tables(rows: list[Row], floors: dict[str, Series], profiles: dict, vs:
         p(line)
     p()
     p("x floor: median over the rounds of build wall / floor wall (the floor of the same install, run in the "
-      "same round); now / before: median of the paired wall ratios.")
+      "same round); x floor CPU: the same of CPU time (steadier on a loaded machine); now / before: median of "
+      "the paired wall ratios.")
     if not profiles:
         return
     for install in INSTALLS:
