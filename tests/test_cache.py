@@ -122,10 +122,14 @@ def test_a_hit_is_a_fresh_equal_object_from_memory_then_disk(cache_dir):
         made.append(1)
         return {"a": np.arange(3.0), "b": [1, 2]}
 
+    assert not cache.stored("toy", ("k", 1))
     with cache.use_cache():
+        assert not cache.stored("toy", ("k", 1))
         first = cache.cached("toy", ("k", 1), compute)
+        assert cache.stored("toy", ("k", 1)) and not cache.stored("toy", ("k", 2))
         second = cache.cached("toy", ("k", 1), compute)
         cache.clear_memory()
+        assert cache.stored("toy", ("k", 1))  # on disk
         third = cache.cached("toy", ("k", 1), compute)
         other = cache.cached("toy", ("k", 2), compute)
     assert len(made) == 2  # the first and the other key; the rest are hits
@@ -416,3 +420,22 @@ def test_check_neither_reads_nor_writes_the_cache(warmed, cache_dir, tmp_path):
     assert main(["check", str(out), "-q"]) == 0  # its rebuild's DXF is the true one, not the poisoned entry's
     assert main(["check", DEFAULT, "-q"]) == 0
     assert {(p, p.stat().st_mtime, p.stat().st_size) for p in entries(cache_dir)} == listing
+
+
+@pytest.mark.slow
+def test_synth_reuses_synthesis_and_its_plots(cache_dir):
+    """``synth`` on a warm cache takes the synthesis and its figures from it (the figures closure itself is not
+    stored: a stored result draws through the ``synthesis_plots`` entry) and gives the uncached files."""
+    from fabricate.pipeline import run_synth
+
+    design = load_design(DEFAULT)
+    with cache.use_cache():
+        cold = run_synth(design)
+        cache.clear_memory()
+        cache.stats.clear()
+        warm = run_synth(design)
+    assert cache.stats["synthesis"]["hits"] == 1 and cache.stats["synthesis_plots"] == {"hits": 1, "misses": 0,
+                                                                                         "stores": 0}
+    fresh = run_synth(design)
+    assert warm.files == cold.files == fresh.files
+    assert any(rel.startswith("plots/") for rel in fresh.files)
