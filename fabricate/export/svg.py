@@ -18,13 +18,29 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from xml.sax.saxutils import escape, quoteattr
 
 import numpy as np
 
 from fabricate.export.labels import Label
 from fabricate.export.layout import Placement
 from fabricate.parts.model import BulgePath, Part
+
+
+# xml.sax.saxutils' escape and quoteattr, the same text: importing that module imports urllib.request, and
+# with it http.client and ssl, which a build never uses
+def escape(data: str) -> str:
+    """``data`` with ``&``, ``<`` and ``>`` as XML entities (``xml.sax.saxutils.escape``)."""
+    return data.replace("&", "&amp;").replace(">", "&gt;").replace("<", "&lt;")
+
+
+def quoteattr(data: str) -> str:
+    """``data`` escaped and quoted as an XML attribute value (``xml.sax.saxutils.quoteattr``)."""
+    data = escape(data).replace("\n", "&#10;").replace("\r", "&#13;").replace("\t", "&#9;")
+    if '"' not in data:
+        return f'"{data}"'
+    if "'" not in data:
+        return f"'{data}'"
+    return '"{}"'.format(data.replace('"', "&quot;"))
 
 #: Stroke colours by operation (shop conventions, see the module docstring).
 CUT_COLOUR, ENGRAVE_COLOUR = "#ff0000", "#0000ff"
