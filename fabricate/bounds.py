@@ -42,8 +42,14 @@ MAX_SPRING_RATE = 1.0e4
 #: ``process.chord_tolerance_mm``: the polygonisation sagitta; vertex counts grow as 1/sqrt(tol), and the
 #: STEP export's shape fixing works to a tenth of it (100-tooth gears at 0.001 mm: 65 s of STEP alone).
 MIN_CHORD_TOLERANCE_MM = 0.002
-#: ``checks.sweep_poses``: poses of the swept motion and the interference check.
-MAX_SWEEP_POSES = 5000
+#: ``checks.sweep_poses``: poses of the swept motion, the interference check and the strength statics. Their memory
+#: is flat in the poses (the posed outlines and the gear contact's nearest vertices go a chunk of poses at a time:
+#: the default finger's interference proof peaked at 145 MB at 360 poses and 155 MB at 5000, its strength check at
+#: 159 and 179 MB; ``bench_bounds.py --poses-memory``), so time bounds them. CPU seconds of each kind's worst
+#: template (every other count at its bound, one BLAS thread) at 5000 and 10000 poses: underactuated finger 29.7
+#: and 53.8 s (4.8 ms a pose: the worst kind), compliant gripper 20.0 and 39.6, Watt six-bar 28.8 and 32.0, five-bar
+#: 23.2 and 28.7 (measured on two cores shared with other work, load 8-13: the wall times were 1.3-2x these).
+MAX_SWEEP_POSES = 10000
 #: ``gears.mesh_steps``: poses of the gear mesh check.
 MAX_MESH_STEPS = 7200
 #: ``gears.teeth`` / ``gear_pair.teeth`` and the teeth a module gives: teeth of one gear (cost grows
@@ -54,7 +60,8 @@ MAX_TEETH = 100
 #: 100 + 100 teeth at 1500 steps, 30 + 30 at 5000).
 MAX_MESH_STEP_TEETH = 300_000
 #: Gear pair kind: ``checks.sweep_poses`` × (z_a + z_b) (posing, layering and the interference sweep of
-#: the toothed outlines; 5000 poses × 400 teeth spent 70 s in the parts stage alone).
+#: the toothed outlines; 5000 poses × 400 teeth spent 70 s in the parts stage alone; the fewest teeth the shipped
+#: pair's module cuts, 9 + 9, at 8333 poses: 8.5 s of CPU in all).
 MAX_POSE_TEETH = 150_000
 #: Gear pair kind: ``parts.gif_frames`` × (z_a + z_b) (each frame draws both toothed outlines).
 MAX_FRAME_TEETH = 12_000
@@ -128,7 +135,8 @@ MAX_SOLVER_S = 10.0
 #: sweep's clearance tests), the sweep 20 s, strength 16 s, exports 5 s, parts 6 s; at 2000 poses (15 sliders,
 #: 2 gear pairs of 37 + 37 teeth) 59 s of CPU, 49 s wall; at the bound (1500 poses, 15 sliders, 2 pairs of
 #: 13 + 13 teeth) 52 s of CPU with the picture child, 56 s wall on cores shared with other work; its exact form
-#: with 12 copies 59 s of CPU, 53 s wall.
+#: with 12 copies 59 s of CPU, 53 s wall. Few bodies reach :data:`MAX_SWEEP_POSES`: the shipped Stephenson six-bar
+#: (6 bodies) at 10000 poses took 14.8 s of CPU.
 MAX_LINKAGE_POSE_BODIES = 60_000
 #: Linkage kind: characters of all its gear expressions together. Each is evaluated at every solver step and
 #: throughout gear cutting: 8 expressions of 1000 characters took 13 s of solving (648 poses) and 10 s of
@@ -193,10 +201,12 @@ def check_expression(text: str, path: str) -> None:
 
 # -- processes and threads -------------------------------------------------------------------------
 
-#: Peak resident memory (MB) of one local Dask worker process of ``fabricate sweep``: its imports and the builds
-#: it runs (idle, a worker holds about 75 MB; building the shipped Stephenson six-bar at 90 to 720 poses each of
-#: two workers peaked at 474 MB). ``--workers`` is bounded by the available memory divided by it.
-WORKER_MB = 500.0
+#: Peak resident memory (MB) of one local Dask worker process of ``fabricate sweep``: its imports, the builds it
+#: runs and the stage results it keeps for its later points (idle, a worker holds about 75 MB; building the
+#: shipped Stephenson six-bar at 90 to 720 poses each of two workers peaked at 474 MB; the kept results are bounded
+#: by the in-process cache layer's 256 MB, ``fabricate.cache.MEMORY_MAX_BYTES``; the shipped hand-size sweep's
+#: largest process peaked at 577 MB). ``--workers`` is bounded by the available memory divided by it.
+WORKER_MB = 750.0
 def available_cores() -> int:
     """Cores this process may run on (its CPU affinity where the platform has one)."""
     try:

@@ -13,8 +13,17 @@ RSS, exit code and the ratios to the 60 s / 4 GB budget.
 with two (fabricate pins OpenBLAS to one thread where it solves, :func:`fabricate.bounds.blas_threads`, so this
 shows what is left unpinned), ``--blas both`` (default) each kind both ways.
 
-Run: ``python tests/benchmarks/bench_bounds.py [--blas 1|2|both] [kind ...]`` (not part of the test suite;
-about ten minutes on an idle machine).
+``--poses N`` sets ``checks.sweep_poses`` of the kinds that take the generic bound (default
+:data:`fabricate.bounds.MAX_SWEEP_POSES`): two runs at two counts give each kind's cost per pose. ``gear_pair_poses``
+and ``linkage_poses_few`` are the most poses the products with the teeth and the bodies allow (the fewest teeth, the
+shipped six-bar's six bodies).
+
+``--poses-memory [template ...]`` (Linux) is the memory figure of the chunked sweeps instead: each stage that goes
+through every pose, run at 360 and at the most poses in its own process, its peak resident memory and the ratio
+(:func:`poses_memory`).
+
+Run: ``python tests/benchmarks/bench_bounds.py [--blas 1|2|both] [--poses N] [kind ...]`` (not part of the test
+suite; about ten minutes on an idle machine).
 """
 
 from __future__ import annotations
@@ -83,6 +92,16 @@ WORST: dict[str, tuple[str, dict[tuple[str, str], Any]]] = {
     }),
     "underactuated": ("finger_underactuated.toml", {
         ("push_rod", "samples"): bounds.MAX_STROKE_SAMPLES,
+    }),
+    # the most poses the products with the teeth and the bodies allow: the fewest teeth of a gear pair that still
+    # make a closed elliptic pair of whole teeth, and the shipped Stephenson six-bar (6 bodies)
+    "gear_pair_poses": ("gear_pair_elliptic.toml", {
+        # 8 + 8 (gears.min_teeth) is refused at the template's module: the ellipse's flattest curvature holds 7.8
+        ("gears", "teeth"): [9, 9],
+        ("checks", "sweep_poses"): min(bounds.MAX_SWEEP_POSES, bounds.MAX_POSE_TEETH // 18),
+    }),
+    "linkage_poses_few": ("linkage_stephenson.toml", {
+        ("checks", "sweep_poses"): min(bounds.MAX_SWEEP_POSES, bounds.MAX_LINKAGE_POSE_BODIES // 6),
     }),
     "compliant_gripper": ("gripper_compliant.toml", {
         # the shipped 31 x 31 x 91 spring triples: path samples up to the spring-table bound
@@ -312,16 +331,17 @@ def run(kind: str, work: Path, blas: int) -> dict[str, Any]:
 
 #: Run in its own process by ``--poses-memory``: builds a template's inputs up to the parts, then runs each stage
 #: that goes through every pose (the motion sweep again, the exports with motion.csv and the MJCF model, the
-#: interference proof, the gear mesh check, the strength statics and findings) with the peak resident memory reset
-#: before it (Linux ``/proc/self/clear_refs``, after glibc's ``malloc_trim``); prints each stage's peak (VmHWM)
-#: and the resident memory it started from (MB). The interference proof and the gear mesh check are measured
+#: interference proof, the gear mesh check, the strength statics and findings, the pictures a build's child draws
+#: and the strength and clearance plots) with the peak resident memory reset before it (Linux
+#: ``/proc/self/clear_refs``, after glibc's ``malloc_trim``); prints each stage's peak (VmHWM) and the resident
+#: memory it started from (MB). The interference proof and the gear mesh check are measured
 #: inside ``run_checks`` by wrapping them.
 STAGE_PEAKS = """
 import ctypes, json, sys
 import fabricate.checks as checks
 from fabricate.design import design_from_text
 from fabricate.pipeline import (BuildRun, _synthesis_stage, _make_gears, _make_parts, _check, _check_strength,
-                                _export, _record_optional_outputs, OptionalOutputs)
+                                _export, _record_optional_outputs, OptionalOutputs, _picture_jobs)
 from fabricate.bounds import blas_threads
 
 def status(key):
@@ -354,13 +374,16 @@ with blas_threads():
     measured("exports", _export)(run, _record_optional_outputs(run))
     _check(run)
     measured("strength", _check_strength)(run)
+    measured("pictures", lambda: [job() for job in _picture_jobs(run)])()
+    from fabricate.strength.plots import strength_plot
+    measured("plots", lambda: (strength_plot(run.strength, run.mechanism.input_unit), run.checks.figures()))()
 print(json.dumps(out))
 """
 
 #: ``--poses-memory``: the templates and pose counts whose stage peaks are compared.
 POSES_MEMORY_TEMPLATES = ("finger_five_bar_ncg", "linkage_stephenson")
 POSES_MEMORY_COUNTS = (360, bounds.MAX_SWEEP_POSES)
-POSES_MEMORY_STAGES = ("motion sweep", "exports", "interference", "gear mesh", "strength")
+POSES_MEMORY_STAGES = ("motion sweep", "exports", "interference", "gear mesh", "strength", "pictures", "plots")
 
 
 def poses_memory(templates: tuple[str, ...] = POSES_MEMORY_TEMPLATES,
@@ -397,11 +420,15 @@ def main(argv: list[str]) -> None:
     parser.add_argument("--blas", choices=("1", "2", "both"), default="both")
     parser.add_argument("--poses-memory", action="store_true",
                         help="peak memory of the interference and strength sweeps at 360 and the most poses")
+    parser.add_argument("--poses", type=int, help="checks.sweep_poses of the shipped kinds' worst templates (default "
+                        f"the bound, {bounds.MAX_SWEEP_POSES}; the gear pair and linkages keep their products)")
     parser.add_argument("kinds", nargs="*", metavar="kind", help=f"of {', '.join([*WORST, *GENERATED])}")
     args = parser.parse_args(argv)
     if args.poses_memory:
         poses_memory(tuple(args.kinds) or POSES_MEMORY_TEMPLATES)
         return
+    if args.poses:
+        _GENERIC[("checks", "sweep_poses")] = args.poses
     kinds = args.kinds or [*WORST, *GENERATED]
     unknown = [k for k in kinds if k not in WORST and k not in GENERATED]
     if unknown:
