@@ -16,6 +16,7 @@ import shapely.ops
 from fabricate.catalogue.hardware import ISO4762, screw
 from fabricate.drive import geometry as geo
 from fabricate.drive.records import MOUNT_PART, Fastener, Standoff, fit_hole, screw_size
+from fabricate.errors import GeometryError, SpecError
 from fabricate.parts.model import BulgePath, Hole, Part
 from fabricate.parts.profiles import circle_hull
 from fabricate.planar import rotation
@@ -321,7 +322,13 @@ class MountPlacement:
                                              geo.circle_ring(st.centre, inner, tol)[::-1]), st.z_mm,
                                             st.z_mm + st.length_mm))
                 count += 1
-            fix = geo.screw_into(size, float(ground.thickness_mm) + (hi - lo), t)
+            try:
+                fix = geo.screw_into(size, float(ground.thickness_mm) + (hi - lo), t)
+            except SpecError as exc:
+                # a stack too tall for a standard screw through its standoffs: the design, not the input, is at
+                # fault (a build failure naming it, exit 1)
+                raise GeometryError(f"the actuator's mount plate stands {hi - lo:.3g} mm off the ground part: "
+                                    f"no standard screw clamps it through its standoffs ({exc.message})") from None
             fasteners.append(Fastener(fix.designation, count, "mount plate to the ground part through the standoffs "
                                       "(taps into the plate)", fix.clamp_mm, fix.engagement_mm))
         else:

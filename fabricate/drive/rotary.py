@@ -99,6 +99,21 @@ def output_depth(design: Any, mechanism: Mechanism) -> tuple[str, float] | None:
     return driver.body, float(output.length_mm) - float(process.layer_gap_mm) - motor_top_mm(entry, t) - 0.5 * t
 
 
+def motor_reach(design: Any, mechanism: Mechanism) -> tuple[str, np.ndarray, float] | None:
+    """Where a shaft (or bare spline) motor stands and how far its body reaches: (ground body, output axis in
+    its coordinates, radius mm of the body's farthest corner from the axis), for the layer order to know which
+    pins' ends the motor may meet (:func:`~fabricate.parts.layers.order_layers` ``near_motor``). None where
+    :func:`output_depth` is None (no such motor)."""
+    if output_depth(design, mechanism) is None:
+        return None
+    found = _rotary_drive(design, mechanism)
+    assert found is not None  # output_depth resolved it
+    entry, driver = found
+    corners = [math.hypot(x, y) for b in entry.body or () for x in (b.x0, b.x1) for y in (b.y0, b.y1)]
+    axis = np.asarray(mechanism.body(driver.reference).point(driver_joint(mechanism, driver)), dtype=np.float64)
+    return driver.reference, axis, max(corners, default=0.0)
+
+
 class RotaryPlacement(MountPlacement):
     """Placing a servo, gear motor or stepper on an angle driver (see :mod:`fabricate.drive.parts`)."""
 

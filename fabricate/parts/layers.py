@@ -235,15 +235,20 @@ def pin_neighbours(pins: Sequence[tuple[np.ndarray, str]], world_poses: Mapping[
 
 #: The layer order tries at most this many arrangements for one number of layers.
 MAX_ARRANGEMENTS = 400_000
-#: What a driven part out of its motor shaft's reach counts in the layer order (a collision counts 1).
-OUT_OF_REACH = 1000
+#: What a collision counts in the layer order (as much as a stack no standard pin covers, whose pin is then cut
+#: from rod: weighing collisions more makes the plain order trade them for taller stacks, e.g. the laser five-bar's
+#: 28.7 mm mount standoffs, longer than a standard screw clamps).
+COLLISION = 1
+#: What a driven part out of its motor shaft's reach counts in the layer order (it cannot be built at all).
+OUT_OF_REACH = 1000 * COLLISION
 
 
 def order_layers(layers: Mapping[str, int], crossings: Sequence[tuple[str, str, str]],
                  max_layers: int = 7, *, pins: Sequence[tuple[str, ...]] = (),
                  end_crossings: Sequence[tuple[int, str]] = (), pin_pairs: Sequence[tuple[int, int]] = (),
                  end_reach: Callable[[float], float] | None = None, thickness_mm: float = 1.0,
-                 gap_mm: float = 0.0, spare_layers: int = 0, outer: Sequence[tuple[str, float]] = ()
+                 gap_mm: float = 0.0, spare_layers: int = 0, outer: Sequence[tuple[str, float]] = (),
+                 one_end: bool = False, near_motor: Sequence[int] | None = None, split: bool = False
                  ) -> dict[str, int]:
     """Renumber the layers (keeping who shares a layer) so no body sits between the layers of a pin it
     passes over, nor where a pin's end sticks out of its stack.
@@ -273,6 +278,7 @@ def order_layers(layers: Mapping[str, int], crossings: Sequence[tuple[str, str, 
         Pins whose stacks or ends come near each other (:func:`pin_neighbours`).
     end_reach : callable, optional
         Stack length (mm) -> how far (mm) the pin and its retention reach beyond each end face; none: 0.
+        Infinite: no standard pin covers that stack (one violation per such pin).
     thickness_mm, gap_mm : float
         Layer thickness and the gap between layers (:func:`layer_z`).
     spare_layers : int
@@ -281,15 +287,56 @@ def order_layers(layers: Mapping[str, int], crossings: Sequence[tuple[str, str, 
         (body, depth mm): the body's part lies at most this deep under the stack's bottom or top face (a motor's
         short shaft reaches it from outside the stack; :data:`OUT_OF_REACH` violations if not), and at most that
         less how far the pins' ends stick out there (one violation if not: the motor meets a pin's end).
+    one_end : bool
+        The reach sticks out of one end of each stack only (a pressed pin's stub): the bottom where the
+        stack's bottom layer is the lowest and its top layer not the highest, else the top
+        (:func:`~fabricate.parts.retention.press_stub_at_bottom`, the same rule).
+    near_motor : sequence of int, optional
+        The pins (indices into ``pins``) within reach of the motor of ``outer``: only their ends (where they
+        stick out) count against the motor's side; the motor may go under or over the stack, a violation only
+        where it meets such an end on both. None: any pin's end at the stack's faces counts (the largest
+        reach).
+    split : bool
+        Where no arrangement is free of violations, try giving one body of a shared layer a layer of its own:
+        the split with the fewest violations, then the fewest layers, where it has fewer violations in no more
+        layers than the best arrangement without a split (empty layers included) or one more than the colours.
 
     Returns
     -------
     dict[str, int]
     """
+    args = (crossings, max_layers, pins, end_crossings, pin_pairs, end_reach, thickness_mm, gap_mm, spare_layers,
+            outer, one_end, near_motor)
+    bad, best = _best_order(layers, *args)
+    if bad == 0 or not split:
+        return best
+    # no order of the colours works: give one body of a shared layer a layer of its own (a legal colouring
+    # still: the conflict graph only asks for different layers), the first that works in body order
     count = 1 + max(layers.values(), default=0)
-    ends = end_reach is not None and bool(pins) and bool(end_crossings or pin_pairs)
+    height = 1 + max(best.values(), default=0)
+    key = (bad, height)
+    for body in layers:
+        if sum(v == layers[body] for v in layers.values()) < 2 or count + 1 > max_layers:
+            continue
+        bad_split, ordered = _best_order({**layers, body: count}, *args)
+        # fewer violations in no more layers than the plain order takes, or the split's own one more (a taller
+        # stack takes longer pins and standoff screws than the standard series has); then the fewest layers
+        split_height = 1 + max(ordered.values())
+        if split_height <= max(height, count + 1) and (bad_split, split_height) < key:
+            key, best = (bad_split, split_height), ordered
+    return best
+
+
+def _best_order(layers: Mapping[str, int], crossings: Sequence[tuple[str, str, str]], max_layers: int,
+                pins: Sequence[tuple[str, ...]], end_crossings: Sequence[tuple[int, str]],
+                pin_pairs: Sequence[tuple[int, int]], end_reach: Callable[[float], float] | None,
+                thickness_mm: float, gap_mm: float, spare_layers: int, outer: Sequence[tuple[str, float]],
+                one_end: bool, near_motor: Sequence[int] | None) -> tuple[int, dict[str, int]]:
+    """(violations, layers) of the best arrangement of the colours of ``layers`` (see :func:`order_layers`)."""
+    count = 1 + max(layers.values(), default=0)
+    ends = end_reach is not None and bool(pins) and (bool(end_crossings or pin_pairs) or near_motor is not None)
     if (not crossings and not ends and not outer) or count > max_layers:
-        return dict(layers)
+        return 0, dict(layers)
     pitch = thickness_mm + gap_mm
     eps = 1e-6
     best: tuple[int, np.ndarray] | None = None
@@ -303,40 +350,59 @@ def order_layers(layers: Mapping[str, int], crossings: Sequence[tuple[str, str, 
         bad = np.zeros(len(perms), dtype=np.int64)
         reach_of = np.array([end_reach(s * pitch + thickness_mm) if end_reach is not None else 0.0
                              for s in range(slots)])
-        stuck_out = float(np.max(reach_of))
-        for body, depth in outer:
-            zc = perms[:, layers[body]] * pitch
-            top = (perms.max(axis=1) - perms[:, layers[body]]) * pitch
-            # out of the shaft's reach the design cannot be built: that outweighs any collision
-            bad += OUT_OF_REACH * ((zc > depth + eps) & (top > depth + eps))
-            bad += (zc > depth - stuck_out + eps) & (top > depth - stuck_out + eps)
+        # a stack no standard pin covers (infinite reach) is a violation of its own: its pin would be cut from rod
+        unbuyable = ~np.isfinite(reach_of)
+        reach_of = np.where(unbuyable, 0.0, reach_of)
         for a, b, c in crossings:
             pa, pb, pc = perms[:, layers[a]], perms[:, layers[b]], perms[:, layers[c]]
-            bad += (np.minimum(pa, pb) < pc) & (pc < np.maximum(pa, pb))
+            bad += COLLISION * ((np.minimum(pa, pb) < pc) & (pc < np.maximum(pa, pb)))
         if ends:
             lo = np.stack([perms[:, [layers[b] for b in bodies]].min(axis=1) for bodies in pins], axis=1)
             hi = np.stack([perms[:, [layers[b] for b in bodies]].max(axis=1) for bodies in pins], axis=1)
             z0, z1 = lo * pitch, hi * pitch + thickness_mm
             reach = reach_of[hi - lo]
+            bad += unbuyable[hi - lo].sum(axis=1)
+            if one_end:  # the stub's end: the bottom where only the bottom is the outermost layer
+                bottom = (lo == perms.min(axis=1)[:, None]) & (hi != perms.max(axis=1)[:, None])
+                r0, r1 = np.where(bottom, reach, 0.0), np.where(bottom, 0.0, reach)
+            else:
+                r0 = r1 = reach
             for i, body in end_crossings:
                 zc = perms[:, layers[body]] * pitch
-                below = (zc < z0[:, i]) & (zc + thickness_mm > z0[:, i] - reach[:, i] + eps)
-                above = (zc >= z1[:, i] - eps) & (zc < z1[:, i] + reach[:, i] - eps)
-                bad += (reach[:, i] > eps) & (below | above)
+                below = (r0[:, i] > eps) & (zc < z0[:, i]) & (zc + thickness_mm > z0[:, i] - r0[:, i] + eps)
+                above = (r1[:, i] > eps) & (zc >= z1[:, i] - eps) & (zc < z1[:, i] + r1[:, i] - eps)
+                bad += COLLISION * (below | above)
             for i, j in pin_pairs:
                 for p, q in ((i, j), (j, i)):
                     # the ends of p against all of q (its stack and its ends)
-                    q0, q1 = z0[:, q] - reach[:, q], z1[:, q] + reach[:, q]
-                    hit_bottom = (z0[:, p] - reach[:, p] < q1 - eps) & (q0 < z0[:, p] - eps)
-                    hit_top = (z1[:, p] < q1 - eps) & (q0 < z1[:, p] + reach[:, p] - eps)
-                    bad += (reach[:, p] > eps) & (hit_bottom | hit_top)
+                    q0, q1 = z0[:, q] - r0[:, q], z1[:, q] + r1[:, q]
+                    hit_bottom = (r0[:, p] > eps) & (z0[:, p] - r0[:, p] < q1 - eps) & (q0 < z0[:, p] - eps)
+                    hit_top = (r1[:, p] > eps) & (z1[:, p] < q1 - eps) & (q0 < z1[:, p] + r1[:, p] - eps)
+                    bad += COLLISION * (hit_bottom | hit_top)
+        for body, depth in outer:
+            zc = perms[:, layers[body]] * pitch
+            z_top = perms.max(axis=1) * pitch + thickness_mm
+            top = z_top - zc - thickness_mm
+            # out of the shaft's reach the design cannot be built: that outweighs any collision
+            bad += OUT_OF_REACH * ((zc > depth + eps) & (top > depth + eps))
+            if ends and near_motor is not None:
+                # the motor (under the stack: its face depth below the driven part's near face; over it: above
+                # its far face) meets the ends of the pins within its reach that stick out that far
+                idx = list(near_motor)
+                low = np.min(z0[:, idx] - r0[:, idx], axis=1, initial=np.inf) if idx else np.full(len(perms), np.inf)
+                high = np.max(z1[:, idx] + r1[:, idx], axis=1, initial=-np.inf) if idx else np.full(len(perms),
+                                                                                                    -np.inf)
+                bad += COLLISION * ((low < zc - depth - eps) & (high > zc + thickness_mm + depth + eps))
+            else:
+                stuck_out = float(np.max(reach_of))
+                bad += COLLISION * ((zc > depth - stuck_out + eps) & (top > depth - stuck_out + eps))
         k = int(np.argmin(bad))
         if best is None or int(bad[k]) < best[0]:
             best = (int(bad[k]), perms[k])
         if best[0] == 0:
             break
     assert best is not None
-    return {name: int(best[1][layer]) for name, layer in layers.items()}
+    return best[0], {name: int(best[1][layer]) for name, layer in layers.items()}
 
 
 def layer_z(layer: int, thickness_mm: float, gap_mm: float) -> float:

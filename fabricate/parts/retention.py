@@ -18,13 +18,13 @@ Two sizes of a hole are kept apart (:class:`HoleSize`):
 Retention (the profile's ``retention``)
 ---------------------------------------
 ``press``  the pin is pressed into the part that holds it (``holder``, at an end of the stack where one has a
-           hole) and runs in the others. It needs no length beyond the stack: a pin that stuck out would
-           sweep through the next layer's parts (a 1.7 mm stub under ``linkage_stephenson``'s crank hits the
-           frame), so the longest standard pin no longer than the stack is taken if it keeps two thirds of
-           each end part on it (:data:`SHORT_OF_END`; it ends inside the holder first); else the shortest
-           one over the stack, sticking out where no layer lies beyond the stack (the top first; under the
-           ground, the base needs a clearance hole), else out of the holder's outer face (out of the top
-           where that face is the ground's mounting face or the holder is in the middle).
+           hole) and runs in the others. It is the shortest standard pin over the stack, so every part runs
+           on it over its whole thickness and the holder grips it over its whole thickness: flush at one end,
+           the standard length's extra sticks out of the other as a bare stub (out of the top of the stack,
+           or of the bottom where only the bottom has no layer beyond it: :func:`press_stub_at_bottom`). The
+           layer order keeps the room the stub sweeps clear of other parts, as it does for a clip's end (a
+           1.7 mm stub under ``linkage_stephenson``'s crank would hit its frame; under the ground the base
+           needs a clearance hole, which the hardware report says).
 ``clip``   the pin runs in every part and sticks out at both ends far enough for a DIN 6799 retaining
            washer (groove width m + edge margin n); what the standard length has over goes equally to
            both ends, where standard washers (DIN 125-A / DIN 988) fill it under the clip as far as they
@@ -35,6 +35,7 @@ Retention (the profile's ``retention``)
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
@@ -43,7 +44,7 @@ import numpy as np
 
 from fabricate.catalogue.clips import RetainingRing, e_clip
 from fabricate.catalogue.hardware import Washer, fill_gap, washers_for_shaft
-from fabricate.catalogue.pins import PinChoice, dowel_pin, pin_lengths
+from fabricate.catalogue.pins import PinChoice, dowel_pin
 from fabricate.errors import SpecError
 from fabricate.process import ProcessSpec
 
@@ -89,11 +90,6 @@ def hole_size(process: ProcessSpec, diameter_mm: float, fit: str) -> HoleSize:
     else:
         raise ValueError(f"unknown fit {fit!r}")
     return HoleSize(fit, nominal, nominal + process.hole_compensation_mm)
-
-
-#: A pressed pin may end this fraction of an end part's thickness short of the part's outer face (so two
-#: thirds of the part stay on the pin): a design rule of this module, not a standard's.
-SHORT_OF_END = 1.0 / 3.0
 
 
 def cap_height_mm(process: ProcessSpec, pin_mm: float) -> float:
@@ -194,8 +190,7 @@ class PinPlan:
 
 
 def plan_pin(joint: str, process: ProcessSpec, stack_z_mm: tuple[float, float], holder: str = "",
-             holder_z_mm: tuple[float, float] | None = None, holder_is_ground: bool = False,
-             end_thickness_mm: tuple[float, float] = (0.0, 0.0),
+             holder_z_mm: tuple[float, float] | None = None,
              free_ends: tuple[bool, bool] = (False, False)) -> PinPlan:
     """The standard pin for one joint and what goes on its ends.
 
@@ -210,13 +205,9 @@ def plan_pin(joint: str, process: ProcessSpec, stack_z_mm: tuple[float, float], 
         The body holding a pressed pin (``press`` only).
     holder_z_mm : (float, float), optional
         Bottom and top of the holder's part (``press``).
-    holder_is_ground : bool
-        The holder is the ground, whose bottom face is its mounting face: nothing sticks out of it.
-    end_thickness_mm : (float, float)
-        Thickness of the parts at the bottom and top of the stack (0 where none, e.g. a spring's coil):
-        how far a pressed pin may end inside them.
     free_ends : (bool, bool)
-        No layer lies beyond the stack's bottom / top: where a pressed pin that must stick out does.
+        No layer lies beyond the stack's bottom / top: which end a pressed pin's extra length sticks out of
+        (:func:`press_stub_at_bottom`).
 
     Raises
     ------
@@ -230,8 +221,7 @@ def plan_pin(joint: str, process: ProcessSpec, stack_z_mm: tuple[float, float], 
     stack = z1 - z0
     try:
         if scheme == "press":
-            return _plan_press(joint, d, standard, (z0, z1), holder, holder_z_mm, holder_is_ground,
-                               end_thickness_mm, free_ends)
+            return _plan_press(joint, d, standard, (z0, z1), holder, holder_z_mm, free_ends)
         if scheme == "clip":
             ring = e_clip(d)
             each = ring.protrusion_mm
@@ -256,20 +246,19 @@ def plan_pin(joint: str, process: ProcessSpec, stack_z_mm: tuple[float, float], 
 def end_reach_mm(process: ProcessSpec, stack_mm: float) -> float:
     """How far (mm) a pin on a stack ``stack_mm`` long, with what its retention puts on its ends (washers and
     a clip, or a cap), reaches beyond each end face: what the layer order keeps clear
-    (:func:`~fabricate.parts.layers.order_layers`). 0 for a press fit (its pin ends inside the stack, or
-    sticks out only where no layer lies) and where no standard pin covers the stack (a rod cut to it)."""
-    if process.retention == "press":
-        return 0.0
+    (:func:`~fabricate.parts.layers.order_layers`). A pressed pin's stub sticks out of ONE end only (the
+    layer order's ``one_end``). Infinite where no standard pin covers the stack (the layer order counts such a
+    stack as a violation: its pin would be a rod cut to length)."""
     try:
         plan = plan_pin("", process, (0.0, float(stack_mm)))
     except SpecError:
-        return 0.0
+        return math.inf
     return max(max(e.protrusion_mm, e.cap_mm) for e in plan.ends)
 
 
 def end_radius_mm(process: ProcessSpec) -> float:
     """Radius (mm) of what a pin's retention puts on its ends: the largest of the clip and the washers a pin of
-    the profile takes, or the cap; 0 for a press fit."""
+    the profile takes, or the cap; the pin itself for a press fit (its bare stub)."""
     d = float(process.pin_diameter_mm)
     if process.retention == "clip":
         try:
@@ -279,7 +268,7 @@ def end_radius_mm(process: ProcessSpec) -> float:
         return 0.5 * max([ring] + [w.d2_mm for w in washers_for_shaft(d)])
     if process.retention == "cap":
         return 0.5 * (hole_size(process, d, "running").modelled_mm + 2.0 * max(process.min_wall_mm, 0.5 * d))
-    return 0.0
+    return 0.5 * d
 
 
 def _washers(d: float, gap: float) -> tuple[Washer, ...]:
@@ -292,44 +281,25 @@ def _washers(d: float, gap: float) -> tuple[Washer, ...]:
         return ()
 
 
+def press_stub_at_bottom(free_ends: tuple[bool, bool]) -> bool:
+    """Where a pressed pin's extra length sticks out: out of the bottom of its stack only where no layer lies
+    below it and one lies above it; else out of the top. The layer order keeps that room clear by the same rule
+    (:func:`~fabricate.parts.layers.order_layers` with ``one_end``)."""
+    return bool(free_ends[0]) and not bool(free_ends[1])
+
+
 def _plan_press(joint: str, d: float, standard: str, stack: tuple[float, float], holder: str,
-                holder_z: tuple[float, float] | None, holder_is_ground: bool,
-                end_thickness: tuple[float, float], free_ends: tuple[bool, bool]) -> PinPlan:
+                holder_z: tuple[float, float] | None, free_ends: tuple[bool, bool]) -> PinPlan:
     z0, z1 = stack
-    length = z1 - z0
     hz = holder_z if holder_z is not None else (z0, z1)
-    thickness = hz[1] - hz[0]
-    at_bottom = abs(hz[0] - z0) < 1e-6
-    at_top = abs(hz[1] - z1) < 1e-6
-    lengths = pin_lengths(d, standard)
-    # the longest standard pin that still keeps PRESS_KEEP of each end part on it: it ends inside the
-    # end parts (the holder's end first) and nothing sticks out of the stack into another layer's way
-    room = (SHORT_OF_END * end_thickness[0], SHORT_OF_END * end_thickness[1])
-    fits = [v for v in lengths if v <= length + _EPS and length - v <= room[0] + room[1] + _EPS]
-    if fits:
-        value = max(fits)
-        deficit = length - value
-        first = 0 if at_bottom else 1
-        into = [0.0, 0.0]
-        into[first] = min(deficit, room[first])
-        into[1 - first] = deficit - into[first]
-        ends = (PinEnd(protrusion_mm=-into[0]), PinEnd(protrusion_mm=-into[1]))
-        engaged = thickness - (into[0] if at_bottom else into[1] if at_top else 0.0)
-        return PinPlan(joint, d, "press", holder, PinChoice(f"{standard} {d:g} × {value:g}", value), stack, 0.0,
-                       ends, engaged)
-    # none that short: the shortest over the stack, sticking out where no layer lies beyond (the top layer's
-    # top, else the bottom layer's bottom); else out of the holder's outer face (the holder grips it there),
-    # or of the top where that face is the ground's mounting face
-    choice = dowel_pin(d, length, standard)
-    over = choice.length_mm - length
-    if free_ends[1]:
-        bottom = False
-    elif free_ends[0]:
-        bottom = True  # under the bottom layer (under the ground: the base needs a clearance hole there)
-    else:
-        bottom = at_bottom and not (holder_is_ground or at_top)
-    ends = (PinEnd(protrusion_mm=over), PinEnd()) if bottom else (PinEnd(), PinEnd(protrusion_mm=over))
-    return PinPlan(joint, d, "press", holder, choice, stack, 0.0, ends, thickness)
+    # the shortest standard pin over the stack: the holder grips it over its whole thickness and every part
+    # runs on its full length; one end is flush, the standard length's extra sticks out of the other as a bare
+    # stub, into room the layer order kept clear (press_stub_at_bottom)
+    choice = dowel_pin(d, z1 - z0, standard)
+    over = choice.length_mm - (z1 - z0)
+    stub = PinEnd(protrusion_mm=over)
+    ends = (stub, PinEnd()) if press_stub_at_bottom(free_ends) else (PinEnd(), stub)
+    return PinPlan(joint, d, "press", holder, choice, stack, 0.0, ends, hz[1] - hz[0])
 
 
 def washer_designation(w: Washer) -> str:
@@ -457,16 +427,10 @@ def retain_pins(pins: Sequence[Any], spacers: Sequence[Any], parts: Sequence[Par
         centre = (np.asarray(next(h.centre for h in first.holes if h.joint == pin.joint), dtype=np.float64)
                   if first is not None else np.zeros(2))
         press = process.retention == "press" and first is not None
-        on_pin = [p for p in parts if p.body in pin.bodies and p.role != "spacer"
-                  and any(h.joint == pin.joint for h in p.holes)]
-        ends_t = (max((p.thickness_mm for p in on_pin if abs(p.z_mm - stack[0]) < 1e-6), default=0.0),
-                  max((p.thickness_mm for p in on_pin if abs(p.z_mm + p.thickness_mm - stack[1]) < 1e-6),
-                      default=0.0))
         note = ""
         try:
             plan = plan_pin(pin.joint, process, stack, pin.bodies[0] if press else "",
                             (first.z_mm, first.z_mm + first.thickness_mm) if first is not None else None,
-                            pin.bodies[0] == ground, ends_t,
                             (int(pin.layers[0]) == lowest, int(pin.layers[1]) == highest))
         except SpecError as exc:
             # no standard pin (a diameter outside the series, a stack beyond its lengths): a pin cut from rod to

@@ -55,7 +55,7 @@ from fabricate.catalogue.springs import (
 )
 from fabricate.errors import SpecError
 from fabricate.mechanism import Mechanism, Motion, Revolute
-from fabricate.parts.model import Hole, Part
+from fabricate.parts.model import Hole, Part, circle_polygon
 
 if TYPE_CHECKING:
     from fabricate.parts.bom import Pin
@@ -305,11 +305,45 @@ def _on_pin(pin: Pin, parts: Sequence[Part], ends: Sequence[tuple[str, str]], le
         stack = (z0, z1 + length) if side == "top" else (z0 - length, z1)
         try:
             plan_pin(pin.joint, process, stack, holder if press and first is not None else "",
-                     (first.z_mm, first.z_mm + first.thickness_mm) if first is not None else None, holder == ground)
+                     (first.z_mm, first.z_mm + first.thickness_mm) if first is not None else None)
         except SpecError:
             continue
         return side, body
     return None
+
+
+def _room_blocked(pin: Pin, side: str, length: float, radius: float, parts: Sequence[Part], motion: Motion,
+                  process: ProcessSpec) -> bool:
+    """Whether a part of another stack comes within the running clearance of a coil of ``radius`` (mm) standing
+    ``length`` mm beyond the ``side`` face of the pin's stack (with the pin's retention reach beyond it),
+    anywhere over the motion: the room the layer order could not know of (it orders the stacks before the
+    springs are placed)."""
+    from fabricate.parts.layers import MAX_CONFLICT_POSES, min_distance_over_motion
+    from fabricate.parts.retention import end_reach_mm
+    from fabricate.planar import relative_poses
+
+    z0, z1 = float(pin.z_mm), float(pin.z_mm) + float(pin.length_mm)
+    reach = end_reach_mm(process, z1 - z0 + length)
+    reach = 0.0 if not math.isfinite(reach) else reach
+    room = (z1, z1 + length + reach) if side == "top" else (z0 - length - reach, z0)
+    body = pin.bodies[0]
+    hole = next((h for p in parts if p.body == body for h in p.holes if h.joint == pin.joint), None)
+    if hole is None:
+        return False
+    disc = circle_polygon(np.asarray(hole.centre, dtype=np.float64), 2.0 * radius, process.chord_tolerance_mm)
+    k = len(motion.inputs)
+    pick = np.unique(np.linspace(0, max(k - 1, 0), min(k, MAX_CONFLICT_POSES)).round().astype(int))
+    for part in parts:
+        if part.body in pin.bodies and any(h.joint == pin.joint for h in part.holes):
+            continue  # the pin's own stack
+        if part.z_mm + part.thickness_mm <= room[0] + 1e-9 or part.z_mm >= room[1] - 1e-9:
+            continue
+        rel = relative_poses(motion.pose(body)[pick], motion.pose(part.body)[pick])
+        clear = process.running_clearance_mm
+        outline = part.outline.polygon(process.chord_tolerance_mm)
+        if min_distance_over_motion(disc, outline, rel, within=clear) < clear:
+            return True
+    return False
 
 
 def _arbor_mm(pin: Pin, process: ProcessSpec) -> float:
@@ -404,6 +438,10 @@ def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, pa
         legs = (legs_default, legs_default)
         ends = _ends(pin, parts_by, process)
         spring, within = _sized(rate, work, preload, legs, pin_mm)
+        # an end whose room beyond the stack no other part sweeps first (a stable sort)
+        coil_r = 0.5 * spring.outer_d_mm + spring.wire_d_mm + process.running_clearance_mm
+        ends.sort(key=lambda e: _room_blocked(pin, e[0], spring.body_length_wound_mm, coil_r, parts, motion,
+                                              process))
         seat = _on_pin(pin, parts, ends, spring.body_length_wound_mm, process, ground)
         arbor_od = 0.0
         if seat is None and ends:

@@ -84,8 +84,40 @@ def test_end_reach_is_the_planned_pins(laser_process):
         assert end_reach_mm(laser_process, stack) == pytest.approx(max(e.protrusion_mm for e in plan.ends))
         assert end_reach_mm(laser_process, stack) > laser_process.layer_gap_mm  # into the next sheet
     assert end_radius_mm(laser_process) >= 0.5 * plan.ends[0].retainer.ring_od_mm
+    # a press fit: the bare stub of the shortest standard pin over the stack (Ø3: 8 mm on 6.5, 14 on 13.5)
     press = dataclasses.replace(laser_process, retention="press", press_fit_interference_mm=0.05)
-    assert end_reach_mm(press, 6.5) == 0.0 and end_radius_mm(press) == 0.0
+    assert end_reach_mm(press, 6.5) == pytest.approx(1.5) and end_reach_mm(press, 13.5) == pytest.approx(0.5)
+    assert end_radius_mm(press) == 1.5
+
+
+def test_a_pressed_pin_stub_takes_room_at_one_end_only():
+    """A pressed pin's stub sticks out of the top of its stack unless only its bottom is the outermost layer
+    (retention.press_stub_at_bottom): c over the pin of a and b must keep off that end only."""
+    layers = {"a": 1, "b": 2, "c": 0, "d": 3}
+    kwargs = dict(pins=[("a", "b")], end_crossings=[(0, "c")], end_reach=lambda stack: 1.7, thickness_mm=T,
+                  gap_mm=GAP)
+    # both ends inside: the stub is at the top, c at the bottom is clear of it (both-end room would not be)
+    assert order_layers(layers, [], one_end=True, **kwargs) == layers
+    assert _end_hits(layers, ("a", "b"), "c", 1.7)
+    # c above the pin: the stub's end, so c moves off it
+    above = {"a": 1, "b": 2, "c": 3, "d": 0}
+    ordered = order_layers(above, [], one_end=True, **kwargs)
+    lo, hi = sorted((ordered["a"], ordered["b"]))
+    stub_at_bottom = lo == 0 and hi != max(ordered.values())
+    assert ordered != above and not (ordered["c"] == (lo - 1 if stub_at_bottom else hi + 1))
+
+
+def test_a_stack_no_standard_pin_covers_is_a_violation():
+    """Three bodies c, a, b on one pin (c in the middle): a stack over the longest standard pin (infinite reach)
+    is avoided where an order keeps it within the series."""
+    layers = {"a": 0, "b": 2, "c": 1, "d": 3}
+    reach = {1: 0.0, 2: 0.0, 3: np.inf, 4: np.inf}  # by the number of layers the stack spans
+    kwargs = dict(pins=[("a", "b"), ("c", "d")], pin_pairs=[(0, 1)], thickness_mm=T, gap_mm=GAP,
+                  end_reach=lambda stack: reach[round((stack - T) / PITCH) + 1])
+    ordered = order_layers(layers, [], **kwargs)
+    for pin in (("a", "b"), ("c", "d")):
+        assert abs(ordered[pin[0]] - ordered[pin[1]]) <= 1  # two layers each, within the series
+    assert ordered != layers
 
 
 def test_clip_pins_of_a_crank_rocker_hit_no_part(four_bar, laser_process):
@@ -98,3 +130,36 @@ def test_clip_pins_of_a_crank_rocker_hit_no_part(four_bar, laser_process):
                                min_clearance_mm=laser_process.running_clearance_mm, pins=partset.pins,
                                spacers=partset.spacers)
     assert not sweep.collisions, [(p.a, p.b) for p in sweep.collisions]
+
+
+def test_the_motor_meets_only_the_pin_ends_within_its_reach():
+    """A motor's short shaft reaches one layer deep (depth = one pitch) to its driven part in the middle layer. A
+    pin with clip ends over the whole stack sticks out of both faces: where it is within the motor's reach
+    (near_motor) the driven part must move to a face (the motor then clears it from outside); a pin out of its
+    reach leaves the colouring as it is. Without near_motor every pin end counts (the largest reach)."""
+    layers = {"g": 0, "driven": 1, "x": 2}
+    kwargs = dict(pins=[("g", "x")], end_reach=lambda stack: 1.75, thickness_mm=T, gap_mm=GAP,
+                  outer=[("driven", PITCH)])
+    assert order_layers(layers, [], near_motor=[], **kwargs) == layers
+    for near in ([0], None):
+        ordered = order_layers(layers, [], near_motor=near, **kwargs)
+        assert ordered["driven"] in (min(ordered.values()), max(ordered.values())), near
+    # one layer too deep even without a pin end: out of the shaft's reach, always moved
+    assert order_layers(layers, [], near_motor=[], **{**kwargs, "outer": [("driven", 1.0)]})["driven"] != 1
+
+
+def test_a_shared_layer_is_split_where_no_order_of_the_layers_works():
+    """a and d share a layer; c may not lie between a and b, b not between d and c, a not between b and c: each
+    of the three orders of the three layers breaks one. Giving d a layer of its own (a, b, c, d) breaks none."""
+    layers = {"a": 0, "d": 0, "b": 1, "c": 2}
+    crossings = [("a", "b", "c"), ("d", "c", "b"), ("b", "c", "a")]
+
+    def broken(order):
+        return [(p, q, r) for p, q, r in crossings
+                if min(order[p], order[q]) < order[r] < max(order[p], order[q])]
+
+    plain = order_layers(layers, crossings)
+    assert plain["a"] == plain["d"] and len(broken(plain)) == 1
+    split = order_layers(layers, crossings, split=True)
+    assert split["a"] != split["d"] and broken(split) == []
+    assert sorted(split.values()) == [0, 1, 2, 3]

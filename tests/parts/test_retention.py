@@ -4,6 +4,7 @@ sizes (nominal vs modelled), and the standard pin each retention scheme takes fo
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import pytest
 
@@ -11,12 +12,14 @@ from fabricate.catalogue.clips import e_clip
 from fabricate.catalogue.pins import ISO2338_LENGTHS_MM, ISO8734_LENGTHS_MM, pin_lengths
 from fabricate.errors import SpecError
 from fabricate.parts.retention import (
-    SHORT_OF_END,
     choose_holder,
+    end_radius_mm,
+    end_reach_mm,
     fill_layer_gap,
     hole_label,
     hole_size,
     plan_pin,
+    press_stub_at_bottom,
 )
 from fabricate.process import parse_process, process_override
 from fabricate.table import Table
@@ -88,46 +91,47 @@ def test_nominal_and_modelled_hole_sizes_are_kept_apart():
 
 
 # -- pins --------------------------------------------------------------------------------------------------
-def test_press_pin_ends_inside_the_end_parts_when_a_standard_length_allows():
+def test_press_pin_is_the_shortest_standard_pin_over_the_stack_flush_at_one_end():
     sla = _process(profile="sla", pin_diameter_mm=2.0)
-    plan = plan_pin("A", sla, (0.0, 6.3), "crank", (0.0, 3.0), end_thickness_mm=(3.0, 3.0))
-    assert plan.choice.designation == "ISO 8734 2 × 6" and plan.length_mm in ISO8734_LENGTHS_MM
-    # 0.3 mm short of the holder's (bottom) face, flush with the top: nothing sticks out of the stack
-    assert plan.ends[0].protrusion_mm == pytest.approx(-0.3) and plan.ends[1].protrusion_mm == 0.0
-    assert plan.engagement_mm == pytest.approx(2.7) and plan.z_mm == pytest.approx(0.3)
-    # a pin as long as the stack whenever one is: no shortfall at all
-    exact = plan_pin("A", sla, (0.0, 12.0), "crank", (0.0, 3.0), end_thickness_mm=(3.0, 3.0))
+    plan = plan_pin("A", sla, (0.0, 6.3), "crank", (0.0, 3.0))
+    # 6 mm would end inside the stack: the next standard length, 8 mm, covers it
+    assert plan.choice.designation == "ISO 8734 2 × 8" and plan.length_mm in ISO8734_LENGTHS_MM
+    assert plan.length_mm >= plan.stack_mm + plan.allowance_mm and plan.allowance_mm == 0.0
+    # flush with the bottom, the standard length's extra (1.7 mm) a bare stub out of the top
+    assert plan.ends[0].protrusion_mm == 0.0 and plan.ends[1].protrusion_mm == pytest.approx(1.7)
+    assert plan.ends[1].washers == () and plan.ends[1].retainer is None
+    assert plan.engagement_mm == pytest.approx(3.0) and plan.z_mm == pytest.approx(0.0)
+    # a stack a standard length long: flush at both ends
+    exact = plan_pin("A", sla, (0.0, 12.0), "crank", (0.0, 3.0))
     assert exact.length_mm == 12.0 and exact.ends[0].protrusion_mm == exact.ends[1].protrusion_mm == 0.0
 
 
-def test_press_pin_short_of_the_stack_keeps_two_thirds_of_each_end_part():
+def test_press_pin_no_standard_length_covers_is_refused_naming_the_pin_diameter():
     sla = _process(profile="sla", pin_diameter_mm=3.0)
-    longest = pin_lengths(3.0, "ISO 8734")[-1]
-    plan = plan_pin("A", sla, (0.0, 36.6), "palm", (0.0, 12.0), end_thickness_mm=(12.0, 12.0))
-    assert plan.length_mm == longest == 30.0
-    # 6.6 mm short: the holder's end takes its third (4 mm), the top part the rest
-    assert plan.ends[0].protrusion_mm == pytest.approx(-12.0 * SHORT_OF_END)
-    assert plan.ends[1].protrusion_mm == pytest.approx(-(6.6 - 12.0 * SHORT_OF_END))
-    assert plan.engagement_mm == pytest.approx(12.0 * (1 - SHORT_OF_END))
-    with pytest.raises(SpecError) as err:  # 3 mm end parts cannot take 6.6 mm, and no pin reaches
-        plan_pin("A", sla, (0.0, 36.6), "palm", (0.0, 3.0), end_thickness_mm=(3.0, 3.0))
+    assert pin_lengths(3.0, "ISO 8734")[-1] == 30.0
+    with pytest.raises(SpecError) as err:  # the gripper's 3 x 12 mm plates: 36.6 mm, past Ø3's 30 mm
+        plan_pin("A", sla, (0.0, 36.6), "palm", (0.0, 12.0))
     assert err.value.path == "process.pin_diameter_mm" and "longest ISO 8734" in err.value.message
+    assert plan_pin("A", _process(profile="sla", pin_diameter_mm=4.0), (0.0, 36.6), "palm").length_mm == 40.0
 
 
-def test_press_pin_that_must_stick_out_does_so_where_no_layer_lies_beyond():
+def test_press_stub_sticks_out_of_the_top_unless_only_the_bottom_is_free():
     sla = _process(profile="sla", pin_diameter_mm=3.0)  # the shortest Ø3 ISO 8734 pin is 8 mm
-    kwargs = dict(holder_z_mm=(3.3, 6.3), end_thickness_mm=(3.0, 3.0))
-    top_free = plan_pin("A", sla, (3.3, 9.6), "crank", free_ends=(False, True), **kwargs)
-    assert top_free.length_mm == 8.0 and top_free.length_mm >= top_free.stack_mm + top_free.allowance_mm
-    assert top_free.ends[0].protrusion_mm == 0.0 and top_free.ends[1].protrusion_mm == pytest.approx(1.7)
-    bottom_free = plan_pin("A", sla, (3.3, 9.6), "crank", free_ends=(True, False), **kwargs)
-    assert bottom_free.ends[0].protrusion_mm == pytest.approx(1.7) and bottom_free.z_mm == pytest.approx(1.6)
-    # layers on both sides: out of the holder's outer face (the holder grips it there)...
-    boxed = plan_pin("A", sla, (3.3, 9.6), "crank", **kwargs)
-    assert boxed.ends[0].protrusion_mm == pytest.approx(1.7)
-    # ...but never out of the ground's mounting face
-    ground = plan_pin("A", sla, (3.3, 9.6), "frame", holder_is_ground=True, **kwargs)
-    assert ground.ends[0].protrusion_mm == 0.0 and ground.ends[1].protrusion_mm == pytest.approx(1.7)
+    stubs = {}
+    for free in ((False, True), (True, False), (False, False), (True, True)):
+        plan = plan_pin("A", sla, (3.3, 9.6), "crank", (3.3, 6.3), free_ends=free)
+        assert plan.length_mm == 8.0 and sorted(e.protrusion_mm for e in plan.ends) == pytest.approx([0.0, 1.7])
+        stubs[free] = "bottom" if plan.ends[0].protrusion_mm > 0 else "top"
+        assert stubs[free] == ("bottom" if press_stub_at_bottom(free) else "top")
+        assert plan.z_mm == pytest.approx(1.6 if stubs[free] == "bottom" else 3.3)
+    assert stubs == {(False, True): "top", (True, False): "bottom", (False, False): "top", (True, True): "top"}
+
+
+def test_end_reach_is_the_stub_or_infinite_where_no_standard_pin_covers():
+    sla = _process(profile="sla", pin_diameter_mm=3.0)
+    assert end_reach_mm(sla, 6.3) == pytest.approx(1.7) and end_reach_mm(sla, 8.0) == 0.0
+    assert end_reach_mm(sla, 9.6) == pytest.approx(0.4) and end_reach_mm(sla, 30.01) == math.inf
+    assert end_radius_mm(sla) == 1.5  # the bare pin
 
 
 def test_clip_pin_sticks_out_for_the_ring_at_both_ends():
