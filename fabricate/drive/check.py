@@ -255,6 +255,12 @@ def run_drive(design: DesignSpec, mechanism: Mechanism, motion: Motion, hints: A
         volts = f" at {actuator.voltage_v:g} V" if actuator.voltage_v is not None else ""
         result.notes.append(f"the catalogue gives no rated (continuous) value: the stall or holding value{volts} is "
                             "used, so the margin is all the reserve there is")
+        if actuator.kind == "stepper":
+            # no pull-out curve was found for the catalogued steppers (catalogue/actuators.py gaps): say so
+            result.notes.append("a stepper's holding torque is its torque at standstill; its pull-out torque falls "
+                                "with the step rate and depends on the driver (no pull-out curve in the catalogue): "
+                                "the check assumes the motion is run slowly; at speed, hold the effort to the "
+                                "maker's pull-out curve at that step rate")
     load = design.load
     if load is not None and spec.driver == 0 and (load.input_force_N or load.input_torque_Nmm):
         push = load.input_force_N if driver.kind == "slide" else load.input_torque_Nmm

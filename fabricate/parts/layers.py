@@ -6,9 +6,11 @@ the two outlines is compared with the clearance. Bodies joined by a pin always c
 share the pin). Bodies carrying meshing gears are merged into one group first (their teeth must lie in
 one plane) and the groups are coloured greedily (DSATUR, ties broken by body order so it is
 deterministic). The colours are then put in order (:func:`order_layers`): no body between the two layers of a
-pin it passes over; where a pin's retention sticks out of its stack (a clip and its washers, or a cap), no
-body that passes over the pin's end and no pin near it in the room beyond the end face, with empty layers put
-in where no order of the colours gives that room; a motor's short shaft's driven part near a face of the stack.
+pin it passes over; where a pin's retention sticks out of its stack (a clip and its washers, a cap, or a pressed
+pin's bare stub at one end), no body that passes over the pin's end and no pin near it in the room beyond the end
+face, with empty layers put in where no order of the colours gives that room; no stack longer than a standard pin;
+a motor's short shaft's driven part near a face of the stack, clear of the pin ends within the motor's reach.
+Where no order of the colours does all that, one body of a shared layer may take a layer of its own.
 """
 
 from __future__ import annotations

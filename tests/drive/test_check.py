@@ -272,3 +272,13 @@ def test_every_shipped_template_is_driven_by_its_actuator(template: str, shipped
     assert not any(f.startswith("drive:") for f in outcome.failures)
     assert "plots/drive.png" in outcome.files
     assert "## Drive" in outcome.files["report.md"].decode("utf-8")
+
+
+def test_a_stepper_held_to_its_holding_torque_says_it_assumes_a_slow_motion() -> None:
+    """The catalogue has no pull-out curve for its steppers: the check holds a NEMA 17 to its holding torque
+    (its stall value) and the report says what that assumes; a servo's stall value carries no such note."""
+    *_, stepper = _drive(crank_slider(PUSH, '[actuator]\nmodel = "nema17"'), poses=11)
+    assert stepper.rating_kind == "stall" and stepper.rating == pytest.approx(400.0)
+    assert [n for n in stepper.notes if "pull-out" in n and "holding torque" in n]
+    *_, servo = _drive(crank_slider(PUSH, '[actuator]\nmodel = "mg90s"'), poses=11)
+    assert servo.rating_kind == "stall" and not [n for n in servo.notes if "pull-out" in n]
