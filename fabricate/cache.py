@@ -433,7 +433,10 @@ def _disk_put(key: str, data: bytes) -> None:
     header = MAGIC + key.encode("ascii") + b"\n" + hashlib.sha256(data).hexdigest().encode("ascii") + b"\n"
     tmp = None
     try:
-        path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+        if not path.parent.is_dir():  # the cache's own folders private (their parents as the system makes them)
+            cache_dir().mkdir(parents=True, exist_ok=True, mode=0o700)
+            _entries_dir().mkdir(exist_ok=True, mode=0o700)
+            path.parent.mkdir(exist_ok=True, mode=0o700)
         fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".pkl", dir=path.parent)
         with os.fdopen(fd, "wb") as fh:
             fh.write(header)

@@ -139,6 +139,9 @@ def test_a_hit_is_a_fresh_equal_object_from_memory_then_disk(cache_dir):
     assert other is not first
     assert cache.stats["toy"] == {"hits": 2, "misses": 2, "stores": 2}
     assert len(entries(cache_dir)) == 2
+    if os.name == "posix":  # pickles are read back: only their owner may write the folders
+        assert all(path.stat().st_mode & 0o077 == 0 for path in (cache_dir, entries(cache_dir)[0].parent,
+                                                                    entries(cache_dir)[0].parent.parent))
 
 
 def test_off_unless_turned_on_and_no_cache_env_wins(cache_dir, monkeypatch):
