@@ -83,6 +83,10 @@ class SweepOutcome:
     #: Largest peak resident memory of a worker process (MB; 0 when unknown): its imports, its points and the
     #: stage results it keeps (see :data:`fabricate.bounds.WORKER_MB`).
     worker_peak_mb: float = 0.0
+    #: CPU seconds the workers spent over ``points_seconds`` (all of them together; 0 when unknown): divided by
+    #: ``points_seconds`` it is the cores they had, which on a machine shared with other work can be fewer than
+    #: the workers.
+    worker_cpu_seconds: float = 0.0
 
 
 # -- Dask ----------------------------------------------------------------------------------------------------
@@ -197,7 +201,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     client = cluster = None
     interrupted = False
     n_workers = tasks = 0
-    points_seconds = 0.0
+    points_seconds = worker_cpu = 0.0
     if todo:  # a cluster that cannot be had is a usage error: nothing is written
         client, cluster = connect(workers, scheduler)
         try:
@@ -214,10 +218,12 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
             say(f"sweep {spec.name}: {len(points)} points ({resumed} done earlier), stage {spec.stage}, "
                 f"{n_workers} Dask worker{'s' if n_workers != 1 else ''}"
                 f"{' at ' + scheduler if scheduler else ' (local cluster)'}")
-            began = time.perf_counter()
+            began, cpu = time.perf_counter(), _workers_cpu(client)
             tasks = _run_points(client, spec, todo, done, journal, out, start, resumed, len(points), draw, say,
                                 cache)
             points_seconds = time.perf_counter() - began
+            after = _workers_cpu(client)
+            worker_cpu = sum(after[w] - cpu[w] for w in after if w in cpu)
         elif not quiet:
             say(f"sweep {spec.name}: all {len(points)} points done earlier; writing the results")
     except KeyboardInterrupt:
@@ -258,7 +264,8 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     code = 130 if interrupted else (1 if counts.get(str(EXIT_INTERNAL)) else 0)
     return SweepOutcome(exit_code=code, out=out, total=len(points), done=len(rows), resumed=resumed,
                         counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers,
-                        tasks=tasks, notes=notes, points_seconds=points_seconds, worker_peak_mb=worker_peak)
+                        tasks=tasks, notes=notes, points_seconds=points_seconds, worker_peak_mb=worker_peak,
+                        worker_cpu_seconds=worker_cpu)
 
 
 def group_order(fields: Sequence[tuple[str, Sequence[str | int]]], points: Sequence[Mapping[str, Any]],
@@ -293,6 +300,14 @@ def _warm(client: Any) -> None:
         client.run(warm)
     except Exception:  # noqa: BLE001 - a worker that cannot run it will show why in its first point
         pass
+
+
+def _workers_cpu(client: Any) -> dict[str, float]:
+    """``{worker address: its process's CPU seconds so far}`` (empty when they cannot say)."""
+    try:
+        return {str(k): float(v) for k, v in client.run(time.process_time).items()}
+    except Exception:  # noqa: BLE001 - a figure for benchmarks
+        return {}
 
 
 def _worker_peak_mb(client: Any) -> float:

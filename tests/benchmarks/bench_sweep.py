@@ -35,6 +35,8 @@ sys.path.insert(0, str(ROOT))
 
 #: Each Dask run's largest worker peak memory, printed at the end.
 PEAKS: list[str] = []
+#: Per Dask run: the cores its workers had (CPU seconds over the points' wall time) and points per CPU second.
+CORES: list[str] = []
 #: Default points per stage (a synthesis point takes ~0.2 s, a build point of 60 poses ~1.5 s on an idle core).
 DEFAULT_POINTS = {"synth": 48, "build": 16}
 
@@ -73,6 +75,9 @@ def _dask(spec: Any, workers: int) -> tuple[float, float, float]:
         elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu
     assert outcome.exit_code == 0 and outcome.done == outcome.total, outcome
     PEAKS.append(f"{spec.stage}, {workers} worker{'s' if workers > 1 else ''}: {outcome.worker_peak_mb:.0f} MB")
+    CORES.append(f"{spec.stage}, {workers} worker{'s' if workers > 1 else ''}: "
+                 f"{outcome.worker_cpu_seconds / max(outcome.points_seconds, 1e-9):.2f} cores, "
+                 f"{spec.count() / max(outcome.worker_cpu_seconds, 1e-9):.2f} points per worker CPU second")
     return outcome.points_seconds, elapsed, cpu
 
 
@@ -137,6 +142,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"| {stage} | {n} | {name} | {seconds:.2f} | {whole:.2f} | {cpu:.2f} | {rate:.2f} | {ratio} "
                   f"| {load} |", flush=True)
     print(f"\nworkers' peak resident memory: {'; '.join(PEAKS)}")
+    print(f"cores the workers had (their CPU seconds over the points' wall time): {'; '.join(CORES)}")
     if args.overhead:
         print(f"\nno-op task round trip (submit + result, median of 200): {_noop_round_trip() * 1000:.2f} ms")
     return 0
