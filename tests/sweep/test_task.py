@@ -83,6 +83,7 @@ def test_a_build_sweep_synthesises_a_shared_synthesis_once_and_gives_the_same_ro
         return synthesise(design, *args, **kwargs)
 
     monkeypatch.setattr(pipeline, "synthesise", spy)
+    monkeypatch.delenv("FABRICATE_NO_CACHE", raising=False)  # the suite's default (tests/conftest.py): on here
     cache.clear_memory()
     before = dict(cache.stats.get("synthesis", {"hits": 0, "misses": 0}))
     shared = run_batch(batch, spec.base, spec.field_parts(), spec.stage, list(spec.metrics), cache=True)
