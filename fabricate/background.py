@@ -164,9 +164,10 @@ class Background:
             self._conn.close()
             self._process.join()
             self._process = None
-            # the child's workers (run_isolated) are this process's children: reaped here, their time and
-            # memory are the build's (the child is gone, so an unused one reads the end of its input)
-            _reap_handed(kill=False)
+            # the child's workers (prestart) are this process's children: reaped here, so their time and memory
+            # are the build's. The child is gone with every answer it asked for; a worker it did not use (a
+            # cached result) need not finish its warm-up
+            _reap_handed(kill=True)
             if ok:
                 return payload
         return _run_jobs(self.jobs)
