@@ -72,6 +72,9 @@ class DriveResult:
         The driver's travel over the motion (deg or mm, summed over direction changes).
     reason : str or None
         Why the check could not run (then it neither passes nor fails).
+    notes : list of str
+    mount_failures : list of str
+        The mount plate's holes over-stressed by the reaction torque (:func:`rate_mount`).
     """
 
     spec: ActuatorSpec | None
@@ -87,6 +90,7 @@ class DriveResult:
     travel: float = 0.0
     reason: str | None = None
     notes: list[str] = field(default_factory=list)
+    mount_failures: list[str] = field(default_factory=list)
 
     @property
     def allowed(self) -> float:
@@ -127,7 +131,7 @@ class DriveResult:
         """One line per reason the actuator cannot drive the design (empty when it can or was not checked)."""
         if self.reason is not None or self.actuator is None or self.spec is None:
             return []
-        out = []
+        out = list(self.mount_failures)
         a, k = self.actuator, self.peak
         if self.effort[k] > self.allowed:
             many = f" ({self.copies} copies)" if self.copies > 1 else ""
@@ -313,3 +317,48 @@ def drive_markdown(section: Mapping[str, Any]) -> list[str]:
 
 def _num(x: Any) -> str:
     return f"{x:.4g}" if isinstance(x, (int, float)) and not isinstance(x, bool) else str(x)
+
+
+def rate_mount(result: DriveResult, partset: Any, design: DesignSpec) -> None:
+    """The actuator's mount plate (role ``mount``) against the reaction torque: the peak effort ``T`` the
+    motor gives comes back through its own fixing screws into the plate and out through the standoff screws
+    into the ground part. A screw group at radii ``r_i`` about the output axis takes ``F_i = T r_i / sum r_j**2``
+    (the rigid-plate share); each hole bears ``F / (d t)`` on the plate (``d`` the screw or hole, ``t`` the
+    plate), held to the part material's compressive strength with ``[checks] min_safety_factor``. Adds a note
+    with the numbers, and a failure below the factor; nothing where there is no plate, no rotary effort or no
+    material."""
+    import re
+
+    placed = getattr(partset, "actuator", None)
+    material = design.process.part_material()
+    if (placed is None or not placed.mount_part or result.reason is not None or result.unit != "N·mm"
+            or not len(result.effort) or material is None or result.actuator is None):
+        return
+    torque = float(result.effort[result.peak])
+    plate = partset.part(placed.mount_part)
+    t = float(plate.thickness_mm)
+    groups: list[tuple[str, np.ndarray, float]] = []
+    if placed.standoffs:
+        sizes = [re.search(r"M(\d+(?:\.\d+)?)", f.designation) for f in placed.fasteners
+                 if f.purpose.startswith("mount plate to the ground")]
+        d = float(sizes[0].group(1)) if sizes and sizes[0] else min(s.inner_diameter_mm for s in placed.standoffs)
+        radii = np.array([float(np.hypot(*(np.asarray(s.centre) - np.asarray(placed.axis)))) for s in placed.standoffs])
+        groups.append(("standoff screws", radii, d))
+    holes = result.actuator.mounting_holes or ()
+    if holes:
+        radii = np.array([math.hypot(h.x, h.y) for h in holes])
+        groups.append(("actuator's fixing holes", radii, min(h.diameter_mm for h in holes)))
+    need = float(design.checks.min_safety_factor)
+    for what, radii, d in groups:
+        if float(np.sum(radii ** 2)) <= 0.0:
+            continue
+        force = torque * float(np.max(radii)) / float(np.sum(radii ** 2))
+        stress = force / (d * t)
+        factor = material.compressive_MPa / stress if stress > 0.0 else math.inf
+        line = (f"mount plate {placed.mount_part}, {what}: {len(radii)} at up to {float(np.max(radii)):.3g} mm from "
+                f"the axis take the {torque:.4g} N·mm reaction as {force:.3g} N each, bearing {stress:.3g} MPa on "
+                f"Ø{d:g} in the {t:g} mm plate: safety factor {factor:.3g} against {material.compressive_MPa:g} MPa "
+                "compressive")
+        result.notes.append(line)
+        if factor < need:
+            result.mount_failures.append(f"drive: {line} < {need:g}; a thicker plate (process.thickness_mm)")

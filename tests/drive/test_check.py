@@ -282,3 +282,27 @@ def test_a_stepper_held_to_its_holding_torque_says_it_assumes_a_slow_motion() ->
     assert [n for n in stepper.notes if "pull-out" in n and "holding torque" in n]
     *_, servo = _drive(crank_slider(PUSH, '[actuator]\nmodel = "mg90s"'), poses=11)
     assert servo.rating_kind == "stall" and not [n for n in servo.notes if "pull-out" in n]
+
+
+@pytest.mark.slow
+def test_the_mount_plate_bears_the_reaction_torque(shipped_build) -> None:
+    """The gear pair's NEMA 17 on its mount plate: its peak torque T comes back through the two standoff screws
+    at radii r_i about the axis as F = T max(r) / sum(r**2) each, bearing F / (d t) on the plate, recomputed here
+    from the placed standoffs; the same plate under 1e4 times the torque fails naming the plate."""
+    from fabricate.drive.check import DriveResult, rate_mount
+
+    outcome = shipped_build("gear_pair_elliptic")
+    placed, partset = outcome.partset.actuator, outcome.partset
+    torque = outcome.report["drive"]["peak_effort"]
+    r = np.array([np.hypot(*(np.asarray(s.centre) - placed.axis)) for s in placed.standoffs])
+    t = partset.part(placed.mount_part).thickness_mm
+    stress = torque * r.max() / np.sum(r ** 2) / (3.0 * t)  # M3 standoff screws
+    (note,) = [n for n in outcome.report["drive"]["notes"] if "standoff screws" in n]
+    assert f"bearing {stress:.3g} MPa" in note and f"{len(r)} at up to {r.max():.3g} mm" in note
+    material = outcome.design.process.part_material()
+    assert f"safety factor {material.compressive_MPa / stress:.3g}" in note
+    assert not any(f.startswith("drive: mount plate") for f in outcome.failures)
+    entry = outcome.design.actuator.entry()
+    heavy = DriveResult(outcome.design.actuator, entry, np.zeros(1), "deg", effort=np.array([torque * 1e4]))
+    rate_mount(heavy, partset, outcome.design)
+    assert [f for f in heavy.failures() if f.startswith(f"drive: mount plate {placed.mount_part}, standoff screws")]
