@@ -183,7 +183,8 @@ def _check_assembly(mechanism: Mechanism) -> None:
                                                           f"numbers, got {pose!r:.80}")
 
 
-def build(design: DesignSpec | str | Path | Mapping[str, Any], process: str | Path | None = None) -> Build:
+def build(design: DesignSpec | str | Path | Mapping[str, Any], process: str | Path | None = None, *,
+          cache: bool = False) -> Build:
     """Run the whole pipeline in memory.
 
     Parameters
@@ -193,12 +194,17 @@ def build(design: DesignSpec | str | Path | Mapping[str, Any], process: str | Pa
         (through :func:`from_mechanism` with its defaults).
     process : str or Path, optional
         ``"sla"``, ``"laser"`` or a profile file: replaces the design's process (``--process``).
+    cache : bool
+        Reuse (and store) stage results in the stage cache, as ``fabricate build`` does (:mod:`fabricate.cache`:
+        an edit of one table reruns only the stages that read it; the files are the same bytes either way).
+        Off by default here: a library call writes nothing to the user's cache folder unless asked.
 
     Raises
     ------
     SpecError, SynthesisError
         Bad input or nothing feasible (the CLI's exit code 2); an argument of the wrong type names it.
     """
+    from fabricate.cache import use_cache
     from fabricate.mechanism import Mechanism
     from fabricate.pipeline import run_build
 
@@ -215,7 +221,10 @@ def build(design: DesignSpec | str | Path | Mapping[str, Any], process: str | Pa
 
         override = process_override(str(path_argument(process, "process", '"sla", "laser" or a process profile file')))
         design = design_from_text(design.template_text, design.template, override)
-    return run_build(design)
+    if not isinstance(cache, bool):
+        raise SpecError("cache", f"expected True or False, got {type_name(cache)}")
+    with use_cache(cache):
+        return run_build(design)
 
 
 #: Deepest nesting of a dict of tables (a template's deepest is a few levels; a cycle would recurse forever).

@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any, NoReturn, TextIO
 
 from fabricate import __version__
+from fabricate.cache import use_cache
 from fabricate.errors import FabricateError, SpecError
 
 DEFAULT_TEMPLATE = "finger_five_bar_ncg"
@@ -177,6 +178,8 @@ def _say(line: str) -> None:
 
 
 QUIET_HELP = "no progress output (the result line and any failures are still printed)"
+NO_CACHE_HELP = ("compute every stage afresh: neither read nor write the stage cache ($FABRICATE_CACHE_DIR, else "
+                 "~/.cache/fabricate; $FABRICATE_NO_CACHE=1 turns it off everywhere; 'check' never uses it)")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -213,6 +216,7 @@ def _parser() -> argparse.ArgumentParser:
         cmd.add_argument("--force", action="store_true",
                          help="replace an output folder that holds files fabricate did not write")
         cmd.add_argument("-q", "--quiet", action="store_true", help=QUIET_HELP)
+        cmd.add_argument("--no-cache", action="store_true", help=NO_CACHE_HELP)
     c = sub.add_parser("check", help="verify an output folder (files, contents, rebuild) or check a template")
     c.add_argument("target", help="template, or a folder written by 'fabricate build'")
     c.add_argument("-q", "--quiet", action="store_true", help=QUIET_HELP)
@@ -246,6 +250,7 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("-o", "--output", type=Path, help="output folder (default outputs/<name>-sweep/): new, empty, "
                                                      "or an earlier run of the same sweep, which is resumed")
     w.add_argument("-q", "--quiet", action="store_true", help=QUIET_HELP)
+    w.add_argument("--no-cache", action="store_true", help=NO_CACHE_HELP)
     sub.add_parser("list", help="templates shipped")
     i = sub.add_parser("init", help="write an editable copy of a shipped template (or, with --process, of a "
                                      "process profile) into the current folder")
@@ -340,7 +345,8 @@ def _build(args: argparse.Namespace) -> int:
         protect[Path(args.process)] = "the process profile in use"
     # refuse a bad output folder before the work, and again under the lock when writing
     out = check_output_dir(target, force=args.force, stage=stage, protect=protect)
-    outcome = (run_build if stage == "build" else run_synth)(design, _progress(args.quiet))
+    with use_cache(not args.no_cache):  # stage results reused across runs (fabricate/cache.py)
+        outcome = (run_build if stage == "build" else run_synth)(design, _progress(args.quiet))
     write_output(outcome.files, out, force=args.force, stage=stage, protect=protect,
                  warn=lambda msg: _say(f"fabricate: warning: {msg}"))
     args.written = out  # an interruption from here on comes after a complete write
@@ -363,7 +369,8 @@ def _check(args: argparse.Namespace) -> int:
                 raise SpecError(args.target, "no such folder or template: 'check' takes a folder written by "
                                              "'fabricate build' or a template (a file, or a name from "
                                              "'fabricate list'), and neither exists") from None
-        outcome = run_build(load_design(args.target, args.process, args.printer), _progress(args.quiet))
+        with use_cache(False):  # check never reads or writes the stage cache: its verdict is a fresh build
+            outcome = run_build(load_design(args.target, args.process, args.printer), _progress(args.quiet))
         _summary(outcome.report, None)
         return outcome.exit_code
     from fabricate.verify import verify_output
@@ -373,7 +380,8 @@ def _check(args: argparse.Namespace) -> int:
     if args.printer:
         raise SpecError("--printer", "a folder is checked with the printer it was built for (see its report)")
 
-    problems, report = verify_output(target, _progress(args.quiet))
+    with use_cache(False):
+        problems, report = verify_output(target, _progress(args.quiet))
     if report is None:
         print(f"{target}: FAILED")
         for problem in problems:
@@ -452,8 +460,9 @@ def _sweep(args: argparse.Namespace) -> int:
     near = base_dir / spec.template if base_dir is not None else None
     template = near if near is not None and near.is_file() else find_template(spec.template)
     protect = [template] if source is None else [source, template]
-    outcome = run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler, quiet=args.quiet,
-                        protect=protect)
+    with use_cache(not args.no_cache):
+        outcome = run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler, quiet=args.quiet,
+                            protect=protect)
     if outcome.exit_code == EXIT_INTERRUPTED:
         signum = args.received[0] if getattr(args, "received", None) else signal.SIGINT
         _say(f"fabricate: {STOP_SIGNALS[signal.Signals(signum).name]}; {outcome.done} of {outcome.total} points are "

@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from fabricate import __version__
-from fabricate.background import Background
+from fabricate import __version__, cache
+from fabricate.background import Background, in_thread
 from fabricate.bounds import blas_threads
 from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
 from fabricate.kinds import KINDS
@@ -159,18 +159,27 @@ def synthesise(design: DesignSpec, progress: Progress = _quiet) -> SynthesisResu
 def _synthesis_stage(design: DesignSpec, progress: Progress, stage: str
                      ) -> tuple[SynthesisResult, dict[str, Any], Motion | None, list[str]]:
     """Synthesis and the swept motion; a lock-up inside the range is a design failure, not an error."""
-    result = synthesise(design, progress)
+    result, motion, lockup = cache.cached("synthesis", cache.synthesis_key(design),
+                                          lambda: _synthesis_and_motion(design, progress))
     # the schema version first: a reader learns which contract the rest follows before reading it
     report: dict[str, Any] = {"schema_version": SCHEMA_VERSION, "design": design_section(design, stage)}
-    progress("sweep")
-    try:
-        motion = result.mechanism.sweep(design.checks.sweep_poses)
-    except LockupError as exc:
+    if motion is None:
         report["synthesis"] = result.report
-        return result, report, None, [f"motion: {exc}"]
+        return result, report, None, [f"motion: {lockup}"]
     report["mechanism"] = mechanism_section(result.mechanism, motion)
     report["synthesis"] = result.report
     return result, report, motion, []
+
+
+def _synthesis_and_motion(design: DesignSpec, progress: Progress
+                          ) -> tuple[SynthesisResult, Motion | None, str | None]:
+    """Synthesis and its sweep, or the lock-up that stops the sweep: one entry of :mod:`fabricate.cache`."""
+    result = cache.storable_synthesis(synthesise(design, progress), design)
+    progress("sweep")
+    try:
+        return result, result.mechanism.sweep(design.checks.sweep_poses), None
+    except LockupError as exc:
+        return result, None, str(exc)
 
 
 @dataclass(frozen=True)
@@ -272,6 +281,11 @@ def run_build(design: DesignSpec, progress: Progress = _quiet, *,
     SpecError, SynthesisError
         Invalid input or nothing feasible (the CLI exits 2 and writes nothing).
     """
+    if (optional is None or (optional.step and optional.step_files is None)) and \
+            not cache.stored("step", cache.pictures_key(design, "step")):  # a stored STEP result needs no OCP
+        from fabricate.export import prestart_step
+
+        prestart_step()  # OCP imports in the STEP worker on the second core while synthesis runs
     result, report, motion, failures = _synthesis_stage(design, progress, "build")
     if motion is None:
         report["checks"] = {"passed": False, "failures": failures}
@@ -323,8 +337,9 @@ def _make_gears(run: BuildRun) -> None:
 
     run.enter("gears")
     # gears.module_mm = "auto": the smallest standard module the process makes and the load allows
-    run.gear_pairs = build_gear_pairs(run.mechanism, run.design.gears, run.design.process.chord_tolerance_mm,
-                                      lambda: module_limits(run.design, run.mechanism, run.motion, run.synthesis.parts))
+    run.gear_pairs = cache.cached("gears", cache.gears_key(run.design), lambda: build_gear_pairs(
+        run.mechanism, run.design.gears, run.design.process.chord_tolerance_mm,
+        lambda: module_limits(run.design, run.mechanism, run.motion, run.synthesis.parts)))
     run.report["gears"] = [pair.report() for pair in run.gear_pairs]
 
 
@@ -336,8 +351,8 @@ def _size_links(run: BuildRun) -> None:
     run.enter("sizing")
     design, mechanism, motion, gear_pairs, hints = run.design, run.mechanism, run.motion, run.gear_pairs, \
         run.synthesis.parts
-    width, tried = size_link_width(design, mechanism, motion, gear_pairs, hints,
-                                   lambda d: build_parts(d, mechanism, motion, gear_pairs, hints))
+    width, tried = cache.cached("sizing", cache.sizing_key(design), lambda: size_link_width(
+        design, mechanism, motion, gear_pairs, hints, lambda d: build_parts(d, mechanism, motion, gear_pairs, hints)))
     run.design = dataclasses.replace(design, parts=dataclasses.replace(design.parts, link_width_mm=width))
     run.sizing = {"link_width_mm": width, "tried": [{"link_width_mm": w, "least_safety_factor": sf}
                                                     for w, sf in tried]}
@@ -348,7 +363,8 @@ def _make_parts(run: BuildRun) -> None:
     from fabricate.parts.build import build_parts
 
     run.enter("parts")
-    run.partset = build_parts(run.design, run.mechanism, run.motion, run.gear_pairs, run.synthesis.parts)
+    run.partset = cache.cached("parts", cache.parts_key(run.design), lambda: build_parts(
+        run.design, run.mechanism, run.motion, run.gear_pairs, run.synthesis.parts))
 
 
 def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
@@ -359,19 +375,27 @@ def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
     result, gear_pairs, design, partset, motion = run.synthesis, run.gear_pairs, run.design, run.partset, run.motion
     optional = run.optional
 
+    def step_files() -> dict[str, bytes]:
+        return cache.cached("step", cache.pictures_key(design, "step"), lambda: export_step(design, partset, motion))
+
     def step_job() -> dict[str, bytes]:
         if optional is None:
-            return export_step(design, partset, motion)
+            return step_files()
         if not optional.step:
             return {}
-        return dict(optional.step_files) if optional.step_files is not None else export_step(design, partset,
-                                                                                             motion)
+        return dict(optional.step_files) if optional.step_files is not None else step_files()
 
     from fabricate.export.guide import guide_picture_files
 
-    return [lambda: synthesis_plots(result), lambda: gear_pictures(gear_pairs),
-            lambda: export_previews(design, partset, motion), step_job,
-            lambda: guide_picture_files(partset, motion)]
+    # each job's result is a cache entry (fabricate.cache; the synthesis plots are the result's own figures')
+    # the STEP job mostly waits on its own process (export_step): in a thread, the pictures are drawn meanwhile
+    return [lambda: synthesis_plots(result),
+            lambda: cache.cached("gear_pictures", cache.pictures_key(design, "gear_pictures"),
+                                 lambda: gear_pictures(gear_pairs)),
+            lambda: cache.cached("previews", cache.pictures_key(design, "previews"),
+                                 lambda: export_previews(design, partset, motion)), in_thread(step_job),
+            lambda: cache.cached("guide_pictures", cache.pictures_key(design, "guide_pictures"),
+                                 lambda: guide_picture_files(partset, motion))]
 
 
 def _record_optional_outputs(run: BuildRun) -> bool:
@@ -398,8 +422,17 @@ def _export(run: BuildRun, with_step: bool) -> None:
 
     run.enter("exports")
     assert run.partset is not None  # the parts stage ran
-    exported, parts_report = export_all(run.design, run.partset, run.mechanism, run.motion, previews=False,
-                                        step=False, with_step=with_step, sections=run.report)
+    partset = run.partset
+
+    def make() -> tuple[dict[str, bytes], list[dict[str, Any]], Any]:
+        sections: dict[str, Any] = {}  # a cut process adds its "cut" section: part of the cached result
+        files, parts = export_all(run.design, partset, run.mechanism, run.motion, previews=False, step=False,
+                                  with_step=with_step, sections=sections)
+        return files, parts, sections.get("cut")
+
+    exported, parts_report, cut = cache.cached("exports", cache.exports_key(run.design, with_step), make)
+    if cut is not None:
+        run.report["cut"] = cut
     run.files.update(exported)
     run.report["parts"] = parts_report
     run.report["bom"] = list(getattr(run.partset, "bom", []))
@@ -429,7 +462,9 @@ def _check(run: BuildRun) -> None:
 
     run.enter("checks")
     assert run.partset is not None  # the parts stage ran
-    run.checks = run_checks(run.design, run.partset, run.mechanism, run.motion, run.gear_pairs)
+    partset = run.partset
+    run.checks = cache.cached("checks", cache.checks_key(run.design), lambda: run_checks(
+        run.design, partset, run.mechanism, run.motion, run.gear_pairs))
     run.report["interference"] = run.checks.interference
     run.failures = list(run.checks.failures)
     for pair in run.gear_pairs:
@@ -442,8 +477,9 @@ def _check_strength(run: BuildRun) -> None:
 
     run.enter("strength")
     assert run.partset is not None  # the parts stage ran
-    run.strength = run_strength(run.design, run.partset, run.mechanism, run.motion, run.gear_pairs,
-                                run.synthesis.parts)
+    partset = run.partset
+    run.strength = cache.cached("strength", cache.strength_key(run.design), lambda: run_strength(
+        run.design, partset, run.mechanism, run.motion, run.gear_pairs, run.synthesis.parts))
     run.report["strength"] = run.strength.report()
     if run.sizing is not None:
         run.report["strength"]["sizing"] = run.sizing
@@ -452,12 +488,13 @@ def _check_strength(run: BuildRun) -> None:
 
 def _check_drive(run: BuildRun) -> None:
     """The actuator against the input effort the statics compute at every pose: report.json's ``drive``."""
-    from fabricate.drive.check import run_drive
+    from fabricate.drive.check import rate_mount, run_drive
 
     run.enter("drive")
     assert run.partset is not None  # the parts stage ran
     run.drive = run_drive(run.design, run.mechanism, run.motion, run.synthesis.parts, run.strength,
                           copies=run.partset.copies)
+    rate_mount(run.drive, run.partset, run.design)  # the mount plate's holes against the reaction torque
     run.report["drive"] = run.drive.report()
     run.failures += run.drive.failures()
 
@@ -480,13 +517,16 @@ def _plots(run: BuildRun, pictures: Background) -> None:
 
     run.enter("plots")
     assert run.checks is not None and run.strength is not None  # both checks ran
-    if run.strength.findings:
-        run.files["plots/strength.png"] = strength_plot(run.strength, run.mechanism.input_unit)
-    if run.drive is not None and run.drive.reason is None:
+    strength, drive, checks = run.strength, run.drive, run.checks
+    if strength.findings:
+        run.files["plots/strength.png"] = cache.cached("strength_plot", cache.strength_key(run.design), lambda:
+                                                       strength_plot(strength, run.mechanism.input_unit))
+    if drive is not None and drive.reason is None:
         from fabricate.drive.plots import drive_plot
 
-        run.files["plots/drive.png"] = drive_plot(run.drive)
-    for name, data in sorted(run.checks.figures().items()):
+        run.files["plots/drive.png"] = cache.cached("drive_plot", cache.drive_key(run.design),
+                                                    lambda: drive_plot(drive))
+    for name, data in sorted(cache.cached("check_figures", cache.checks_key(run.design), checks.figures).items()):
         run.files[f"plots/{name}"] = data
     run.files.update(pictures.result())
 

@@ -10,7 +10,7 @@ a correct test (the suite must pass with the cores busy).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pytest
@@ -25,6 +25,18 @@ from fabricate.process import ProcessSpec
 # Test modules' own @settings(...) inherit what they do not set from this profile.
 settings.register_profile("fabricate", deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile("fabricate")
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _no_stage_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """The suite never touches the user's stage cache (fabricate/cache.py): its folder is a temporary one, and the
+    cache is off (``FABRICATE_NO_CACHE``, which subprocesses inherit too), so a CLI build in one test never serves
+    another's stages (one that monkeypatches a stage must see it run). tests/test_cache.py turns it on to test it."""
+    patch = pytest.MonkeyPatch()
+    patch.setenv("FABRICATE_CACHE_DIR", str(tmp_path_factory.mktemp("stage-cache")))
+    patch.setenv("FABRICATE_NO_CACHE", "1")
+    yield
+    patch.undo()
 
 
 def make_four_bar(crank: float = 15.0, coupler: float = 40.0, rocker: float = 30.0, ground: float = 40.0,
