@@ -70,9 +70,11 @@ def _polar_tables(table: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
     return key.ravel(), phi.ravel(), ranges
 
 
-#: Posed outline vertices (both gears) held at once by :func:`mesh_check` (~1 GB of arrays and shapely
-#: geometry at the peak, measured 0.2 MB per step for 30-tooth gears of ~14000 vertices).
-MESH_VERTICES_PER_CHUNK = 4_000_000
+#: Posed outline vertices (both gears) held at once by :func:`mesh_check` (measured 0.2 MB per step for 30-tooth
+#: gears of ~14000 vertices, so ~50 MB of arrays and shapely geometry at the peak). 4000000 held ~1 GB: the
+#: default finger's mesh check then peaked at 225 MB at 360 poses and 1318 MB at 5000 (5.9x); at 200000 it is
+#: 1.16x (bench_bounds --poses-memory). Chunking changes no value: the areas are per step.
+MESH_VERTICES_PER_CHUNK = 200_000
 
 #: Posed flank points of gear a held at once by :func:`free_play` within :func:`mesh_check`: about 150 bytes
 #: each across its temporaries (the finger's 720 steps in one piece peaked at 175 MB; 100000 points hold
