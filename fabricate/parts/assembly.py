@@ -243,9 +243,13 @@ def _retention(pin: Any) -> tuple[str, str]:
     on_ends = "; ".join(f"{where}: {' + '.join(items)}" for where, items in zip(("bottom", "top"), ends, strict=False)
                         if items)
     if scheme == "press":
-        short = min(getattr(pin, "protrusion_mm", (0.0, 0.0))) < 0.0
+        bottom, top = (float(v) for v in getattr(pin, "protrusion_mm", (0.0, 0.0)))
+        # the standard length's extra stands out of one face as a bare stub (parts/retention.py), flush at the other
+        ends = ("flush with both faces" if max(bottom, top) <= 1e-9 else
+                f"flush with the {'top' if bottom > top else 'bottom'} face, {max(bottom, top):.2f} mm out of the "
+                f"{'bottom' if bottom > top else 'top'}")
         text = (f"press the pin into {getattr(pin, 'holder', '') or 'the part that holds it'} "
-                f"({float(getattr(pin, 'engagement_mm', 0.0)):.3g} mm engaged{', short of its face' if short else ''})"
+                f"({float(getattr(pin, 'engagement_mm', 0.0)):.3g} mm engaged, {ends})"
                 "; it runs free in the other parts")
         return text, "bench vice or arbor press (press the pin in square, supporting the part round the hole)"
     if scheme == "clip":

@@ -384,7 +384,7 @@ def _layers(outlines: Mapping[str, BulgePath], holes: Mapping[str, Sequence[Hole
     crossings = pin_crossings(coarse, poses, [(holes_at[(a, name)], a, b) for name, bodies in pin_joints
                                               for i, a in enumerate(bodies) for b in bodies[i + 1:]],
                               radius, clearance_mm + CONFLICT_CHORD_MM)
-    from fabricate.drive.rotary import output_depth, replaced_joint  # the drive sits above the parts layer
+    from fabricate.drive.rotary import motor_reach, output_depth, replaced_joint  # the drive sits above parts
 
     depth = output_depth(design, mechanism)
     outer = [depth] if depth is not None else []
@@ -401,10 +401,17 @@ def _layers(outlines: Mapping[str, BulgePath], holes: Mapping[str, Sequence[Hole
     over = [(i, c) for i, ((centre, a), (_, bodies)) in enumerate(zip(at, kept, strict=True))
             for _, _, c in pin_crossings(coarse, poses, [(centre, a, a)], max(radius, end_r),
                                          clearance_mm + CONFLICT_CHORD_MM) if c not in bodies]
+    # the pins whose ends a motor under or over the stack may meet: those within its body's reach of its axis
+    motor = motor_reach(design, mechanism)
+    near = None if motor is None else [i for i, j in pin_neighbours(at + [(motor[1], motor[0])], poses,
+                                                                   motor[2] + end_r + clearance_mm)
+                                       if j == len(at)]
+    # a pin's end against a neighbour's stack: its spacers are bosses (radius) round the pin
     return order_layers(layers, crossings, pins=[tuple(bodies) for _, bodies in kept], end_crossings=over,
-                        pin_pairs=pin_neighbours(at, poses, 2.0 * end_r + clearance_mm),
+                        pin_pairs=pin_neighbours(at, poses, max(radius, end_r) + end_r + clearance_mm),
                         end_reach=lambda stack: end_reach_mm(process, stack), thickness_mm=process.thickness_mm,
-                        gap_mm=process.layer_gap_mm, spare_layers=3, outer=outer)
+                        gap_mm=process.layer_gap_mm, spare_layers=3, outer=outer,
+                        one_end=process.retention == "press", near_motor=near, split=True)
 
 
 def _body_parts(drawing: _Drawing, mechanism: Mechanism, outlines: Mapping[str, BulgePath],

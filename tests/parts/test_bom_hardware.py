@@ -1,8 +1,8 @@
 """Standard hardware and fits in built designs (issue 25, items 2 and 3).
 
 - every pin is a standard pin (its designation reads back to its length, in the ISO 8734 / ISO 2338 series)
-  and covers its stack plus what its retention needs; a pressed pin ends no more than a third of an end
-  part short of the stack's faces, and only when a standard length that short exists;
+  and covers its stack plus what its retention needs; a pressed pin is the shortest one over its stack,
+  flush at one end with the rest a bare stub at the other;
 - every screw, washer and clip of the BOM is a catalogued standard item, every row says print, cut or buy;
 - every hole has its fit's nominal size (press: pin - the profile's interference; running: pin + 2 x the
   running clearance) and is modelled with the process's compensation on top;
@@ -25,7 +25,6 @@ import trimesh
 from fabricate.catalogue.designations import parse_designation
 from fabricate.catalogue.pins import PinChoice, pin_lengths
 from fabricate.parts.build import build_parts
-from fabricate.parts.retention import SHORT_OF_END
 from fabricate.parts.spec import PartsSpec
 from fabricate.templates import shipped_templates
 
@@ -35,6 +34,11 @@ EPS = 1e-9
 
 def _standard(designation: str) -> str:
     return " ".join(designation.split()[:2])  # "ISO 8734 2 × 20" -> "ISO 8734"
+
+
+def holes_part(on_pin, body):
+    (part,) = [p for p in on_pin if p.body == body]
+    return part
 
 
 def check_pins(partset, process) -> None:
@@ -59,22 +63,12 @@ def check_pins(partset, process) -> None:
             holes = {p.body: next(h for h in p.holes if h.joint == pin.joint) for p in on_pin}
             assert holes[pin.holder].fit == "press"
             assert all(h.fit == "running" for b, h in holes.items() if b != pin.holder)
-            if pin.length_mm >= pin.stack_mm - EPS:  # covers the stack...
-                assert min(pin.protrusion_mm) >= -EPS
-                # ...and is the shortest that does, and no shorter pin keeps two thirds of the end parts
-                assert not [v for v in lengths if pin.stack_mm - EPS <= v < pin.length_mm]
-                ends = [max((p.thickness_mm for p in on_pin if abs(p.z_mm - z0) < 1e-6), default=0.0),
-                        max((p.thickness_mm for p in on_pin if abs(p.z_mm + p.thickness_mm - z1) < 1e-6),
-                            default=0.0)]
-                assert not [v for v in lengths if v < pin.stack_mm - EPS
-                            and pin.stack_mm - v <= SHORT_OF_END * sum(ends) + EPS]
-            else:  # ends inside the end parts, each keeping two thirds of its thickness on the pin
-                for side, z in ((0, z0), (1, z1)):
-                    short = -pin.protrusion_mm[side]
-                    if short > EPS:
-                        (end,) = [p for p in on_pin if abs((p.z_mm if side == 0 else p.z_mm + p.thickness_mm) - z)
-                                  < 1e-6]
-                        assert short <= SHORT_OF_END * end.thickness_mm + EPS
+            # the shortest standard pin over the stack: flush at one end, the rest a stub out of the other
+            assert pin.length_mm >= pin.stack_mm - EPS
+            assert not [v for v in lengths if pin.stack_mm - EPS <= v < pin.length_mm]
+            assert min(pin.protrusion_mm) == pytest.approx(0.0, abs=1e-9)
+            assert max(pin.protrusion_mm) == pytest.approx(pin.length_mm - pin.stack_mm, abs=1e-9)
+            assert pin.engagement_mm == pytest.approx(holes_part(on_pin, pin.holder).thickness_mm, abs=1e-9)
         else:
             assert pin.length_mm >= pin.stack_mm + pin.allowance_mm - EPS
             assert min(pin.protrusion_mm) >= 0.5 * pin.allowance_mm - EPS
