@@ -11,6 +11,7 @@ import dataclasses
 import os
 import pickle
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +26,7 @@ DEFAULT = "finger_five_bar_ncg"
 
 
 @pytest.fixture
-def cache_dir(tmp_path, monkeypatch) -> Path:
+def cache_dir(tmp_path, monkeypatch) -> Iterator[Path]:
     """A fresh, empty cache folder for this test, the in-process layer and the statistics forgotten."""
     folder = tmp_path / "cache"
     monkeypatch.setenv("FABRICATE_CACHE_DIR", str(folder))
