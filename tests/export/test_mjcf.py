@@ -385,10 +385,12 @@ def test_mjcf_contacts_agree_with_the_interference_proof(shipped_build: Callable
 
 
 @pytest.mark.slow
-def test_mjcf_contacts_find_the_collision_of_the_14_mm_link_six_bar() -> None:
-    """The Watt six-bar with 14 mm links: fabricate's interference check rejects it (the proximal link runs
-    into the spacer at d0); MuJoCo's collision of the same meshes finds the same two parts in contact, and
-    no penetration between convex parts fabricate proves clear."""
+def test_mjcf_contacts_find_the_collision_of_the_24_mm_link_six_bar() -> None:
+    """The Watt six-bar with 24 mm links: fabricate's interference check rejects it (the rocker runs into the
+    spacer at d); MuJoCo's collision of the same meshes finds the same two parts in contact, and no penetration
+    between convex parts fabricate proves clear. (At 14 mm the proximal link hit spacer_d0 until pressed pins
+    covered their stacks; since then 10-20 mm links fail only on pin_d's stub in spacer_f, a pin MuJoCo models as
+    a joint, not a geom.)"""
     import re
 
     from fabricate.design import design_from_text
@@ -396,14 +398,19 @@ def test_mjcf_contacts_find_the_collision_of_the_14_mm_link_six_bar() -> None:
     from fabricate.templates import find_template
 
     text = find_template("finger_watt_six_bar").read_text(encoding="utf-8")
-    text = re.sub(r"^link_width_mm\s*=.*$", "link_width_mm = 14.0", text, count=1, flags=re.M)
+    text = re.sub(r"^link_width_mm\s*=.*$", "link_width_mm = 24.0", text, count=1, flags=re.M)
     build = run_build(design_from_text(text, "finger_watt_six_bar.toml"))
     assert build.motion is not None
     collisions = build.report["interference"]["collisions"]
     assert collisions
     deepest = deepest_contacts(build, np.arange(0, len(build.motion.inputs), 10))
-    for hit in collisions:
-        assert deepest.get(frozenset((hit["a"], hit["b"])), 0.0) > 1e-3
+    # the model's geoms are the parts (its pins are joints): a pressed pin's stub in a spacer (spacer_f / pin_d
+    # since pins cover their stacks) is fabricate's alone
+    parts = {p.name for p in build.partset.parts}
+    between_parts = [hit for hit in collisions if {hit["a"], hit["b"]} <= parts]
+    assert between_parts  # else this test compares nothing
+    for hit in between_parts:
+        assert deepest.get(frozenset((hit["a"], hit["b"])), 0.0) > 1e-3, hit
     wrong, _ = clearance_disagreements(build)
     assert not wrong
 
