@@ -197,15 +197,18 @@ _FDM_BUILDS: dict[str, BuildOutcome] = {}
 @pytest.mark.slow
 @pytest.mark.parametrize("preset", sorted(PRINTERS))
 def test_prusaslicer_slices_plates_on_every_printer_preset(preset, tmp_path, shipped_build):
-    """Jansen's leg (8 parts, 3 SL1S plates) and the Watt six-bar packed for each preset's bed: SLA presets
-    with the SLA build's parts, FDM presets with the template built with --process fdm."""
+    """Jansen's leg (8 parts, 3 SL1S plates) or the Watt six-bar packed for each preset's bed: SLA presets with
+    the SLA build's parts, FDM presets with the template built with --process fdm. One template per preset, in
+    turn by the presets' technique, so each technique slices both (the SL1S, the smallest bed, slices every
+    template's own plates in the test above)."""
     spec = printer(preset)
-    for template in ("jansen_leg", "finger_watt_six_bar"):
-        if spec.technique == "sla":
-            outcome, process = shipped_build(template), None
-        else:
-            if template not in _FDM_BUILDS:
-                _FDM_BUILDS[template] = run_build(load_design(template, "fdm"))
-            outcome, process = _FDM_BUILDS[template], "fdm"
-        plates, margin = _relaid(outcome, preset, process)
-        _slice_plates(plates, spec, outcome.design.process.first_layer_compensation_mm, margin, tmp_path / template)
+    same_technique = sorted(name for name in PRINTERS if printer(name).technique == spec.technique)
+    template = ("jansen_leg", "finger_watt_six_bar")[same_technique.index(preset) % 2]
+    if spec.technique == "sla":
+        outcome, process = shipped_build(template), None
+    else:
+        if template not in _FDM_BUILDS:
+            _FDM_BUILDS[template] = run_build(load_design(template, "fdm"))
+        outcome, process = _FDM_BUILDS[template], "fdm"
+    plates, margin = _relaid(outcome, preset, process)
+    _slice_plates(plates, spec, outcome.design.process.first_layer_compensation_mm, margin, tmp_path / template)
