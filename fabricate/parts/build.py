@@ -191,7 +191,10 @@ def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_p
     drawing = _Drawing.start(mechanism, sizes.boss_radius_mm)
     pin_joints = _add_joints(drawing, mechanism, motion, sizes, process)
     _add_pads(drawing, mechanism, hints.pads or {}, parts_spec, sizes.boss_radius_mm, tol)
-    _add_gears(drawing, mechanism, gear_pairs, sizes.hub_mm, tol)
+    _add_gears(drawing, mechanism, gear_pairs, sizes.hub_mm, tol,
+               _mesh_limits(mechanism, motion, gear_pairs, process.running_clearance_mm),
+               0.5 * sizes.hole_mm + process.min_wall_mm,
+               explicit_hub=bool(parts_spec.hub_diameter_mm or gear_hub))
     outlines = _outlines(drawing, mechanism, motion, sizes, parts_spec, process)
     layers = _layers(outlines, drawing.holes, pin_joints, mechanism, motion, gear_pairs, sizes.boss_radius_mm,
                      design)
@@ -326,14 +329,50 @@ def _add_pads(drawing: _Drawing, mechanism: Mechanism, pads: Mapping[str, PadHin
             drawing.circles[body].append((centre, max(r_pad, radius)))
 
 
+def _mesh_limits(mechanism: Mechanism, motion: Motion, gear_pairs: Sequence[GearPair],
+                 clearance: float) -> dict[tuple[str, str], float]:
+    """The largest radius a boss or hub round each gear's axis may have: ``clearance`` short of the nearest
+    the mating gear comes to the axis over the motion (its tips, reaching down to this gear's root).
+
+    Returns
+    -------
+    dict
+        (body, axis joint) -> radius, mm.
+    """
+    out: dict[tuple[str, str], float] = {}
+    for pair in gear_pairs:
+        for side, other in (("a", "b"), ("b", "a")):
+            body, axis, _ = gear_outline_in_body(mechanism, pair, side)
+            mate, _, ring = gear_outline_in_body(mechanism, pair, other)
+            centre = mechanism.body(body).point(axis)
+            own, theirs = motion.pose(body), motion.pose(mate)
+            world = np.einsum("nij,vj->nvi", rotation(theirs[:, 2]), ring) + theirs[:, None, :2]
+            local = np.einsum("nji,nvj->nvi", rotation(own[:, 2]), world - own[:, None, :2])
+            reach = float(np.min(shapely.distance(shapely.polygons(local), shapely.Point(*centre))))
+            key = (body, axis)
+            out[key] = min(out.get(key, math.inf), reach - clearance)
+    return out
+
+
 def _add_gears(drawing: _Drawing, mechanism: Mechanism, gear_pairs: Sequence[GearPair], hub_mm: float,
-               tol: float) -> None:
-    """Each gear of each pair, with a hub round its axis, fused to the body that carries it."""
+               tol: float, limits: Mapping[tuple[str, str], float] | None = None, least: float = 0.0,
+               explicit_hub: bool = False) -> None:
+    """Each gear of each pair, with a hub round its axis, fused to the body that carries it.
+
+    A boss (and a derived hub) round a gear's axis is cut back to its ``limits`` radius, no smaller than
+    ``least`` (the hole and the process's minimum wall): the gear itself is the web round its bore, and a
+    boss grown past the root (a laser's webs as thick as the stock) would collide with the mating gear's
+    teeth. A hub the design sets (``hub_diameter_mm``) is kept as given."""
+    limits = limits or {}
     for pair in gear_pairs:
         for side in ("a", "b"):
             body, axis, outline = gear_outline_in_body(mechanism, pair, side)
             centre = mechanism.body(body).point(axis)
-            drawing.fused[body] += [outline, circle_polygon(centre, hub_mm, tol)]
+            limit = max(limits.get((body, axis), math.inf), least)
+            drawing.circles[body] = [(c, min(r, limit)) if float(np.hypot(*(c - centre))) < 1e-9 else (c, r)
+                                     for c, r in drawing.circles[body]]
+            hub = hub_mm if explicit_hub else min(hub_mm, 2.0 * limit)
+            drawing.fused[body] += [outline, circle_polygon(centre, hub, tol)]
             drawing.gears[body].append(pair.name)
 
 
