@@ -3,7 +3,9 @@
 Shops (SendCutSend, Ponoko...) reject a cut file whose paths are open, whose lines overlap or repeat (two
 passes of the beam), and parts whose holes, bridges or hole-to-edge distances are below the stock's minimum.
 The numbers are the process profile's ``[shop]`` (``min_hole_mm``, ``min_web_mm``, ``min_hole_edge_mm``),
-each defaulting to half the stock's thickness (SendCutSend's rule of thumb; see templates/process_laser.toml).
+each defaulting to half the stock's thickness (SendCutSend's rule of thumb; see templates/process_laser.toml);
+a part cut from another of the shop's stocks (an actuator's mount plate, :mod:`fabricate.drive.mount`) is held
+to half its own stock's thickness.
 Only a cut process (``technique = "cut"``) is checked.
 
 Every part is checked on what the shop gets, its cut path (the kerf-offset outline, holes and slots of
@@ -51,10 +53,14 @@ class ShopRules:
     min_hole_edge_mm: float
 
     @classmethod
-    def of(cls, process: ProcessSpec) -> ShopRules:
-        """The profile's ``[shop]``; a rule it does not give is half the stock's thickness."""
-        given = dict(getattr(process, "shop", ()) or ())
-        half = 0.5 * float(process.thickness_mm)
+    def of(cls, process: ProcessSpec, thickness_mm: float | None = None) -> ShopRules:
+        """The profile's ``[shop]`` for a part cut from its stock; a rule it does not give, or any rule for a part
+        cut from another of the shop's stocks (``thickness_mm``: the profile's numbers are its own stock's), is
+        half that stock's thickness."""
+        t = float(process.thickness_mm) if thickness_mm is None else float(thickness_mm)
+        own = abs(t - float(process.thickness_mm)) <= 1e-9
+        given = dict(getattr(process, "shop", ()) or ()) if own else {}
+        half = 0.5 * t
         return cls(min_hole_mm=float(given.get("min_hole_mm", half)), min_web_mm=float(given.get("min_web_mm", half)),
                    min_hole_edge_mm=float(given.get("min_hole_edge_mm", half)))
 
@@ -205,7 +211,9 @@ def check_shop(parts: Sequence[Part], process: ProcessSpec) -> ShopResult | None
         return None
     rules = ShopRules.of(process)
     failures: list[str] = []
-    for part in parts:
-        failures += check_part(part, rules, float(process.kerf_mm))
+    for part in parts:  # a part cut from another stock (an actuator's mount plate) is held to that stock's rules
+        own = rules if abs(float(part.thickness_mm) - float(process.thickness_mm)) <= 1e-9 else \
+            ShopRules.of(process, float(part.thickness_mm))
+        failures += check_part(part, own, float(process.kerf_mm))
     return ShopResult(rules=rules, parts_checked=len(parts), failures=tuple(failures))
 

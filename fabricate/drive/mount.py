@@ -45,10 +45,48 @@ class MountPlacement:
     wall: float
     notes: list[str]
     new_ground_holes: list[Hole]
+    resized_ground_holes: list[Hole]  # the ground's mounting holes opened for a larger standoff screw
     ground_arms: list[np.ndarray]
 
     def _output_reach(self) -> float:
         raise NotImplementedError  # RotaryPlacement's
+
+    def _plate_mm(self) -> float:
+        """The mount plate's thickness: the process's stock, but on a cut process the thickest stock the shop
+        lists (``stock_thickness_mm``), no thicker than the process's, whose shop rules the plate's fixed features
+        meet. The actuator fixes where its screw holes sit against the body's cutout: a standard servo's tab holes
+        leave 2.3 mm of acrylic to its case, and the same holes' pilots are below the minimum hole of a 6 mm sheet
+        (half its thickness), where a 3 mm sheet takes both. With none that does, the process's stock (the shop
+        check names what fails)."""
+        t0 = float(self.process.thickness_mm)
+        if self.process.technique != "cut" or not self.entry.mounting_holes:
+            return t0
+        stock = {float(s) for s in getattr(self.process, "stock_thickness_mm", ()) or () if float(s) < t0 - 1e-9}
+        return next((t for t in sorted(stock | {t0}, reverse=True) if self._plate_meets_shop(t)), t0)
+
+    def _plate_meets_shop(self, t: float) -> bool:
+        """Whether a mount plate ``t`` thick meets the shop's rules for that stock
+        (:class:`fabricate.checks.shop.ShopRules`) where the actuator fixes its features: its fixing holes and
+        the standoffs' pilots not below the minimum hole, the web between the fixing holes and between each and
+        the body's cutouts (in the actuator's frame, where the placement does not matter)."""
+        from fabricate.checks.shop import ShopRules
+
+        entry = self.entry
+        rules = ShopRules.of(self.process, t)
+        pz = geo.mount_plate_z(entry)
+        holes = [(np.array([mh.x, mh.y]), 0.5 * geo.fastening(entry, mh, t, self.c, self.comp).plate_hole_mm)
+                 for mh in entry.mounting_holes or ()]
+        d = float(screw_size(float(self.design.parts.mounting_hole_mm)).lstrip("M"))
+        diameters = [2.0 * r for _, r in holes] + [geo.PILOT_FRACTION * d + self.comp]
+        if min(diameters) < rules.min_hole_mm - 1e-9:
+            return False
+        cuts = [shapely.Polygon(r) for r in geo.plate_cutouts(entry, pz, pz + t, self.c)]
+        for i, (a, ra) in enumerate(holes):
+            if any(float(np.hypot(*(a - b))) - ra - rb < rules.min_web_mm - 1e-9 for b, rb in holes[i + 1:]):
+                return False
+            if any(cut.distance(shapely.Point(*a)) - ra < rules.min_web_mm - 1e-9 for cut in cuts):
+                return False
+        return True
 
     def _orient(self, angle: float, centre: np.ndarray, ground: Part, flip: bool, z_face: float) -> float:
         """The turn nearest ``angle`` (10 degree steps) at which the actuator's body keeps clear of the
@@ -57,7 +95,7 @@ class MountPlacement:
         entry = self.entry
         if not entry.body:
             return angle
-        t = float(self.process.thickness_mm)
+        t = self._plate_mm()
         pz = geo.mount_plate_z(entry)
         place0 = geo.Placement(centre, angle, flip, z_face)
         plate = place0.z_range(pz, pz + t)
@@ -122,15 +160,19 @@ class MountPlacement:
                             float(pin.z_mm), float(pin.z_mm + pin.length_mm)))
         return out
 
-    def _standoff_sites(self, place: geo.Placement, ground: Part, lo: float, hi: float) -> list[Hole]:
+    def _standoff_sites(self, place: geo.Placement, ground: Part, lo: float, hi: float,
+                        screw_mm: float | None = None) -> list[Hole]:
         """Where the standoffs stand on the ground part (holes of the ground): its mounting holes that keep
         clear of the actuator (body, output) and of every part moving between the plate and the ground; else
         two new holes (``standoff_1``, ``standoff_2``), as far apart as the ground part's free material allows;
-        none if it has none."""
+        none if it has none. ``screw_mm``: the standoffs' screw (default the design's mounting screw; a larger
+        one cannot use the ground's mounting holes, sized for that)."""
         from fabricate.parts.partset import swept_region
 
         entry, c = self.entry, self.c
-        nominal = float(self.design.parts.mounting_hole_mm) + 2.0 * c
+        design_mm = float(self.design.parts.mounting_hole_mm)
+        screw_mm = design_mm if screw_mm is None else float(screw_mm)
+        nominal = screw_mm + 2.0 * c
         hole_d = nominal + self.comp
         outer = hole_d + 2.0 * max(self.wall, 0.25 * hole_d)
         forbidden = []
@@ -140,7 +182,7 @@ class MountPlacement:
                 forbidden.append(shapely.Polygon(geo.placed_ring(geo.rectangle(b.x0, b.y0, b.x1, b.y1), place)))
         out_reach = self._output_reach()
         forbidden.append(shapely.Point(*place.centre).buffer(out_reach, 64))
-        t = float(self.process.thickness_mm)
+        t = self._plate_mm()
         for mh in entry.mounting_holes or ():  # the plate's own screws: their holes and heads
             f = geo.fastening(entry, mh, t, c, self.comp)
             head = ISO4762[f.size].head_d_mm if f.tapped else 0.0
@@ -157,6 +199,9 @@ class MountPlacement:
         clear = [h for h in existing if not keep_out.contains(shapely.Point(h.centre))
                  and keep_out.distance(shapely.Point(h.centre)) > 0.0]
         if len(clear) >= min(2, len(existing)) and clear:
+            if screw_mm > design_mm + 1e-9:  # a larger screw than the holes were cut for: open them to its clearance
+                clear = [fit_hole(h.joint, h.centre, nominal, self.comp, fit="clearance") for h in clear]
+                self.resized_ground_holes = list(clear)
             return clear
         # new sites on the ground part's own material, clear of its holes
         inset = max(0.5 * outer, 0.5 * hole_d + self.wall)
@@ -255,13 +300,30 @@ class MountPlacement:
                                  for k, p in enumerate(sites)]
         return list(self.new_ground_holes)
 
+    def _standoff_size(self, clamp_mm: float, plate_mm: float) -> str:
+        """The standoffs' screw size: the design's mounting screw (``parts.mounting_hole_mm``), else, where no
+        standard length of it passes ``clamp_mm`` (the ground part and the standoffs) and engages the plate,
+        the next larger ISO 4762 size that does: ISO 4762 stops M3 at 30 mm and M4 at 40, and an actuator over
+        a tall stack of sheets stands higher than that. The design's size when none does (the build then names
+        the stack)."""
+        size = screw_size(float(self.design.parts.mounting_hole_mm))
+        larger = sorted((s for s in ISO4762 if float(s.lstrip("M")) >= float(size.lstrip("M"))),
+                        key=lambda s: float(s.lstrip("M")))
+        for candidate in larger:
+            try:
+                geo.screw_into(candidate, clamp_mm, plate_mm)
+            except SpecError:
+                continue
+            return candidate
+        return size
+
     def _mount(self, place: geo.Placement, ground: Part, flip: bool
                ) -> tuple[Part, list[Fastener], list[Standoff], list[Part], list[geo.Solid]]:
         """The mount plate on the actuator's flange, its screws, and the standoffs to the ground part."""
         from fabricate.parts.partset import SlottedPart, safe_name
 
         entry, process, tol = self.entry, self.process, self.tol
-        t = float(process.thickness_mm)
+        t = self._plate_mm()
         pz = geo.mount_plate_z(entry)
         z0, z1 = place.z_range(pz, pz + t)
         holes: list[Hole] = []
@@ -294,10 +356,10 @@ class MountPlacement:
         standoff_parts: list[Part] = []
         g0, g1 = float(ground.z_mm), float(ground.z_mm + ground.thickness_mm)
         lo, hi = (g1, z0) if flip else (z1, g0)
-        mounting = self._standoff_sites(place, ground, lo, hi) if hi - lo > 1e-6 else []
+        size = self._standoff_size(float(ground.thickness_mm) + (hi - lo), t)
+        d = float(size.lstrip("M"))
+        mounting = self._standoff_sites(place, ground, lo, hi, d) if hi - lo > 1e-6 else []
         if mounting:
-            size = screw_size(float(self.design.parts.mounting_hole_mm))
-            d = float(size.lstrip("M"))
             printed = process.technique == "additive"
             count = 0
             for h in mounting:

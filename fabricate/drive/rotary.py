@@ -130,6 +130,7 @@ class RotaryPlacement(MountPlacement):
         self.wall = float(self.process.min_wall_mm)
         self.notes: list[str] = []
         self.new_ground_holes: list[Hole] = []
+        self.resized_ground_holes: list[Hole] = []
         self.ground_arms: list[np.ndarray] = []
 
     # the pin the output replaces
@@ -150,7 +151,7 @@ class RotaryPlacement(MountPlacement):
         """Stack z of the output face with the actuator under (``flip`` False) or over the stack: a horn flush
         with the driven part; a shaft's tip flush with its far face, the motor and its plate clear of the
         stack (``inf`` when the shaft then does not reach half way into the driven part)."""
-        entry, t = self.entry, float(self.process.thickness_mm)
+        entry, t = self.entry, self._plate_mm()  # the mount plate's stock
         z_d, t_d = float(driven.z_mm), float(driven.thickness_mm)
         if entry.horn is not None:
             seat1 = geo.horn_seat_z(entry)[1]
@@ -402,7 +403,8 @@ class RotaryPlacement(MountPlacement):
         fasteners += mount_fasteners
         solids += mount_solids
         ground_pad = circle_hull(np.asarray(c_g, dtype=float)[None, :], 0.5 * (clear + self.comp) + self.wall)
-        ground_holes += self.new_ground_holes
+        resized = {h.joint: h for h in self.resized_ground_holes}
+        ground_holes = [resized.get(h.joint, h) for h in ground_holes] + self.new_ground_holes
         outline = fuse_pad(ground.outline, ground_pad, self.tol) if passes else ground.outline
         if self.ground_arms:
             outline = fuse_polygons(outline, list(self.ground_arms), self.tol)

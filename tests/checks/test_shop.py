@@ -78,3 +78,16 @@ def test_the_laser_profile_reads_its_sheets_and_shop_rules():
     with pytest.raises(SpecError) as info:
         parse_process(Table({"profile": "laser", "sheets": {"A4": [297.0]}}, "process"))
     assert info.value.path == "process.sheets.A4"
+
+
+def test_a_part_cut_from_another_stock_is_held_to_half_that_stock(laser_process):
+    six = dataclasses.replace(laser_process, thickness_mm=6.0)  # a template's 6 mm: [shop] dropped, half of 6
+    assert ShopRules.of(six) == ShopRules(3.0, 3.0, 3.0)
+    assert ShopRules.of(six, 3.0) == ShopRules(1.5, 1.5, 1.5)
+    given = dataclasses.replace(laser_process, shop=(("min_hole_mm", 1.0),))  # the profile's numbers: its own stock's
+    assert ShopRules.of(given, 3.0).min_hole_mm == 1.0 and ShopRules.of(given, 6.0).min_hole_mm == 3.0
+    # a 2.4 mm hole: below a 6 mm sheet's minimum, within a 3 mm sheet's
+    thick = dataclasses.replace(with_holes(("A", (0.0, 0.0), 2.4)), thickness_mm=6.0)
+    thin = dataclasses.replace(thick, thickness_mm=3.0)
+    assert [f for f in check_shop([thick], six).failures if "minimum hole 3 mm" in f]
+    assert check_shop([thin], six).passed
