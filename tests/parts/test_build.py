@@ -1466,3 +1466,41 @@ def test_pad_segment_is_the_circular_segment():
     assert np.all(ring[:, 0] - ring[:, 1] >= 40.0 - 1e-9)  # the segment lies beyond the chord x - y = 40
     with pytest.raises(GeometryError, match="not one circle"):
         pad_segment(centre, start, np.array([70.0, 36.0]), 0.005)
+
+
+def gear_overlap(partset, motion, pair) -> float:
+    """Largest plan overlap (mm^2) of the two parts carrying ``pair``'s gears over ``motion``."""
+    from fabricate.planar import rotation
+
+    a = next(p for p in partset.parts if p.body == pair.body_a)
+    b = next(p for p in partset.parts if p.body == pair.body_b)
+    worst = 0.0
+    for k in range(len(motion.inputs)):
+        polys = []
+        for part in (a, b):
+            pose = motion.pose(part.body)[k]
+            polys.append(shapely.Polygon(part.outline.polygon(0.01) @ rotation(pose[2]).T + pose[:2]))
+        worst = max(worst, polys[0].intersection(polys[1]).area)
+    return worst
+
+
+def test_bosses_round_gear_axes_clear_the_mating_gear(monkeypatch):
+    """A wall grown past the gears' roots (a laser's webs as thick as a 6 mm stock, here a requested 12 mm wall)
+    is cut back round each gear's axis: the gears' parts never overlap, where the full bosses would."""
+    import dataclasses
+
+    from fabricate import pipeline
+    from fabricate.design import load_design
+    from fabricate.parts import build
+
+    design = load_design("gear_pair_elliptic", "laser")
+    design = dataclasses.replace(design, parts=dataclasses.replace(design.parts, boss_wall_mm=12.0))
+    result, report, motion, _ = pipeline._synthesis_stage(design, pipeline._quiet, "build")
+    run = pipeline.BuildRun(design, result, motion, report)
+    pipeline._make_gears(run)
+    (pair,) = run.gear_pairs
+    partset = build_parts(design, result.mechanism, motion, run.gear_pairs, result.parts)
+    assert gear_overlap(partset, motion, pair) == 0.0
+    monkeypatch.setattr(build, "_mesh_limits", lambda *args: {})
+    full = build_parts(design, result.mechanism, motion, run.gear_pairs, result.parts)
+    assert gear_overlap(full, motion, pair) > 1.0
