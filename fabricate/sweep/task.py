@@ -19,7 +19,8 @@ import math
 import os
 import sys
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 from fabricate.sweep.paths import Metric
@@ -139,6 +140,19 @@ def run_point(index: int, values: Mapping[str, Any], pid: str, base: Mapping[str
     return row
 
 
+@contextmanager
+def _serial() -> Iterator[None]:
+    """``FABRICATE_SERIAL`` while a task runs, as it was after: a caller in its own process (the API, a test)
+    keeps its forked picture child for its later builds."""
+    before = os.environ.get("FABRICATE_SERIAL")
+    os.environ["FABRICATE_SERIAL"] = before or "1"
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop("FABRICATE_SERIAL", None)
+
+
 def run_batch(points: Sequence[tuple[int, Mapping[str, Any], str]], base: Mapping[str, Any],
               fields: Sequence[tuple[str, Sequence[str | int]]], stage: str,
               metrics: Sequence[Metric], cache: bool = False) -> list[dict[str, Any]]:
@@ -151,8 +165,7 @@ def run_batch(points: Sequence[tuple[int, Mapping[str, Any], str]], base: Mappin
     """
     from fabricate.cache import use_cache
 
-    os.environ.setdefault("FABRICATE_SERIAL", "1")
-    with use_cache(cache, disk=False):
+    with _serial(), use_cache(cache, disk=False):
         return [run_point(i, values, pid, base, fields, stage, metrics) for i, values, pid in points]
 
 
@@ -163,8 +176,7 @@ def build_point(values: Mapping[str, Any], base: Mapping[str, Any],
     sweep's worker may still hold its stages, with ``cache``)."""
     from fabricate.cache import use_cache
 
-    os.environ.setdefault("FABRICATE_SERIAL", "1")
-    with use_cache(cache, disk=False):
+    with _serial(), use_cache(cache, disk=False):
         code, reason, _report, outcome = evaluate(point_text(base, fields, values), "build")
     return code, reason, (dict(outcome.files) if outcome is not None else {})
 

@@ -43,8 +43,9 @@ def pair(result, a: str, b: str):
 
 def test_a_body_on_the_ground_may_touch_its_parts_but_not_cut_into_them(built):
     ground = built[0].part("ground")
-    # flush under the ground plate, overlapping it in plan: touching is how it is fixed
-    under = item("motor", "ground", "body", square(40.0, 0.0, 4.0), ground.z_mm - 10.0, ground.z_mm)
+    # flush under the ground plate, overlapping it in plan between its pins (pressed pins stick out below it since
+    # they cover their stacks): touching is how it is fixed
+    under = item("motor", "ground", "body", square(20.0, 0.0, 4.0), ground.z_mm - 10.0, ground.z_mm)
     result = run(built, under)
     p = pair(result, "ground", "motor")
     assert p.relation == "fixed" and p.required_mm == 0.0 and not p.collides
@@ -53,7 +54,7 @@ def test_a_body_on_the_ground_may_touch_its_parts_but_not_cut_into_them(built):
     # one pose settles a pair of one body: the same value at every pose
     assert np.all(p.clearance == p.clearance[0]) and np.all(p.exact)
     # sunk 1 mm into the plate it is an overlap, at every pose
-    sunk = item("motor", "ground", "body", square(40.0, 0.0, 4.0), ground.z_mm - 10.0, ground.z_mm + 1.0)
+    sunk = item("motor", "ground", "body", square(20.0, 0.0, 4.0), ground.z_mm - 10.0, ground.z_mm + 1.0)
     result = run(built, sunk)
     p = pair(result, "ground", "motor")
     assert p.collides and len(p.collision_indices) == len(result.inputs)

@@ -56,7 +56,14 @@ def test_empty_table_gives_the_documented_defaults():
     for name, value in DEFAULTS.items():
         got = getattr(spec, name)
         assert got == value and type(got) is type(value), name
-    assert spec == GearSpec(**DEFAULTS)
+    # the module is chosen, so the pressure angle is too: Shigley's full-depth 20, 22.5, 25 deg, 20 first, each with
+    # the default 1.25 m dedendum and a root fillet that fits the rack at it (the default 0.38 m at 20 deg, no
+    # larger at the steeper angles, whose flanks leave less room at the root)
+    candidates = spec.pressure_angle_candidates
+    assert [c[0] for c in candidates] == [20.0, 22.5, 25.0]
+    assert all(c[1] == 1.25 for c in candidates) and candidates[0][2] == 0.38
+    assert all(0.0 < b[2] <= a[2] for a, b in zip(candidates, candidates[1:]))
+    assert spec == GearSpec(**DEFAULTS, pressure_angle_candidates=candidates)
 
 
 def test_dataclass_defaults_match_the_documented_ones():
