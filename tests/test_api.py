@@ -74,6 +74,7 @@ def test_load_takes_a_dict_and_names_a_bad_field():
         fabricate.load(tables)
 
 
+@pytest.mark.slow
 def test_a_mechanism_built_in_code_goes_through_the_same_pipeline():
     """A four-bar made with fabricate.mechanism (no template) is written as a linkage template, built,
     and passes; its motion.csv follows the original mechanism's sweep (the written linkage has other body

@@ -61,6 +61,7 @@ def test_absurd_phalanx_length_names_the_field(value: str, tmp_path: Path, capsy
     _assert_refused(path, "finger.lengths_mm[0]", tmp_path, capsys)
 
 
+@pytest.mark.slow
 def test_pin_too_large_for_the_link_names_pin_diameter_and_its_limit(tmp_path: Path, capsys) -> None:
     path = _template(tmp_path, FIVE_BAR, [(r'^profile = "sla"', 'profile = "sla"\npin_diameter_mm = 30')])
     err = _assert_refused(path, "process.pin_diameter_mm", tmp_path, capsys)

@@ -238,6 +238,7 @@ def test_text_the_output_cannot_encode_is_escaped_not_fatal(monkeypatch):
     assert buffer.getvalue() == b"folder caf\\xe9-\\udcff\n"
 
 
+@pytest.mark.slow
 def test_a_closed_stderr_does_not_turn_an_error_into_a_crash(tmp_path):
     missing = str(tmp_path / "missing")
     reader, writer = os.pipe()

@@ -166,6 +166,7 @@ def test_joint_point_missing_is_named():
                   joints=(Revolute("X", "g", "a"),), gears=(), drivers=(), input_range=(0, 1))
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None)
 @given(crank=st.floats(5.0, 12.0), coupler=st.floats(35.0, 45.0), rocker=st.floats(25.0, 35.0),
        start=st.floats(0.0, 360.0))

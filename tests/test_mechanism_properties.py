@@ -268,6 +268,7 @@ def _velocity_matches_finite_differences(mech: Mechanism, count: int = 9, h: flo
             np.testing.assert_allclose(v[name], (ahead[name] - behind[name]) / (2 * h), atol=atol, err_msg=name)
 
 
+@pytest.mark.slow
 def test_velocity_of_off_axis_and_slider_mechanisms():
     """The constraint Jacobian (through velocity = -J^-1 dres/ds) against finite differences of the solved
     poses: a crank-slider (slider joint: projection and fixed-angle rows) and a four-bar whose joint points

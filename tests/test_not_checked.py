@@ -96,6 +96,7 @@ def _section(markdown: str, title: str) -> str:
 
 # -- through the command line ---------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_profile_without_materials_is_not_checked_and_says_so(tmp_path, capsys):
     code, stdout, stderr, out = _cli(tmp_path, capsys, "nomat", _tables(), "--process",
                                      str(_profile_without_materials(tmp_path)))
@@ -115,6 +116,7 @@ def test_profile_without_materials_is_not_checked_and_says_so(tmp_path, capsys):
     assert not (out / "plots" / "strength.png").exists()
 
 
+@pytest.mark.slow
 def test_template_without_load_is_not_checked_and_writes_no_infinite_factor(tmp_path, capsys):
     code, stdout, stderr, out = _cli(tmp_path, capsys, "noload", _tables(load=False))
     assert code == 0, stdout + stderr
@@ -145,6 +147,7 @@ def test_synth_never_says_checks_passed(tmp_path, capsys):
     assert "## Checks: none run" in md and "PASSED" not in md
 
 
+@pytest.mark.slow
 def test_a_loaded_design_with_materials_is_checked_and_lists_nothing():
     """The control: the same four-bar with its load and the profile's materials is checked (a verdict of
     True or False, a finite factor per part) and ``not_checked`` is empty."""
@@ -207,6 +210,7 @@ def test_report_json_writes_null_for_infinite_values():
     assert data == {"strength": {"parts": [{"min_safety_factor": None}], "x": None, "y": None}}
 
 
+@pytest.mark.slow
 def test_the_api_names_what_was_not_checked() -> None:
     """``Build.not_checked`` says what ``passed`` does not cover (issue 23 item 5)."""
     unloaded = fabricate.build(fabricate.load(_tables(load=False)))

@@ -154,6 +154,7 @@ def test_the_outputs_readme_rebuild_recipe_works_as_written(built_linkage, tmp_p
     assert not (source / "outputs").exists()
 
 
+@pytest.mark.slow
 def test_a_default_output_is_never_written_into_a_fabricate_output_folder(built_linkage, tmp_path, monkeypatch,
                                                                            capsys):
     """Issue 23: run from inside a build folder (or a folder in it), the default output (outputs/<name>/

@@ -129,6 +129,7 @@ def _even_odd_area(faces: list[shapely.Polygon]) -> float:
     return area
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which("openscad") is None, reason="OpenSCAD not installed")
 def test_segment_arcs_give_openscad_the_reported_areas(tmp_path):
     profile = tmp_path / "laser_segments.toml"

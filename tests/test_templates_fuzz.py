@@ -139,6 +139,7 @@ def _run(main_args: list[str], capsys) -> tuple[int, str]:
     return code, captured.err
 
 
+@pytest.mark.slow
 def test_every_numeric_field_refuses_what_is_not_a_finite_number(tmp_path, capsys):
     """finger_five_bar_ncg (41 numbers, lists included) x 13 values: 533 runs, all exit 2 naming the field."""
     data = parse_toml(TEMPLATES["finger_five_bar_ncg.toml"], "t")

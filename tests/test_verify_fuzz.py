@@ -180,6 +180,7 @@ def _write_text(path: Path, text: str) -> None:
     path.write_bytes(text.encode("utf-8", errors="surrogateescape"))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(REPORT_CASES))
 def test_random_edits_of_report_json_end_in_a_documented_exit(built, tmp_path, capsys, seed):
     rng = random.Random(seed)

@@ -236,6 +236,7 @@ def measured_tip_land_mm(outline: np.ndarray, pitch: np.ndarray, addendum_mm: fl
     return min(lands)
 
 
+@pytest.mark.slow
 def test_laser_default_finger_takes_the_first_standard_angle_a_module_passes_at(finger):
     """``--process laser`` on the shipped finger (which fixes 0.5 mm and 20 deg for its SLA figures): the teeth are
     sized again for the laser, on the template's 6 mm plates (a stock the laser profile names). At 20 deg no standard
@@ -263,6 +264,7 @@ def test_laser_default_finger_takes_the_first_standard_angle_a_module_passes_at(
     assert min(lands) == pytest.approx(pair.checks["tip_land_min_mm"], abs=1e-3)
 
 
+@pytest.mark.slow
 def test_fdm_default_finger_names_the_contact_no_module_or_angle_relieves(finger):
     """``--process fdm`` on the shipped finger: PLA's contact on the template's 6 mm plates keeps no safety factor 2
     at any module or standard angle (sigma_H^2 ~ 1 / (b sin 2 alpha)); the failure says so once, with the

@@ -62,7 +62,7 @@ def test_empty_table_gives_the_documented_defaults():
     candidates = spec.pressure_angle_candidates
     assert [c[0] for c in candidates] == [20.0, 22.5, 25.0]
     assert all(c[1] == 1.25 for c in candidates) and candidates[0][2] == 0.38
-    assert all(0.0 < b[2] <= a[2] for a, b in zip(candidates, candidates[1:]))
+    assert all(0.0 < b[2] <= a[2] for a, b in zip(candidates, candidates[1:], strict=False))
     assert spec == GearSpec(**DEFAULTS, pressure_angle_candidates=candidates)
 
 

@@ -3,11 +3,14 @@ never one that passed only because nothing was checked."""
 
 from __future__ import annotations
 
+import pytest
+
 from fabricate.sweep.task import EXIT_OK, evaluate
 from fabricate.tomlwrite import dumps
 from tests.test_not_checked import _tables
 
 
+@pytest.mark.slow
 def test_a_point_built_without_a_load_says_strength_was_not_checked() -> None:
     code, reason, report, _ = evaluate(dumps(_tables(load=False)), "build")
     assert code == EXIT_OK
@@ -15,6 +18,7 @@ def test_a_point_built_without_a_load_says_strength_was_not_checked() -> None:
     assert "strength not checked: no [load] in the template" in reason
 
 
+@pytest.mark.slow
 def test_a_checked_point_has_no_reason_and_a_synth_point_no_not_checked_note() -> None:
     code, reason, report, _ = evaluate(dumps(_tables(load=True)), "build")
     assert (code, reason) == (EXIT_OK, "")
@@ -60,6 +64,7 @@ def test_a_grid_is_sent_group_by_group_whatever_its_field_order() -> None:
     assert [points[i]["gear_pair.eccentricity"] for i in order] == [0.1] * 3 + [0.2] * 3
 
 
+@pytest.mark.slow
 def test_a_build_sweep_synthesises_a_shared_synthesis_once_and_gives_the_same_rows(monkeypatch) -> None:
     """Two build points of the Stephenson six-bar that differ only in [load]: in one batch with the cache it is
     synthesised once (the second point's synthesis is a cache hit); the second point's row (exit code, reason,
