@@ -390,8 +390,9 @@ def export_step(design: DesignSpec, partset: PartSet, motion: Motion) -> dict[st
     if not step_available():
         return {}
     # in a fresh process: OCP's 220 MB stay out of the processes holding the rest of the build
-    return run_isolated("fabricate.export.step", "step_files", list(partset.parts), motion.poses_at(0),
-                        partset.chord_tolerance_mm, design.name)
+    files: dict[str, bytes] = run_isolated("fabricate.export.step", "step_files", list(partset.parts),
+                                           motion.poses_at(0), partset.chord_tolerance_mm, design.name)
+    return files
 
 
 #: What a build says when the optional ``cad`` extra is missing.

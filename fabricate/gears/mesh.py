@@ -24,7 +24,7 @@ Backlash is the circumferential free play at the pitch curve, ``(free_plus + fre
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
@@ -153,7 +153,7 @@ def free_play(pair: GearPair, x_a: np.ndarray, return_contacts: bool = False) ->
     return _free_play(pair, x_a, _flank_tables(pair), return_contacts)
 
 
-def _flank_tables(pair: GearPair) -> tuple[np.ndarray, ...]:
+def _flank_tables(pair: GearPair) -> tuple[Any, ...]:
     """What :func:`free_play` compares, independent of the steps: both gears' padded flank tables and gear
     b's polar search table (made once per mesh check, not once per chunk of steps)."""
     table_a, present_a, off_a = _pad_flanks(pair.cut_a.flanks)

@@ -48,7 +48,7 @@ def compliant_figures(spec, path, grasp, motion, optimum) -> dict[str, bytes]:
         pts = np.array([[0.0, 0.0], st.B, st.C, st.D, st.E, st.M])
         ax.plot(pts[:5, 0], pts[:5, 1], "-o", ms=3, color=colour, label=f"stroke {motion.strokes[k]:.1f} mm")
         ax.plot(pts[4:, 0], pts[4:, 1], ":", color=colour)
-        circ = Circle(st.pad_centre, g.r, fill=False, lw=0.5, color=colour)
+        circ = Circle((float(st.pad_centre[0]), float(st.pad_centre[1])), g.r, fill=False, lw=0.5, color=colour)
         ax.add_patch(circ)
     wall = spec.load.radius - g.l1
     ax.axvline(wall, color="k", lw=1.5)
