@@ -16,7 +16,8 @@ Checks against the process profile (:class:`fabricate.process.ProcessSpec`), by 
   margin (the gap kept at the plate's edge), at some rotation on the plate (the smallest box either way
   round, or across the diagonal: :func:`fabricate.export.layout.fitting_angle`, the turn the plates use) and
   are no taller than the build height; on a sheet layout they fit the sheet less its margin the same way and
-  are as thick as it (spacers are tubes, not cut from the sheet).
+  are as thick as it or as another stock the process lists (``stock_thickness_mm``; the layout nests each
+  thickness on sheets of its own), spacers aside (tubes, not cut from the sheet).
 
 Webs around holes are exact (circle to circle, hole to the outline's true lines and arcs); the files
 are polygonised at the chord tolerance (chords inside the outline's arcs, holes' polygons inside their
@@ -176,10 +177,15 @@ def check_printability(parts: Sequence[Part], process: ProcessSpec, gear_pairs: 
         height = float(process.build_volume_mm[2])
         sheet = process.layout == "sheet"
         if sheet:
-            thick_ok = part.role == "spacer" or abs(part.thickness_mm - height) <= 1e-6
+            # a part as thick as a stock the process lists is cut from that stock (the layout nests each
+            # thickness on its own sheets: fabricate.export.dxf.sized_sheets)
+            stock = [height, *(float(s) for s in getattr(process, "stock_thickness_mm", ()) or ())]
+            thick_ok = part.role == "spacer" or any(abs(part.thickness_mm - s) <= 1e-6 for s in stock)
             if not thick_ok:
+                listed = sorted(set(stock) - {height})
+                also = f" (stock: {', '.join(f'{s:g}' for s in listed)} mm)" if listed else ""
                 failures.append(f"printability: {part.name} is {part.thickness_mm:g} mm thick, the sheet "
-                                f"{height:g} mm")
+                                f"{height:g} mm{also}")
         else:
             thick_ok = part.thickness_mm <= height + 1e-9
         if not in_area or (not sheet and not thick_ok):

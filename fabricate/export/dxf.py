@@ -10,7 +10,8 @@ Labels go on ``ENGRAVE`` (blue). In a cut file (:attr:`DxfStyle.labels` ``"outli
 outline of its text, closed bulge-free LWPOLYLINEs (:mod:`fabricate.export.labels`), never a TEXT entity: a
 shop's software has not the font, or no text support at all (OpenSCAD: "Unsupported DXF Entity 'TEXT'").
 A sheet (``cut/sheet_N.dxf``) holds its parts and nothing else: no border a shop cutting every contour would
-cut; its size is the drawing limits ($LIMMIN/$LIMMAX) and extents.
+cut; its size is the drawing limits ($LIMMIN/$LIMMAX) and extents. Its parts are all of one thickness, the
+stock it is cut from (:func:`sized_sheets`: a 3 mm actuator plate beside 6 mm links gets a sheet of its own).
 
 A drawing (``drawings/NAME.dxf``, for CAD, never sent to a cutter) keeps TEXT: its part name and hole notes
 are to be read and edited in LibreCAD or FreeCAD, which draw TEXT in their own fonts.
@@ -257,11 +258,31 @@ def part_dxf(part: Part, kerf_mm: float, style: DxfStyle = EXACT, label: Label |
     return document_bytes(doc)
 
 
+def by_thickness(parts: Sequence[Part]) -> dict[float, list[int]]:
+    """The parts' indices grouped by thickness (each group is cut from its own stock), the groups in the order
+    their first part comes; one group (every part in order) when all share one thickness."""
+    groups: dict[float, list[int]] = {}
+    for k, part in enumerate(parts):
+        groups.setdefault(round(float(part.thickness_mm), 6), []).append(k)
+    return groups
+
+
 def sheet_layout(parts: Sequence[Part], kerf_mm: float, sheet_mm: tuple[float, float], margin_mm: float,
                  spacing_mm: float) -> list[Placement]:
-    """Nest the parts' cut outlines on sheets of ``sheet_mm`` (bounding-rectangle shelves, no overlap)."""
+    """Nest the parts' cut outlines on sheets of ``sheet_mm`` (bounding-rectangle shelves, no overlap), each
+    sheet holding parts of one thickness (:func:`by_thickness`: a sheet is one stock)."""
     outlines = [cut_geometry(p, kerf_mm)[0].polygon(0.05) for p in parts]
-    return shelf_pack(outlines, sheet_mm, margin_mm, spacing_mm + kerf_mm)
+    groups = by_thickness(parts)
+    if len(groups) <= 1:
+        return shelf_pack(outlines, sheet_mm, margin_mm, spacing_mm + kerf_mm)
+    placements: list[Placement] = [Placement(0.0, np.zeros(2), 0, np.zeros(2))] * len(parts)
+    first = 0
+    for members in groups.values():
+        packed = shelf_pack([outlines[k] for k in members], sheet_mm, margin_mm, spacing_mm + kerf_mm)
+        for k, pl in zip(members, packed, strict=True):
+            placements[k] = Placement(pl.angle, pl.offset, first + pl.sheet, pl.size)
+        first += 1 + max(pl.sheet for pl in packed)
+    return placements
 
 
 def sheet_dxf(parts: Sequence[Part], kerf_mm: float, placements: Sequence[Placement],
@@ -301,6 +322,8 @@ class Sheet:
         Area the sheet's cut paths enclose (kerf applied: what a reader of its layer CUT measures).
     parts : tuple of str
         The part names on it, one per copy, in layout order.
+    thickness_mm : float
+        The stock's thickness: every part on it is this thick (a layout nests each thickness on its own sheets).
     """
 
     index: int
@@ -309,6 +332,7 @@ class Sheet:
     part_area_mm2: float
     cut_area_mm2: float
     parts: tuple[str, ...]
+    thickness_mm: float = 0.0
 
     @property
     def utilisation(self) -> float:
@@ -318,7 +342,8 @@ class Sheet:
     def report(self) -> dict[str, Any]:
         """report.json's row of the sheet (see :func:`fabricate.export.cut_report`)."""
         return {"index": self.index + 1, "file": f"cut/sheet_{self.index + 1}.dxf", "stock": self.name,
-                "size_mm": [round(v, 3) for v in self.size_mm], "part_area_mm2": round(self.part_area_mm2, 3),
+                "thickness_mm": round(self.thickness_mm, 6), "size_mm": [round(v, 3) for v in self.size_mm],
+                "part_area_mm2": round(self.part_area_mm2, 3),
                 "cut_area_mm2": round(self.cut_area_mm2, 3),
                 "utilisation": round(self.utilisation, 4), "parts": list(self.parts)}
 
@@ -326,12 +351,14 @@ class Sheet:
 def sized_sheets(parts: Sequence[Part], kerf_mm: float, stock: Sequence[tuple[str, float, float]],
                  bed_mm: tuple[float, float], margin_mm: float,
                  spacing_mm: float) -> tuple[list[Placement], list[Sheet]]:
-    """Nest the parts, each sheet on the smallest standard stock that holds its parts.
+    """Nest the parts, each sheet holding parts of one thickness on the smallest standard stock that holds them.
 
-    The parts are first nested on the largest stock that fits the bed (or the bed itself when the profile
-    names no stock, or none fits), which fixes how many sheets there are and which parts go on each; then
-    each sheet's parts are nested again on every smaller stock (as listed, then a quarter turn), smallest
-    area first, and the first that holds them all on one sheet is that sheet's.
+    Each thickness is nested on its own sheets (:func:`by_thickness`: a sheet is cut from one stock), the
+    thicknesses in the order their first part comes. The parts of a thickness are first nested on the largest
+    stock that fits the bed (or the bed itself when the profile names no stock, or none fits), which fixes how
+    many sheets there are and which parts go on each; then each sheet's parts are nested again on every smaller
+    stock (as listed, then a quarter turn), smallest area first, and the first that holds them all on one sheet
+    is that sheet's.
 
     Parameters
     ----------
@@ -356,25 +383,38 @@ def sized_sheets(parts: Sequence[Part], kerf_mm: float, stock: Sequence[tuple[st
                     key=lambda s: (s[1][0] * s[1][1], s[1][0], s[0]))
     largest = usable[-1] if usable else ("bed", (float(bed_mm[0]), float(bed_mm[1])))
     outlines = [cut_geometry(p, kerf_mm)[0].polygon(0.05) for p in parts]
-    placements = shelf_pack(outlines, largest[1], margin_mm, spacing_mm + kerf_mm)
+    placements: list[Placement] = [Placement(0.0, np.zeros(2), 0, np.zeros(2))] * len(parts)
     sheets: list[Sheet] = []
-    for number in sorted({pl.sheet for pl in placements}):
-        on = [k for k, pl in enumerate(placements) if pl.sheet == number]
-        chosen, placed = largest, [placements[k] for k in on]
-        for name, (w, h) in usable[:-1]:
-            for size in dict.fromkeys(((w, h), (h, w))):
-                trial = shelf_pack([outlines[k] for k in on], size, margin_mm, spacing_mm + kerf_mm)
-                if all(pl.sheet == 0 and fits(pl, size, margin_mm) for pl in trial):
-                    chosen, placed = (name, size), trial
-                    break
-            if chosen[0] != largest[0]:
-                break
-        for k, pl in zip(on, placed, strict=True):
-            placements[k] = Placement(pl.angle, pl.offset, len(sheets), pl.size)
-        sheets.append(Sheet(len(sheets), chosen[0], chosen[1], sum(parts[k].area_mm2() for k in on),
-                            sum(cut_area(parts[k], kerf_mm) for k in on), tuple(parts[k].name for k in on)))
+    for thickness, members in by_thickness(parts).items():
+        packed = shelf_pack([outlines[k] for k in members], largest[1], margin_mm, spacing_mm + kerf_mm)
+        for number in sorted({pl.sheet for pl in packed}):
+            mine = [i for i, pl in enumerate(packed) if pl.sheet == number]
+            placements, sheet = _sized_sheet(parts, outlines, [members[i] for i in mine], [packed[i] for i in mine],
+                                             placements, len(sheets), thickness, usable, largest, kerf_mm,
+                                             margin_mm, spacing_mm)
+            sheets.append(sheet)
     return placements, sheets
 
+
+def _sized_sheet(parts: Sequence[Part], outlines: Sequence[np.ndarray], on: list[int], placed: list[Placement],
+                 placements: list[Placement], index: int, thickness: float,
+                 usable: Sequence[tuple[str, tuple[float, float]]], largest: tuple[str, tuple[float, float]],
+                 kerf_mm: float, margin_mm: float, spacing_mm: float) -> tuple[list[Placement], Sheet]:
+    """Sheet ``index`` of :func:`sized_sheets`: parts ``on`` (as nested on the largest stock, ``placed``) on the
+    smallest stock that holds them all; ``placements`` with theirs set."""
+    chosen = largest
+    for name, (w, h) in usable[:-1]:
+        for size in dict.fromkeys(((w, h), (h, w))):
+            trial = shelf_pack([outlines[k] for k in on], size, margin_mm, spacing_mm + kerf_mm)
+            if all(pl.sheet == 0 and fits(pl, size, margin_mm) for pl in trial):
+                chosen, placed = (name, size), trial
+                break
+        if chosen[0] != largest[0]:
+            break
+    for k, pl in zip(on, placed, strict=True):
+        placements[k] = Placement(pl.angle, pl.offset, index, pl.size)
+    return placements, Sheet(index, chosen[0], chosen[1], sum(parts[k].area_mm2() for k in on),
+                             sum(cut_area(parts[k], kerf_mm) for k in on), tuple(parts[k].name for k in on), thickness)
 
 
 def audit_problems(data: bytes) -> list[str]:

@@ -640,3 +640,19 @@ def test_the_gripper_palm_on_every_sla_preset_fits_or_is_named(shipped_build):
                                                  "build volume")
         verdicts[name] = fits_area
     assert verdicts["prusa_sl1s"] is False and verdicts["elegoo_saturn_3"] is True
+
+
+def test_a_laser_part_as_thick_as_a_listed_stock_passes_and_no_other_thickness(laser_process):
+    """On a 6 mm sheet with 3 and 6 mm stock listed (``stock_thickness_mm``) a 3 mm part passes and fits (the
+    layout nests it on a 3 mm sheet); a 4 mm part still fails, the message naming the stock; without the list
+    the 3 mm part fails as before."""
+    six = dataclasses.replace(laser_process, thickness_mm=6.0, build_volume_mm=(600.0, 400.0, 6.0),
+                              stock_thickness_mm=(3.0, 6.0))
+    parts = [box_part(name, (50, 20), thickness=t, process="laser") for name, t in (("a", 6.0), ("b", 3.0))]
+    result = check_printability(parts, six)
+    assert result.passed and all(row.fits for row in result.parts)
+    result = check_printability([box_part("c", (50, 20), thickness=4.0, process="laser")], six)
+    assert result.failures == ("printability: c is 4 mm thick, the sheet 6 mm (stock: 3 mm)",)
+    assert not result.parts[0].fits
+    result = check_printability(parts, dataclasses.replace(six, stock_thickness_mm=()))
+    assert result.failures == ("printability: b is 3 mm thick, the sheet 6 mm",)

@@ -1,18 +1,25 @@
 """Hole labels of the part drawings (issue 25, item 2): the nominal hole and its fit, and apart from it the CAD
-size with the process's compensation; never in a cut file."""
+size with the process's compensation; never in a cut file. The cut layout's sheets per stock thickness (issue 26,
+item 2: a 3 mm actuator plate beside 6 mm links)."""
 
 from __future__ import annotations
 
+import dataclasses
 import io
+import json
 import re
 import xml.etree.ElementTree as ET
 
 import ezdxf
+import numpy as np
 import pytest
 
-from fabricate.export.dxf import MIN_DRAWING_TEXT_MM, DxfStyle, part_dxf
+from fabricate.cli import main
+from fabricate.drive.records import MOUNT_PART
+from fabricate.export.dxf import MIN_DRAWING_TEXT_MM, DxfStyle, part_dxf, sheet_layout, sized_sheets
 from fabricate.export.svg import part_svg
 from fabricate.parts.build import build_parts
+from tests.export.test_labels import PONOKO, bar
 from tests.parts.test_build import design_for
 
 
@@ -57,3 +64,47 @@ def test_cut_files_carry_no_hole_labels(parts):
         titles = [c.find("s:title", ns).text for c in circles]
         assert all("CAD Ø" in t and "cut path Ø" in t for t in titles)
         assert not [t for t in svg.findall(".//s:text", ns) if "Ø" in (t.text or "")]
+
+
+def test_each_sheet_holds_parts_of_one_thickness():
+    """Mixed stock (6 mm links, a 3 mm plate): the 6 mm parts are nested exactly as they are alone, the 3 mm one
+    on a sheet of its own that states its thickness; sheet_layout nests the same way."""
+    links = [dataclasses.replace(bar(f"l{k}"), thickness_mm=6.0) for k in range(3)]
+    plate = bar("plate", length=40.0, width=20.0)  # 3 mm
+    mixed = [links[0], plate, *links[1:]]
+    placements, sheets = sized_sheets(mixed, 0.2, PONOKO, (790.0, 384.0), 5.0, 3.0)
+    assert [(s.thickness_mm, s.parts) for s in sheets] == [(6.0, ("l0", "l1", "l2")), (3.0, ("plate",))]
+    assert [s.report()["thickness_mm"] for s in sheets] == [6.0, 3.0]
+    assert all(mixed[k].thickness_mm == sheets[pl.sheet].thickness_mm for k, pl in enumerate(placements))
+    alone, sheets_alone = sized_sheets(links, 0.2, PONOKO, (790.0, 384.0), 5.0, 3.0)
+    assert [s.report() for s in sheets_alone] == [sheets[0].report()]
+    for pl, mine in zip(alone, [placements[0], *placements[2:]], strict=True):
+        assert pl.sheet == mine.sheet and pl.angle == mine.angle and np.array_equal(pl.offset, mine.offset)
+    layout = sheet_layout(mixed, 0.2, (181.0, 181.0), 5.0, 3.0)
+    assert [pl.sheet for pl in layout] == [0, 1, 0, 0]
+    assert [pl.sheet for pl in sheet_layout(links, 0.2, (181.0, 181.0), 5.0, 3.0)] == [0, 0, 0]
+
+
+@pytest.mark.slow
+def test_the_laser_default_finger_cuts_its_3mm_plate_on_a_3mm_sheet(tmp_path, capsys):
+    """``fabricate build --process laser`` of the default finger: its links are 6 mm, its actuator plate is cut
+    from the 3 mm stock. The build exits 0, the plate is on a sheet of thickness 3 with no 6 mm part, every
+    sheet's parts are as thick as it, and ``fabricate check`` passes on the written folder."""
+    out = tmp_path / "out"
+    code = main(["build", "finger_five_bar_ncg", "--process", "laser", "-o", str(out), "-q"])
+    captured = capsys.readouterr()
+    assert code == 0, captured.out + captured.err
+    report = json.loads((out / "report.json").read_text())
+    thickness = {p["name"]: p["thickness_mm"] for p in report["parts"]}
+    assert thickness[MOUNT_PART] == 3.0 and 6.0 in thickness.values()
+    sheets = report["cut"]["sheets"]
+    for sheet in sheets:
+        assert {thickness[name] for name in sheet["parts"]} == {sheet["thickness_mm"]}, sheet
+        assert (out / sheet["file"]).is_file() and (out / sheet["file"]).with_suffix(".svg").is_file()
+    (plate_sheet,) = [s for s in sheets if MOUNT_PART in s["parts"]]
+    assert plate_sheet["thickness_mm"] == 3.0
+    assert not [name for name in plate_sheet["parts"] if thickness[name] == 6.0]
+    code = main(["check", str(out), "-q"])
+    captured = capsys.readouterr()
+    assert code == 0, captured.out + captured.err
+    assert "Traceback" not in captured.out + captured.err
