@@ -95,17 +95,19 @@ _SHIPPED_BUILDS: dict[str, BuildOutcome] = {}
 
 
 @pytest.fixture(scope="session")
-def shipped_build() -> Callable[[str], BuildOutcome]:
-    """``shipped_build(name)``: ``run_build(load_design(name))`` of a shipped template, built once per test
-    process and shared by every test that only reads it.
+def shipped_build() -> Callable[..., BuildOutcome]:
+    """``shipped_build(name, process=None)``: ``run_build(load_design(name, process))`` of a shipped template,
+    built once per test process and shared by every test that only reads it.
 
     The outcome is shared: a test must not change it (copy what it edits). ``run_build`` is the real
     pipeline's, bound at import, so a module that monkeypatches ``fabricate.pipeline.run_build`` does not
     change what is cached here.
     """
-    def get(name: str) -> BuildOutcome:
-        if name not in _SHIPPED_BUILDS:
-            _SHIPPED_BUILDS[name] = run_build(load_design(name))
-        return _SHIPPED_BUILDS[name]
+    def get(name: str, process: str | None = None) -> BuildOutcome:
+        """``process``: a shipped profile's name, as ``--process`` gives it (``"laser"``, ``"fdm"``)."""
+        key = name if process is None else f"{name}--process-{process}"
+        if key not in _SHIPPED_BUILDS:
+            _SHIPPED_BUILDS[key] = run_build(load_design(name, process))
+        return _SHIPPED_BUILDS[key]
 
     return get

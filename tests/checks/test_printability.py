@@ -601,6 +601,24 @@ def test_a_part_fits_if_some_turn_on_the_plate_fits(sla_process, size, fits_area
     assert result.passed is fits_area and result.parts[0].fits is fits_area
 
 
+def _plan_size(part, process) -> str:
+    """A part's plan size as the check names it (long × short side of its smallest rotated rectangle, one
+    decimal, mm), by rotating calipers: the smallest rectangle has a side on an edge of the convex hull."""
+    from scipy.spatial import ConvexHull
+
+    outline = part.polygons(process.chord_tolerance_mm)[0]
+    hull = outline[ConvexHull(outline).vertices]
+    edges = np.roll(hull, -1, axis=0) - hull
+    best = None
+    for angle in np.arctan2(edges[:, 1], edges[:, 0]):
+        c, s = np.cos(-angle), np.sin(-angle)
+        turned = hull @ np.array([[c, s], [-s, c]])
+        sides = np.ptp(turned, axis=0)
+        if best is None or sides[0] * sides[1] < best[0] * best[1]:
+            best = sides
+    return f"{max(best):.1f} × {min(best):.1f}"
+
+
 @pytest.mark.slow
 def test_the_gripper_palm_on_the_sl1s_fails_naming_it():
     """Issue 26's reproduction: the gripper built for the SL1S (--printer prusa_sl1s) exits 1, the palm named
@@ -610,7 +628,9 @@ def test_the_gripper_palm_on_the_sl1s_fails_naming_it():
 
     outcome = run_build(load_design("gripper_compliant", None, "prusa_sl1s"))
     assert outcome.exit_code == 1
-    assert ("printability: palm (129.9 × 45.1 × 12 mm) does not fit the prusa_sl1s build volume 127 × 80 × 150 mm "
+    size = _plan_size(next(p for p in outcome.partset.parts if p.name == "palm"), outcome.design.process)
+    assert size.startswith("129.9 × ")  # the paper's 129.88 mm palm; its width follows the pin bosses
+    assert (f"printability: palm ({size} × 12 mm) does not fit the prusa_sl1s build volume 127 × 80 × 150 mm "
             "inside its 4 mm margin (119 × 72 mm usable, at any rotation on the plate)") in outcome.failures
     palm = next(p for p in outcome.report["parts"] if p["name"] == "palm")
     assert palm["plate"]["fits"] is False
@@ -636,8 +656,8 @@ def test_the_gripper_palm_on_every_sla_preset_fits_or_is_named(shipped_build):
         fits_area = fitting_angle(palm.polygons(process.chord_tolerance_mm)[0], *usable) is not None
         assert result.passed is fits_area
         if not fits_area:
-            assert result.failures[0].startswith(f"printability: palm (129.9 × 45.1 × 12 mm) does not fit the {name} "
-                                                 "build volume")
+            assert result.failures[0].startswith(f"printability: palm ({_plan_size(palm, process)} × 12 mm) does "
+                                                 f"not fit the {name} build volume")
         verdicts[name] = fits_area
     assert verdicts["prusa_sl1s"] is False and verdicts["elegoo_saturn_3"] is True
 

@@ -63,15 +63,13 @@ def test_a_stack_too_tall_for_the_designs_screw_takes_the_next_size():
 
 
 @pytest.mark.slow
-def test_the_laser_default_finger_builds_with_no_collision_and_within_the_shop_rules():
+def test_the_laser_default_finger_builds_with_no_collision_and_within_the_shop_rules(shipped_build):
     """``fabricate build --process laser`` of the default finger (its 6 mm stock kept) passes: the gears' bosses
     clear the mating teeth, the servo's plate (3 mm stock, on its tabs) clears pin A's clip end and meets the
     shop's rules, the standoffs' M4 screws clamp the 23.4 mm stack, and the plate, as thick as a listed stock, is
     nested on a 3 mm sheet of its own (tests/export/test_dxf.py)."""
-    from fabricate.design import load_design
-    from fabricate.pipeline import run_build
 
-    outcome = run_build(load_design("finger_five_bar_ncg", "laser"))
+    outcome = shipped_build("finger_five_bar_ncg", "laser")
     report = outcome.report
     assert report["interference"]["passed"] and not report["interference"]["collisions"]
     assert report["interference"]["shop"]["passed"], report["interference"]["shop"]["failures"]

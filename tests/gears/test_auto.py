@@ -339,10 +339,10 @@ def test_fixed_module_the_process_cannot_make_fails_the_build_naming_the_tip_lan
 
 @pytest.mark.slow
 @pytest.mark.parametrize(("process", "code"), [("laser", None), ("fdm", 1)])
-def test_process_builds_of_the_default_finger(process, code):
+def test_process_builds_of_the_default_finger(process, code, shipped_build):
     """The whole build: the laser's gears and their strength pass (its other checks are the parts'); the FDM build
     exits 1 naming the contact no module or angle relieves."""
-    outcome = run_build(load_design("finger_five_bar_ncg", process))
+    outcome = shipped_build("finger_five_bar_ncg", process)
     failures = outcome.report["checks"]["failures"]
     gear = outcome.report["gears"][0]
     if code is None:
