@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from fabricate import __version__, cache
+from fabricate import __version__, cache, stage_keys
 from fabricate.background import Background, in_thread
 from fabricate.bounds import blas_threads
 from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
@@ -159,7 +159,7 @@ def synthesise(design: DesignSpec, progress: Progress = _quiet) -> SynthesisResu
 def _synthesis_stage(design: DesignSpec, progress: Progress, stage: str
                      ) -> tuple[SynthesisResult, dict[str, Any], Motion | None, list[str]]:
     """Synthesis and the swept motion; a lock-up inside the range is a design failure, not an error."""
-    result, motion, lockup = cache.cached("synthesis", cache.synthesis_key(design),
+    result, motion, lockup = cache.cached("synthesis", stage_keys.synthesis_key(design),
                                           lambda: _synthesis_and_motion(design, progress))
     # the schema version first: a reader learns which contract the rest follows before reading it
     report: dict[str, Any] = {"schema_version": SCHEMA_VERSION, "design": design_section(design, stage)}
@@ -174,7 +174,7 @@ def _synthesis_stage(design: DesignSpec, progress: Progress, stage: str
 def _synthesis_and_motion(design: DesignSpec, progress: Progress
                           ) -> tuple[SynthesisResult, Motion | None, str | None]:
     """Synthesis and its sweep, or the lock-up that stops the sweep: one entry of :mod:`fabricate.cache`."""
-    result = cache.storable_synthesis(synthesise(design, progress), design)
+    result = stage_keys.storable_synthesis(synthesise(design, progress), design)
     progress("sweep")
     try:
         return result, result.mechanism.sweep(design.checks.sweep_poses), None
@@ -282,7 +282,7 @@ def run_build(design: DesignSpec, progress: Progress = _quiet, *,
         Invalid input or nothing feasible (the CLI exits 2 and writes nothing).
     """
     if (optional is None or (optional.step and optional.step_files is None)) and \
-            not cache.stored("step", cache.pictures_key(design, "step")):  # a stored STEP result needs no OCP
+            not cache.stored("step", stage_keys.pictures_key(design, "step")):  # a stored STEP result needs no OCP
         from fabricate.export import prestart_step
 
         prestart_step()  # OCP imports in the STEP worker on the second core while synthesis runs
@@ -337,7 +337,7 @@ def _make_gears(run: BuildRun) -> None:
 
     run.enter("gears")
     # gears.module_mm = "auto": the smallest standard module the process makes and the load allows
-    run.gear_pairs = cache.cached("gears", cache.gears_key(run.design), lambda: build_gear_pairs(
+    run.gear_pairs = cache.cached("gears", stage_keys.gears_key(run.design), lambda: build_gear_pairs(
         run.mechanism, run.design.gears, run.design.process.chord_tolerance_mm,
         lambda: module_limits(run.design, run.mechanism, run.motion, run.synthesis.parts)))
     run.report["gears"] = [pair.report() for pair in run.gear_pairs]
@@ -351,7 +351,7 @@ def _size_links(run: BuildRun) -> None:
     run.enter("sizing")
     design, mechanism, motion, gear_pairs, hints = run.design, run.mechanism, run.motion, run.gear_pairs, \
         run.synthesis.parts
-    width, tried = cache.cached("sizing", cache.sizing_key(design), lambda: size_link_width(
+    width, tried = cache.cached("sizing", stage_keys.sizing_key(design), lambda: size_link_width(
         design, mechanism, motion, gear_pairs, hints, lambda d: build_parts(d, mechanism, motion, gear_pairs, hints)))
     run.design = dataclasses.replace(design, parts=dataclasses.replace(design.parts, link_width_mm=width))
     run.sizing = {"link_width_mm": width, "tried": [{"link_width_mm": w, "least_safety_factor": sf}
@@ -363,7 +363,7 @@ def _make_parts(run: BuildRun) -> None:
     from fabricate.parts.build import build_parts
 
     run.enter("parts")
-    run.partset = cache.cached("parts", cache.parts_key(run.design), lambda: build_parts(
+    run.partset = cache.cached("parts", stage_keys.parts_key(run.design), lambda: build_parts(
         run.design, run.mechanism, run.motion, run.gear_pairs, run.synthesis.parts))
 
 
@@ -376,7 +376,8 @@ def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
     optional = run.optional
 
     def step_files() -> dict[str, bytes]:
-        return cache.cached("step", cache.pictures_key(design, "step"), lambda: export_step(design, partset, motion))
+        return cache.cached("step", stage_keys.pictures_key(design, "step"),
+                            lambda: export_step(design, partset, motion))
 
     def step_job() -> dict[str, bytes]:
         if optional is None:
@@ -390,11 +391,11 @@ def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
     # each job's result is a cache entry (fabricate.cache; the synthesis plots are the result's own figures')
     # the STEP job mostly waits on its own process (export_step): in a thread, the pictures are drawn meanwhile
     return [lambda: synthesis_plots(result),
-            lambda: cache.cached("gear_pictures", cache.pictures_key(design, "gear_pictures"),
+            lambda: cache.cached("gear_pictures", stage_keys.pictures_key(design, "gear_pictures"),
                                  lambda: gear_pictures(gear_pairs)),
-            lambda: cache.cached("previews", cache.pictures_key(design, "previews"),
+            lambda: cache.cached("previews", stage_keys.pictures_key(design, "previews"),
                                  lambda: export_previews(design, partset, motion)), in_thread(step_job),
-            lambda: cache.cached("guide_pictures", cache.pictures_key(design, "guide_pictures"),
+            lambda: cache.cached("guide_pictures", stage_keys.pictures_key(design, "guide_pictures"),
                                  lambda: guide_picture_files(partset, motion))]
 
 
@@ -430,7 +431,7 @@ def _export(run: BuildRun, with_step: bool) -> None:
                                   with_step=with_step, sections=sections)
         return files, parts, sections.get("cut")
 
-    exported, parts_report, cut = cache.cached("exports", cache.exports_key(run.design, with_step), make)
+    exported, parts_report, cut = cache.cached("exports", stage_keys.exports_key(run.design, with_step), make)
     if cut is not None:
         run.report["cut"] = cut
     run.files.update(exported)
@@ -463,7 +464,7 @@ def _check(run: BuildRun) -> None:
     run.enter("checks")
     assert run.partset is not None  # the parts stage ran
     partset = run.partset
-    run.checks = cache.cached("checks", cache.checks_key(run.design), lambda: run_checks(
+    run.checks = cache.cached("checks", stage_keys.checks_key(run.design), lambda: run_checks(
         run.design, partset, run.mechanism, run.motion, run.gear_pairs))
     run.report["interference"] = run.checks.interference
     run.failures = list(run.checks.failures)
@@ -478,7 +479,7 @@ def _check_strength(run: BuildRun) -> None:
     run.enter("strength")
     assert run.partset is not None  # the parts stage ran
     partset = run.partset
-    run.strength = cache.cached("strength", cache.strength_key(run.design), lambda: run_strength(
+    run.strength = cache.cached("strength", stage_keys.strength_key(run.design), lambda: run_strength(
         run.design, partset, run.mechanism, run.motion, run.gear_pairs, run.synthesis.parts))
     run.report["strength"] = run.strength.report()
     if run.sizing is not None:
@@ -519,14 +520,14 @@ def _plots(run: BuildRun, pictures: Background) -> None:
     assert run.checks is not None and run.strength is not None  # both checks ran
     strength, drive, checks = run.strength, run.drive, run.checks
     if strength.findings:
-        run.files["plots/strength.png"] = cache.cached("strength_plot", cache.strength_key(run.design), lambda:
+        run.files["plots/strength.png"] = cache.cached("strength_plot", stage_keys.strength_key(run.design), lambda:
                                                        strength_plot(strength, run.mechanism.input_unit))
     if drive is not None and drive.reason is None:
         from fabricate.drive.plots import drive_plot
 
-        run.files["plots/drive.png"] = cache.cached("drive_plot", cache.drive_key(run.design),
+        run.files["plots/drive.png"] = cache.cached("drive_plot", stage_keys.drive_key(run.design),
                                                     lambda: drive_plot(drive))
-    for name, data in sorted(cache.cached("check_figures", cache.checks_key(run.design), checks.figures).items()):
+    for name, data in sorted(cache.cached("check_figures", stage_keys.checks_key(run.design), checks.figures).items()):
         run.files[f"plots/{name}"] = data
     run.files.update(pictures.result())
 

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from fabricate import cache
+from fabricate import cache, stage_keys
 from fabricate.design import design_from_text, load_design
 from fabricate.templates import TEMPLATE_DIR
 
@@ -68,8 +68,8 @@ def test_each_stage_key_moves_with_its_inputs_only():
     """An edit of a section moves exactly the keys of the stages that read it (the design sections as
     ``fabricate.cache`` documents them)."""
     base = design_from_text((TEMPLATE_DIR / f"{DEFAULT}.toml").read_text(encoding="utf-8"), f"{DEFAULT}.toml")
-    stages = {"synthesis": cache.synthesis_key, "gears": cache.gears_key, "parts": cache.parts_key,
-              "checks": cache.checks_key, "strength": cache.strength_key, "drive": cache.drive_key}
+    stages = {"synthesis": stage_keys.synthesis_key, "gears": stage_keys.gears_key, "parts": stage_keys.parts_key,
+              "checks": stage_keys.checks_key, "strength": stage_keys.strength_key, "drive": stage_keys.drive_key}
 
     def moved(design) -> set[str]:
         return {name for name, key in stages.items()
@@ -91,9 +91,10 @@ def test_each_stage_key_moves_with_its_inputs_only():
     # a chosen module reads the process and the load: then a load edit moves the gears and all after them
     auto = replace("gears", module_mm=None)
     loaded = dataclasses.replace(auto, load=dataclasses.replace(auto.load, tip_force_N=1.2))
-    assert cache.stage_key("gears", cache.gears_key(loaded)) != cache.stage_key("gears", cache.gears_key(auto))
-    assert cache.stage_key("synthesis", cache.synthesis_key(loaded)) == \
-        cache.stage_key("synthesis", cache.synthesis_key(auto))
+    assert cache.stage_key("gears", stage_keys.gears_key(loaded)) != \
+        cache.stage_key("gears", stage_keys.gears_key(auto))
+    assert cache.stage_key("synthesis", stage_keys.synthesis_key(loaded)) == \
+        cache.stage_key("synthesis", stage_keys.synthesis_key(auto))
 
 
 def test_a_key_holds_the_code_that_computes_it(monkeypatch, tmp_path):
@@ -300,7 +301,7 @@ def test_every_stage_reads_only_what_its_key_holds(variant):
     if variant != "default":
         text = text.replace("module_mm = 0.5", 'module_mm = "auto"')
     design = design_from_text(text, f"{DEFAULT}.toml", None if variant == "default" else _laser())
-    gears = GEARS_CHOSEN if cache.module_is_chosen(design) else GEARS
+    gears = GEARS_CHOSEN if stage_keys.module_is_chosen(design) else GEARS
     parts = gears | PARTS_OF
     log: set[str] = set()
     result, motion, _ = pipeline._synthesis_and_motion(traced(design, "", log), pipeline._quiet)

@@ -54,6 +54,7 @@ from fabricate.parts.bom import (
     with_sources,
 )
 from fabricate.parts.features import pad_segment, slider_guides
+from fabricate.parts.gear_seats import gear_outline_in_body, mesh_limits
 from fabricate.parts.layers import (
     assign_layers,
     conflict_graph,
@@ -76,7 +77,6 @@ from fabricate.parts.retention import cap_parts, choose_holder, end_radius_mm, e
 from fabricate.parts.spec import PartsSpec
 from fabricate.parts.spring_rows import with_spring_rows
 from fabricate.parts.springs import place_springs
-from fabricate.planar import rotation
 from fabricate.process import ProcessSpec
 
 if TYPE_CHECKING:  # the gears and the design sit above the parts layer
@@ -126,36 +126,6 @@ def derive_sizes(process: ProcessSpec, parts: PartsSpec, hints: PartHints,
                  press_nominal_mm=press.nominal_mm, mount_nominal_mm=mounting.nominal_mm)
 
 
-def gear_outline_in_body(mechanism: Mechanism, pair: GearPair, side: str) -> tuple[str, str, np.ndarray]:
-    """A gear outline mapped into the coordinates of the body that carries it.
-
-    Parameters
-    ----------
-    pair : GearPair
-        Needs ``name``, ``body_a``, ``body_b``, ``axis_a``, ``axis_b``, ``outline_a``, ``outline_b``.
-    side : str
-        ``"a"`` or ``"b"``.
-
-    Returns
-    -------
-    (body, axis joint, (n, 2) array)
-        u = u_axis + R(beta) g, beta = direction of JB - JA in the carrier (gear-frame convention).
-    """
-    coupling = next((g for g in mechanism.gears if g.name == pair.name), None)
-    carrier = mechanism.body(coupling.carrier) if coupling is not None else None
-    ja, jb = pair.axis_a, pair.axis_b
-    if carrier is not None and ja in carrier.points and jb in carrier.points:
-        d = carrier.point(jb) - carrier.point(ja)
-    else:  # no carrier record: the line of centres as seen in body a
-        d = mechanism.body(pair.body_a).point(jb) - mechanism.body(pair.body_a).point(ja)
-    beta = math.atan2(d[1], d[0])
-    body = pair.body_a if side == "a" else pair.body_b
-    axis = ja if side == "a" else jb
-    outline = np.asarray(pair.outline_a if side == "a" else pair.outline_b, dtype=np.float64)
-    u_axis = mechanism.body(body).point(axis)
-    return body, axis, outline @ rotation(beta).T + u_axis
-
-
 def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_pairs: Sequence[GearPair],
                 hints: PartHints | None = None) -> PartSet:
     """Turn a solved mechanism into parts.
@@ -192,7 +162,7 @@ def build_parts(design: DesignSpec, mechanism: Mechanism, motion: Motion, gear_p
     pin_joints = _add_joints(drawing, mechanism, motion, sizes, process)
     _add_pads(drawing, mechanism, hints.pads or {}, parts_spec, sizes.boss_radius_mm, tol)
     _add_gears(drawing, mechanism, gear_pairs, sizes.hub_mm, tol,
-               _mesh_limits(mechanism, motion, gear_pairs, process.running_clearance_mm),
+               mesh_limits(mechanism, motion, gear_pairs, process.running_clearance_mm),
                0.5 * sizes.hole_mm + process.min_wall_mm,
                explicit_hub=bool(parts_spec.hub_diameter_mm or gear_hub))
     outlines = _outlines(drawing, mechanism, motion, sizes, parts_spec, process)
@@ -327,31 +297,6 @@ def _add_pads(drawing: _Drawing, mechanism: Mechanism, pads: Mapping[str, PadHin
                 drawing.fused[body].append(segment)
         else:
             drawing.circles[body].append((centre, max(r_pad, radius)))
-
-
-def _mesh_limits(mechanism: Mechanism, motion: Motion, gear_pairs: Sequence[GearPair],
-                 clearance: float) -> dict[tuple[str, str], float]:
-    """The largest radius a boss or hub round each gear's axis may have: ``clearance`` short of the nearest
-    the mating gear comes to the axis over the motion (its tips, reaching down to this gear's root).
-
-    Returns
-    -------
-    dict
-        (body, axis joint) -> radius, mm.
-    """
-    out: dict[tuple[str, str], float] = {}
-    for pair in gear_pairs:
-        for side, other in (("a", "b"), ("b", "a")):
-            body, axis, _ = gear_outline_in_body(mechanism, pair, side)
-            mate, _, ring = gear_outline_in_body(mechanism, pair, other)
-            centre = mechanism.body(body).point(axis)
-            own, theirs = motion.pose(body), motion.pose(mate)
-            world = np.einsum("nij,vj->nvi", rotation(theirs[:, 2]), ring) + theirs[:, None, :2]
-            local = np.einsum("nji,nvj->nvi", rotation(own[:, 2]), world - own[:, None, :2])
-            reach = float(np.min(shapely.distance(shapely.polygons(local), shapely.Point(*centre))))
-            key = (body, axis)
-            out[key] = min(out.get(key, math.inf), reach - clearance)
-    return out
 
 
 def _add_gears(drawing: _Drawing, mechanism: Mechanism, gear_pairs: Sequence[GearPair], hub_mm: float,

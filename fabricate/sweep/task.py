@@ -28,7 +28,7 @@ from fabricate.sweep.paths import Metric
 #: Exit codes of a row, as the CLI's: 0 passes, 1 fails a check, 2 invalid or infeasible, 3 internal error.
 EXIT_OK, EXIT_FAILED, EXIT_INVALID, EXIT_INTERNAL = 0, 1, 2, 3
 
-#: Template tables synthesis never reads (:func:`fabricate.cache.synthesis_key`): a point that varies only fields
+#: Template tables synthesis never reads (:func:`fabricate.stage_keys.synthesis_key`): a point that varies only fields
 #: in these (and ``[checks]`` but its ``sweep_poses``) shares the synthesis of the other points of its group.
 NOT_SYNTHESIS_TABLES = frozenset({"process", "parts", "load"})
 
@@ -37,7 +37,7 @@ def synthesis_group(fields: Sequence[tuple[str, Sequence[str | int]]], values: M
     """The values of a point's varied fields that synthesis may read, as a text: points with the same text share
     their synthesis (and its swept motion).
 
-    A scheduling hint only: the cache's own key (:func:`fabricate.cache.synthesis_key`, of the validated design)
+    A scheduling hint only: the cache's own key (:func:`fabricate.stage_keys.synthesis_key`, of the validated design)
     decides what is reused, so a field taken for one that synthesis reads when it does not costs a synthesis,
     never a wrong result. ``[process]``, ``[parts]``, ``[load]``, ``[checks]`` (but ``sweep_poses``) and
     ``design.description`` are the fields it does not read.

@@ -32,10 +32,10 @@ from fabricate.parts.build import (
     _check_pin_webs,
     build_parts,
     derive_sizes,
-    gear_outline_in_body,
     merge_coincident_pins,
 )
 from fabricate.parts.features import _guide_spacing, _segment_distance, pad_segment
+from fabricate.parts.gear_seats import gear_outline_in_body
 from fabricate.parts.layers import assign_layers
 from fabricate.parts.model import BulgePath, Hole, Part
 from fabricate.parts.partset import CONFLICT_CHORD_MM, SlottedPart, overlapping_cuts, swept_region
@@ -1501,6 +1501,6 @@ def test_bosses_round_gear_axes_clear_the_mating_gear(monkeypatch):
     (pair,) = run.gear_pairs
     partset = build_parts(design, result.mechanism, motion, run.gear_pairs, result.parts)
     assert gear_overlap(partset, motion, pair) == 0.0
-    monkeypatch.setattr(build, "_mesh_limits", lambda *args: {})
+    monkeypatch.setattr(build, "mesh_limits", lambda *args: {})
     full = build_parts(design, result.mechanism, motion, run.gear_pairs, result.parts)
     assert gear_overlap(full, motion, pair) > 1.0
