@@ -37,6 +37,13 @@ def init(args: argparse.Namespace) -> int:
         raise SpecError(str(source), "has no [design] name to replace")
     target = Path.cwd() / f"{name}.toml"
     design_from_text(text, target)  # the copy must be a valid template before it is written
+    _write_new(target, text)
+    print(f"wrote {target.name} (from {source.name}); build it with: fabricate build {target.name}")
+    return EXIT_OK
+
+
+def _write_new(target: Path, text: str) -> None:
+    """Write ``text`` to a new file ``target``: ``init`` never overwrites one."""
     try:
         with open(target, "x", encoding="utf-8") as fh:
             fh.write(text)
@@ -44,8 +51,6 @@ def init(args: argparse.Namespace) -> int:
         raise SpecError(str(target), "exists already; init never overwrites a file") from exc
     except OSError as exc:
         raise SpecError(str(target), f"cannot be written: {exc.strerror}") from exc
-    print(f"wrote {target.name} (from {source.name}); build it with: fabricate build {target.name}")
-    return EXIT_OK
 
 
 def init_process(args: argparse.Namespace) -> int:
@@ -56,13 +61,7 @@ def init_process(args: argparse.Namespace) -> int:
         raise SpecError("NAME", "init --process writes a process profile: name its file with -o, not NAME")
     target = args.output if args.output is not None else Path(f"my_{args.process}.toml")
     text = profile_copy(args.process, target)
-    try:
-        with open(target, "x", encoding="utf-8") as fh:
-            fh.write(text)
-    except FileExistsError as exc:
-        raise SpecError(str(target), "exists already; init never overwrites a file") from exc
-    except OSError as exc:
-        raise SpecError(str(target), f"cannot be written: {exc.strerror}") from exc
+    _write_new(target, text)
     print(f"wrote {target} (from the shipped {args.process} profile); calibrate it with: fabricate coupon "
           f"--process {target}; build with: fabricate build TEMPLATE --process {target}")
     return EXIT_OK

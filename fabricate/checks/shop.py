@@ -26,6 +26,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import shapely
 
+from fabricate.parts.profiles import touching_pairs
+
 if TYPE_CHECKING:
     from fabricate.parts.model import Part
     from fabricate.process import ProcessSpec
@@ -170,13 +172,8 @@ def cut_path_problems(part: Part, kerf_mm: float) -> list[str]:
         if diameter <= 0.0:
             return [f"hole {hole.joint}: the cut circle has no size (Ø{diameter:.3f} mm after the kerf)"]
         contours.append((f"hole {hole.joint}", shapely.Point(centre).buffer(diameter / 2.0, 64).exterior))
-    problems = []
-    lines = [c for _, c in contours]
-    tree = shapely.STRtree(lines)
-    for i, j in zip(*tree.query(lines, predicate="intersects"), strict=True):
-        if i < j:
-            problems.append(f"the cut {contours[i][0]} and {contours[j][0]} touch or overlap (a line cut twice)")
-    return problems
+    return [f"the cut {contours[i][0]} and {contours[j][0]} touch or overlap (a line cut twice)"
+            for i, j in touching_pairs([c for _, c in contours])]
 
 
 def check_part(part: Part, rules: ShopRules, kerf_mm: float) -> list[str]:

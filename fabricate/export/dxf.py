@@ -42,7 +42,7 @@ from shapely.ops import polylabel
 from fabricate.export.labels import Label, label_part
 from fabricate.export.layout import Placement, fits, shelf_pack
 from fabricate.parts.model import BulgePath, Hole, Part
-from fabricate.parts.profiles import offset_path
+from fabricate.parts.profiles import offset_path, touching_pairs
 
 #: Smallest text in a drawing (mm): ISO 3098 / ASME Y14.2 ask for at least 2.5 mm on printed drawings.
 MIN_DRAWING_TEXT_MM = 2.5
@@ -480,9 +480,6 @@ def cut_file_problems(data: bytes) -> list[str]:
             rings.append((where, shapely.Point(e.dxf.center.x, e.dxf.center.y).buffer(e.dxf.radius, 64).exterior))
         elif layer == "CUT":
             problems.append(f"{where}: not a closed contour")
-    lines = [ring for _, ring in rings]
-    tree = shapely.STRtree(lines)
-    for i, j in zip(*tree.query(lines, predicate="intersects"), strict=True):
-        if i < j:
-            problems.append(f"{rings[i][0]} and {rings[j][0]} touch, cross or repeat (a line cut twice)")
+    problems += [f"{rings[i][0]} and {rings[j][0]} touch, cross or repeat (a line cut twice)"
+                 for i, j in touching_pairs([ring for _, ring in rings])]
     return problems

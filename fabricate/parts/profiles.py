@@ -9,6 +9,7 @@ gear teeth are a polygon already (chord error within the tolerance it was built 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 import shapely
@@ -211,3 +212,10 @@ def offset_path(path: BulgePath, distance_mm: float) -> BulgePath:
     if path.area() < 0:
         shift = -shift
     return BulgePath(path.vertices + distance_mm * shift, path.bulges.copy())
+
+
+def touching_pairs(lines: Sequence[shapely.Geometry]) -> list[tuple[int, int]]:
+    """Index pairs ``i < j`` of the geometries that touch, cross or overlap, each pair once (a laser would cut
+    such contours twice, or cut one part into another)."""
+    tree = shapely.STRtree(lines)
+    return [(int(i), int(j)) for i, j in zip(*tree.query(lines, predicate="intersects"), strict=True) if i < j]
