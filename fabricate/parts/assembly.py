@@ -297,6 +297,55 @@ def _actuator_words(actuator: Any) -> str:
     return _words(entry, "name", "model", "key") or _words(actuator, "name", "model", "key")
 
 
+@dataclass(frozen=True)
+class _GuideFacts:
+    """What the guide reads from a part set, looked up once: the steps below take it as their input."""
+
+    partset: PartSet
+    rows: list[dict[str, Any]]
+    copies: int
+    by_name: dict[str, Any]
+    stack_of: dict[str, PinStack]
+    springs: dict[str, Any]
+    actuator: Any
+    act_words: str
+    ground: list[str]
+
+    @classmethod
+    def of(cls, partset: PartSet, stacks: Sequence[PinStack]) -> _GuideFacts:
+        actuator = getattr(partset, "actuator", None)
+        return cls(partset, [dict(r) for r in partset.bom], max(int(partset.copies), 1),
+                   {p.name: p for p in partset.parts}, {s.pin: s for s in stacks},
+                   {sp.pin: sp for sp in getattr(partset, "springs", ()) or ()}, actuator,
+                   _actuator_words(actuator), [p.name for p in partset.parts if p.role == "ground"])
+
+    @property
+    def ground_bodies(self) -> set[str]:
+        return {self.by_name[n].body for n in self.ground}
+
+
+@dataclass
+class _GuideSteps:
+    """The guide as it grows: each step takes its BOM units from ``units`` and records what is in place."""
+
+    units: dict[str, list[GuideItem]]
+    steps: list[GuideStep] = dataclasses.field(default_factory=list)
+    placed: list[str] = dataclasses.field(default_factory=list)
+    pins_in: list[str] = dataclasses.field(default_factory=list)
+    springs_in: list[str] = dataclasses.field(default_factory=list)
+    mounted: bool = False
+
+    def add(self, key: str, title: str, text: Sequence[str], tool: str, new: Sequence[str] = (),
+            new_pins: Sequence[str] = (), new_springs: Sequence[str] = (), new_actuator: bool = False) -> None:
+        self.placed.extend(n for n in new if n not in self.placed)
+        self.pins_in.extend(new_pins)
+        self.springs_in.extend(new_springs)
+        self.mounted = self.mounted or new_actuator
+        self.steps.append(GuideStep(len(self.steps) + 1, title, tuple(self.units.pop(key, [])), tuple(text), tool,
+                                    tuple(self.placed), tuple(new), tuple(self.pins_in), tuple(new_pins),
+                                    tuple(self.springs_in), tuple(new_springs), self.mounted, new_actuator))
+
+
 def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCheck) -> tuple[GuideStep, ...]:
     """The numbered assembly guide of one part set (pure: no drawing, no files).
 
@@ -306,69 +355,83 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
     of every BOM row is fitted in exactly one step (per copy; shared rows in all): the quantities the steps
     list add up to the BOM's.
     """
-    copies = max(int(partset.copies), 1)
-    rows = [dict(r) for r in partset.bom]
-    by_name = {p.name: p for p in partset.parts}
-    stack_of = {s.pin: s for s in stacks}
-    pins = list(partset.pins)
-    springs = {sp.pin: sp for sp in getattr(partset, "springs", ()) or ()}
-    actuator = getattr(partset, "actuator", None)
-    act_words = _actuator_words(actuator)
-    ground = [p.name for p in partset.parts if p.role == "ground"]
-    ground_bodies = {by_name[n].body for n in ground}
+    facts = _GuideFacts.of(partset, stacks)
+    order = _pin_order(facts)
+    part_step = _part_steps(facts, order)
+    guide = _GuideSteps(_deal_units(facts, part_step))
+    _ground_step(guide, facts, part_step)
+    for pin in order:
+        _pin_steps(guide, facts, pin, part_step)
+    _drive_step(guide, facts, part_step)
+    _bought_steps(guide, facts.copies)
+    _check_step(guide, check, bool(facts.springs))
+    return tuple(guide.steps)
 
-    # the pin order: from what is placed, outwards (ties: the part set's order)
+
+def _pin_order(facts: _GuideFacts) -> list[Any]:
+    """The pins in the order they go in: from what is placed, outwards (ties: the part set's order)."""
     order: list[Any] = []
-    reached = set(ground_bodies)
-    left = list(pins)
+    reached = set(facts.ground_bodies)
+    left = list(facts.partset.pins)
     while left:
         nxt = next((p for p in left if reached & set(p.bodies)), left[0])
         left.remove(nxt)
         order.append(nxt)
         reached |= set(nxt.bodies)
+    return order
 
-    # which step a part comes in: its body's first pin (the ground first); a printed spacer with its pin
-    part_step: dict[str, str] = {n: "ground" for n in ground}
-    seen_bodies = set(ground_bodies)
+
+def _part_steps(facts: _GuideFacts, order: Sequence[Any]) -> dict[str, str]:
+    """Which step each part comes in: its body's first pin (the ground first); a printed spacer with its pin."""
+    part_step: dict[str, str] = {n: "ground" for n in facts.ground}
+    seen_bodies = set(facts.ground_bodies)
+    parts = facts.partset.parts
     for pin in order:
-        stack = stack_of.get(pin.joint)
+        stack = facts.stack_of.get(pin.joint)
         for item in stack.items if stack else ():
-            if item.kind == "spacer" and item.item in by_name:
+            if item.kind == "spacer" and item.item in facts.by_name:
                 part_step.setdefault(item.item, f"pin:{pin.joint}")
         for body in pin.bodies:
             if body in seen_bodies:
                 continue
             seen_bodies.add(body)
-            for part in partset.parts:
+            for part in parts:
                 if part.body == body and part.role not in ("spacer", "mount", "standoff", "arbor", "cap"):
                     part_step.setdefault(part.name, f"pin:{pin.joint}")
-    for sp in springs.values():
+    for sp in facts.springs.values():
         if sp.arbor:
             part_step[sp.arbor] = f"spring:{sp.pin}"  # the coil's arbor goes on with the coil
-    for part in partset.parts:
+    for part in parts:
         if part.role == "cap":  # a pin's bonded end cap, with its pin
-            joint = next((h.joint for h in part.holes if h.joint in stack_of), "")
+            joint = next((h.joint for h in part.holes if h.joint in facts.stack_of), "")
             if joint:
                 part_step.setdefault(part.name, f"pin:{joint}")
         part_step.setdefault(part.name, "drive" if part.role in ("mount", "standoff") else "ground")
+    return part_step
 
-    # every BOM unit to one step: (step key) -> {item: GuideItem}
+
+def _deal_units(facts: _GuideFacts, part_step: dict[str, str]) -> dict[str, list[GuideItem]]:
+    """Every BOM unit to one step: ``{step key: [GuideItem]}``.
+
+    Step keys: "ground", "pin:<pin>", "spring:<pin>", "drive", "purchased", "shared drive", "shared", "check".
+    """
     units: dict[str, list[GuideItem]] = {}
 
     def give(key: str, row: dict[str, Any], qty: int, shared: bool) -> None:
         if qty > 0:
             units.setdefault(key, []).append(GuideItem(str(row.get("item")), str(row.get("kind", "")), qty, shared))
 
-    # step keys: "ground", "pin:<pin>", "spring:<pin>", "drive", "purchased", "shared drive", "shared", "check"
+    pins = facts.partset.pins
+    stack_of, springs, act_words = facts.stack_of, facts.springs, facts.act_words
     pin_of_joint = {j: p.joint for p in pins for j in p.joint.split("+")} | {p.joint: p.joint for p in pins}
-    for row in rows:
+    for row in facts.rows:
         qty = int(row.get("qty", 0) or 0)
-        shared = bool(row.get("shared")) or qty % copies != 0
-        per = qty if shared else qty // copies
+        shared = bool(row.get("shared")) or qty % facts.copies != 0
+        per = qty if shared else qty // facts.copies
         kind = str(row.get("kind", ""))
         name = str(row.get("item", ""))
         joints = [pin_of_joint[j] for j in row.get("joints", []) or [] if j in pin_of_joint]
-        if name in by_name and kind not in ("pin", "washer", "spacer", "spring", "screw", "purchased"):
+        if name in facts.by_name and kind not in ("pin", "washer", "spacer", "spring", "screw", "purchased"):
             give(part_step[name], row, per, shared)
         elif kind == "spring" and joints:
             _round_robin(give, [f"spring:{j}" if j in springs else f"pin:{j}" for j in joints], row, per, shared)
@@ -383,99 +446,107 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
             give("ground", row, per, shared)  # the ground's mounting screws and their washers
         else:
             give("shared" if shared else "purchased", row, per, shared)
+    return units
 
-    steps: list[GuideStep] = []
-    placed: list[str] = []
-    pins_in: list[str] = []
-    springs_in: list[str] = []
 
-    mounted = [False]
-
-    def add(key: str, title: str, text: Sequence[str], tool: str, new: Sequence[str] = (),
-            new_pins: Sequence[str] = (), new_springs: Sequence[str] = (), new_actuator: bool = False) -> None:
-        placed.extend(n for n in new if n not in placed)
-        pins_in.extend(new_pins)
-        springs_in.extend(new_springs)
-        mounted[0] = mounted[0] or new_actuator
-        steps.append(GuideStep(len(steps) + 1, title, tuple(units.pop(key, [])), tuple(text), tool,
-                               tuple(placed), tuple(new), tuple(pins_in), tuple(new_pins), tuple(springs_in),
-                               tuple(new_springs), mounted[0], new_actuator))
-
+def _ground_step(guide: _GuideSteps, facts: _GuideFacts, part_step: dict[str, str]) -> None:
+    """Step 1: the ground part, with its mounting screws."""
     new_ground = [n for n, k in part_step.items() if k == "ground"]
-    screws = [r for r in rows if r.get("kind") == "screw" and not _is_drive(r, act_words)]
+    screws = [r for r in facts.rows if r.get("kind") == "screw" and not _is_drive(r, facts.act_words)]
     text = [f"Lay {', '.join(new_ground) or 'the ground part'} flat on the bench, bottom face down (the z heights "
             "below are measured up from the bottom of the stack)."]
     if screws:
         text.append("Fix it to the base plate or the test stand with the screws below through its mounting holes; "
                     "do not tighten fully until the motion check.")
-    add("ground", "The ground part", text, _screw_tool(screws) if screws else "none", new_ground)
+    guide.add("ground", "The ground part", text, _screw_tool(screws) if screws else "none", new_ground)
 
-    for pin in order:
-        stack = stack_of.get(pin.joint)
-        new = [n for n, k in part_step.items() if k == f"pin:{pin.joint}"]
-        arbors = {sp.arbor for sp in springs.values()}
-        on = [i for i in (stack.items if stack else ()) if i.kind != "spring" and i.item not in arbors]
-        listing = "; ".join(f"{i.label} ({i.kind}, z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" if i.kind != "part"
-                            else f"{i.label} (z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" for i in on)
-        retention, tool = _retention(pin)
-        spring = springs.get(pin.joint)
-        text = [f"Stack, bottom to top: {listing}.",
-                f"Push {_pin_words(pin)} through the stack from z {float(pin.z_mm):.2f} mm; every part "
-                "but the one that holds the pin must turn freely on it."]
-        clip_over_coil = spring is not None and getattr(pin, "retention", "") == "clip" and not spring.arbor
-        if clip_over_coil and spring is not None:
-            text.append(f"Retention: {retention}. Fit the {'bottom' if spring.side == 'top' else 'top'} end's now; "
-                        f"the {spring.side} end's go on over the torsion spring in the next step.")
-        else:
-            text.append(f"Retention: {retention}.")
-            if spring is not None:
-                text.append(f"The torsion spring goes on the pin's {spring.side} end in the next step.")
-        add(f"pin:{pin.joint}", f"Pin {pin.joint}", text, tool, new, new_pins=(pin.joint,))
+
+def _pin_steps(guide: _GuideSteps, facts: _GuideFacts, pin: Any, part_step: dict[str, str]) -> None:
+    """A pin's step (its stack, bottom to top, and its retention), then its torsion spring's where it has one."""
+    stack = facts.stack_of.get(pin.joint)
+    new = [n for n, k in part_step.items() if k == f"pin:{pin.joint}"]
+    arbors = {sp.arbor for sp in facts.springs.values()}
+    on = [i for i in (stack.items if stack else ()) if i.kind != "spring" and i.item not in arbors]
+    listing = "; ".join(f"{i.label} ({i.kind}, z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" if i.kind != "part"
+                        else f"{i.label} (z {i.z_mm[0]:.2f}–{i.z_mm[1]:.2f} mm)" for i in on)
+    retention, tool = _retention(pin)
+    spring = facts.springs.get(pin.joint)
+    text = [f"Stack, bottom to top: {listing}.",
+            f"Push {_pin_words(pin)} through the stack from z {float(pin.z_mm):.2f} mm; every part "
+            "but the one that holds the pin must turn freely on it."]
+    clip_over_coil = spring is not None and getattr(pin, "retention", "") == "clip" and not spring.arbor
+    if clip_over_coil and spring is not None:
+        text.append(f"Retention: {retention}. Fit the {'bottom' if spring.side == 'top' else 'top'} end's now; "
+                    f"the {spring.side} end's go on over the torsion spring in the next step.")
+    else:
+        text.append(f"Retention: {retention}.")
         if spring is not None:
-            s = spring.spring
-            upper = 1.0 if spring.hand == "RH" else -1.0
-            far_turn = upper if spring.side == "top" else -upper
-            way = "counter-clockwise" if far_turn > 0 else "clockwise"
-            seat = (f"the arbor {spring.arbor} (bond it to {spring.near_part}'s face round the pin's {spring.side} "
-                    "end first, with retaining adhesive)" if spring.arbor else f"the pin's {spring.side} end")
-            text = [f"Slide the coil ({spring.hand} wound, Ø{s.wire_d_mm:.2f} mm wire, OD {s.outer_d_mm:.2f} mm) "
-                    f"over {seat} until it sits on {spring.near_part}.",
-                    f"Hook the near leg's bent end into the anchor hole in {spring.near_part} "
-                    f"(Ø{spring.anchor_hole_mm:.2f} mm, {spring.leg_radii_mm[0]:g} mm from the pin).",
-                    f"Wind the far leg {spring.deflection_deg[0]:.0f}° {way} (seen from above) and drop its end into "
-                    f"the anchor hole in {spring.far_part} ({spring.leg_radii_mm[1]:g} mm from the pin; the leg's "
-                    f"end runs {spring.leg_axial_mm[1]:.1f} mm along the pin to it).",
-                    "Fit the pin's end items over the coil now: its clip keeps the spring on the pin." if clip_over_coil
-                    else "The legs' ends in their anchor holes keep the coil in place."]
-            add(f"spring:{pin.joint}", f"Torsion spring at {spring.joint}", text,
-                "long-nose pliers (to wind and place the legs)",
-                [n for n, k in part_step.items() if k == f"spring:{pin.joint}"], new_springs=(spring.joint,))
+            text.append(f"The torsion spring goes on the pin's {spring.side} end in the next step.")
+    guide.add(f"pin:{pin.joint}", f"Pin {pin.joint}", text, tool, new, new_pins=(pin.joint,))
+    if spring is not None:
+        guide.add(f"spring:{pin.joint}", f"Torsion spring at {spring.joint}", _spring_text(spring, clip_over_coil),
+                  "long-nose pliers (to wind and place the legs)",
+                  [n for n, k in part_step.items() if k == f"spring:{pin.joint}"], new_springs=(spring.joint,))
 
+
+def _spring_text(spring: Any, clip_over_coil: bool) -> list[str]:
+    """How to fit a torsion spring: the coil over its seat, the near leg hooked, the far leg wound and placed."""
+    s = spring.spring
+    upper = 1.0 if spring.hand == "RH" else -1.0
+    far_turn = upper if spring.side == "top" else -upper
+    way = "counter-clockwise" if far_turn > 0 else "clockwise"
+    seat = (f"the arbor {spring.arbor} (bond it to {spring.near_part}'s face round the pin's {spring.side} "
+            "end first, with retaining adhesive)" if spring.arbor else f"the pin's {spring.side} end")
+    return [f"Slide the coil ({spring.hand} wound, Ø{s.wire_d_mm:.2f} mm wire, OD {s.outer_d_mm:.2f} mm) "
+            f"over {seat} until it sits on {spring.near_part}.",
+            f"Hook the near leg's bent end into the anchor hole in {spring.near_part} "
+            f"(Ø{spring.anchor_hole_mm:.2f} mm, {spring.leg_radii_mm[0]:g} mm from the pin).",
+            f"Wind the far leg {spring.deflection_deg[0]:.0f}° {way} (seen from above) and drop its end into "
+            f"the anchor hole in {spring.far_part} ({spring.leg_radii_mm[1]:g} mm from the pin; the leg's "
+            f"end runs {spring.leg_axial_mm[1]:.1f} mm along the pin to it).",
+            "Fit the pin's end items over the coil now: its clip keeps the spring on the pin." if clip_over_coil
+            else "The legs' ends in their anchor holes keep the coil in place."]
+
+
+def _drive_step(guide: _GuideSteps, facts: _GuideFacts, part_step: dict[str, str]) -> None:
+    """The actuator's step (its mount parts, the actuator and its screws), where the design has a drive."""
+    actuator, act_words = facts.actuator, facts.act_words
     drive_parts = [n for n, k in part_step.items() if k == "drive"]
-    if actuator is not None or "drive" in units or drive_parts:
-        words = act_words or "the actuator"
-        text = []
-        if drive_parts:
-            text.append(f"Fit {', '.join(drive_parts)} to the ground part.")
-        driven = _words(actuator, "driven_body", "driven", "body") if actuator is not None else ""
-        mount = _words(actuator, "ground_body", "ground") if actuator is not None else ""
-        text.append(f"Mount {words}{' on ' + mount if mount else ''} with its screws; couple its output to "
-                    f"{driven or 'the driven part'} at the middle of its range before tightening the interface.")
-        text += [str(note) for note in getattr(actuator, "notes", ()) or ()]
-        drive_screws = [r for r in rows if r.get("kind") == "screw" and _is_drive(r, act_words)]
-        add("drive", "The actuator", text, _screw_tool(drive_screws), drive_parts,
-            new_actuator=actuator is not None)
+    if not (actuator is not None or "drive" in guide.units or drive_parts):
+        return
+    words = act_words or "the actuator"
+    text = []
+    if drive_parts:
+        text.append(f"Fit {', '.join(drive_parts)} to the ground part.")
+    driven = _words(actuator, "driven_body", "driven", "body") if actuator is not None else ""
+    mount = _words(actuator, "ground_body", "ground") if actuator is not None else ""
+    text.append(f"Mount {words}{' on ' + mount if mount else ''} with its screws; couple its output to "
+                f"{driven or 'the driven part'} at the middle of its range before tightening the interface.")
+    text += [str(note) for note in getattr(actuator, "notes", ()) or ()]
+    drive_screws = [r for r in facts.rows if r.get("kind") == "screw" and _is_drive(r, act_words)]
+    guide.add("drive", "The actuator", text, _screw_tool(drive_screws), drive_parts,
+              new_actuator=actuator is not None)
+
+
+def _bought_steps(guide: _GuideSteps, copies: int) -> None:
+    """The other bought parts of each copy; for several copies the repeat step and the parts shared by all."""
+    units = guide.units
     if "purchased" in units:
-        add("purchased", "Bought parts of each copy", ["Fit the bought parts below as their descriptions in the "
-                                                       "bill of materials say."], "as the parts need")
+        guide.add("purchased", "Bought parts of each copy", ["Fit the bought parts below as their descriptions in "
+                                                             "the bill of materials say."], "as the parts need")
     if copies > 1:
-        last = len(steps)
-        add("repeat", "The other copies", [f"Repeat steps 1–{last} for each of the {copies} copies."], "as above")
+        last = len(guide.steps)
+        guide.add("repeat", "The other copies", [f"Repeat steps 1–{last} for each of the {copies} copies."],
+                  "as above")
     if "shared drive" in units or "shared" in units:
         units.setdefault("shared", []).extend(units.pop("shared drive", []))
-        add("shared", "Parts shared by all copies", [f"These are bought once for all {copies} copies: fit them as "
-                                                     "their descriptions in the bill of materials say."],
-            "as the parts need")
+        guide.add("shared", "Parts shared by all copies", [f"These are bought once for all {copies} copies: fit "
+                                                           "them as their descriptions in the bill of materials "
+                                                           "say."], "as the parts need")
+
+
+def _check_step(guide: _GuideSteps, check: MotionCheck, has_springs: bool) -> None:
+    """The last step, the motion check (after a step for any BOM row the rules above did not place)."""
     a, b = check.input_range
     text = [f"Move the input by hand through its whole range, {a:.4g} to {b:.4g} {check.unit}, slowly, and back."]
     if check.tip and check.tip_start and check.tip_end:
@@ -485,16 +556,15 @@ def assembly_guide(partset: PartSet, stacks: Sequence[PinStack], check: MotionCh
     text.append("Feel for an even effort: no tight spot, no knock, no part rubbing another" +
                 (f" (the smallest designed clearance between moving parts is {check.min_clearance_mm:.2f} mm)"
                  if check.min_clearance_mm is not None else "") + ".")
-    if springs:
+    if has_springs:
         text.append("Let go at the end of the range: the springs must bring it back to the start.")
     text.append("Then tighten the screws, power the actuator and run the same range.")
-    leftover = [item for key in list(units) for item in units.pop(key)]
+    leftover = [item for key in list(guide.units) for item in guide.units.pop(key)]
     if leftover:  # a row the rules above did not place: still listed once
-        add("ground", "Other parts", ["Fit these as their descriptions in the bill of materials say."],
-            "as the parts need")
-        steps[-1] = dataclasses.replace(steps[-1], items=tuple(leftover))
-    add("check", "Check the motion", text, "none (by hand), then the actuator's controller")
-    return tuple(steps)
+        guide.add("ground", "Other parts", ["Fit these as their descriptions in the bill of materials say."],
+                  "as the parts need")
+        guide.steps[-1] = dataclasses.replace(guide.steps[-1], items=tuple(leftover))
+    guide.add("check", "Check the motion", text, "none (by hand), then the actuator's controller")
 
 
 def _round_robin(give: Any, keys: Sequence[str], row: dict[str, Any], qty: int, shared: bool,
