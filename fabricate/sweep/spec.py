@@ -293,10 +293,35 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None, *
     user gave the entries that did not come from the file: with ``{"vary.gears.module_mm": "--vary
     gears.module_mm"}`` an error in that entry ends "(given as --vary gears.module_mm)".
     """
-    from fabricate.design import design_from_text
-    from fabricate.templates import find_template, parse_toml, path_kind, read_text
-
     origins = origins or {}
+    sweep = _sweep_table(tables)
+    template_arg, path, text, base = _base_template(sweep, base_dir)
+    stage = _choice(sweep, "stage", "synth", STAGES)
+    sampling = _choice(sweep, "sampling", "grid", SAMPLINGS)
+    seed = _int(sweep, "seed", 0, 0, 2**32 - 1)
+    samples = _samples(sweep, sampling)
+    sets = _sets(tables, base, origins)
+    fields = _fields(tables, base, sets, sampling, origins, str(path))
+    count = math.prod(len(f.values or ()) for f in fields) if sampling == "grid" else samples
+    if count > MAX_POINTS:
+        raise SpecError("vary", f"the sweep has {count} points; at most {MAX_POINTS}")
+    metrics = _metrics(sweep, stage, fields)
+    best, best_metric, best_goal = _best(sweep, metrics)
+    map_raw = _map_fields(sweep, fields)
+    batch = sweep.get("batch_seconds", 1.0)
+    if isinstance(batch, bool) or not isinstance(batch, (int, float)) or not 0.01 <= batch <= 600:
+        raise SpecError("sweep.batch_seconds", f"expected a number of seconds in 0.01 .. 600, got {batch!r}")
+    name = sweep.get("name", Path(str(template_arg)).stem)
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}", name):
+        raise SpecError("sweep.name", f"expected a plain name (letters, digits, _ . -), got {name!r}")
+    return SweepSpec(name=name, template=str(template_arg), template_text=text, base=base, fields=tuple(fields),
+                     sampling=sampling, samples=samples, seed=seed, stage=stage, metrics=metrics, best=best,
+                     best_metric=best_metric, best_goal=best_goal, map_fields=tuple(map_raw),
+                     batch_seconds=float(batch), sets=sets)
+
+
+def _sweep_table(tables: Mapping[str, Any]) -> Mapping[str, Any]:
+    """The ``[sweep]`` table, once the spec has no unknown table and it no unknown field."""
     if not isinstance(tables, Mapping):
         raise SpecError("", f"expected the tables of a sweep spec, got {type(tables).__name__}")
     unknown = sorted(str(k) for k in set(tables) - {"sweep", "vary", "set"})
@@ -309,6 +334,15 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None, *
     if bad:
         close = difflib.get_close_matches(bad[0], sorted(_SWEEP_KEYS), n=1)
         raise SpecError(f"sweep.{bad[0]}", "unknown field" + (f' (did you mean "{close[0]}"?)' if close else ""))
+    return sweep
+
+
+def _base_template(sweep: Mapping[str, Any], base_dir: Path | None) -> tuple[str, Path, str, dict[str, Any]]:
+    """``sweep.template`` as given, the file it names (looked for in ``base_dir`` first), its text and its
+    tables; the template must be valid by itself."""
+    from fabricate.design import design_from_text
+    from fabricate.templates import find_template, parse_toml, path_kind, read_text
+
     template_arg = sweep.get("template")
     if not isinstance(template_arg, str) or not template_arg:
         raise SpecError("sweep.template", "expected the base template's name or path")
@@ -317,22 +351,25 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None, *
         else find_template(template_arg)
     text = read_text(path)
     design_from_text(text, path)  # the base template must be valid by itself
-    base = parse_toml(text, str(path))
+    return template_arg, path, text, parse_toml(text, str(path))
 
-    stage = _choice(sweep, "stage", "synth", STAGES)
-    sampling = _choice(sweep, "sampling", "grid", SAMPLINGS)
-    seed = _int(sweep, "seed", 0, 0, 2**32 - 1)
+
+def _samples(sweep: Mapping[str, Any], sampling: str) -> int:
+    """``sweep.samples``: 0 for a grid (its values set its size); a power of two for Sobol'."""
     if sampling == "grid":
         if "samples" in sweep:
             raise SpecError("sweep.samples", "a grid's size is set by its values; samples is for lhs/sobol")
-        samples = 0
-    else:
-        samples = _int(sweep, "samples", 64, 1, MAX_POINTS)
-        if sampling == "sobol" and samples & (samples - 1):
-            raise SpecError("sweep.samples", f"a Sobol' sequence keeps its balance only with a power of two "
-                                             f"points (e.g. {1 << max(0, samples.bit_length() - 1)} or "
-                                             f"{1 << samples.bit_length()}), got {samples}")
+        return 0
+    samples = _int(sweep, "samples", 64, 1, MAX_POINTS)
+    if sampling == "sobol" and samples & (samples - 1):
+        raise SpecError("sweep.samples", f"a Sobol' sequence keeps its balance only with a power of two "
+                                         f"points (e.g. {1 << max(0, samples.bit_length() - 1)} or "
+                                         f"{1 << samples.bit_length()}), got {samples}")
+    return samples
 
+
+def _sets(tables: Mapping[str, Any], base: dict[str, Any], origins: Mapping[str, str]) -> dict[str, Any]:
+    """``[set]``: each a field of the template, applied to ``base`` (in place)."""
     sets_raw = tables.get("set", {})
     if not isinstance(sets_raw, Mapping):
         raise SpecError("set", "expected a table of field path = value")
@@ -347,7 +384,12 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None, *
             except (ValueError, KeyError) as exc:
                 raise SpecError(where, f"not a field of the template ({exc})") from None
         sets[key] = value
+    return sets
 
+
+def _fields(tables: Mapping[str, Any], base: dict[str, Any], sets: Mapping[str, Any], sampling: str,
+            origins: Mapping[str, str], source: str) -> list[Field]:
+    """``[vary]``: the varied fields, each a field of the template (or one its kind knows) not also set."""
     vary = tables.get("vary")
     if not isinstance(vary, Mapping) or not vary:
         raise SpecError("vary", "expected a table of field path = values, with at least one field")
@@ -377,12 +419,12 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None, *
             values, low, high = parse_values(raw, where, sampling, integer)
             fields.append(Field(path=key, parts=parts, values=values, low=low, high=high, integer=integer))
             if current is None:
-                _check_known(base, fields[-1], where, str(path))
+                _check_known(base, fields[-1], where, source)
+    return fields
 
-    count = math.prod(len(f.values or ()) for f in fields) if sampling == "grid" else samples
-    if count > MAX_POINTS:
-        raise SpecError("vary", f"the sweep has {count} points; at most {MAX_POINTS}")
 
+def _metrics(sweep: Mapping[str, Any], stage: str, fields: Sequence[Field]) -> tuple[Metric, ...]:
+    """``sweep.metrics``: report key paths, each once, none a column's name, none a full build's in a synth."""
     metrics_raw = sweep.get("metrics", default_metrics(stage))
     if not isinstance(metrics_raw, list) or len(metrics_raw) > MAX_METRICS:
         raise SpecError("sweep.metrics", f"expected a list of at most {MAX_METRICS} report key paths")
@@ -396,20 +438,29 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None, *
         if stage == "synth" and m.section in BUILD_ONLY_SECTIONS:
             raise SpecError(f"sweep.metrics[{i}]", f'"{m.name}" is written by a full build only: set '
                                                    'sweep.stage = "build" (or --stage build)')
+    return metrics
 
+
+def _best(sweep: Mapping[str, Any], metrics: Sequence[Metric]) -> tuple[int, Metric | None, str]:
+    """How many best points to rank (``sweep.best``), by which metric, and its goal (``min`` or ``max``)."""
     best = _int(sweep, "best", 0, 0, MAX_BEST)
     best_metric = None
     best_goal = _choice(sweep, "best_goal", "min", ("min", "max"))
     if best:
         if "best_metric" in sweep:
             best_metric = parse_metric(sweep["best_metric"], "sweep.best_metric")
-            if best_metric.name not in names:
+            if best_metric.name not in [m.name for m in metrics]:
                 raise SpecError("sweep.best_metric", f'"{best_metric.name}" is not one of sweep.metrics')
         elif metrics:
             best_metric = metrics[0]
         else:
             raise SpecError("sweep.best", "ranking the best points needs a metric (sweep.metrics)")
+    return best, best_metric, best_goal
 
+
+def _map_fields(sweep: Mapping[str, Any], fields: Sequence[Field]) -> list[Any]:
+    """``sweep.map``: the feasibility map's two axes, different varied numeric fields (the first two by
+    default), or none."""
     numeric = [f.path for f in fields if _is_numeric(f)]
     map_raw = sweep.get("map", numeric[:2] if len(numeric) >= 2 else [])
     if not isinstance(map_raw, list) or len(map_raw) not in (0, 2):
@@ -419,18 +470,7 @@ def sweep_from_tables(tables: Mapping[str, Any], base_dir: Path | None = None, *
             raise SpecError(f"sweep.map[{i}]", f'"{path}" is not a varied numeric field')
     if len(map_raw) == 2 and map_raw[0] == map_raw[1]:
         raise SpecError("sweep.map", "the two axes must be different fields")
-
-    batch = sweep.get("batch_seconds", 1.0)
-    if isinstance(batch, bool) or not isinstance(batch, (int, float)) or not 0.01 <= batch <= 600:
-        raise SpecError("sweep.batch_seconds", f"expected a number of seconds in 0.01 .. 600, got {batch!r}")
-
-    name = sweep.get("name", Path(str(template_arg)).stem)
-    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}", name):
-        raise SpecError("sweep.name", f"expected a plain name (letters, digits, _ . -), got {name!r}")
-    return SweepSpec(name=name, template=str(template_arg), template_text=text, base=base, fields=tuple(fields),
-                     sampling=sampling, samples=samples, seed=seed, stage=stage, metrics=metrics, best=best,
-                     best_metric=best_metric, best_goal=best_goal, map_fields=tuple(map_raw),
-                     batch_seconds=float(batch), sets=sets)
+    return map_raw
 
 
 @contextlib.contextmanager
