@@ -212,7 +212,8 @@ SG90 = Actuator(
              ("horn", KARTCHNB_HORN),
              ("stall_torque_nmm", SG90_DATASHEET), ("no_load_speed", SG90_DATASHEET),
              ("voltage_v", SG90_DATASHEET)),
-    gaps=(("rated_torque_nmm", "the datasheet gives the stall torque only"),),
+    gaps=(("rated_torque_nmm", "the SG90 datasheet figures give the stall torque only (1.8 kgf·cm at 4.8 V); no "
+                               "continuous or rated torque"),),
 )
 
 # MG90S (clone) as measured (mg90s_clone.scad): aft 18.31, wing 2.53, fore 7.62, axle 4.00, body width
@@ -237,7 +238,8 @@ MG90S = Actuator(
              ("horn", KARTCHNB_HORN + " (the 20T size the MG90S spline measures)"),
              ("stall_torque_nmm", MG90S_DATASHEET), ("no_load_speed", MG90S_DATASHEET),
              ("voltage_v", MG90S_DATASHEET)),
-    gaps=(("rated_torque_nmm", "the datasheet gives the stall torque only"),),
+    gaps=(("rated_torque_nmm", "the MG90S datasheet gives the stall torque only (1.8 kgf·cm at 4.8 V, 2.2 at "
+                               "6 V); no continuous or rated torque"),),
 )
 
 # ---------------------------------------------------------------------------------------------------------
@@ -261,11 +263,24 @@ MG996R_DRAWING = {"case_l": 40.3, "over_tabs": 53.6, "case_w": 20.0,  # MG996R_D
 # sees a body no smaller than the MG996R (tests/catalogue/test_actuators.py checks it).
 _STD = {"aft": 26.79, "wing": 4.00, "fore": 6.43, "body_w": 40.86, "wing_w": 54.15,  # s3003_clone.scad
         "axle_off": 10.15, "body_l": 20.30}  # s3003_clone.scad
+# The MG996R's tooth count: no maker's text states it. One public model of the MG996R states it, and the
+# hobby standard it names agrees: NoahMSchool/RobotArmEPQ EPQCAD/Component_data.scad (the version with
+# per-servo spline fields) gives "MG996R_data = [... 25, //TeethCount  6.4, //shaft_diameter  4,
+# //shaft_depth]"; hugokernel/OpenSCAD_ServoArms servo_arm.scad gives the "Futaba 3F Standard Spline"
+# FUTABA_3F_SPLINE as 25 teeth on a Ø5.92 head, and Kartchner measured the standard-size servo's axle at
+# Ø5.80 (s3003_clone.scad), the 3F size. The same Component_data.scad also says 25 for the SG90, which
+# Kartchner measured as 20T: its counts are a modeller's, so the count is entered "as modelled".
+MG996R_TEETH = ("NoahMSchool/RobotArmEPQ, EPQCAD/Component_data.scad (https://github.com/NoahMSchool/RobotArmEPQ), "
+                "MG996R_data: '25, //TeethCount' (as modelled; the same file gives 25 for its SG90, which "
+                "Kartchner measured 20T, so this is a modeller's count, not a maker's); consistent with "
+                "hugokernel/OpenSCAD_ServoArms servo_arm.scad (https://github.com/hugokernel/OpenSCAD_ServoArms) "
+                "FUTABA_3F_SPLINE 'Futaba 3F Standard Spline': 25 teeth, head Ø5.92")
 MG996R = Actuator(
     key="mg996r", name="TowerPro MG996R metal-gear standard servo", kind="servo",
     body=_servo_body(**_STD),
     mounting_holes=_servo_holes(10.15, 6.43, 24.43, 4.42, 4.50),  # s3003_clone.scad x ±24.43, y ±4.50, Ø4.42
-    spline=Spline(teeth=None, diameter_mm=5.80, length_mm=5.52),  # s3003_clone.scad axle Ø5.80, axle h 5.52
+    spline=Spline(teeth=25,  # MG996R_TEETH: Component_data.scad MG996R_data '25, //TeethCount' (as modelled)
+                  diameter_mm=5.80, length_mm=5.52),  # s3003_clone.scad axle Ø5.80, axle h 5.52
     horn=None, shaft=None,
     rated_torque_nmm=None,
     stall_torque_nmm=9.4 * KGF_CM_NMM,  # MG996R_DATASHEET: stall torque 9.4 kgf·cm (4.8 V)
@@ -277,12 +292,16 @@ MG996R = Actuator(
               + MG996R_DATASHEET),
              ("mounting_holes", KARTCHNB_SERVOS.format(file="s3003_clone.scad") + " (the standard-size servo's "
               "four tab holes; the MG996R ships with 4 fixing screws, " + MG996R_DATASHEET + ")"),
-             ("spline", KARTCHNB_SERVOS.format(file="s3003_clone.scad") + " (axle diameter and height)"),
+             ("spline", KARTCHNB_SERVOS.format(file="s3003_clone.scad") + " (axle diameter and height); "
+              "teeth: " + MG996R_TEETH),
              ("stall_torque_nmm", MG996R_DATASHEET), ("no_load_speed", MG996R_DATASHEET),
              ("voltage_v", MG996R_DATASHEET)),
-    gaps=(("rated_torque_nmm", "the datasheet gives the stall torque only"),
-          ("horn", "no source dimensions the horns supplied with the MG996R"),
-          ("spline.teeth", "no source states the MG996R spline's tooth count (s3003_clone.scad: 'unknown')")),
+    gaps=(("rated_torque_nmm", "the datasheet (Handsontec EMH-1056) gives the stall torque only, at 4.8 V and 6 V; "
+                               "no continuous or rated torque"),
+          ("horn", "no text source dimensions the horns supplied with the MG996R (hub, socket depth, arm-hole "
+                   "radii): the datasheet shows them in its drawing only; Kartchner's servohorn_lib measures 20T "
+                   "and 3F horns but no MG996R horn; alexandrepires5/HRManipulator CAD/measures.scad models an "
+                   "MG946R horn without its socket or hole radii")),
 )
 
 # ---------------------------------------------------------------------------------------------------------
@@ -296,6 +315,11 @@ POLOLU_DATASHEET = ("Pololu 'Micro Metal Gearmotors' datasheet Rev 2.0 (May 2018
 POLOLU_PRODUCT = ("Pololu product 5215 page (https://www.pololu.com/product/5215): 'gearbox cross section of 10×12 mm "
                   "and a 9 mm long, 3 mm diameter D-shaped gearbox output shaft' (the whole family)")
 
+N20_DFLAT = ("salamanders/balance_bot, printed_parts/dcmotor.scad (https://github.com/salamanders/balance_bot), "
+             "an N20 modelled for a D-bore hub: 'shaft_diameter = 3.0'; 'The \"D\" thickness (Distance from flat "
+             "surface to opposite curved wall) For a 3mm shaft, this is usually 2.5mm. Measure yours with "
+             "calipers!' 'shaft_flat_thickness = 2.5' (as modelled for the N20 class, not Pololu's drawing)")
+
 N20 = Actuator(
     key="n20", name="Pololu micro metal gearmotor 100:1 LP 6V (N20 class)", kind="gearmotor",
     # the text gives the gearbox (10×12 mm cross-section, POLOLU_PRODUCT; L = 9 mm long, POLOLU_DATASHEET,
@@ -303,7 +327,8 @@ N20 = Actuator(
     body=None,
     mounting_holes=None,
     spline=None, horn=None,
-    shaft=Shaft(diameter_mm=3.0, length_mm=9.0, flats=1, across_flats_mm=None,  # POLOLU_PRODUCT: Ø3 D, 9 long
+    shaft=Shaft(diameter_mm=3.0, length_mm=9.0, flats=1,  # POLOLU_PRODUCT: Ø3 D-shaped, 9 mm long
+                across_flats_mm=2.5,  # N20_DFLAT: flat to the far side 2.5 mm, as modelled (a modeller's value)
                 flat_length_mm=None),
     rated_torque_nmm=1.7 * KGF_MM_NMM,  # POLOLU_DATASHEET: 1.7 kg·mm at maximum efficiency
     stall_torque_nmm=7.4 * KGF_MM_NMM,  # POLOLU_DATASHEET: stall extrapolation 7.4 kg·mm
@@ -311,16 +336,20 @@ N20 = Actuator(
     no_load_speed=rpm_to_deg_s(130.0),  # POLOLU_DATASHEET: no load 130 RPM
     voltage_v=6.0,  # POLOLU_DATASHEET: rated voltage 6 V (LP 6V)
     stroke_mm=None, closed_length_mm=None,
-    sources=(("shaft", POLOLU_PRODUCT),
+    sources=(("shaft", POLOLU_PRODUCT + "; across the flat: " + N20_DFLAT),
              ("rated_torque_nmm", POLOLU_DATASHEET + " (the torque at maximum efficiency taken as rated)"),
              ("stall_torque_nmm", POLOLU_DATASHEET), ("no_load_speed", POLOLU_DATASHEET),
              ("voltage_v", POLOLU_DATASHEET)),
     gaps=(("body", "gearbox 10×12 mm (product page) × 9 mm (datasheet L); the motor can's length and the "
-                   "shaft's place in the gearbox section are on the datasheet drawing only"),
-          ("mounting_holes", "two M1.6 tapped holes in the gearbox face (datasheet text); their spacing is on "
-                             "the drawing only"),
-          ("shaft.across_flats_mm", "the D flat's depth is on the drawing only"),
-          ("shaft.flat_length_mm", "the flat's length is on the drawing only")),
+                   "shaft's place in the gearbox section are on Pololu's datasheet drawing only. The public "
+                   "models found are of other N20-class motors (a round gearbox, 'n20_reductor_dia = 14', in "
+                   "K. Aziiev's OpenSCAD car parameters.scad; a bare 10×12 block in salamanders/balance_bot "
+                   "dcmotor.scad): none gives the Pololu can or the shaft's offset"),
+          ("mounting_holes", "two M1.6 tapped holes in the gearbox face (datasheet text: 'Max length for M1.6 "
+                             "mounting screws is 1.3 mm'); their spacing and place are on the drawing only, and "
+                             "no public model or text found states them"),
+          ("shaft.flat_length_mm", "the flat's length is on Pololu's drawing only; the model giving the flat's "
+                                   "depth (N20_DFLAT) cuts it along the whole shaft without stating a length")),
 )
 
 # ---------------------------------------------------------------------------------------------------------
@@ -352,12 +381,17 @@ NEMA17 = Actuator(
     sources=(("body", f"{NOP_NEMA}; {NEMA_FRAME}; length: {HS4401}"),
              ("mounting_holes", f"{NOP_NEMA}; {NEMA_FRAME}"), ("shaft", f"{NOP_NEMA}; {NEMA_FRAME}"),
              ("stall_torque_nmm", HS4401 + " (holding torque, the most the stepper holds at standstill)")),
-    gaps=(("rated_torque_nmm", "the pull-out torque over speed depends on the driver; no curve found"),
+    gaps=(("rated_torque_nmm", "no pull-out (pull-out torque over speed) curve or table for the 17HS4401 was "
+                               "found in text; it depends on the driver's voltage and current as well"),
           ("no_load_speed", "a stepper's speed is set by its driver"),
-          ("voltage_v", "the row gives current and phase resistance, no rated voltage"),
-          ("shaft.flats", "whether the 17HS4401's shaft has a D flat was not found"),
-          ("shaft.across_flats_mm", "no D-flat depth found"),
-          ("shaft.flat_length_mm", "no D-flat length found")),
+          ("voltage_v", "the HS4401 row gives 1.7 A and 1.5 Ω a phase, no rated voltage; the public notes "
+                        "disagree (one test repository drives it as '3.8V/1.5A'), so none is entered"),
+          ("shaft.flats", "NEMA 17 frames ship with round or D-cut 5 mm shafts, and no text found says which the "
+                          "17HS4401 has: the generic models differ (NopSCADlib NEMA17M round; AuroraSCAD "
+                          "motor.scad motortype_NEMA17 a flat 4.5 across). A flat in the catalogue would cut a "
+                          "D-bore that a round-shafted motor cannot enter, so the bore stays round"),
+          ("shaft.across_flats_mm", "no D-flat stated for the 17HS4401 (see shaft.flats)"),
+          ("shaft.flat_length_mm", "no D-flat stated for the 17HS4401 (see shaft.flats)")),
 )
 
 NOP_28BYJ = ("NopSCADlib vitamins/geared_steppers.scad, row 28BYJ_48 (can Ø28 × 19, screw pitch 35, lug width 7 and "
@@ -445,9 +479,14 @@ L16 = Actuator(
     sources=(("rated_force_n", WCP_L16 + " (peak power point taken as rated)"),
              ("stall_force_n", WCP_L16), ("no_load_speed", WCP_L16), ("voltage_v", WCP_L16),
              ("stroke_mm", f"{WCP_L16}; {ACTUONIX_L16_OPTIONS}"), ("closed_length_mm", WCP_L16)),
-    gaps=(("body", "the case cross-section is on the datasheet drawing only"),
-          ("mounting_holes", "the clevis hole diameters are on the datasheet drawing only (their spacing, "
-                             "118 mm closed, is closed_length_mm)")),
+    gaps=(("body", "the case cross-section is on the Actuonix datasheet drawing (last page) only: the "
+                   "datasheet text (Rev C, model selection and wiring) and the WCP L16 pages state stroke, "
+                   "ratios, forces, speeds and the closed length, not the case section; no public model of the "
+                   "L16 with its section was found"),
+          ("mounting_holes", "the clevis and rod-end hole diameters are on the datasheet drawing only (their "
+                             "spacing, 118 mm closed, is closed_length_mm); the one text found giving a clevis "
+                             "hole (Ø3.0, 'accepts M3') gives the L16 a 35 N maximum force, contradicting WCP's "
+                             "63:1 figures, so it is not used")),
 )
 
 #: The catalogue, by key. Complete (body, mount, interface, rating): sg90, mg90s, mg996r, nema17, 28byj48

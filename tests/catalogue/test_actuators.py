@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
+import shapely
+from shapely import affinity
 
 from fabricate.catalogue import CATALOGUE, actuator
 from fabricate.catalogue import actuators as act
+from fabricate.drive import geometry as geo
 
 
 def test_mg996r_body_is_no_smaller_than_its_datasheet_drawing():
@@ -27,8 +33,18 @@ def test_mg996r_ratings_are_the_datasheets_at_4_8_volts():
     assert a.stall_torque_nmm == pytest.approx(9.4 * 9.80665 * 10)   # 9.4 kgf·cm
     assert a.no_load_speed == pytest.approx(60 / 0.17)                # 0.17 s/60°
     assert a.voltage_v == 4.8 and a.rated_torque_nmm is None and a.gap("rated_torque_nmm")
-    assert a.spline is not None and a.spline.teeth is None and a.gap("spline.teeth")
     assert "handsontec" in a.source("stall_torque_nmm").lower()
+
+
+def test_mg996r_spline_count_is_the_modelled_25t_at_the_futaba_3f_size():
+    """25 teeth, entered from a public model and said so; the measured axle is the 3F spline's size (the
+    standard the count belongs to: Ø5.92 head), so the count and the diameter describe one spline."""
+    a = actuator("mg996r")
+    assert a.spline is not None and a.spline.teeth == 25 and a.gap("spline.teeth") is None
+    source = a.source("spline")
+    assert "as modelled" in source and "Component_data.scad" in source and "FUTABA_3F_SPLINE" in source
+    assert a.spline.diameter_mm == pytest.approx(5.92, abs=0.2)
+    assert actuator("sg90").spline.teeth == actuator("mg90s").spline.teeth == 20  # the micro size stays 20T
 
 
 @pytest.mark.parametrize("key", [k for k, a in CATALOGUE.items() if a.kind == "servo"])
@@ -52,3 +68,24 @@ def test_the_complete_entries_are_the_ones_a_template_may_name():
     for key in ("n20", "l16"):
         a = actuator(key)
         assert not a.complete and a.gap("body") and a.gap("mounting_holes")
+
+
+def test_n20_d_shaft_is_the_modelled_flat_and_its_d_bore_keys_it():
+    """The N20's D (Ø3, 2.5 from the flat to the far side, as modelled) cuts a D-bore that takes the shaft
+    with the clearance all round and, turned by a few degrees, no longer does: the flat drives the part."""
+    shaft = actuator("n20").shaft
+    assert (shaft.diameter_mm, shaft.flats, shaft.across_flats_mm) == (3.0, 1, 2.5)
+    assert "as modelled" in actuator("n20").source("shaft") and actuator("n20").gap("shaft.across_flats_mm") is None
+    assert geo.shaft_flats(shaft) == 1
+    centre, angle, clearance = np.array([4.0, -1.0]), 0.7, 0.15
+    bore = shapely.Polygon(geo.shaft_bore(shaft, centre, angle, clearance).polygon(1e-4))
+    d_profile = shapely.Polygon(geo.shaft_bore(shaft, centre, angle, 0.0).polygon(1e-4))
+    u = np.array([math.cos(angle), math.sin(angle)])
+    ring = np.asarray(bore.exterior.coords)
+    flat, far = float(((ring - centre) @ u).max()), float(-((ring - centre) @ u).min())
+    assert flat == pytest.approx(2.5 - 1.5 + clearance, abs=1e-9)  # the flat, exact
+    assert far == pytest.approx(1.5 + clearance, abs=2e-4)  # the round side (chords of 1e-4 inside the arc)
+    assert bore.contains(d_profile.buffer(clearance - 1e-3))  # the shaft goes in, with c on every side
+    turned = affinity.rotate(d_profile, 20.0, origin=tuple(centre))
+    assert not bore.contains(turned)  # and cannot turn in it
+    assert bore.area < math.pi * (1.5 + clearance) ** 2  # not a round bore
