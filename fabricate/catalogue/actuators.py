@@ -263,13 +263,13 @@ MG996R_DRAWING = {"case_l": 40.3, "over_tabs": 53.6, "case_w": 20.0,  # MG996R_D
 # sees a body no smaller than the MG996R (tests/catalogue/test_actuators.py checks it).
 _STD = {"aft": 26.79, "wing": 4.00, "fore": 6.43, "body_w": 40.86, "wing_w": 54.15,  # s3003_clone.scad
         "axle_off": 10.15, "body_l": 20.30}  # s3003_clone.scad
-# The MG996R's tooth count: no maker's text states it. One public model of the MG996R states it, and the
-# hobby standard it names agrees: NoahMSchool/RobotArmEPQ EPQCAD/Component_data.scad (the version with
-# per-servo spline fields) gives "MG996R_data = [... 25, //TeethCount  6.4, //shaft_diameter  4,
-# //shaft_depth]"; hugokernel/OpenSCAD_ServoArms servo_arm.scad gives the "Futaba 3F Standard Spline"
-# FUTABA_3F_SPLINE as 25 teeth on a Ø5.92 head, and Kartchner measured the standard-size servo's axle at
-# Ø5.80 (s3003_clone.scad), the 3F size. The same Component_data.scad also says 25 for the SG90, which
-# Kartchner measured as 20T: its counts are a modeller's, so the count is entered "as modelled".
+# The MG996R's tooth count: no maker's text states it. One public model of the MG996R does:
+# NoahMSchool/RobotArmEPQ EPQCAD/Component_data.scad (the version with per-servo spline fields) gives
+# "MG996R_data = [... 25, //TeethCount  6.4, //shaft_diameter  4, //shaft_depth]". It agrees with the
+# 25-tooth "Futaba 3F Standard Spline" of hugokernel/OpenSCAD_ServoArms servo_arm.scad (FUTABA_3F_SPLINE:
+# 25 teeth, Ø5.92 head), within 0.12 mm of the Ø5.80 axle Kartchner measured (s3003_clone.scad). The same
+# Component_data.scad also says 25 for the SG90, which Kartchner measured as 20T: its counts are a
+# modeller's, so the count is entered "as modelled".
 MG996R_TEETH = ("NoahMSchool/RobotArmEPQ, EPQCAD/Component_data.scad (https://github.com/NoahMSchool/RobotArmEPQ), "
                 "MG996R_data: '25, //TeethCount' (as modelled; the same file gives 25 for its SG90, which "
                 "Kartchner measured 20T, so this is a modeller's count, not a maker's); consistent with "
