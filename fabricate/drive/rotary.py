@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -112,6 +113,39 @@ def motor_reach(design: Any, mechanism: Mechanism) -> tuple[str, np.ndarray, flo
     corners = [math.hypot(x, y) for b in entry.body or () for x in (b.x0, b.x1) for y in (b.y0, b.y1)]
     axis = np.asarray(mechanism.body(driver.reference).point(driver_joint(mechanism, driver)), dtype=np.float64)
     return driver.reference, axis, max(corners, default=0.0)
+
+
+@dataclass(frozen=True)
+class _Output:
+    """The actuator's output on the driven part, as :meth:`RotaryPlacement.attach` passes it on.
+
+    Attributes
+    ----------
+    place : geo.Placement
+        The output's frame on the driven part.
+    holes, slots : tuple
+        The driven part's holes (its pin's hole gone, the interface's in) and its new slots (a shaft's bore).
+    pad_circles : tuple of (centre, radius)
+        Circles the driven part's outline grows to cover (a wall round each interface hole).
+    interface : tuple of str
+        The interface's hole and slot names.
+    solids, fasteners : tuple
+        The output's solids (spline, horn, shaft, screw heads) and its screws.
+    passing : tuple of (z0, z1, diameter)
+        What of the output may pass the ground part (output frame z, mm).
+    default_clear : float
+        The ground's clearance hole (nominal, mm) where something passes.
+    """
+
+    place: geo.Placement
+    holes: tuple[Hole, ...]
+    slots: tuple[BulgePath, ...]
+    pad_circles: tuple[tuple[np.ndarray, float], ...]
+    interface: tuple[str, ...]
+    solids: tuple[geo.Solid, ...]
+    fasteners: tuple[Fastener, ...]
+    passing: tuple[tuple[float, float, float], ...]
+    default_clear: float
 
 
 class RotaryPlacement(MountPlacement):
@@ -285,154 +319,31 @@ class RotaryPlacement(MountPlacement):
         return math.atan2(far[1], far[0])
 
     def attach(self) -> PartSet:
+        """The part set with the actuator in its driver's pin's place: its side and orientation, its output's
+        interface in the driven part, its clearance in the ground part, its mount, and the BOM's rows."""
         entry, ps = self.entry, self.ps
         pin = self._pin()
         driven, ground = body_part(ps, self.driven), body_part(ps, self.ground)
-        c_d = self.mechanism.body(self.driven).point(self.joint)
         c_g = self.mechanism.body(self.ground).point(self.joint)
-        # the side whose parts keep clear of the actuator; the ground's side loses a tie (its hole would have
-        # to clear the horn)
-        faces = {side: self._face(side, driven) for side in (True, False)}
-        costs = {side: self._conflicts(side, driven, faces[side]) + (0.5 if (ground.layer < driven.layer) != side
-                                                                      else 0.0) for side in (True, False)}
-        flip = min((True, False), key=lambda side: costs[side])
-        z_face = faces[flip]
-        if not math.isfinite(z_face):
-            raise SpecError("actuator.model", f"{entry.key!r}: its shaft does not reach half way into the driven "
-                                              f"part {driven.name} across the stack on either side")
-        away = self._away(c_g)
-        env = entry.envelope
-        ex = np.array([0.5 * (env.x0 + env.x1), 0.5 * (env.y0 + env.y1)]) if env is not None else np.zeros(2)
-        if flip:
-            ex = ex * np.array([1.0, -1.0])
-        # the body's centre (off the axis for a servo or a 28BYJ-48) points away from what moves
-        angle = math.atan2(away[1], away[0]) - (math.atan2(ex[1], ex[0]) if float(np.hypot(*ex)) > 1e-6 else 0.0)
-        angle = self._orient(angle, c_g, ground, flip, z_face)
-        alpha = self._arm_angle()
-        interface: list[str] = []
-        solids: list[geo.Solid] = []
-        fasteners: list[Fastener] = []
-        slots: list[BulgePath] = []
-        holes = [h for h in driven.holes if h.joint != pin.joint]
-        t_d = float(driven.thickness_mm)
-        pad_circles: list[tuple[np.ndarray, float]] = []
-        if entry.horn is not None:
-            horn, spline = entry.horn, entry.spline
-            assert horn is not None and spline is not None  # a servo entry has both (catalogue)
-            seat0, seat1 = geo.horn_seat_z(entry)
-            bore, size, pilot, horn_screw, used = self._horn_layout(t_d)
-            at = geo.horn_pattern(used, c_d, alpha, flip)
-            holes.append(fit_hole("actuator_hub", c_d, bore, self.comp, fit="clearance"))
-            interface.append("actuator_hub")
-            for k, centre in enumerate(at):
-                holes.append(fit_hole(f"actuator_horn_{k + 1}", centre, pilot, self.comp, fit="tapped"))
-                interface.append(f"actuator_horn_{k + 1}")
-                pad_circles.append((centre, 0.5 * (pilot + self.comp) + self.wall))
-            pad_circles.append((c_d, 0.5 * (bore + self.comp) + self.wall))
-            place_d = geo.Placement(c_d, alpha, flip, z_face)
-            hole_d = min(h.diameter_mm for h in horn.arm_holes)
-            arm = geo.trimmed_horn_ring(at, c_d, horn.hub_d_mm, hole_d, self.tol)
-            arm0 = seat1 - horn.arm_thickness_mm
-            solids += [geo.Solid("actuator_spline", "output", (geo.circle_ring(c_d, spline.diameter_mm, self.tol),),
-                                 *place_d.z_range(0.0, seat0)),
-                       geo.Solid("actuator_horn_hub", "output", (geo.circle_ring(c_d, horn.hub_d_mm, self.tol),),
-                                 *place_d.z_range(seat0, seat1)),
-                       geo.Solid("actuator_horn_arms", "output", (arm,), *place_d.z_range(arm0, seat1))]
-            # the heads sit under the arms, between the horn's arms and the servo's face
-            solids += [geo.Solid(f"actuator_horn_screw_{k + 1}", "screw",
-                                 (geo.circle_ring(centre, horn_screw.head_d_mm, self.tol),),
-                                 *place_d.z_range(arm0 - horn_screw.head_h_mm, arm0))
-                       for k, centre in enumerate(at)]
-            if arm0 - horn_screw.head_h_mm < 0.0:
-                raise SpecError("actuator.model", f"{entry.key!r}: no room for a {size} head under the horn's arms")
-            reach = max(float(np.max(np.hypot(*(arm - c_d).T))), 0.5 * horn.hub_d_mm)
-            fasteners.append(Fastener(horn_screw.designation, len(at), "driven part to the horn, up through its "
-                                      "arms into the part (taps into the part)", horn_screw.clamp_mm,
-                                      horn_screw.engagement_mm))
-            ring_r = math.hypot(used[0].x, used[0].y)
-            self.notes.append(f"open the horn's arm holes {ring_r:g} mm from its axis to Ø"
-                              f"{ISO7089[size][0]:g} mm for the {size} screws and cut the arms back one hole past "
-                              "them; screw the horn to the driven part, press it on the spline, then drive the "
-                              "horn's centre screw through the hub bore")
-            # what passes the ground part: the horn where it overlaps its thickness, else the hub and its screw
-            heads = ring_r + 0.5 * horn_screw.head_d_mm
-            passing = [(geo.output_base_z(entry), seat0, spline.diameter_mm), (seat0, seat1, 2.0 * reach),
-                       (arm0 - horn_screw.head_h_mm, arm0, 2.0 * heads)]
-            default_clear = bore
-        else:
-            shaft = self._shaft()
-            base = geo.output_base_z(entry)
-            flats = geo.shaft_flats(shaft)
-            radial = self.c + 0.5 * self.comp if flats else 0.5 * self.comp
-            if entry.shaft is None:  # a servo's spline, no horn catalogued: the part is pressed on the spline
-                press = float(getattr(self.process, "press_fit_interference_mm", 0.0) or 0.0)
-                radial = 0.5 * (self.comp - press)
-                self.notes.append(f"no horn in the catalogue: press the driven part onto the servo's Ø"
-                                  f"{shaft.diameter_mm:g} mm spline (bore Ø{shaft.diameter_mm - press:g} mm "
-                                  "nominal, the teeth cut their way) and fix it with the servo's centre screw")
-            elif not flats:
-                self.notes.append(f"the Ø{shaft.diameter_mm:g} mm shaft is round (no flat in the catalogue): "
-                                  "the bore is a slip fit; secure the part with adhesive or a clamp")
-            slots.append(geo.shaft_bore(shaft, c_d, alpha, radial))
-            interface.append("actuator_shaft_bore" if entry.shaft is not None else "actuator_spline_bore")
-            pad_circles.append((c_d, 0.5 * shaft.diameter_mm + radial + self.wall))
-            place_d = geo.Placement(c_d, alpha, flip, z_face)
-            solids.append(geo.Solid("actuator_shaft" if entry.shaft is not None else "actuator_spline", "output",
-                                    (geo.circle_ring(c_d, shaft.diameter_mm, self.tol),),
-                                    *place_d.z_range(base, shaft.length_mm)))
-            passing = [(base, shaft.length_mm, shaft.diameter_mm)]
-            default_clear = shaft.diameter_mm + 2.0 * self.c
-        pad = circle_hull(np.array([c for c, _ in pad_circles]), np.array([r for _, r in pad_circles]))
-        new_driven = with_changes(driven, outline=fuse_pad(driven.outline, pad, self.tol), holes=tuple(holes),
-                           **({"slots": tuple(getattr(driven, "slots", ())) + tuple(slots)} if slots else {}))
+        flip, z_face = self._side(driven, ground)
+        away, angle = self._body_angle(c_g, ground, flip, z_face)
+        out = (self._horn_output if entry.horn is not None else self._shaft_output)(driven, pin, flip, z_face)
+        pad = circle_hull(np.array([c for c, _ in out.pad_circles]), np.array([r for _, r in out.pad_circles]))
+        new_driven = with_changes(driven, outline=fuse_pad(driven.outline, pad, self.tol), holes=out.holes,
+                                  **({"slots": tuple(getattr(driven, "slots", ())) + out.slots} if out.slots else {}))
+        clear, passes, ground_holes = self._ground_clearance(ground, pin, c_g, out)
         place_g = geo.Placement(c_g, angle, flip, z_face)
-        # the ground's hole at the joint: a clearance for whatever of the output passes its thickness
-        g0, g1 = float(ground.z_mm), float(ground.z_mm + ground.thickness_mm)
-        passes = []
-        for z0, z1, diameter in passing:
-            lo, hi = place_d.z_range(z0, z1)
-            if lo < g1 - 1e-9 and hi > g0 + 1e-9:
-                passes.append(diameter + 2.0 * self.c)
-        old = next(h for h in ground.holes if h.joint == pin.joint)
-        # nothing passes (the ground lies beyond the driven part): the pin's hole stays as it was
-        clear = max([default_clear, *passes]) if passes else old.nominal_mm
-        ground_holes = [h for h in ground.holes if h.joint != pin.joint]
-        ground_holes.append(fit_hole("actuator_clearance", c_g, clear, self.comp, fit="clearance"))
-        solids += geo.body_solids(entry, place_g)
+        solids = [*out.solids, *geo.body_solids(entry, place_g)]
         mount, mount_fasteners, standoffs, standoff_parts, mount_solids = self._mount(place_g, ground, flip)
-        fasteners += mount_fasteners
+        fasteners = [*out.fasteners, *mount_fasteners]
         solids += mount_solids
-        ground_pad = circle_hull(np.asarray(c_g, dtype=float)[None, :], 0.5 * (clear + self.comp) + self.wall)
-        resized = {h.joint: h for h in self.resized_ground_holes}
-        ground_holes = [resized.get(h.joint, h) for h in ground_holes] + self.new_ground_holes
-        outline = fuse_pad(ground.outline, ground_pad, self.tol) if passes else ground.outline
-        if self.ground_arms:
-            outline = fuse_polygons(outline, list(self.ground_arms), self.tol)
-        new_ground = with_changes(ground, outline=outline, holes=tuple(ground_holes))
+        new_ground = self._ground_part(ground, c_g, clear, passes, ground_holes)
         # the pin's spacers go with it (printed spacer parts too)
         removed = {p.name for p in ps.parts if p.role not in BODY_ROLES and any(h.joint == pin.joint for h in p.holes)}
-        parts = []
-        for p in ps.parts:
-            if p.name in removed:
-                continue
-            parts.append(new_driven if p is driven else new_ground if p is ground else p)
+        parts = [new_driven if p is driven else new_ground if p is ground else p
+                 for p in ps.parts if p.name not in removed]
         parts += [mount, *standoff_parts]
-        pins = tuple(p for p in ps.pins if p is not pin)
-        spacers = tuple(s for s in ps.spacers if s.joint != pin.joint)
-        bom = bom_without(ps.bom, pin, [s for s in ps.spacers if s.joint == pin.joint], removed,
-                           [new_driven, new_ground], self.process, ps.copies)
-        from fabricate.parts.bom import part_rows
-
-        bom += part_rows([mount, *standoff_parts], self.process, ps.copies)
-        bom.append(purchased_row(entry.name, ps.copies, f"{entry.kind} driving {self.driven} about {self.joint} "
-                              f"(catalogue {entry.key!r})", model=entry.key))
-        bom += [screw_row(f, ps.copies) for f in fasteners]
-        tubes: dict[str, int] = {}
-        for s in standoffs:
-            if not s.printed:
-                item = f"standoff tube {s.inner_diameter_mm:.3g}/{s.outer_diameter_mm:.3g} x {s.length_mm:.2f} mm"
-                tubes[item] = tubes.get(item, 0) + ps.copies
-        bom += [purchased_row(item, qty, "actuator mount standoff, cut to length") for item, qty in tubes.items()]
+        bom = self._bom(pin, removed, [new_driven, new_ground], [mount, *standoff_parts], fasteners, standoffs)
         from fabricate.parts.partset import overlapping_cuts
 
         warnings = tuple(ps.warnings) + tuple(w for w in overlapping_cuts([new_driven, new_ground, mount])
@@ -441,8 +352,161 @@ class RotaryPlacement(MountPlacement):
             model=entry.key, name=entry.name, kind=entry.kind, driver=self.index, driver_kind="angle",
             joint=self.joint, driven_body=self.driven, ground_body=self.ground, axis=np.asarray(c_g, dtype=float),
             direction=away, angle=float(angle), z_face=float(z_face), flip=flip, removed_pin=pin.joint,
-            interface=tuple(interface),
+            interface=out.interface,
             mount_part=mount.name, fasteners=tuple(fasteners), standoffs=tuple(standoffs), solids=tuple(solids),
             notes=tuple(self.notes))
-        return dataclasses.replace(ps, parts=tuple(parts), pins=pins, spacers=spacers, bom=bom,
+        return dataclasses.replace(ps, parts=tuple(parts), pins=tuple(p for p in ps.pins if p is not pin),
+                                   spacers=tuple(s for s in ps.spacers if s.joint != pin.joint), bom=bom,
                                    warnings=warnings, actuator=record)
+
+    def _side(self, driven: Part, ground: Part) -> tuple[bool, float]:
+        """Which side of the stack the actuator goes (``flip``: over it) and the stack z of its output face: the
+        side whose parts keep clear of it; the ground's side loses a tie (its hole would have to clear the
+        horn)."""
+        faces = {side: self._face(side, driven) for side in (True, False)}
+        costs = {side: self._conflicts(side, driven, faces[side]) + (0.5 if (ground.layer < driven.layer) != side
+                                                                      else 0.0) for side in (True, False)}
+        flip = min((True, False), key=lambda side: costs[side])
+        z_face = faces[flip]
+        if not math.isfinite(z_face):
+            raise SpecError("actuator.model", f"{self.entry.key!r}: its shaft does not reach half way into the "
+                                              f"driven part {driven.name} across the stack on either side")
+        return flip, z_face
+
+    def _body_angle(self, c_g: np.ndarray, ground: Part, flip: bool, z_face: float) -> tuple[np.ndarray, float]:
+        """The direction away from what moves, and the body's angle about the axis (ground frame): the body's
+        centre (off the axis for a servo or a 28BYJ-48) points away from what moves."""
+        away = self._away(c_g)
+        env = self.entry.envelope
+        ex = np.array([0.5 * (env.x0 + env.x1), 0.5 * (env.y0 + env.y1)]) if env is not None else np.zeros(2)
+        if flip:
+            ex = ex * np.array([1.0, -1.0])
+        angle = math.atan2(away[1], away[0]) - (math.atan2(ex[1], ex[0]) if float(np.hypot(*ex)) > 1e-6 else 0.0)
+        return away, self._orient(angle, c_g, ground, flip, z_face)
+
+    def _horn_output(self, driven: Part, pin: Any, flip: bool, z_face: float) -> _Output:
+        """A servo's horn screwed to the driven part: hub bore, the arm screws' pilots, spline, horn and heads."""
+        entry = self.entry
+        horn, spline = entry.horn, entry.spline
+        assert horn is not None and spline is not None  # a servo entry has both (catalogue)
+        c_d = self.mechanism.body(self.driven).point(self.joint)
+        alpha = self._arm_angle()
+        holes = [h for h in driven.holes if h.joint != pin.joint]
+        seat0, seat1 = geo.horn_seat_z(entry)
+        bore, size, pilot, horn_screw, used = self._horn_layout(float(driven.thickness_mm))
+        at = geo.horn_pattern(used, c_d, alpha, flip)
+        holes.append(fit_hole("actuator_hub", c_d, bore, self.comp, fit="clearance"))
+        interface = ["actuator_hub"]
+        pad_circles: list[tuple[np.ndarray, float]] = []
+        for k, centre in enumerate(at):
+            holes.append(fit_hole(f"actuator_horn_{k + 1}", centre, pilot, self.comp, fit="tapped"))
+            interface.append(f"actuator_horn_{k + 1}")
+            pad_circles.append((centre, 0.5 * (pilot + self.comp) + self.wall))
+        pad_circles.append((c_d, 0.5 * (bore + self.comp) + self.wall))
+        place_d = geo.Placement(c_d, alpha, flip, z_face)
+        hole_d = min(h.diameter_mm for h in horn.arm_holes)
+        arm = geo.trimmed_horn_ring(at, c_d, horn.hub_d_mm, hole_d, self.tol)
+        arm0 = seat1 - horn.arm_thickness_mm
+        solids = [geo.Solid("actuator_spline", "output", (geo.circle_ring(c_d, spline.diameter_mm, self.tol),),
+                            *place_d.z_range(0.0, seat0)),
+                  geo.Solid("actuator_horn_hub", "output", (geo.circle_ring(c_d, horn.hub_d_mm, self.tol),),
+                            *place_d.z_range(seat0, seat1)),
+                  geo.Solid("actuator_horn_arms", "output", (arm,), *place_d.z_range(arm0, seat1))]
+        # the heads sit under the arms, between the horn's arms and the servo's face
+        solids += [geo.Solid(f"actuator_horn_screw_{k + 1}", "screw",
+                             (geo.circle_ring(centre, horn_screw.head_d_mm, self.tol),),
+                             *place_d.z_range(arm0 - horn_screw.head_h_mm, arm0))
+                   for k, centre in enumerate(at)]
+        if arm0 - horn_screw.head_h_mm < 0.0:
+            raise SpecError("actuator.model", f"{entry.key!r}: no room for a {size} head under the horn's arms")
+        reach = max(float(np.max(np.hypot(*(arm - c_d).T))), 0.5 * horn.hub_d_mm)
+        fastener = Fastener(horn_screw.designation, len(at), "driven part to the horn, up through its "
+                            "arms into the part (taps into the part)", horn_screw.clamp_mm, horn_screw.engagement_mm)
+        ring_r = math.hypot(used[0].x, used[0].y)
+        self.notes.append(f"open the horn's arm holes {ring_r:g} mm from its axis to Ø"
+                          f"{ISO7089[size][0]:g} mm for the {size} screws and cut the arms back one hole past "
+                          "them; screw the horn to the driven part, press it on the spline, then drive the "
+                          "horn's centre screw through the hub bore")
+        # what passes the ground part: the horn where it overlaps its thickness, else the hub and its screw
+        heads = ring_r + 0.5 * horn_screw.head_d_mm
+        passing = ((geo.output_base_z(entry), seat0, spline.diameter_mm), (seat0, seat1, 2.0 * reach),
+                   (arm0 - horn_screw.head_h_mm, arm0, 2.0 * heads))
+        return _Output(place_d, tuple(holes), (), tuple(pad_circles), tuple(interface), tuple(solids), (fastener,),
+                       passing, bore)
+
+    def _shaft_output(self, driven: Part, pin: Any, flip: bool, z_face: float) -> _Output:
+        """A shaft (or a servo's bare spline) in a bore of the driven part: flats where the shaft has them."""
+        entry = self.entry
+        c_d = self.mechanism.body(self.driven).point(self.joint)
+        alpha = self._arm_angle()
+        shaft = self._shaft()
+        base = geo.output_base_z(entry)
+        flats = geo.shaft_flats(shaft)
+        radial = self.c + 0.5 * self.comp if flats else 0.5 * self.comp
+        if entry.shaft is None:  # a servo's spline, no horn catalogued: the part is pressed on the spline
+            press = float(getattr(self.process, "press_fit_interference_mm", 0.0) or 0.0)
+            radial = 0.5 * (self.comp - press)
+            self.notes.append(f"no horn in the catalogue: press the driven part onto the servo's Ø"
+                              f"{shaft.diameter_mm:g} mm spline (bore Ø{shaft.diameter_mm - press:g} mm "
+                              "nominal, the teeth cut their way) and fix it with the servo's centre screw")
+        elif not flats:
+            self.notes.append(f"the Ø{shaft.diameter_mm:g} mm shaft is round (no flat in the catalogue): "
+                              "the bore is a slip fit; secure the part with adhesive or a clamp")
+        place_d = geo.Placement(c_d, alpha, flip, z_face)
+        solid = geo.Solid("actuator_shaft" if entry.shaft is not None else "actuator_spline", "output",
+                          (geo.circle_ring(c_d, shaft.diameter_mm, self.tol),), *place_d.z_range(base, shaft.length_mm))
+        return _Output(place_d, tuple(h for h in driven.holes if h.joint != pin.joint),
+                       (geo.shaft_bore(shaft, c_d, alpha, radial),),
+                       ((c_d, 0.5 * shaft.diameter_mm + radial + self.wall),),
+                       ("actuator_shaft_bore" if entry.shaft is not None else "actuator_spline_bore",), (solid,), (),
+                       ((base, shaft.length_mm, shaft.diameter_mm),), shaft.diameter_mm + 2.0 * self.c)
+
+    def _ground_clearance(self, ground: Part, pin: Any, c_g: np.ndarray,
+                          out: _Output) -> tuple[float, bool, list[Hole]]:
+        """The ground's hole at the joint: a clearance for whatever of the output passes its thickness. Returns
+        its nominal size, whether anything passes, and the ground's holes with it in the pin's hole's place."""
+        g0, g1 = float(ground.z_mm), float(ground.z_mm + ground.thickness_mm)
+        passes = []
+        for z0, z1, diameter in out.passing:
+            lo, hi = out.place.z_range(z0, z1)
+            if lo < g1 - 1e-9 and hi > g0 + 1e-9:
+                passes.append(diameter + 2.0 * self.c)
+        old = next(h for h in ground.holes if h.joint == pin.joint)
+        # nothing passes (the ground lies beyond the driven part): the pin's hole stays as it was
+        clear = max([out.default_clear, *passes]) if passes else old.nominal_mm
+        ground_holes = [h for h in ground.holes if h.joint != pin.joint]
+        ground_holes.append(fit_hole("actuator_clearance", c_g, clear, self.comp, fit="clearance"))
+        return clear, bool(passes), ground_holes
+
+    def _ground_part(self, ground: Part, c_g: np.ndarray, clear: float, passes: bool,
+                     ground_holes: list[Hole]) -> Part:
+        """The ground part with the clearance (padded where the output passes) and what the mount changed in
+        it (resized and new holes, arms out to the mount plate)."""
+        ground_pad = circle_hull(np.asarray(c_g, dtype=float)[None, :], 0.5 * (clear + self.comp) + self.wall)
+        resized = {h.joint: h for h in self.resized_ground_holes}
+        holes = [resized.get(h.joint, h) for h in ground_holes] + self.new_ground_holes
+        outline = fuse_pad(ground.outline, ground_pad, self.tol) if passes else ground.outline
+        if self.ground_arms:
+            outline = fuse_polygons(outline, list(self.ground_arms), self.tol)
+        return with_changes(ground, outline=outline, holes=tuple(holes))
+
+    def _bom(self, pin: Any, removed: set[str], changed: list[Part], added: list[Part],
+             fasteners: list[Fastener], standoffs: Any) -> list[dict[str, Any]]:
+        """The BOM without the pin and its spacers, with the changed and added parts, the actuator, its screws
+        and its bought standoff tubes."""
+        entry, ps = self.entry, self.ps
+        bom = bom_without(ps.bom, pin, [s for s in ps.spacers if s.joint == pin.joint], removed, changed,
+                          self.process, ps.copies)
+        from fabricate.parts.bom import part_rows
+
+        bom += part_rows(added, self.process, ps.copies)
+        bom.append(purchased_row(entry.name, ps.copies, f"{entry.kind} driving {self.driven} about {self.joint} "
+                                 f"(catalogue {entry.key!r})", model=entry.key))
+        bom += [screw_row(f, ps.copies) for f in fasteners]
+        tubes: dict[str, int] = {}
+        for s in standoffs:
+            if not s.printed:
+                item = f"standoff tube {s.inner_diameter_mm:.3g}/{s.outer_diameter_mm:.3g} x {s.length_mm:.2f} mm"
+                tubes[item] = tubes.get(item, 0) + ps.copies
+        bom += [purchased_row(item, qty, "actuator mount standoff, cut to length") for item, qty in tubes.items()]
+        return bom
