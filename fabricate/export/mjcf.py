@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import quoteattr
 
@@ -75,6 +76,7 @@ from fabricate.mechanism import Driver, Mechanism, Motion, Revolute, Slider
 
 if TYPE_CHECKING:
     from fabricate.gears.pair import GearPair
+    from fabricate.hints import SpringHint
     from fabricate.parts.partset import PartSet
     from fabricate.spec import DesignSpec
 
@@ -186,15 +188,21 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
         ``{part name: STL bytes}``, the files at ``parts/NAME.stl``.
     """
     del gear_pairs  # the couplings carry the laws
-    hints = partset.hints
-    springs = [s for s in hints.springs if s.joint in spring_joints(partset, mechanism)]
-    tree = kinematic_tree(mechanism, [s.joint for s in springs])
-    masses = body_mass_properties(partset, stl, design.process.density_g_cm3)
-    coordinates = joint_coordinates(mechanism, motion, tree)
-    by_joint = {j.name: j for j in mechanism.joints}
-    notes: list[str] = []
-    first = motion.poses_at(0)
+    bodies = _Bodies.of(design, partset, mechanism, motion, stl)
+    lines = _header_lines(design, partset)
+    lines += bodies.worldbody()
+    equalities, fits, targets = _equality_lines(mechanism, motion, bodies.tree)
+    lines += equalities
+    lines += _actuator_lines(design, mechanism, bodies.tree, targets, max(1, int(partset.copies)))
+    lines += _gear_fit_lines(fits)
+    for note in structure_notes(mechanism, bodies.tree) + bodies.notes:
+        lines.append(f"  <!-- {note} -->")
+    lines.append('</mujoco>')
+    return ("\n".join(lines) + "\n").encode("utf-8")
 
+
+def _header_lines(design: DesignSpec, partset: PartSet) -> list[str]:
+    """The document's head: compiler, solver options, defaults, and a mesh asset per part."""
     lines = ['<mujoco model=' + quoteattr(design.name) + '>',
              f'  <!-- made by fabricate from {design.name}: SI units (m, kg, N); see fabricate/export/mjcf.py -->',
              '  <compiler angle="radian" autolimits="true" inertiafromgeom="false"/>',
@@ -209,40 +217,86 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
         lines.append(f'    <mesh name={quoteattr(part.name)} file={quoteattr(f"parts/{part.name}.stl")} '
                      'scale="0.001 0.001 0.001"/>')
     lines.append('  </asset>')
+    return lines
 
-    # sites: every named point of a body, and the tip
-    tip = hints.tip_point if hints.tip_point in mechanism.point_names() else None
-    tip_body = None
-    if tip is not None:
-        owners = [b for b, pad in (hints.pads or {}).items() if pad.point == tip]
-        tip_body = owners[0] if owners else mechanism.point_owner(tip)
 
-    def body_xml(name: str, indent: str) -> list[str]:
+@dataclass(frozen=True)
+class _Bodies:
+    """What the ``<worldbody>`` is written from: the kinematic tree, the joints' coordinates, the bodies' mass
+    properties, the springs the joints carry and the tip site; ``notes`` collects what the writing finds."""
+
+    partset: PartSet
+    mechanism: Mechanism
+    motion: Motion
+    springs: list[SpringHint]
+    tree: Tree
+    masses: dict[str, MassProperties]
+    coordinates: dict[str, np.ndarray]
+    by_joint: dict[str, Revolute | Slider]
+    tip: str | None
+    tip_body: str | None
+    children: dict[str, list[TreeJoint]]
+    notes: list[str]
+
+    @classmethod
+    def of(cls, design: DesignSpec, partset: PartSet, mechanism: Mechanism, motion: Motion,
+           stl: Mapping[str, bytes]) -> _Bodies:
+        hints = partset.hints
+        springs = [s for s in hints.springs if s.joint in spring_joints(partset, mechanism)]
+        tree = kinematic_tree(mechanism, [s.joint for s in springs])
+        masses = body_mass_properties(partset, stl, design.process.density_g_cm3)
+        coordinates = joint_coordinates(mechanism, motion, tree)
+        # sites: every named point of a body, and the tip
+        tip = hints.tip_point if hints.tip_point in mechanism.point_names() else None
+        tip_body = None
+        if tip is not None:
+            owners = [b for b, pad in (hints.pads or {}).items() if pad.point == tip]
+            tip_body = owners[0] if owners else mechanism.point_owner(tip)
+        children: dict[str, list[TreeJoint]] = {}
+        for tj in tree.joints:
+            children.setdefault(tj.parent, []).append(tj)
+        return cls(partset, mechanism, motion, springs, tree, masses, coordinates,
+                   {j.name: j for j in mechanism.joints}, tip, tip_body, children, [])
+
+    def worldbody(self) -> list[str]:
+        """``<worldbody>``: the ground body and, nested in it, the tree's bodies at the first pose."""
+        first = self.motion.poses_at(0)
+        ground = self.mechanism.ground
+        lines = ['  <worldbody>', f'    <body name={quoteattr(ground)}>']
+        lines += self.body_xml(ground, "      ")
+        for tj in self.children.get(ground, []):
+            lines += self.subtree(tj, "      ", first)
+        lines += ['    </body>', '  </worldbody>']
+        return lines
+
+    def body_xml(self, name: str, indent: str) -> list[str]:
+        """A body's inertial, its parts' mesh geoms and its sites."""
         out: list[str] = []
-        m = masses.get(name)
+        m = self.masses.get(name)
         if m is None or m.mass <= 0.0:
-            notes.append(f"body {name} has no printed part: a nominal 1 g point mass")
+            self.notes.append(f"body {name} has no printed part: a nominal 1 g point mass")
             m = MassProperties(1e-3, np.zeros(3), np.eye(3) * 1e-9)
         i = m.inertia
         out.append(f'{indent}<inertial pos="{_vec(m.com)}" mass="{_num(m.mass)}" '
                    f'fullinertia="{_vec([i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2]])}"/>')
-        for part in partset.parts:
+        for part in self.partset.parts:
             if part.body == name:
                 out.append(f'{indent}<geom name={quoteattr(part.name)} type="mesh" mesh={quoteattr(part.name)} '
                            f'pos="0 0 {_num(part.z_mm * MM)}" rgba="{_COLOURS.get(part.role, "0.6 0.6 0.6 1")}"/>')
-        body = mechanism.body(name)
+        body = self.mechanism.body(name)
         for point, xy in body.points.items():
             out.append(f'{indent}<site name={quoteattr(f"{name}.{point}")} pos="{_vec([xy[0] * MM, xy[1] * MM, 0])}" '
                        'size="0.0008"/>')
-            if point == tip and name == tip_body:
+            if point == self.tip and name == self.tip_body:
                 out.append(f'{indent}<site name="tip" pos="{_vec([xy[0] * MM, xy[1] * MM, 0])}" size="0.0015" '
                            'rgba="1 0.2 0.2 1"/>')
         return out
 
-    def joint_xml(tj: TreeJoint, indent: str) -> str:
-        j = by_joint[tj.name]
-        ref = float(coordinates[tj.name][0])
-        child = mechanism.body(tj.child)
+    def joint_xml(self, tj: TreeJoint, indent: str) -> str:
+        """The joint a tree edge's child body turns or slides on."""
+        j = self.by_joint[tj.name]
+        ref = float(self.coordinates[tj.name][0])
+        child = self.mechanism.body(tj.child)
         anchor = child.point(j.name)
         if isinstance(j, Slider):
             axis = np.asarray(j.axis, dtype=np.float64) / math.hypot(*j.axis)
@@ -251,48 +305,43 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
                 axis = np.array([c * axis[0] + s * axis[1], -s * axis[0] + c * axis[1]])
             # body_a the child: moving it along +u lowers the coordinate, and its qpos is minus the coordinate
             return (f'{indent}<joint name={quoteattr(j.name)} type="slide" pos="{_vec([*(anchor * MM), 0])}" '
-                    f'axis="{_vec([*axis, 0])}" ref="{_num(ref, 15)}"{spring_attr(tj)}/>')
+                    f'axis="{_vec([*axis, 0])}" ref="{_num(ref, 15)}"{self.spring_attr(tj)}/>')
         return (f'{indent}<joint name={quoteattr(j.name)} type="hinge" pos="{_vec([*(anchor * MM), 0])}" '
-                f'axis="0 0 1" ref="{_num(ref, 15)}"{spring_attr(tj)}/>')
+                f'axis="0 0 1" ref="{_num(ref, 15)}"{self.spring_attr(tj)}/>')
 
-    def spring_attr(tj: TreeJoint) -> str:
-        for s in springs:
+    def spring_attr(self, tj: TreeJoint) -> str:
+        """A torsion spring's stiffness and free angle on its joint ('' for a joint without one)."""
+        for s in self.springs:
             if s.joint != tj.name:
                 continue
-            j = by_joint[tj.name]
-            rel = np.degrees(motion.relative_angle(j.body_b, j.body_a))
+            j = self.by_joint[tj.name]
+            rel = np.degrees(self.motion.relative_angle(j.body_b, j.body_a))
             sense = 1.0 if rel[-1] >= rel[0] else -1.0
             free = math.radians(float(rel[0]) - sense * s.preload_deg)  # the relative angle where it is unwound
             stiffness = s.rate_Nmm_per_deg * 180.0 / math.pi * MM  # N·m/rad
             return f' stiffness="{_num(stiffness)}" springref="{_num(tj.sign * free, 15)}"'
         return ""
 
-    children: dict[str, list[TreeJoint]] = {}
-    for tj in tree.joints:
-        children.setdefault(tj.parent, []).append(tj)
-
-    def subtree(tj: TreeJoint, indent: str) -> list[str]:
+    def subtree(self, tj: TreeJoint, indent: str, first: Mapping[str, np.ndarray]) -> list[str]:
+        """A tree edge's child body in its parent's frame, with its joint and its own subtrees."""
         parent, child = first[tj.parent], first[tj.child]
         c, s = math.cos(parent[2]), math.sin(parent[2])
         d = child[:2] - parent[:2]
         local = np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
         out = [f'{indent}<body name={quoteattr(tj.child)} pos="{_vec([*(local * MM), 0])}" '
-               f'quat="{_quat(float(child[2] - parent[2]))}">', joint_xml(tj, indent + "  ")]
-        out += body_xml(tj.child, indent + "  ")
-        for grandchild in children.get(tj.child, []):
-            out += subtree(grandchild, indent + "  ")
+               f'quat="{_quat(float(child[2] - parent[2]))}">', self.joint_xml(tj, indent + "  ")]
+        out += self.body_xml(tj.child, indent + "  ")
+        for grandchild in self.children.get(tj.child, []):
+            out += self.subtree(grandchild, indent + "  ", first)
         out.append(f"{indent}</body>")
         return out
 
-    ground = mechanism.ground
-    lines += ['  <worldbody>', f'    <body name={quoteattr(ground)}>']
-    lines += body_xml(ground, "      ")
-    for tj in children.get(ground, []):
-        lines += subtree(tj, "      ")
-    lines += ['    </body>', '  </worldbody>']
 
-    # equalities: loops, gear laws, drivers
-    lines.append('  <equality>')
+def _equality_lines(mechanism: Mechanism, motion: Motion,
+                    tree: Tree) -> tuple[list[str], list[GearFit], list[tuple[str, float, np.ndarray]]]:
+    """``<equality>``: the loops' connects, the gear laws' segments and the drivers' (inactive) equalities;
+    with the gear fits and the drivers' targets the rest of the document reads."""
+    lines = ['  <equality>']
     for j in tree.loops:
         if isinstance(j, Slider):
             continue
@@ -314,8 +363,12 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
     for k, (joint, _, _) in enumerate(targets):
         lines.append(f'    <joint name="drive_{k}" joint1={quoteattr(joint)} polycoef="0 0 0 0 0" active="false"/>')
     lines.append('  </equality>')
+    return lines, fits, targets
 
-    lines += _actuator_lines(design, mechanism, tree, targets, max(1, int(partset.copies)))
+
+def _gear_fit_lines(fits: Sequence[GearFit]) -> list[str]:
+    """The segmented gear fits' bounds (``<custom>``) and a comment per fit with its largest error."""
+    lines = []
     if fits and any(len(f.coefficients) > 1 for f in fits):
         lines.append('  <custom>')
         for f in fits:
@@ -326,10 +379,7 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
     for f in fits:
         lines.append(f'  <!-- gear {f.name}: {len(f.coefficients)} quartic segment(s), largest error of the fit '
                      f'{_num(f.max_error_rad, 3)} rad -->')
-    for note in structure_notes(mechanism, tree) + notes:
-        lines.append(f"  <!-- {note} -->")
-    lines.append('</mujoco>')
-    return ("\n".join(lines) + "\n").encode("utf-8")
+    return lines
 
 def spring_joints(partset: PartSet, mechanism: Mechanism) -> list[str]:
     """The revolute joints whose torsion spring (a rate above 0) the model carries as joint stiffness."""
