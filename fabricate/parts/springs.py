@@ -20,7 +20,8 @@ length), :func:`place_springs` sizes a music-wire torsion spring with
   anchor hole in the other body's plate. Each anchor is a hole of the leg wire plus the running clearance
   and the process's compensation, at the leg length from the pin where the plate has the process's wall
   around it; the far one also where its leg keeps the running clearance from the near plate over the
-  whole motion (:func:`_anchor`). The interference sweep proves the rest (:func:`spring_sweep_items`).
+  whole motion (:func:`~fabricate.parts.spring_anchors.anchor_point`). The interference sweep proves the
+  rest (:func:`spring_sweep_items`).
 * **Wound the right way**: a torsion spring must be loaded to wind up (its coil closes); a right-hand coil
   winds up when its upper end turns counter-clockwise, seen from above, against its lower end.
 
@@ -38,7 +39,6 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import shapely
 
 from fabricate.catalogue._units import INCH_MM, KSI_MPA
 from fabricate.catalogue.springs import (
@@ -56,19 +56,11 @@ from fabricate.catalogue.springs import (
 from fabricate.errors import SpecError
 from fabricate.mechanism import Mechanism, Motion, Revolute
 from fabricate.parts.model import Hole, Part, circle_polygon
+from fabricate.parts.spring_anchors import ANCHOR_POSES, anchor_point, plate_material, to_frame, towards
 
 if TYPE_CHECKING:
     from fabricate.parts.bom import Pin
     from fabricate.process import ProcessSpec
-
-#: Poses (at most) over which an anchor's leg is kept clear of the other plate while placing it (the
-#: interference sweep then checks every pose).
-ANCHOR_POSES = 90
-#: Angular step (degrees) of the anchor search round the pin.
-ANCHOR_STEP_DEG = 2.0
-#: Radial step (mm) by which an anchor moves in from the leg length when no place fits there.
-ANCHOR_RADIAL_STEP_MM = 0.5
-
 
 @dataclass(frozen=True)
 class PlacedSpring:
@@ -227,58 +219,6 @@ def _part_of(parts: Sequence[Part], body: str, joint: str) -> Part:
     raise SpecError("springs", f"no part of body {body!r} holds pin {joint!r}")
 
 
-def _material(part: Part, tol: float) -> Any:
-    rings = part.polygons(tol)
-    return shapely.Polygon(rings[0], [r for r in rings[1:]]).buffer(0)
-
-
-def _to_frame(points: np.ndarray, pose_from: np.ndarray, pose_to: np.ndarray) -> np.ndarray:
-    """Points (k, 2) of a body at poses ``pose_from`` (n, 3) in the frame of a body at ``pose_to``: (n, k, 2)."""
-    cf, sf = np.cos(pose_from[:, 2]), np.sin(pose_from[:, 2])
-    wx = pose_from[:, None, 0] + cf[:, None] * points[None, :, 0] - sf[:, None] * points[None, :, 1]
-    wy = pose_from[:, None, 1] + sf[:, None] * points[None, :, 0] + cf[:, None] * points[None, :, 1]
-    dx, dy = wx - pose_to[:, None, 0], wy - pose_to[:, None, 1]
-    ct, st = np.cos(pose_to[:, 2])[:, None], np.sin(pose_to[:, 2])[:, None]
-    return np.stack([ct * dx + st * dy, -st * dx + ct * dy], axis=-1)
-
-
-def _anchor(material: Any, axis: np.ndarray, radius_max: float, radius_min: float, keep_in: float,
-            clear_of: tuple[Any, np.ndarray, np.ndarray, float] | None = None) -> tuple[np.ndarray, float]:
-    """An anchor hole centre round ``axis`` in a plate: the largest radius from ``radius_max`` down to
-    ``radius_min`` with a place ``keep_in`` inside the plate's material (its wall round the hole), at the
-    angle of most margin.
-
-    ``clear_of`` = (other plate's material, this body's poses, the other's poses, gap): the leg must also
-    stay ``gap`` outside the other plate at every pose (the far leg passing the near plate).
-    """
-    inner = material.buffer(-keep_in)
-    angles = np.radians(np.arange(0.0, 360.0, ANCHOR_STEP_DEG))
-    radius = radius_max
-    while radius >= radius_min - 1e-9:
-        pts = axis + radius * np.column_stack([np.cos(angles), np.sin(angles)])
-        inside = shapely.contains_xy(inner, pts[:, 0], pts[:, 1])
-        if inside.any():
-            margin = np.where(inside, shapely.distance(inner.boundary, shapely.points(pts)), -np.inf)
-            if clear_of is not None:
-                other, own_poses, other_poses, gap = clear_of
-                seen = _to_frame(pts, own_poses, other_poses)            # (n, k, 2)
-                dist = shapely.distance(other, shapely.points(seen.reshape(-1, 2))).reshape(seen.shape[:2])
-                spare = dist.min(axis=0) - gap
-                margin = np.where(spare >= 0.0, np.minimum(margin, spare), -np.inf)
-            best = int(np.argmax(margin))
-            if math.isfinite(float(margin[best])):
-                return pts[best], radius
-        radius -= ANCHOR_RADIAL_STEP_MM
-    raise SpecError("springs", "no place for a leg anchor")
-
-
-def _towards(material: Any, axis: np.ndarray, radius: float) -> np.ndarray:
-    """The point ``radius`` from ``axis`` towards the plate's centroid (any direction for a round plate)."""
-    direction = np.array([material.centroid.x, material.centroid.y]) - axis
-    norm = float(np.hypot(*direction))
-    return axis + radius * (direction / norm if norm > 1e-9 else np.array([1.0, 0.0]))
-
-
 def _ends(pin: Pin, parts_by: Mapping[str, Part], process: ProcessSpec) -> list[tuple[str, str]]:
     """The stack's ends whose outer plate is one of the spring's two bodies, as ``(side, body)``: the end
     away from a pressed pin's holder first (there the pin's press fit is left as it is)."""
@@ -379,6 +319,36 @@ def _arbor_part(name: str, near: Part, joint: str, diameter: float, z: tuple[flo
                 thickness_mm=z[1] - z[0], z_mm=z[0], layer=near.layer, process=process.name, role="arbor")
 
 
+@dataclass(frozen=True)
+class _SpringAt:
+    """A spring hint resolved on its joint and pin: what sizing, seating and anchoring it read."""
+
+    name: str
+    joint: Revolute
+    k: int
+    pin: Pin
+    rate: float
+    preload: float
+    work: float
+    legs: tuple[float, float]
+    deflection: np.ndarray
+    sense: float
+    parts_by: dict[str, Part]
+
+
+@dataclass(frozen=True)
+class _Anchors:
+    """The legs' anchor holes: centres and radii from the pin in the near and far plates, the hole (modelled
+    mm), and the pin's axis in each body's frame."""
+
+    near_at: np.ndarray
+    near_r: float
+    far_at: np.ndarray
+    far_r: float
+    hole: float
+    axis: dict[str, np.ndarray]
+
+
 def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, parts: Sequence[Part],
                   pins: Sequence[Pin], process: ProcessSpec,
                   ground: str = "") -> tuple[tuple[PlacedSpring, ...], list[Part], list[Pin]]:
@@ -408,125 +378,177 @@ def place_springs(hints: Sequence[Any], mechanism: Mechanism, motion: Motion, pa
     GeometryError
         A spring at a joint that is not a revolute of a pin, or a plate with no room for its anchor.
     """
-    from fabricate.errors import GeometryError
-
     placed: list[PlacedSpring] = []
     parts = list(parts)
     pins = list(pins)
-    tol = process.chord_tolerance_mm
     for hint in hints:
-        rate = float(_get(hint, "rate_Nmm_per_deg", 0.0) or 0.0)
-        name = str(_get(hint, "joint", ""))
-        if rate <= 0.0:
+        at = _spring_at(hint, mechanism, motion, parts, pins)
+        if at is None:
             continue  # no spring there
-        joint = next((j for j in mechanism.joints if j.name == name), None)
-        k = next((i for i, p in enumerate(pins) if name in p.joint.split("+")), None)
-        if not isinstance(joint, Revolute) or k is None:
-            raise GeometryError(f"spring at {name!r}: not a revolute joint with a pin")
-        pin = pins[k]
-        preload = float(_get(hint, "preload_deg", 0.0) or 0.0)
-        legs_hint = _get(hint, "legs_mm")
-        deflection, sense = spring_deflections(mechanism, motion, joint, preload)
-        work = max(float(deflection.max()) - preload, 1e-6)
-        try:
-            parts_by = {b: _part_of(parts, b, pin.joint) for b in (joint.body_a, joint.body_b)}
-        except SpecError as exc:
-            raise GeometryError(f"spring at {name}: {exc}") from None
-        pin_mm = float(pin.diameter_mm)
-        # no leg length given: 2.5 x (pin + 2 mm), a design choice (long enough to reach past a boss)
-        legs_default = float(legs_hint) if legs_hint else 2.5 * (pin_mm + 2.0)
-        legs = (legs_default, legs_default)
-        ends = _ends(pin, parts_by, process)
-        spring, within = _sized(rate, work, preload, legs, pin_mm)
-        # an end whose room beyond the stack no other part sweeps first (a stable sort)
-        coil_r = 0.5 * spring.outer_d_mm + spring.wire_d_mm + process.running_clearance_mm
-        ends.sort(key=lambda e: _room_blocked(pin, e[0], spring.body_length_wound_mm, coil_r, parts, motion,
-                                              process))
-        seat = _on_pin(pin, parts, ends, spring.body_length_wound_mm, process, ground)
-        arbor_od = 0.0
-        if seat is None and ends:
-            # the coil cannot ride on the pin's extension: on a printed arbor round the pin's end, the coil
-            # sized to clear the arbor as the catalogue clears a pin
-            arbor_min = _arbor_mm(pin, process)
-            spring, within = _sized(rate, work, preload, legs, arbor_min)
-            arbor_od = max(arbor_min, math.floor(ARBOR_RATIO * spring.inner_d_wound_mm * 10.0 + 1e-9) / 10.0)
-            seat = ends[0]
-        if seat is None:
-            raise GeometryError(f"spring at {name}: no end of pin {pin.joint}'s stack is one of the joint's plates "
-                                "to seat the coil on")
-        side, near = seat
-        far = joint.body_a if near == joint.body_b else joint.body_b
-        near_part, far_part = parts_by[near], parts_by[far]
-        length = spring.body_length_wound_mm
-        z_top = pin.z_mm + pin.length_mm
-        z = (z_top, z_top + length) if side == "top" else (pin.z_mm - length, pin.z_mm)
-        arbor = ""
-        if arbor_od:
-            # the coil rides on a printed arbor bonded to the near plate's outer face (the pin is not lengthened)
-            arbor = f"spring_arbor_{name}"
-            parts.append(_arbor_part(arbor, near_part, pin.joint, arbor_od, z, process))
-        elif side == "top":
-            pins[k] = replace(pin, length_mm=pin.length_mm + length)
-        else:
-            pins[k] = replace(pin, length_mm=pin.length_mm + length, z_mm=pin.z_mm - length)
-        # anchors: the leg wire plus the running fit and the compensation, with the process's wall round it
-        hole = spring.wire_d_mm + 2.0 * process.running_clearance_mm + process.hole_compensation_mm
-        keep = 0.5 * hole + process.min_wall_mm
-        r_min = 0.5 * spring.outer_d_mm + spring.wire_d_mm + process.running_clearance_mm
-        axis = {b: next(h.centre for h in parts_by[b].holes if h.joint == pin.joint) for b in parts_by}
-        pick = np.unique(np.linspace(0, len(motion.inputs) - 1, min(ANCHOR_POSES, len(motion.inputs)))
-                         .round().astype(int))
-        near_material, far_material = _material(near_part, tol), _material(far_part, tol)
-        try:
-            near_at, near_r = _anchor(near_material, np.asarray(axis[near], dtype=np.float64), legs[0],
-                                      r_min, keep)
-            gap = 0.5 * spring.wire_d_mm + process.running_clearance_mm + tol
-            far_at, far_r = _anchor(far_material, np.asarray(axis[far], dtype=np.float64), legs[1], r_min, keep,
-                                    (near_material, motion.pose(far)[pick], motion.pose(near)[pick], gap))
-        except SpecError:
-            if within:
-                raise GeometryError(f"spring at {name}: no place for its leg anchors in {near_part.name} and "
-                                    f"{far_part.name} within {legs[0]:g} mm of the pin; give longer legs or wider "
-                                    "plates") from None
-            # a spring over its allowable fails the strength check by name; its anchors only stand in: out
-            # from the pin towards each plate's middle, clear of the oversized coil
-            near_r = far_r = max(legs[0], r_min)
-            near_at = _towards(near_material, np.asarray(axis[near], dtype=np.float64), near_r)
-            far_at = _towards(far_material, np.asarray(axis[far], dtype=np.float64), far_r)
-        # a running fit for the leg's end: the nominal (finished) size apart from the process's compensation
-        nominal = hole - process.hole_compensation_mm
-        anchor = Hole(f"spring_{name}", near_at, hole, 0.0, "running", nominal)
-        far_hole = Hole(f"spring_{name}", far_at, hole, 0.0, "running", nominal)
-        for part, extra in ((near_part, anchor), (far_part, far_hole)):
-            idx = next(i for i, p in enumerate(parts) if p.name == part.name)
-            parts[idx] = replace(parts[idx], holes=tuple(parts[idx].holes) + (extra,))
-        # axial runs: the near leg's end into its plate (half its thickness); the far leg from the coil's far
-        # end back past the coil and the plates between, to the middle of the far plate
-        mid_far = far_part.z_mm + 0.5 * far_part.thickness_mm
-        far_end = z[1] if side == "top" else z[0]
-        axial = (0.5 * near_part.thickness_mm, abs(far_end - mid_far))
-        # which end is up: winding up = the upper leg turning counter-clockwise (seen from above) against the
-        # lower one for a right-hand coil; the far body turns against the near one by sense (body_b vs body_a)
-        far_turn = sense if far == joint.body_b else -sense
-        upper_turn = far_turn if side == "top" else -far_turn
-        hand = "RH" if upper_turn > 0 else "LH"
-        # leg angle (near to far, in the near frame) at the first pose, less the preload the way it winds
-        p0_near, p0_far = motion.pose(near)[0], motion.pose(far)[0]
-        far_in_near = _to_frame(np.asarray([far_at, axis[far]]), p0_far[None, :], p0_near[None, :])[0]
-        v_far = far_in_near[0] - far_in_near[1]
-        v_near = near_at - axis[near]
-        assembled = math.degrees(math.atan2(v_far[1], v_far[0]) - math.atan2(v_near[1], v_near[0]))
-        free = (assembled - far_turn * float(deflection[0])) % 360.0
-        placed.append(PlacedSpring(
-            joint=name, pin=pin.joint, spring=spring, near_body=near, far_body=far, near_part=near_part.name,
-            far_part=far_part.name, side=side, pin_body=pin.bodies[0],
-            centre=np.asarray(axis[pin.bodies[0]] if pin.bodies[0] in axis else
-                              next(h.centre for p in parts if p.body == pin.bodies[0] for h in p.holes
-                                   if h.joint == pin.joint), dtype=np.float64),
-            z_mm=(round(z[0], 6), round(z[1], 6)), near_anchor=np.asarray(near_at), far_anchor=np.asarray(far_at),
-            near_axis=np.asarray(axis[near], dtype=np.float64), far_axis=np.asarray(axis[far], dtype=np.float64),
-            leg_radii_mm=(round(float(near_r), 3), round(float(far_r), 3)),
-            leg_axial_mm=(round(axial[0], 3), round(axial[1], 3)), anchor_hole_mm=hole,
-            deflection_deg=(float(deflection.min()), float(deflection.max())), hand=hand, free_angle_deg=free,
-            within_series=within, note=str(_get(hint, "note", "") or ""), arbor=arbor))
+        spring, within, (side, near), arbor_od = _seat_coil(at, parts, motion, process, ground)
+        far = at.joint.body_a if near == at.joint.body_b else at.joint.body_b
+        z, arbor = _fit_coil(at, spring, side, at.parts_by[near], arbor_od, parts, pins, process)
+        anchors = _leg_anchors(at, spring, within, near, far, motion, process)
+        _add_anchor_holes(parts, at, (near, far), anchors, process)
+        placed.append(_placed(hint, at, spring, within, side, (near, far), z, arbor, anchors, motion, parts))
     return tuple(placed), parts, pins
+
+
+def _spring_at(hint: Any, mechanism: Mechanism, motion: Motion, parts: Sequence[Part],
+               pins: Sequence[Pin]) -> _SpringAt | None:
+    """A hint on its revolute joint and pin, with the deflection the motion asks of it (None: a rate of 0)."""
+    from fabricate.errors import GeometryError
+
+    rate = float(_get(hint, "rate_Nmm_per_deg", 0.0) or 0.0)
+    name = str(_get(hint, "joint", ""))
+    if rate <= 0.0:
+        return None
+    joint = next((j for j in mechanism.joints if j.name == name), None)
+    k = next((i for i, p in enumerate(pins) if name in p.joint.split("+")), None)
+    if not isinstance(joint, Revolute) or k is None:
+        raise GeometryError(f"spring at {name!r}: not a revolute joint with a pin")
+    pin = pins[k]
+    preload = float(_get(hint, "preload_deg", 0.0) or 0.0)
+    legs_hint = _get(hint, "legs_mm")
+    deflection, sense = spring_deflections(mechanism, motion, joint, preload)
+    work = max(float(deflection.max()) - preload, 1e-6)
+    try:
+        parts_by = {b: _part_of(parts, b, pin.joint) for b in (joint.body_a, joint.body_b)}
+    except SpecError as exc:
+        raise GeometryError(f"spring at {name}: {exc}") from None
+    # no leg length given: 2.5 x (pin + 2 mm), a design choice (long enough to reach past a boss)
+    legs_default = float(legs_hint) if legs_hint else 2.5 * (float(pin.diameter_mm) + 2.0)
+    return _SpringAt(name, joint, k, pin, rate, preload, work, (legs_default, legs_default), deflection, sense,
+                     parts_by)
+
+
+def _seat_coil(at: _SpringAt, parts: Sequence[Part], motion: Motion, process: ProcessSpec,
+               ground: str) -> tuple[TorsionSpring, bool, tuple[str, str], float]:
+    """The spring (and whether it is within the series), the end of the stack it sits on (side, near body),
+    and the arbor's outside diameter (0: the coil rides on the pin's extension)."""
+    from fabricate.errors import GeometryError
+
+    pin = at.pin
+    ends = _ends(pin, at.parts_by, process)
+    spring, within = _sized(at.rate, at.work, at.preload, at.legs, float(pin.diameter_mm))
+    # an end whose room beyond the stack no other part sweeps first (a stable sort)
+    coil_r = 0.5 * spring.outer_d_mm + spring.wire_d_mm + process.running_clearance_mm
+    ends.sort(key=lambda e: _room_blocked(pin, e[0], spring.body_length_wound_mm, coil_r, parts, motion,
+                                          process))
+    seat = _on_pin(pin, parts, ends, spring.body_length_wound_mm, process, ground)
+    arbor_od = 0.0
+    if seat is None and ends:
+        # the coil cannot ride on the pin's extension: on a printed arbor round the pin's end, the coil
+        # sized to clear the arbor as the catalogue clears a pin
+        arbor_min = _arbor_mm(pin, process)
+        spring, within = _sized(at.rate, at.work, at.preload, at.legs, arbor_min)
+        arbor_od = max(arbor_min, math.floor(ARBOR_RATIO * spring.inner_d_wound_mm * 10.0 + 1e-9) / 10.0)
+        seat = ends[0]
+    if seat is None:
+        raise GeometryError(f"spring at {at.name}: no end of pin {pin.joint}'s stack is one of the joint's plates "
+                            "to seat the coil on")
+    return spring, within, seat, arbor_od
+
+
+def _fit_coil(at: _SpringAt, spring: TorsionSpring, side: str, near_part: Part, arbor_od: float,
+              parts: list[Part], pins: list[Pin], process: ProcessSpec) -> tuple[tuple[float, float], str]:
+    """Make room for the coil beyond the stack's ``side`` end: a printed arbor on the near plate (added to
+    ``parts``), else the pin lengthened (in ``pins``). Returns the coil's z span and the arbor's name ('')."""
+    pin = at.pin
+    length = spring.body_length_wound_mm
+    z_top = pin.z_mm + pin.length_mm
+    z = (z_top, z_top + length) if side == "top" else (pin.z_mm - length, pin.z_mm)
+    arbor = ""
+    if arbor_od:
+        # the coil rides on a printed arbor bonded to the near plate's outer face (the pin is not lengthened)
+        arbor = f"spring_arbor_{at.name}"
+        parts.append(_arbor_part(arbor, near_part, pin.joint, arbor_od, z, process))
+    elif side == "top":
+        pins[at.k] = replace(pin, length_mm=pin.length_mm + length)
+    else:
+        pins[at.k] = replace(pin, length_mm=pin.length_mm + length, z_mm=pin.z_mm - length)
+    return z, arbor
+
+
+def _leg_anchors(at: _SpringAt, spring: TorsionSpring, within: bool, near: str, far: str, motion: Motion,
+                 process: ProcessSpec) -> _Anchors:
+    """Where the legs' ends go: a hole for the leg wire in each plate, the far one clear of the near plate."""
+    from fabricate.errors import GeometryError
+
+    tol = process.chord_tolerance_mm
+    near_part, far_part, legs = at.parts_by[near], at.parts_by[far], at.legs
+    # anchors: the leg wire plus the running fit and the compensation, with the process's wall round it
+    hole = spring.wire_d_mm + 2.0 * process.running_clearance_mm + process.hole_compensation_mm
+    keep = 0.5 * hole + process.min_wall_mm
+    r_min = 0.5 * spring.outer_d_mm + spring.wire_d_mm + process.running_clearance_mm
+    axis = {b: next(h.centre for h in at.parts_by[b].holes if h.joint == at.pin.joint) for b in at.parts_by}
+    pick = np.unique(np.linspace(0, len(motion.inputs) - 1, min(ANCHOR_POSES, len(motion.inputs)))
+                     .round().astype(int))
+    near_material, far_material = plate_material(near_part, tol), plate_material(far_part, tol)
+    try:
+        near_at, near_r = anchor_point(near_material, np.asarray(axis[near], dtype=np.float64), legs[0],
+                                  r_min, keep)
+        gap = 0.5 * spring.wire_d_mm + process.running_clearance_mm + tol
+        far_at, far_r = anchor_point(far_material, np.asarray(axis[far], dtype=np.float64), legs[1], r_min, keep,
+                                (near_material, motion.pose(far)[pick], motion.pose(near)[pick], gap))
+    except SpecError:
+        if within:
+            raise GeometryError(f"spring at {at.name}: no place for its leg anchors in {near_part.name} and "
+                                f"{far_part.name} within {legs[0]:g} mm of the pin; give longer legs or wider "
+                                "plates") from None
+        # a spring over its allowable fails the strength check by name; its anchors only stand in: out
+        # from the pin towards each plate's middle, clear of the oversized coil
+        near_r = far_r = max(legs[0], r_min)
+        near_at = towards(near_material, np.asarray(axis[near], dtype=np.float64), near_r)
+        far_at = towards(far_material, np.asarray(axis[far], dtype=np.float64), far_r)
+    return _Anchors(near_at, near_r, far_at, far_r, hole, axis)
+
+
+def _add_anchor_holes(parts: list[Part], at: _SpringAt, bodies: tuple[str, str], anchors: _Anchors,
+                      process: ProcessSpec) -> None:
+    """The legs' anchor holes into the near and far plates (copies in ``parts``)."""
+    # a running fit for the leg's end: the nominal (finished) size apart from the process's compensation
+    nominal = anchors.hole - process.hole_compensation_mm
+    near_part, far_part = at.parts_by[bodies[0]], at.parts_by[bodies[1]]
+    for part, centre in ((near_part, anchors.near_at), (far_part, anchors.far_at)):
+        extra = Hole(f"spring_{at.name}", centre, anchors.hole, 0.0, "running", nominal)
+        idx = next(i for i, p in enumerate(parts) if p.name == part.name)
+        parts[idx] = replace(parts[idx], holes=tuple(parts[idx].holes) + (extra,))
+
+
+def _placed(hint: Any, at: _SpringAt, spring: TorsionSpring, within: bool, side: str, bodies: tuple[str, str],
+            z: tuple[float, float], arbor: str, anchors: _Anchors, motion: Motion,
+            parts: Sequence[Part]) -> PlacedSpring:
+    """The placed spring's record: its legs' runs, the hand it is wound and its free angle."""
+    near, far = bodies
+    near_part, far_part, pin, axis = at.parts_by[near], at.parts_by[far], at.pin, anchors.axis
+    # axial runs: the near leg's end into its plate (half its thickness); the far leg from the coil's far
+    # end back past the coil and the plates between, to the middle of the far plate
+    mid_far = far_part.z_mm + 0.5 * far_part.thickness_mm
+    far_end = z[1] if side == "top" else z[0]
+    axial = (0.5 * near_part.thickness_mm, abs(far_end - mid_far))
+    # which end is up: winding up = the upper leg turning counter-clockwise (seen from above) against the
+    # lower one for a right-hand coil; the far body turns against the near one by sense (body_b vs body_a)
+    far_turn = at.sense if far == at.joint.body_b else -at.sense
+    upper_turn = far_turn if side == "top" else -far_turn
+    hand = "RH" if upper_turn > 0 else "LH"
+    # leg angle (near to far, in the near frame) at the first pose, less the preload the way it winds
+    p0_near, p0_far = motion.pose(near)[0], motion.pose(far)[0]
+    far_in_near = to_frame(np.asarray([anchors.far_at, axis[far]]), p0_far[None, :], p0_near[None, :])[0]
+    v_far = far_in_near[0] - far_in_near[1]
+    v_near = anchors.near_at - axis[near]
+    assembled = math.degrees(math.atan2(v_far[1], v_far[0]) - math.atan2(v_near[1], v_near[0]))
+    free = (assembled - far_turn * float(at.deflection[0])) % 360.0
+    return PlacedSpring(
+        joint=at.name, pin=pin.joint, spring=spring, near_body=near, far_body=far, near_part=near_part.name,
+        far_part=far_part.name, side=side, pin_body=pin.bodies[0],
+        centre=np.asarray(axis[pin.bodies[0]] if pin.bodies[0] in axis else
+                          next(h.centre for p in parts if p.body == pin.bodies[0] for h in p.holes
+                               if h.joint == pin.joint), dtype=np.float64),
+        z_mm=(round(z[0], 6), round(z[1], 6)), near_anchor=np.asarray(anchors.near_at),
+        far_anchor=np.asarray(anchors.far_at), near_axis=np.asarray(axis[near], dtype=np.float64),
+        far_axis=np.asarray(axis[far], dtype=np.float64),
+        leg_radii_mm=(round(float(anchors.near_r), 3), round(float(anchors.far_r), 3)),
+        leg_axial_mm=(round(axial[0], 3), round(axial[1], 3)), anchor_hole_mm=anchors.hole,
+        deflection_deg=(float(at.deflection.min()), float(at.deflection.max())), hand=hand, free_angle_deg=free,
+        within_series=within, note=str(_get(hint, "note", "") or ""), arbor=arbor)
