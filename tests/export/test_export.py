@@ -7,14 +7,19 @@ through every exporter. Real tools (OpenSCAD, PrusaSlicer) are run when installe
 from __future__ import annotations
 
 import dataclasses
+import fcntl
 import io
 import math
+import os
+import pickle
 import re
 import shutil
 import subprocess
 import xml.etree.ElementTree as ET
 import zipfile
+from collections.abc import Iterator
 from functools import cache
+from pathlib import Path
 from types import SimpleNamespace
 
 import ezdxf
@@ -27,9 +32,10 @@ from ezdxf.math import bulge_to_arc
 from PIL import Image
 
 from fabricate.design import load_design
-from fabricate.export import export_all
+from fabricate.export import export_all, export_step
 from fabricate.export.dxf import DxfStyle, audit_problems, part_dxf, sheet_dxf, sheet_layout
 from fabricate.export.kinematic import kinematic_dxf
+from fabricate.export.step import step_available
 from fabricate.export.stl import (
     SolidCache,
     assembly_3mf,
@@ -79,9 +85,50 @@ def _synthesised(template: str):
     return design, result, gear_pairs
 
 
+#: The folder where this test session's workers share their cases (empty: each process makes its own, as a child
+#: process of test_bytes_do_not_depend_on_the_hash_seed must).
+_SHARED: list[Path] = []
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _share_cases(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """Cases are shared by the session's pytest-xdist workers: each test function is parametrised by case and its
+    parameters are dealt out to both workers, so without this each worker made every case (pytest-xdist gives a
+    worker its own basetemp inside the session's folder; without xdist the basetemp is the session's)."""
+    base = tmp_path_factory.getbasetemp()
+    folder = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "export-cases"
+    folder.mkdir(exist_ok=True)
+    _SHARED[:] = [folder]
+    yield
+    _SHARED.clear()
+
+
 @cache
 def case(name: str) -> SimpleNamespace:
-    """Design, mechanism, motion, part set and exported files of one case (built once per session)."""
+    """Design, mechanism, motion, part set and exported files of one case, made once per test session: the first
+    worker to ask makes it (an exclusive lock per case, so the other waits instead of making it too) and leaves it
+    pickled for the other. A case that does not pickle (the elliptic pair's mechanism holds its compiled law) is
+    made by each worker."""
+    if not _SHARED:
+        return make_case(name)
+    with open(_SHARED[0] / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        path = _SHARED[0] / f"{name}.pickle"
+        if path.is_file():
+            return pickle.loads(path.read_bytes())
+        made = make_case(name)
+        try:
+            blob = pickle.dumps(made, protocol=pickle.HIGHEST_PROTOCOL)
+        except (pickle.PicklingError, AttributeError, TypeError):
+            return made
+        path.with_suffix(".part").write_bytes(blob)
+        path.with_suffix(".part").replace(path)
+        return made
+
+
+def make_case(name: str) -> SimpleNamespace:
+    """One case, made in this process. Its files are every export but STEP (no test here reads a STEP file; they
+    are tests/export/test_step.py's, and the STEP exporter starts a process of its own: 60-90 % of a case's time)."""
     mech_name, process_name = name.rsplit("-", 1)
     process = PROCESSES[process_name]
     hints = PartHints()
@@ -107,7 +154,7 @@ def case(name: str) -> SimpleNamespace:
                                           outline_b=spur_like(6.0, 8, 0.4))]
             hints = PartHints(pads={"rocker": PadHint("B", 4.0)})
     partset = build_parts(design, mechanism, motion, gear_pairs, hints)
-    files, entries = export_all(design, partset, mechanism, motion)
+    files, entries = export_all(design, partset, mechanism, motion, step=False)
     return SimpleNamespace(design=design, process=process, mechanism=mechanism, motion=motion,
                            partset=partset, files=files, entries=entries, gear_pairs=gear_pairs, hints=hints)
 
@@ -474,7 +521,7 @@ def test_previews_and_report_entries(name):
 def test_same_input_gives_identical_bytes(name):
     c = case(name)
     again = build_parts(c.design, c.mechanism, c.motion, c.gear_pairs, c.hints)
-    files, entries = export_all(c.design, again, c.mechanism, c.motion)
+    files, entries = export_all(c.design, again, c.mechanism, c.motion, step=False)
     assert sorted(files) == sorted(c.files)
     assert [k for k in files if files[k] != c.files[k]] == []
     assert entries == c.entries
@@ -603,13 +650,18 @@ def test_prusaslicer_reports_manifold_without_repair(name, tmp_path):
         assert objects == run.stdout.count("manifold = yes") == c.partset.copies * len(c.partset.parts)
 
 
+def with_step(c: SimpleNamespace) -> dict[str, bytes]:
+    """A case's files and its STEP files (none without OCP), as a build writes them."""
+    return {**c.files, **export_step(c.design, c.partset, c.motion)}
+
+
 ENCODE_IN_CHILD = """
 import hashlib, sys
 sys.path.insert(0, {root!r})
-from tests.export.test_export import case
-c = case({name!r})
-for key in sorted(c.files):
-    print(key, hashlib.sha256(c.files[key]).hexdigest())
+from tests.export.test_export import case, with_step
+files = with_step(case({name!r}))
+for key in sorted(files):
+    print(key, hashlib.sha256(files[key]).hexdigest())
 """
 
 
@@ -618,13 +670,12 @@ def test_bytes_do_not_depend_on_the_hash_seed():
     """Two processes with different string-hash seeds write identical files (ezdxf keeps some records
     in sets; the encoders fix their order)."""
     import hashlib
-    import os
     import sys
-    from pathlib import Path
 
     name = "slider_crank-laser"
-    here = case(name)
-    expected = "".join(f"{k} {hashlib.sha256(here.files[k]).hexdigest()}\n" for k in sorted(here.files))
+    here = with_step(case(name))
+    assert any(k.endswith(".step") for k in here) == step_available()
+    expected = "".join(f"{k} {hashlib.sha256(here[k]).hexdigest()}\n" for k in sorted(here))
     script = ENCODE_IN_CHILD.format(root=str(Path(__file__).resolve().parents[2]), name=name)
     for seed in ("1", "12345"):
         env = {**os.environ, "PYTHONHASHSEED": seed}
