@@ -105,69 +105,17 @@ def verdict(report: Mapping[str, Any], failures: Sequence[str] | None = None) ->
 
 def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> str:
     """A human-readable summary of a report (report.md), linking the given image paths."""
-    design = report.get("design", {})
-    checks = report.get("checks", {})
-    out = [f"# {design.get('name', 'design')} ({design.get('kind', '')})", ""]
-    if design.get("description"):
-        out += [design["description"], ""]
-    out += [f"Template: `{design.get('template', '')}` · fabricate {design.get('fabricate_version', '')}", ""]
-    if design.get("stage") == "synth":
-        heading = "## Checks: none run (synth only; `fabricate build` runs them)"
-    else:
-        heading = f"## Checks: {'PASSED' if checks.get('passed') else 'FAILED'}"
-    out += [heading, ""]
-    for failure in checks.get("failures", []):
-        out.append(f"- {failure}")
-    if design.get("stage") != "synth":
-        out += [f"- {note}" for note in not_checked_notes(report)]
-    if checks.get("failures") or (design.get("stage") != "synth" and not_checked(report)):
-        out.append("")
-    for note in report.get("notes", []):
-        out += [f"Note: {note}", ""]
+    out = _verdict_lines(report)
     out += _contents(report)
-    mech = report.get("mechanism", {})
-    if mech.get("joints"):
-        out += ["## Mechanism (first pose)", ""]
-        out += [f"Input range: {_fmt(mech.get('input_range_deg'))} ({mech.get('input_unit', 'deg')})", ""]
-        out += _table(["point", "x mm", "y mm"], [[k, v[0], v[1]] for k, v in mech["joints"].items()])
-        out += [""]
-    synthesis = report.get("synthesis", {})
-    if synthesis:
-        out += ["## Synthesis", ""]
-        scalars = [(k, v) for k, v in synthesis.items() if isinstance(v, (int, float, str, bool))]
-        if "pose_error_mm" in synthesis and isinstance(synthesis["pose_error_mm"], Mapping):
-            pe = synthesis["pose_error_mm"]
-            scalars.insert(0, ("pose_error_mm (max / mean)", f"{_fmt(pe.get('max'))} / {_fmt(pe.get('mean'))}"))
-        out += _table(["quantity", "value"], scalars) + [""]
-    gears = report.get("gears", [])
-    if gears:
-        out += ["## Gears", ""]
-        out += _table(["pair", "teeth", "module mm", "method", "centre mm", "TE deg", "backlash mm",
-                       "interference mm²", "undercut", "min ρ mm"],
-                      [[g.get("name"), g.get("teeth"), g.get("module_mm"), g.get("method"),
-                        g.get("center_distance_mm"), g.get("transmission_error_deg"), g.get("backlash_mm"),
-                        g.get("interference_area_mm2"), g.get("undercut"),
-                        g.get("min_pitch_radius_of_curvature_mm")] for g in gears]) + [""]
-    parts = report.get("parts", [])
-    if parts:
-        out += ["## Parts", ""]
-        out += _table(["part", "process", "layer", "volume mm³", "holes (joint: Ø mm)", "STL", "DXF"],
-                      [[p.get("name"), p.get("process"), p.get("layer"), p.get("volume_mm3"),
-                        ", ".join(f"{h['joint']}: {h['diameter_mm']:.3f}" for h in p.get("holes", [])),
-                        p.get("stl"), p.get("dxf")] for p in parts]) + [""]
+    out += _mechanism_lines(report.get("mechanism", {}))
+    out += _synthesis_lines(report.get("synthesis", {}))
+    out += _gear_lines(report.get("gears", []))
+    out += _part_lines(report.get("parts", []))
     if report.get("cut"):  # a laser build: its sheets, their utilisation, the part-number key and labels
         from fabricate.export.labels import cut_markdown
 
         out += cut_markdown(report["cut"])
-    assembly = report.get("assembly", {})
-    if assembly.get("steps") or assembly.get("guide"):
-        out += ["## Assembly", ""]
-        if assembly.get("guide"):
-            out += [f"Follow [assembly.md](assembly.md): {len(assembly['guide'])} numbered steps, each with its "
-                    "picture, parts, hardware, retention and tool, ending with a check of the motion.", ""]
-        if assembly.get("steps"):
-            out += ["Each pin's stack from bottom to top (also in `assembly.csv`):", ""]
-            out += list(assembly["steps"]) + [""]
+    out += _assembly_lines(report.get("assembly", {}))
     bom = report.get("bom", [])
     if bom:
         out += ["## Bill of materials", ""]
@@ -199,6 +147,88 @@ def report_markdown(report: Mapping[str, Any], images: Sequence[str] = ()) -> st
     if inter:
         out += ["---", "", "Appendix.", ""] + interference_markdown(inter)
     return "\n".join(out)
+
+
+def _verdict_lines(report: Mapping[str, Any]) -> list[str]:
+    """The title, the design's description and template, the verdict with its failures, and the notes."""
+    design = report.get("design", {})
+    checks = report.get("checks", {})
+    out = [f"# {design.get('name', 'design')} ({design.get('kind', '')})", ""]
+    if design.get("description"):
+        out += [design["description"], ""]
+    out += [f"Template: `{design.get('template', '')}` · fabricate {design.get('fabricate_version', '')}", ""]
+    if design.get("stage") == "synth":
+        heading = "## Checks: none run (synth only; `fabricate build` runs them)"
+    else:
+        heading = f"## Checks: {'PASSED' if checks.get('passed') else 'FAILED'}"
+    out += [heading, ""]
+    for failure in checks.get("failures", []):
+        out.append(f"- {failure}")
+    if design.get("stage") != "synth":
+        out += [f"- {note}" for note in not_checked_notes(report)]
+    if checks.get("failures") or (design.get("stage") != "synth" and not_checked(report)):
+        out.append("")
+    for note in report.get("notes", []):
+        out += [f"Note: {note}", ""]
+    return out
+
+
+def _mechanism_lines(mech: Mapping[str, Any]) -> list[str]:
+    """The input range and the joints at the first pose."""
+    if not mech.get("joints"):
+        return []
+    out = ["## Mechanism (first pose)", ""]
+    out += [f"Input range: {_fmt(mech.get('input_range_deg'))} ({mech.get('input_unit', 'deg')})", ""]
+    out += _table(["point", "x mm", "y mm"], [[k, v[0], v[1]] for k, v in mech["joints"].items()])
+    return out + [""]
+
+
+def _synthesis_lines(synthesis: Mapping[str, Any]) -> list[str]:
+    """The synthesis' scalar results, the pose error first."""
+    if not synthesis:
+        return []
+    scalars = [(k, v) for k, v in synthesis.items() if isinstance(v, (int, float, str, bool))]
+    if "pose_error_mm" in synthesis and isinstance(synthesis["pose_error_mm"], Mapping):
+        pe = synthesis["pose_error_mm"]
+        scalars.insert(0, ("pose_error_mm (max / mean)", f"{_fmt(pe.get('max'))} / {_fmt(pe.get('mean'))}"))
+    return ["## Synthesis", ""] + _table(["quantity", "value"], scalars) + [""]
+
+
+def _gear_lines(gears: Sequence[Mapping[str, Any]]) -> list[str]:
+    """A row per gear pair."""
+    if not gears:
+        return []
+    return ["## Gears", ""] + _table(
+        ["pair", "teeth", "module mm", "method", "centre mm", "TE deg", "backlash mm", "interference mm²",
+         "undercut", "min ρ mm"],
+        [[g.get("name"), g.get("teeth"), g.get("module_mm"), g.get("method"), g.get("center_distance_mm"),
+          g.get("transmission_error_deg"), g.get("backlash_mm"), g.get("interference_area_mm2"), g.get("undercut"),
+          g.get("min_pitch_radius_of_curvature_mm")] for g in gears]) + [""]
+
+
+def _part_lines(parts: Sequence[Mapping[str, Any]]) -> list[str]:
+    """A row per part: process, layer, volume, holes and its files."""
+    if not parts:
+        return []
+    return ["## Parts", ""] + _table(
+        ["part", "process", "layer", "volume mm³", "holes (joint: Ø mm)", "STL", "DXF"],
+        [[p.get("name"), p.get("process"), p.get("layer"), p.get("volume_mm3"),
+          ", ".join(f"{h['joint']}: {h['diameter_mm']:.3f}" for h in p.get("holes", [])),
+          p.get("stl"), p.get("dxf")] for p in parts]) + [""]
+
+
+def _assembly_lines(assembly: Mapping[str, Any]) -> list[str]:
+    """Where the assembly guide is, and each pin's stack."""
+    if not (assembly.get("steps") or assembly.get("guide")):
+        return []
+    out = ["## Assembly", ""]
+    if assembly.get("guide"):
+        out += [f"Follow [assembly.md](assembly.md): {len(assembly['guide'])} numbered steps, each with its "
+                "picture, parts, hardware, retention and tool, ending with a check of the motion.", ""]
+    if assembly.get("steps"):
+        out += ["Each pin's stack from bottom to top (also in `assembly.csv`):", ""]
+        out += list(assembly["steps"]) + [""]
+    return out
 
 
 def _contents(report: Mapping[str, Any]) -> list[str]:
