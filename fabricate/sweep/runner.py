@@ -183,10 +183,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     points = spec.points()
     ids = [spec.point_id(values) for values in points]
     by_id = dict(zip(ids, range(len(points)), strict=True))
-    done: dict[str, dict[str, Any]] = {}
-    if resuming:
-        done = {pid: row for pid, row in read_journal(out, spec).items()
-                if pid in by_id and row["exit_code"] != EXIT_INTERNAL}
+    done = _journal_rows(out, spec, by_id) if resuming else {}
     resumed = len(done)
     say = log or (lambda msg: None if quiet else print(msg, file=sys.stderr, flush=True))
     draw = (not quiet) and (sys.stderr.isatty() if progress_bar is None else progress_bar)
@@ -203,13 +200,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     n_workers = tasks = 0
     points_seconds = worker_cpu = 0.0
     if todo:  # a cluster that cannot be had is a usage error: nothing is written
-        client, cluster = connect(workers, scheduler)
-        try:
-            n_workers = _wait_for_workers(client, scheduler)
-            _warm(client)
-        except BaseException:
-            _close(client, cluster)
-            raise
+        client, cluster, n_workers = _start_cluster(workers, scheduler)
     out.mkdir(parents=True, exist_ok=True)
     write_file(out / SWEEP_JSON, _json(sweep_record(spec, {"points": len(points), "done": resumed, "complete": False})))
     journal = Journal(out / JOURNAL)
@@ -235,23 +226,58 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     if interrupted:
         # a stop can land between a row's journal write and its count: the journal is what a resume reads, so
         # the record counts what it holds (the same rows the resume will call "done earlier")
-        done = {pid: row for pid, row in read_journal(out, spec).items()
-                if pid in by_id and row["exit_code"] != EXIT_INTERNAL}
+        done = _journal_rows(out, spec, by_id)
     rows = [done[pid] for pid in ids if pid in done]
+    counts, best, notes, worker_peak, interrupted = _finish(
+        out, spec, rows, done, len(points), interrupted, (client, cluster), (workers, scheduler), say, protect, cache)
+    code = 130 if interrupted else (1 if counts.get(str(EXIT_INTERNAL)) else 0)
+    return SweepOutcome(exit_code=code, out=out, total=len(points), done=len(rows), resumed=resumed,
+                        counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers,
+                        tasks=tasks, notes=notes, points_seconds=points_seconds, worker_peak_mb=worker_peak,
+                        worker_cpu_seconds=worker_cpu)
+
+
+def _journal_rows(out: Path, spec: SweepSpec, by_id: Mapping[str, int]) -> dict[str, dict[str, Any]]:
+    """The journal's rows of this spec's points that are done (not an internal error: those run again)."""
+    return {pid: row for pid, row in read_journal(out, spec).items()
+            if pid in by_id and row["exit_code"] != EXIT_INTERNAL}
+
+
+def _start_cluster(workers: int | None, scheduler: str | None) -> tuple[Any, Any, int]:
+    """Client and (local) cluster with their workers up and warm, and how many workers; closed again when that
+    fails."""
+    client, cluster = connect(workers, scheduler)
+    try:
+        n_workers = _wait_for_workers(client, scheduler)
+        _warm(client)
+    except BaseException:
+        _close(client, cluster)
+        raise
+    return client, cluster, n_workers
+
+
+def _finish(out: Path, spec: SweepSpec, rows: list[dict[str, Any]], done: Mapping[str, Mapping[str, Any]],
+            total: int, interrupted: bool, dask: tuple[Any, Any], connect_to: tuple[int | None, str | None],
+            say: Progress, protect: Sequence[Path], cache: bool
+            ) -> tuple[dict[str, int], list[dict[str, Any]], list[str], float, bool]:
+    """Write the tables and plots, build the best points (a complete, uninterrupted sweep), and the final
+    sweep.json; then close the client and cluster (``dask``: either may be None). Returns the counts, the best
+    points, the notes, the workers' peak memory (MB) and whether the sweep was interrupted."""
+    client, cluster = dask
     try:
         _write_results(out, spec, rows)
         best: list[dict[str, Any]] = []
-        if not interrupted and len(rows) == len(points):
+        if not interrupted and len(rows) == total:
             best = _best(spec, rows)
             if best:
                 if client is None:
-                    client, cluster = connect(workers, scheduler)
+                    client, cluster = connect(*connect_to)
                 _build_best(client, spec, best, out, say, protect, cache)
         counts = _counts(done)
-        complete = len(rows) == len(points)
+        complete = len(rows) == total
         notes = _notes(spec, rows)
         write_file(out / SWEEP_JSON, _json(sweep_record(spec, {
-            "points": len(points), "done": len(rows), "complete": complete, "counts": counts,
+            "points": total, "done": len(rows), "complete": complete, "counts": counts,
             "best": best, "notes": notes,
             "files": ["sweep.csv", "sweep.parquet", JOURNAL, "plots/", *(["best/"] if best else [])],
         })))
@@ -261,11 +287,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     finally:
         worker_peak = _worker_peak_mb(client) if client is not None and not interrupted else 0.0
         _close(client, cluster)
-    code = 130 if interrupted else (1 if counts.get(str(EXIT_INTERNAL)) else 0)
-    return SweepOutcome(exit_code=code, out=out, total=len(points), done=len(rows), resumed=resumed,
-                        counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers,
-                        tasks=tasks, notes=notes, points_seconds=points_seconds, worker_peak_mb=worker_peak,
-                        worker_cpu_seconds=worker_cpu)
+    return counts, best, notes, worker_peak, interrupted
 
 
 def group_order(fields: Sequence[tuple[str, Sequence[str | int]]], points: Sequence[Mapping[str, Any]],
