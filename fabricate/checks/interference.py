@@ -295,6 +295,17 @@ class _PlanarMemo:
             rel = self._rel[(body_a, body_b)] = RelativePoses.between(self.poses[body_a], self.poses[body_b])
         return rel
 
+    def lower_bound(self, oa: Outline, ob: Outline, bodies: tuple[str, str]) -> np.ndarray:
+        """The broad phase: per pose, the distance of the outlines' bounding circles (read-only)."""
+        key = ("lower", id(oa), id(ob), bodies)
+        found = self._values.get(key)
+        if found is None:
+            centre_b = self.relative(*bodies).apply(ob.centre[None, :])[:, 0]
+            found = np.hypot(*(centre_b - oa.centre).T) - oa.radius - ob.radius
+            found.flags.writeable = False
+            self._values[key] = found
+        return found
+
     def clearance(self, oa: Outline, ob: Outline, bodies: tuple[str, str], index: np.ndarray) -> np.ndarray:
         """:func:`planar_clearance` of ``ob`` posed at the poses ``index`` of ``bodies`` (read-only)."""
         return self._ask("clearance", oa, ob, bodies, index)
@@ -395,8 +406,7 @@ def _sweep_pair(a: SweepItem, b: SweepItem, oa: Outline, ob: Outline, pose_a: np
     rel = planar_memo.relative(*bodies)
     # broad phase: bounding circles; a pose whose circles are farther apart than the search length
     # keeps that distance as a lower bound of its clearance
-    centre_b = rel.apply(ob.centre[None, :])[:, 0]
-    lower = np.hypot(*(centre_b - oa.centre).T) - oa.radius - ob.radius
+    lower = planar_memo.lower_bound(oa, ob, bodies)
     planar = np.maximum(lower, search)
     exact = np.zeros(n, dtype=bool)
     near = np.nonzero(lower < search)[0]
