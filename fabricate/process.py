@@ -338,29 +338,7 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
     if override is not None and not override.text:
         override = None  # only --printer: the template's own profile
     profile = table.string("profile", DEFAULT_PROFILE, choices=shipped_profiles())
-    if override is None:
-        base_path = TEMPLATE_DIR / f"process_{profile}.toml"
-        base = read_toml(base_path) if base_path.is_file() else {}
-        path = table.path or "process"
-    else:
-        base = parse_toml(override.text, override.source)
-        path = f"--process {override.source}"
-    merged = dict(base)
-    for key in table.data:
-        if key != "profile":
-            table._used.add(key)
-            if override is None or key in DESIGN_PROCESS_FIELDS:
-                merged[key] = table.data[key]
-    if override is not None and "thickness_mm" in table.data and _keeps_thickness(base, table.data["thickness_mm"]):
-        merged["thickness_mm"] = table.data["thickness_mm"]
-        volume = base.get("build_volume_mm")
-        if base.get("layout") == "sheet" and isinstance(volume, list) and len(volume) == 3:
-            merged["build_volume_mm"] = [*volume[:2], table.data["thickness_mm"]]  # a sheet is the stock it is cut from
-        if base.get("thickness_mm") != table.data["thickness_mm"]:
-            # the profile's [shop] numbers are its own stock's: at another stock the shop check takes its rule of
-            # half the stock thickness (fabricate.checks.shop)
-            merged.pop("shop", None)
-    t = Table(merged, path)
+    t = _merged(table, profile, override)
     name = t.string("method", profile) if override is None else t.string("method")
     if not _PROCESS_NAME.fullmatch(name):
         raise SpecError(t.field("method"), "expected a process name of lower-case letters, digits, _ and - "
@@ -408,6 +386,42 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
         shop=_shop(t.table("shop", {})),
     )
     t.finish()
+    _check_spec(spec, t, cli_printer, materials, material)
+    return spec
+
+
+def _merged(table: Table, profile: str, override: ProcessOverride | None) -> Table:
+    """The profile's fields (the shipped ``profile``'s, or ``--process``'s) with the template's over them: all of
+    them, or with an override only :data:`DESIGN_PROCESS_FIELDS` and a thickness the new process makes."""
+    if override is None:
+        base_path = TEMPLATE_DIR / f"process_{profile}.toml"
+        base = read_toml(base_path) if base_path.is_file() else {}
+        path = table.path or "process"
+    else:
+        base = parse_toml(override.text, override.source)
+        path = f"--process {override.source}"
+    merged = dict(base)
+    for key in table.data:
+        if key != "profile":
+            table._used.add(key)
+            if override is None or key in DESIGN_PROCESS_FIELDS:
+                merged[key] = table.data[key]
+    if override is not None and "thickness_mm" in table.data and _keeps_thickness(base, table.data["thickness_mm"]):
+        merged["thickness_mm"] = table.data["thickness_mm"]
+        volume = base.get("build_volume_mm")
+        if base.get("layout") == "sheet" and isinstance(volume, list) and len(volume) == 3:
+            merged["build_volume_mm"] = [*volume[:2], table.data["thickness_mm"]]  # a sheet is the stock it is cut from
+        if base.get("thickness_mm") != table.data["thickness_mm"]:
+            # the profile's [shop] numbers are its own stock's: at another stock the shop check takes its rule of
+            # half the stock thickness (fabricate.checks.shop)
+            merged.pop("shop", None)
+    return Table(merged, path)
+
+
+def _check_spec(spec: ProcessSpec, t: Table, cli_printer: str, materials: Mapping[str, Material],
+                material: str) -> None:
+    """What no single field shows: the printer holds the process, a press fit has an interference, the pin
+    is not below the process's minimum."""
     _check_printer(spec, "--printer" if cli_printer else t.field("printer"))
     if spec.retention == "press" and spec.press_fit_interference_mm <= 0.0:
         why = (f"{materials[material].name} takes no press fit (the profile gives it no press_fit_interference_mm)"
@@ -417,7 +431,6 @@ def parse_process(table: Table, override: ProcessOverride | None = None) -> Proc
     if spec.pin_diameter_mm < spec.min_pin_mm:
         raise SpecError(t.field("pin_diameter_mm"),
                         f"pin {spec.pin_diameter_mm:g} mm is below the process minimum {spec.min_pin_mm:g} mm")
-    return spec
 
 
 def _printer_name(t: Table, template: Table, cli_printer: str, template_fields: bool) -> str:
