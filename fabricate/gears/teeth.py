@@ -158,50 +158,10 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     """
     profile = rack if gear == "a" else rack.for_gear_b()
     z = len(tooth_centres)
-    base = offset_profile(profile.points, profile.normals, delta, gear)
-    k = len(base)
-    pts = np.tile(base, (z, 1))
-    pts[:, 0] += np.repeat(tooth_centres, k)
-    normals = np.tile(profile.normals, (z, 1))
-    element = np.tile(profile.element, z)
-    flank_u = np.tile(profile.flank_u, z) + np.repeat(tooth_centres, k)
-    owner = np.repeat(np.arange(z), k)  # the tooth each point belongs to (its osculating circle)
-    if not closed:
-        # a sector ends exactly where the next period would start (the space centre at the root)
-        end = base[:1] + [tooth_centres[-1] + rack.pitch, 0.0]
-        pts = np.vstack([pts, end])
-        normals = np.vstack([normals, profile.normals[:1]])
-        element = np.concatenate([element, profile.element[:1]])
-        flank_u = np.concatenate([flank_u, [np.nan]])
-        owner = np.concatenate([owner, [z - 1]])
-    s = contact_abscissa(pts, normals)
-    if method == "exact":
-        frames = pitch.frames(s, gear)
-    else:
-        cf = pitch.frames(np.asarray(tooth_centres, dtype=np.float64), gear)
-        per_point = PitchFrames(cf.point[owner], cf.tangent[owner], cf.normal[owner], cf.curvature[owner])
-        frames = osculating_frames(s, np.asarray(tooth_centres, dtype=np.float64)[owner], per_point)
-    chain = envelope(pts, s, frames, gear)
-    p = rack.pitch
-    # tip curve: pitch curve offset outwards by the addendum
-    if closed:
-        perimeter = pitch.perimeter_a if gear == "a" else pitch.perimeter_b
-        s_tip = np.linspace(0.0, perimeter, max(200, int(perimeter / p * 60)), endpoint=False)
-    else:
-        lo, hi = tooth_centres[0] - 1.5 * p, tooth_centres[-1] + 1.5 * p
-        s_tip = np.linspace(lo, hi, max(100, int((hi - lo) / p * 60)))
-    tf = pitch.frames(s_tip, gear)
-    tip = tf.point + addendum_mm * tf.normal
-    origin = np.zeros((1, 2))
-    if closed:
-        chain_poly, tip_poly = Polygon(chain), Polygon(tip)
-    else:
-        chain_poly, tip_poly = Polygon(np.vstack([chain, origin])), Polygon(np.vstack([tip, origin]))
-    self_intersecting = not chain_poly.is_valid
-    if self_intersecting:
-        chain_poly = _largest_polygon(shapely.make_valid(chain_poly))
-    if not tip_poly.is_valid:
-        tip_poly = _largest_polygon(shapely.make_valid(tip_poly))
+    points = _rack_points(profile, rack.pitch, tooth_centres, delta, gear, closed)
+    chain = _envelope_chain(pitch, gear, points, tooth_centres, method)
+    tip = _tip_curve(pitch, gear, tooth_centres, rack.pitch, addendum_mm, closed)
+    chain_poly, tip_poly, self_intersecting = _valid_polygons(chain, tip, closed)
     teeth = chain_poly.intersection(tip_poly)
     root_min = float(np.min(np.hypot(chain[:, 0], chain[:, 1])))
     if not closed:
@@ -220,21 +180,108 @@ def cut_gear(pitch: PitchCurves, gear: str, rack: RackProfile, tooth_centres: np
     on_tip = dense_poly.exterior.intersection(tip_curve.buffer(1e-6))
     pieces = sorted(g.length for g in getattr(on_tip, "geoms", [on_tip]) if g.geom_type == "LineString")
     tip_land = float(pieces[0]) if len(pieces) >= z else 0.0
-    # involute flanks for the mesh check
-    is_flank = element == FLANK
-    inside = shapely.contains_xy(tip_poly, chain[:, 0], chain[:, 1])
+    flanks = _flanks(chain, points, tip_poly, dense_poly if self_intersecting else None, rack.pitch, rack_origin,
+                     2 * z if closed else None)
+    return GearTeeth(outline=outline, dense=dense, flanks=flanks,
+                     tooth_centres=np.asarray(tooth_centres, dtype=np.float64), tip_land_min_mm=tip_land,
+                     self_intersecting=self_intersecting, root_radius_min_mm=root_min)
+
+
+@dataclass(frozen=True)
+class _RackPoints:
+    """The cutter's profile points over every tooth: their normals, profile element, rack abscissa on the
+    flank (NaN off a flank) and the tooth each belongs to."""
+
+    pts: np.ndarray
+    normals: np.ndarray
+    element: np.ndarray
+    flank_u: np.ndarray
+    owner: np.ndarray
+
+
+def _rack_points(profile: RackProfile, p: float, tooth_centres: np.ndarray, delta: float, gear: str,
+                 closed: bool) -> _RackPoints:
+    """The cutter's profile repeated at every tooth centre (pitch ``p``), offset by ``delta`` into the gear; a
+    sector's ends exactly where the next period would start."""
+    z = len(tooth_centres)
+    base = offset_profile(profile.points, profile.normals, delta, gear)
+    k = len(base)
+    pts = np.tile(base, (z, 1))
+    pts[:, 0] += np.repeat(tooth_centres, k)
+    normals = np.tile(profile.normals, (z, 1))
+    element = np.tile(profile.element, z)
+    flank_u = np.tile(profile.flank_u, z) + np.repeat(tooth_centres, k)
+    owner = np.repeat(np.arange(z), k)  # the tooth each point belongs to (its osculating circle)
+    if not closed:
+        # a sector ends exactly where the next period would start (the space centre at the root)
+        end = base[:1] + [tooth_centres[-1] + p, 0.0]
+        pts = np.vstack([pts, end])
+        normals = np.vstack([normals, profile.normals[:1]])
+        element = np.concatenate([element, profile.element[:1]])
+        flank_u = np.concatenate([flank_u, [np.nan]])
+        owner = np.concatenate([owner, [z - 1]])
+    return _RackPoints(pts, normals, element, flank_u, owner)
+
+
+def _envelope_chain(pitch: PitchCurves, gear: str, points: _RackPoints, tooth_centres: np.ndarray,
+                    method: str) -> np.ndarray:
+    """The rack's envelope in the gear frame: on the pitch curve's frames (exact), or on each tooth's
+    osculating circle (approx)."""
+    s = contact_abscissa(points.pts, points.normals)
+    if method == "exact":
+        frames = pitch.frames(s, gear)
+    else:
+        owner = points.owner
+        cf = pitch.frames(np.asarray(tooth_centres, dtype=np.float64), gear)
+        per_point = PitchFrames(cf.point[owner], cf.tangent[owner], cf.normal[owner], cf.curvature[owner])
+        frames = osculating_frames(s, np.asarray(tooth_centres, dtype=np.float64)[owner], per_point)
+    return envelope(points.pts, s, frames, gear)
+
+
+def _tip_curve(pitch: PitchCurves, gear: str, tooth_centres: np.ndarray, p: float, addendum_mm: float,
+               closed: bool) -> np.ndarray:
+    """The tip curve: the pitch curve offset outwards by the addendum (a sector's 1.5 pitches past its ends)."""
+    if closed:
+        perimeter = pitch.perimeter_a if gear == "a" else pitch.perimeter_b
+        s_tip = np.linspace(0.0, perimeter, max(200, int(perimeter / p * 60)), endpoint=False)
+    else:
+        lo, hi = tooth_centres[0] - 1.5 * p, tooth_centres[-1] + 1.5 * p
+        s_tip = np.linspace(lo, hi, max(100, int((hi - lo) / p * 60)))
+    tf = pitch.frames(s_tip, gear)
+    return tf.point + addendum_mm * tf.normal
+
+
+def _valid_polygons(chain: np.ndarray, tip: np.ndarray, closed: bool) -> tuple[Polygon, Polygon, bool]:
+    """The envelope and the tip curve as polygons (a sector's closed at the centre), each its largest valid
+    piece; and whether the envelope crossed itself (undercut)."""
+    origin = np.zeros((1, 2))
+    if closed:
+        chain_poly, tip_poly = Polygon(chain), Polygon(tip)
+    else:
+        chain_poly, tip_poly = Polygon(np.vstack([chain, origin])), Polygon(np.vstack([tip, origin]))
+    self_intersecting = not chain_poly.is_valid
     if self_intersecting:
+        chain_poly = _largest_polygon(shapely.make_valid(chain_poly))
+    if not tip_poly.is_valid:
+        tip_poly = _largest_polygon(shapely.make_valid(tip_poly))
+    return chain_poly, tip_poly, self_intersecting
+
+
+def _flanks(chain: np.ndarray, points: _RackPoints, tip_poly: Polygon, undercut: Polygon | None, p: float,
+            rack_origin: float, count: int | None) -> dict[int, np.ndarray]:
+    """The involute-flank points inside the tip curve by flank index (modulo ``count`` for a full gear), for
+    the mesh check; with an undercut outline (``undercut``: the dense outline) only those still on it."""
+    is_flank = points.element == FLANK
+    inside = shapely.contains_xy(tip_poly, chain[:, 0], chain[:, 1])
+    if undercut is not None:
         # undercut: the fillet trochoid cut away part of the flanks; keep only flank points that are
         # still on the outline (inside a thin band around it)
-        band = dense_poly.buffer(1e-6, quad_segs=2).difference(dense_poly.buffer(-1e-6, quad_segs=2))
+        band = undercut.buffer(1e-6, quad_segs=2).difference(undercut.buffer(-1e-6, quad_segs=2))
         inside &= shapely.contains_xy(band, chain[:, 0], chain[:, 1])
-    keys = flank_index(flank_u, p, rack_origin)
+    keys = flank_index(points.flank_u, p, rack_origin)
     flanks: dict[int, np.ndarray] = {}
-    count = 2 * z if closed else None
     for j in np.unique(keys[is_flank]):
         sel = is_flank & inside & (keys == j)
         if np.count_nonzero(sel) >= 2:
             flanks[int(j % count) if count else int(j)] = chain[sel]
-    return GearTeeth(outline=outline, dense=dense, flanks=flanks,
-                     tooth_centres=np.asarray(tooth_centres, dtype=np.float64), tip_land_min_mm=tip_land,
-                     self_intersecting=self_intersecting, root_radius_min_mm=root_min)
+    return flanks
