@@ -378,88 +378,44 @@ class _System:
 
     def jacobian(self, q: np.ndarray, s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Residual vector (m,), Jacobian (m, n) and d(residual)/ds (m,) at poses ``q``."""
-        rows: list[np.ndarray] = []
-        res: list[float] = []
-        dres_ds: list[float] = []
-        n = self.n
-
-        def row() -> np.ndarray:
-            r = np.zeros(n)
-            rows.append(r)
-            return r
-
-        def add_point_terms(r2: list[np.ndarray], body: str, local: np.ndarray, sign: float) -> None:
-            k = self.index.get(body)
-            if k is None:
-                return
-            th = q[3 * k + 2]
-            dR = np.array([[-np.sin(th), -np.cos(th)], [np.cos(th), -np.sin(th)]]) @ local
-            for axis in (0, 1):
-                r2[axis][3 * k + axis] += sign
-                r2[axis][3 * k + 2] += sign * dR[axis]
-
-        def world(body: str, local: np.ndarray) -> np.ndarray:
-            return transform_points(self._pose(q, body), local)
-
-        def angle_row(body: str, reference: str) -> np.ndarray:
-            r = row()
-            if body in self.index:
-                r[3 * self.index[body] + 2] += 1.0
-            if reference in self.index:
-                r[3 * self.index[reference] + 2] -= 1.0
-            return r
-
-        def projection(body_a: str, body_b: str, pa_local: np.ndarray, pb_local: np.ndarray,
-                       direction: np.ndarray) -> None:
-            """Row and value of (p_b - p_a) . u, u a unit direction fixed in body_a."""
-            u_world = rotation(self._pose(q, body_a)[2]) @ (direction / np.hypot(*direction))
-            pa, pb = world(body_a, pa_local), world(body_b, pb_local)
-            r = row()
-            grad = [np.zeros(n), np.zeros(n)]
-            add_point_terms(grad, body_b, pb_local, 1.0)
-            add_point_terms(grad, body_a, pa_local, -1.0)
-            r += grad[0] * u_world[0] + grad[1] * u_world[1]
-            if body_a in self.index:  # u turns with body_a
-                r[3 * self.index[body_a] + 2] += float(np.dot(pb - pa, np.array([-u_world[1], u_world[0]])))
-            res.append(float(np.dot(pb - pa, u_world)))
-
+        rows = _Rows(self, q)
         rev_res, rev_jac = self._revolute_block(q)
-        rows.extend(rev_jac)
-        res.extend(rev_res)
-        dres_ds.extend([0.0] * len(rev_res))
+        rows.rows.extend(rev_jac)
+        rows.res.extend(rev_res)
+        rows.dres_ds.extend([0.0] * len(rev_res))
         for j in self.others:  # sliders: relative rotation locked, point b on a's line
-            angle_row(j.body_b, j.body_a)
-            res.append(self._pose(q, j.body_b)[2] - self._pose(q, j.body_a)[2] - j.angle)
-            dres_ds.append(0.0)
+            rows.angle_row(j.body_b, j.body_a)
+            rows.res.append(self._pose(q, j.body_b)[2] - self._pose(q, j.body_a)[2] - j.angle)
+            rows.dres_ds.append(0.0)
             # (pb - pa) . n = 0 with n the slide axis turned +90 deg, fixed in body_a
             axis = np.asarray(j.axis, dtype=np.float64)
-            projection(j.body_a, j.body_b, self.bodies[j.body_a].point(j.name), self.bodies[j.body_b].point(j.name),
-                       np.array([-axis[1], axis[0]]))
-            dres_ds.append(0.0)
+            rows.projection(j.body_a, j.body_b, self.bodies[j.body_a].point(j.name),
+                            self.bodies[j.body_b].point(j.name), np.array([-axis[1], axis[0]]))
+            rows.dres_ds.append(0.0)
         for g in self.mech.gears:
             thc = self._pose(q, g.carrier)[2]
             xa = self._pose(q, g.gear_a)[2] - thc
             xb = self._pose(q, g.gear_b)[2] - thc
             slope = float(g.law(xa, 1))
-            r = row()
+            r = rows.row()
             for body, coef in ((g.gear_b, 1.0), (g.gear_a, -slope), (g.carrier, slope - 1.0)):
                 if body in self.index:
                     r[3 * self.index[body] + 2] += coef
-            res.append(xb - float(g.law(xa)))
-            dres_ds.append(0.0)
+            rows.res.append(xb - float(g.law(xa)))
+            rows.dres_ds.append(0.0)
         for d in self.mech.drivers:
             value, dvalue = self._driver_value(d, s)
             if d.kind == "angle":
-                angle_row(d.body, d.reference)
-                res.append(self._pose(q, d.body)[2] - self._pose(q, d.reference)[2] - value)
+                rows.angle_row(d.body, d.reference)
+                rows.res.append(self._pose(q, d.body)[2] - self._pose(q, d.reference)[2] - value)
             else:
                 slider = next(j for j in self.mech.joints if j.name == d.joint and isinstance(j, Slider))
-                projection(d.reference, d.body, self.bodies[d.reference].point(d.joint),
-                           self.bodies[d.body].point(d.joint), np.asarray(slider.axis, dtype=np.float64))
-                res[-1] -= value
-            dres_ds.append(-dvalue)
-        jac = np.array(rows).reshape(len(res), n)
-        return np.asarray(res), jac, np.asarray(dres_ds)
+                rows.projection(d.reference, d.body, self.bodies[d.reference].point(d.joint),
+                                self.bodies[d.body].point(d.joint), np.asarray(slider.axis, dtype=np.float64))
+                rows.res[-1] -= value
+            rows.dres_ds.append(-dvalue)
+        jac = np.array(rows.rows).reshape(len(rows.res), self.n)
+        return np.asarray(rows.res), jac, np.asarray(rows.dres_ds)
 
     def newton(self, q: np.ndarray, s: float, max_iter: int = 30) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
         """Gauss-Newton from ``q``.
@@ -539,6 +495,61 @@ class _System:
                 raise LockupError(s, f"{self.mech.name}: lock-up, no assembly beyond this input")
         return q
 
+
+
+class _Rows:
+    """The constraint rows of :meth:`_System.jacobian` as they are added at poses ``q``: each row's Jacobian
+    entries, residual and d(residual)/ds."""
+
+    def __init__(self, system: _System, q: np.ndarray) -> None:
+        self.system, self.q, self.n = system, q, system.n
+        self.rows: list[np.ndarray] = []
+        self.res: list[float] = []
+        self.dres_ds: list[float] = []
+
+    def row(self) -> np.ndarray:
+        r = np.zeros(self.n)
+        self.rows.append(r)
+        return r
+
+    def add_point_terms(self, r2: list[np.ndarray], body: str, local: np.ndarray, sign: float) -> None:
+        """Add d(world point)/dq of ``local`` on ``body`` (times ``sign``) to the x and y rows ``r2``."""
+        k = self.system.index.get(body)
+        if k is None:
+            return
+        th = self.q[3 * k + 2]
+        dR = np.array([[-np.sin(th), -np.cos(th)], [np.cos(th), -np.sin(th)]]) @ local
+        for axis in (0, 1):
+            r2[axis][3 * k + axis] += sign
+            r2[axis][3 * k + 2] += sign * dR[axis]
+
+    def world(self, body: str, local: np.ndarray) -> np.ndarray:
+        return transform_points(self.system._pose(self.q, body), local)
+
+    def angle_row(self, body: str, reference: str) -> np.ndarray:
+        """A row of theta_body - theta_reference (its residual is the caller's)."""
+        index = self.system.index
+        r = self.row()
+        if body in index:
+            r[3 * index[body] + 2] += 1.0
+        if reference in index:
+            r[3 * index[reference] + 2] -= 1.0
+        return r
+
+    def projection(self, body_a: str, body_b: str, pa_local: np.ndarray, pb_local: np.ndarray,
+                   direction: np.ndarray) -> None:
+        """Row and value of (p_b - p_a) . u, u a unit direction fixed in body_a."""
+        index = self.system.index
+        u_world = rotation(self.system._pose(self.q, body_a)[2]) @ (direction / np.hypot(*direction))
+        pa, pb = self.world(body_a, pa_local), self.world(body_b, pb_local)
+        r = self.row()
+        grad = [np.zeros(self.n), np.zeros(self.n)]
+        self.add_point_terms(grad, body_b, pb_local, 1.0)
+        self.add_point_terms(grad, body_a, pa_local, -1.0)
+        r += grad[0] * u_world[0] + grad[1] * u_world[1]
+        if body_a in index:  # u turns with body_a
+            r[3 * index[body_a] + 2] += float(np.dot(pb - pa, np.array([-u_world[1], u_world[0]])))
+        self.res.append(float(np.dot(pb - pa, u_world)))
 
 
 def _solve_square(jac: np.ndarray, rhs: np.ndarray) -> np.ndarray:
