@@ -7,6 +7,7 @@ turn of the actuator's body that lets the standoffs clear it. A mixin of
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -26,6 +27,17 @@ if TYPE_CHECKING:
     from fabricate.mechanism import Mechanism, Motion
     from fabricate.parts.partset import PartSet
     from fabricate.process import ProcessSpec
+
+
+@dataclass
+class _Plate:
+    """The mount plate as its steps add to it: its holes, the circles its outline covers, the screws (BOM
+    rows) and the solids of its screw heads and bought standoff tubes."""
+
+    holes: list[Hole] = field(default_factory=list)
+    circles: list[tuple[np.ndarray, float]] = field(default_factory=list)
+    fasteners: list[Fastener] = field(default_factory=list)
+    solids: list[geo.Solid] = field(default_factory=list)
 
 
 class MountPlacement:
@@ -320,85 +332,100 @@ class MountPlacement:
     def _mount(self, place: geo.Placement, ground: Part, flip: bool
                ) -> tuple[Part, list[Fastener], list[Standoff], list[Part], list[geo.Solid]]:
         """The mount plate on the actuator's flange, its screws, and the standoffs to the ground part."""
-        from fabricate.parts.partset import SlottedPart, safe_name
+        from fabricate.parts.partset import SlottedPart
 
-        entry, process, tol = self.entry, self.process, self.tol
+        entry, process = self.entry, self.process
         t = self._plate_mm()
         pz = geo.mount_plate_z(entry)
         z0, z1 = place.z_range(pz, pz + t)
-        holes: list[Hole] = []
-        circles: list[tuple[np.ndarray, float]] = []
-        fasteners: list[Fastener] = []
-        solids: list[geo.Solid] = []
+        plate = _Plate()
+        self._plate_screws(plate, place, pz, t)
+        slots = [BulgePath.polyline(geo.placed_ring(r, place)) for r in geo.plate_cutouts(entry, pz, pz + t, self.c)]
+        for cut in slots:
+            plate.circles += [(v, self.wall) for v in cut.vertices]
+        plate.circles.append((np.asarray(place.centre, dtype=float), self.wall))
+        g0, g1 = float(ground.z_mm), float(ground.z_mm + ground.thickness_mm)
+        standoffs, standoff_parts = self._standoffs(plate, place, ground, (g1, z0) if flip else (z1, g0), t)
+        circles = plate.circles
+        outline = circle_hull(np.array([c for c, _ in circles]), np.array([r for _, r in circles]))
+        layers = [p.layer for p in self.ps.parts]
+        part = SlottedPart(name=MOUNT_PART, body=self.ground, outline=outline, holes=tuple(plate.holes),
+                           thickness_mm=t, z_mm=z0, layer=max(layers) + 1 if flip else min(layers) - 1,
+                           process=process.name, role="mount", slots=tuple(slots))
+        return part, plate.fasteners, standoffs, standoff_parts, plate.solids
+
+    def _plate_screws(self, plate: _Plate, place: geo.Placement, pz: float, t: float) -> None:
+        """The screws from the actuator's flange into the plate (``t`` thick from ``pz``): their holes, the
+        plate round them, their BOM rows (one per kind) and the heads of those into the actuator's own
+        tapped holes."""
+        entry, tol = self.entry, self.tol
         by_screw: dict[tuple[str, float, float, str], int] = {}
         for k, mh in enumerate(entry.mounting_holes or ()):
             f = geo.fastening(entry, mh, t, self.c, self.comp)
             centre = place.plan(np.array([mh.x, mh.y]))
             nominal = f.plate_hole_mm - self.comp
-            holes.append(fit_hole(f"actuator_screw_{k + 1}", centre, nominal, self.comp,
-                               fit="clearance" if f.tapped else "tapped"))
-            circles.append((centre, 0.5 * f.plate_hole_mm + self.wall))
+            plate.holes.append(fit_hole(f"actuator_screw_{k + 1}", centre, nominal, self.comp,
+                                        fit="clearance" if f.tapped else "tapped"))
+            plate.circles.append((centre, 0.5 * f.plate_hole_mm + self.wall))
             s = screw(f.size, f.clamp_mm, f.engagement_mm)
             key = (s.designation, s.clamp_mm, s.engagement_mm,
                    "actuator to its mount plate" + (" (into its tapped holes)" if f.tapped
                                                      else " (taps into the plate)"))
             by_screw[key] = by_screw.get(key, 0) + 1
             if f.tapped:  # the head bears on the plate's far face from the actuator
-                solids.append(geo.Solid(f"actuator_screw_head_{k + 1}", "fixing",
-                                        (geo.circle_ring(centre, s.head_d_mm, tol),),
-                                        *place.z_range(pz + t, pz + t + s.head_h_mm)))
-        fasteners += [Fastener(d, n, purpose, clamp, engage) for (d, clamp, engage, purpose), n in by_screw.items()]
-        slots = [BulgePath.polyline(geo.placed_ring(r, place)) for r in geo.plate_cutouts(entry, pz, pz + t, self.c)]
-        for cut in slots:
-            circles += [(v, self.wall) for v in cut.vertices]
-        circles.append((np.asarray(place.centre, dtype=float), self.wall))
+                plate.solids.append(geo.Solid(f"actuator_screw_head_{k + 1}", "fixing",
+                                              (geo.circle_ring(centre, s.head_d_mm, tol),),
+                                              *place.z_range(pz + t, pz + t + s.head_h_mm)))
+        plate.fasteners += [Fastener(d, n, purpose, clamp, engage)
+                            for (d, clamp, engage, purpose), n in by_screw.items()]
+
+    def _standoffs(self, plate: _Plate, place: geo.Placement, ground: Part, span: tuple[float, float],
+                   t: float) -> tuple[list[Standoff], list[Part]]:
+        """The standoffs between the ground part and the plate (``span``: their z from, to): printed parts
+        for an additive process, else bought tubes (solids); the plate's pilot holes and the screws through
+        them. None (a note) where the ground has no place for them."""
+        from fabricate.parts.partset import safe_name
+
+        process, tol = self.process, self.tol
+        lo, hi = span
         standoffs: list[Standoff] = []
         standoff_parts: list[Part] = []
-        g0, g1 = float(ground.z_mm), float(ground.z_mm + ground.thickness_mm)
-        lo, hi = (g1, z0) if flip else (z1, g0)
         size = self._standoff_size(float(ground.thickness_mm) + (hi - lo), t)
         d = float(size.lstrip("M"))
         mounting = self._standoff_sites(place, ground, lo, hi, d) if hi - lo > 1e-6 else []
-        if mounting:
-            printed = process.technique == "additive"
-            count = 0
-            for h in mounting:
-                inner = float(h.diameter_mm)
-                outer = inner + 2.0 * max(self.wall, 0.25 * inner)
-                st = Standoff(h.joint, np.asarray(h.centre, dtype=float), inner, outer, hi - lo, lo, printed)
-                standoffs.append(st)
-                pilot = geo.PILOT_FRACTION * d
-                name = h.joint.removeprefix("actuator_")
-                holes.append(fit_hole(f"actuator_{name}", st.centre, pilot, self.comp, fit="tapped"))
-                circles.append((st.centre, max(0.5 * outer, 0.5 * (pilot + self.comp) + self.wall)))
-                ring = circle_hull(st.centre[None, :], 0.5 * outer)
-                if printed:
-                    standoff_parts.append(Part(name=safe_name(name if name.startswith("standoff") else
-                                                              f"standoff_{name}"), body=self.ground, outline=ring,
-                                               holes=(fit_hole(h.joint, st.centre, inner - self.comp, self.comp),),
-                                               thickness_mm=st.length_mm, z_mm=st.z_mm, layer=ground.layer,
-                                               process=process.name, role="standoff"))
-                else:
-                    solids.append(geo.Solid(name if name.startswith("standoff") else f"standoff_{name}", "standoff",
-                                            (geo.circle_ring(st.centre, outer, tol),
-                                             geo.circle_ring(st.centre, inner, tol)[::-1]), st.z_mm,
-                                            st.z_mm + st.length_mm))
-                count += 1
-            try:
-                fix = geo.screw_into(size, float(ground.thickness_mm) + (hi - lo), t)
-            except SpecError as exc:
-                # a stack too tall for a standard screw through its standoffs: the design, not the input, is at
-                # fault (a build failure naming it, exit 1)
-                raise GeometryError(f"the actuator's mount plate stands {hi - lo:.3g} mm off the ground part: "
-                                    f"no standard screw clamps it through its standoffs ({exc.message})") from None
-            fasteners.append(Fastener(fix.designation, count, "mount plate to the ground part through the standoffs "
-                                      "(taps into the plate)", fix.clamp_mm, fix.engagement_mm))
-        else:
+        if not mounting:
             self.notes.append("no place on the ground part for the mount's standoffs: fix the mount plate to the "
                               "same base as the ground part")
-        outline = circle_hull(np.array([c for c, _ in circles]), np.array([r for _, r in circles]))
-        layers = [p.layer for p in self.ps.parts]
-        plate = SlottedPart(name=MOUNT_PART, body=self.ground, outline=outline, holes=tuple(holes), thickness_mm=t,
-                            z_mm=z0, layer=max(layers) + 1 if flip else min(layers) - 1, process=process.name,
-                            role="mount", slots=tuple(slots))
-        return plate, fasteners, standoffs, standoff_parts, solids
+            return standoffs, standoff_parts
+        printed = process.technique == "additive"
+        for h in mounting:
+            inner = float(h.diameter_mm)
+            outer = inner + 2.0 * max(self.wall, 0.25 * inner)
+            st = Standoff(h.joint, np.asarray(h.centre, dtype=float), inner, outer, hi - lo, lo, printed)
+            standoffs.append(st)
+            pilot = geo.PILOT_FRACTION * d
+            name = h.joint.removeprefix("actuator_")
+            plate.holes.append(fit_hole(f"actuator_{name}", st.centre, pilot, self.comp, fit="tapped"))
+            plate.circles.append((st.centre, max(0.5 * outer, 0.5 * (pilot + self.comp) + self.wall)))
+            ring = circle_hull(st.centre[None, :], 0.5 * outer)
+            if printed:
+                standoff_parts.append(Part(name=safe_name(name if name.startswith("standoff") else
+                                                          f"standoff_{name}"), body=self.ground, outline=ring,
+                                           holes=(fit_hole(h.joint, st.centre, inner - self.comp, self.comp),),
+                                           thickness_mm=st.length_mm, z_mm=st.z_mm, layer=ground.layer,
+                                           process=process.name, role="standoff"))
+            else:
+                plate.solids.append(geo.Solid(name if name.startswith("standoff") else f"standoff_{name}",
+                                              "standoff", (geo.circle_ring(st.centre, outer, tol),
+                                                           geo.circle_ring(st.centre, inner, tol)[::-1]),
+                                              st.z_mm, st.z_mm + st.length_mm))
+        try:
+            fix = geo.screw_into(size, float(ground.thickness_mm) + (hi - lo), t)
+        except SpecError as exc:
+            # a stack too tall for a standard screw through its standoffs: the design, not the input, is at
+            # fault (a build failure naming it, exit 1)
+            raise GeometryError(f"the actuator's mount plate stands {hi - lo:.3g} mm off the ground part: "
+                                f"no standard screw clamps it through its standoffs ({exc.message})") from None
+        plate.fasteners.append(Fastener(fix.designation, len(mounting), "mount plate to the ground part through "
+                                        "the standoffs (taps into the plate)", fix.clamp_mm, fix.engagement_mm))
+        return standoffs, standoff_parts
