@@ -198,6 +198,19 @@ def pyplot() -> Any:
     return plt
 
 
+def load_agg() -> None:
+    """Import what :func:`figure` draws with (matplotlib's object-oriented Agg API) now.
+
+    A build calls it before it forks its picture child when both will draw: the child then inherits the
+    modules instead of importing them again (a cold build imported matplotlib twice, once in each process).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.backends.backend_agg
+    import matplotlib.figure  # noqa: F401 - imported for the child to inherit
+
+
 def figure(size: tuple[float, float], dpi: float) -> Any:
     """A standalone figure (not registered with pyplot) on an Agg canvas."""
     import matplotlib
