@@ -140,15 +140,19 @@ class Background:
     def __init__(self, jobs: list[Callable[[], dict[str, bytes]]]) -> None:
         self.jobs = jobs
         self._process = None
+        self._handed: list[Any] = []
         if os.environ.get("FABRICATE_SERIAL") or "fork" not in multiprocessing.get_all_start_methods():
             return
         if multiprocessing.current_process().daemon:  # e.g. a Dask worker: daemons may not have children
             return
         ctx = multiprocessing.get_context("fork")
+        before = {id(proc) for proc in _HANDED}
         self._conn, sender = ctx.Pipe(duplex=False)
         self._process = ctx.Process(target=_child, args=(jobs, sender, os.getpid(), self._conn), daemon=True)
         try:
             self._process.start()
+            # the workers this fork handed over are this child's: reaped with it, not with another child
+            self._handed = [proc for proc in _HANDED if id(proc) not in before]
         except OSError:  # no fork now (EAGAIN, ENOMEM): the jobs run here when asked for
             self._process = None
             self._conn.close()
@@ -167,7 +171,7 @@ class Background:
             # the child's workers (prestart) are this process's children: reaped here, so their time and memory
             # are the build's. The child is gone with every answer it asked for; a worker it did not use (a
             # cached result) need not finish its warm-up
-            _reap_handed(kill=True)
+            _reap_handed(kill=True, procs=self._handed)
             if ok:
                 return payload
         return _run_jobs(self.jobs)
@@ -183,13 +187,16 @@ class Background:
             self._process.join()
             self._conn.close()
             self._process = None
-            _reap_handed(kill=True)
+            _reap_handed(kill=True, procs=self._handed)
 
 
-def _reap_handed(kill: bool) -> None:
-    """Wait for (or kill) the workers handed to a forked child (:func:`prestart`)."""
-    while _HANDED:
-        proc = _HANDED.pop()
+def _reap_handed(kill: bool, procs: list[Any] | None = None) -> None:
+    """Wait for (or kill) the workers handed to a forked child (:func:`prestart`): ``procs`` (those handed to
+    one child), or every one."""
+    procs = list(_HANDED) if procs is None else list(procs)
+    _HANDED[:] = [proc for proc in _HANDED if all(proc is not p for p in procs)]
+    while procs:
+        proc = procs.pop()
         if kill:
             with contextlib.suppress(OSError):
                 proc.kill()
