@@ -11,10 +11,14 @@ from __future__ import annotations
 
 import copy
 import fcntl
+import hashlib
 import math
 import os
+import shutil
 from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -22,6 +26,7 @@ from hypothesis import HealthCheck, settings
 
 from fabricate import cache
 from fabricate.design import load_design
+from fabricate.export.step import step_available as _step_available
 from fabricate.mechanism import Body, Driver, Mechanism, Revolute
 from fabricate.pipeline import BuildOutcome, run_build
 from fabricate.planar import circle_circle_intersection
@@ -145,5 +150,113 @@ def shipped_build(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., Bui
                 cache.stats.update(stats)
                 patch.undo()
         return _SHIPPED_BUILDS[key]
+
+    return get
+
+
+@contextmanager
+def _stage_cache_in(store: Path) -> Iterator[None]:
+    """The stage cache on in folder ``store`` for the block, its in-process layer and counts as they were after."""
+    patch = pytest.MonkeyPatch()
+    patch.setenv("FABRICATE_CACHE_DIR", str(store))
+    patch.delenv("FABRICATE_NO_CACHE", raising=False)
+    stats = copy.deepcopy(cache.stats)
+    try:
+        with cache.use_cache(True):
+            yield
+    finally:
+        cache.clear_memory()
+        cache.stats.clear()
+        cache.stats.update(stats)
+        patch.undo()
+
+
+@pytest.fixture(scope="session")
+def shared_stage_cache(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., AbstractContextManager[None]]:
+    """``with shared_stage_cache(key): ...`` runs the block with the stage cache on, in the folder ``shipped_build``
+    fills (shared by the session's workers), as ``shipped_build`` builds: for a test that needs a build of a
+    design as it is, not the work of its stages (a ``fabricate check``'s rebuild, repeated builds of one design).
+    ``key`` (e.g. a hash of the design) takes an exclusive lock for the block, so two workers that need the same
+    design wait for one cold build instead of making two. Never for a test that patches a stage (a stage served
+    by the cache does not run) or what the keys take from the install (``step_available``: a key holds the
+    installed OCP's version, so a build that pretends OCP is missing would be served STEP files)."""
+    shared = _session_folder(tmp_path_factory)
+    store = shared / "shipped-stage-cache"
+    store.mkdir(exist_ok=True)
+
+    @contextmanager
+    def block(key: str | None = None) -> Iterator[None]:
+        if key is None:
+            with _stage_cache_in(store):
+                yield
+            return
+        name = hashlib.sha256(key.encode()).hexdigest()[:16]
+        with open(shared / f"stage-cache-{name}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+            with _stage_cache_in(store):
+                yield
+
+    return block
+
+
+class BuiltFolder(NamedTuple):
+    """An output folder as ``fabricate build NAME -o DIR`` wrote it, and that command's exit code."""
+
+    path: Path
+    exit_code: int
+
+
+#: ``{key: folder}`` of this test process: the session's shared folders it has already seen built.
+_BUILT_FOLDERS: dict[str, BuiltFolder] = {}
+
+
+@pytest.fixture(scope="session")
+def built_folder(tmp_path_factory: pytest.TempPathFactory, _no_stage_cache: None) -> Callable[..., BuiltFolder]:
+    """``built_folder(name, process=None, *, step=True, read_only=False)``: the folder ``fabricate build NAME -o DIR -q
+    [--process PROCESS]`` writes, built once per test session (the real command in-process: its manifest, report
+    and atomic writer) and handed out as a fresh copy a test may change freely.
+
+    The build is cold (``FABRICATE_NO_CACHE``: no stage is served by the cache), so two of its files compared with
+    ``shipped_build``'s are two independent builds. The first worker to ask builds it into a folder the session's
+    workers share, under an exclusive lock per folder; the others copy it. ``step=False`` builds as an install
+    without the ``cad`` extra does (``step_available`` False: no STEP files, "skipped" in the report).
+    ``read_only=True`` gives the shared folder itself (no copy), which the test must then only read.
+
+    The command runs with the real ``fabricate.pipeline.run_build`` and ``step_available``, whatever the asking
+    test has patched (its module may memoise rebuilds or pretend OCP is missing).
+    """
+    import fabricate.export.step as step_module
+    import fabricate.pipeline as pipeline
+    from fabricate.cli import main
+
+    shared = _session_folder(tmp_path_factory) / "built-folders"
+    shared.mkdir(exist_ok=True)
+
+    def get(name: str, process: str | None = None, *, step: bool = True, read_only: bool = False) -> BuiltFolder:
+        key = name + ("" if process is None else f"--process-{process}") + ("" if step else "--no-step")
+        if key not in _BUILT_FOLDERS:
+            home = shared / key
+            home.mkdir(exist_ok=True)
+            done = home / "exit_code"
+            with open(home / "lock", "w") as lock:
+                fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+                if not done.exists():
+                    patch = pytest.MonkeyPatch()
+                    patch.setenv("FABRICATE_NO_CACHE", "1")
+                    patch.setattr(pipeline, "run_build", run_build)
+                    patch.setattr(step_module, "step_available", _step_available if step else lambda: False)
+                    try:
+                        code = main(["build", name, "-o", str(home / name), "-q",
+                                     *([] if process is None else ["--process", process])])
+                    finally:
+                        patch.undo()
+                    done.write_text(str(code))
+                _BUILT_FOLDERS[key] = BuiltFolder(home / name, int(done.read_text()))
+        found = _BUILT_FOLDERS[key]
+        if read_only:
+            return found
+        target = tmp_path_factory.mktemp(key) / name
+        shutil.copytree(found.path, target, symlinks=True)
+        return BuiltFolder(target, found.exit_code)
 
     return get

@@ -79,16 +79,14 @@ TEMPLATES = [p.stem for p in shipped_templates()]
 
 
 @pytest.fixture(scope="module")
-def builds(tmp_path_factory):
-    """Each shipped template built by the command into a folder: ``(exit code, folder)``, cached for the module
-    (the second build, for determinism, is the session's in-memory ``shipped_build``)."""
-    cache: dict[str, tuple[int, Path]] = {}
+def builds(built_folder):
+    """Each shipped template built cold by the command into a folder: ``(exit code, folder)``, once per test
+    session (``built_folder``; the second build, for determinism, is the session's in-memory ``shipped_build``).
+    The folder is shared: these tests only read it."""
 
-    def get(name: str):
-        if name not in cache:
-            out = tmp_path_factory.mktemp(name) / "out"
-            cache[name] = (main(["build", name, "-o", str(out), "-q"]), out)
-        return cache[name]
+    def get(name: str) -> tuple[int, Path]:
+        found = built_folder(name, read_only=True)
+        return found.exit_code, found.path
 
     return get
 

@@ -6,7 +6,10 @@ template with no ``[load]``) and a synthesis-only run are reported as "not check
 names them, the summary line says it in brackets and stderr carries a note, while the exit code stays 0
 (the issue asks to report, not to fail).
 
-The design is a small crank-rocker four-bar (24 poses) written here, so each build takes seconds.
+The design is a small crank-rocker four-bar (24 poses) written here, so each build takes seconds. The loaded
+and the unloaded design are each built by two tests: those builds run with the session's shared stage cache
+(``shared_stage_cache``), so the second of each is served by the first's stages (byte-identical, per
+tests/test_cache.py).
 """
 
 from __future__ import annotations
@@ -15,6 +18,8 @@ import copy
 import json
 import math
 import re
+from collections.abc import Callable
+from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import Any
 
@@ -116,9 +121,15 @@ def test_profile_without_materials_is_not_checked_and_says_so(tmp_path, capsys):
     assert not (out / "plots" / "strength.png").exists()
 
 
+def _api_build(shared_stage_cache: Callable[..., AbstractContextManager[None]], load: bool) -> fabricate.Build:
+    with shared_stage_cache(f"tests/test_not_checked four_bar_nc load={load}"):
+        return fabricate.build(fabricate.load(_tables(load=load)), cache=True)
+
+
 @pytest.mark.slow
-def test_template_without_load_is_not_checked_and_writes_no_infinite_factor(tmp_path, capsys):
-    code, stdout, stderr, out = _cli(tmp_path, capsys, "noload", _tables(load=False))
+def test_template_without_load_is_not_checked_and_writes_no_infinite_factor(tmp_path, capsys, shared_stage_cache):
+    with shared_stage_cache("tests/test_not_checked four_bar_nc load=False"):
+        code, stdout, stderr, out = _cli(tmp_path, capsys, "noload", _tables(load=False))
     assert code == 0, stdout + stderr
     report = _strict_json(out / "report.json")
     strength = report["strength"]
@@ -148,10 +159,10 @@ def test_synth_never_says_checks_passed(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_a_loaded_design_with_materials_is_checked_and_lists_nothing():
+def test_a_loaded_design_with_materials_is_checked_and_lists_nothing(shared_stage_cache):
     """The control: the same four-bar with its load and the profile's materials is checked (a verdict of
     True or False, a finite factor per part) and ``not_checked`` is empty."""
-    build = fabricate.build(fabricate.load(_tables()))
+    build = _api_build(shared_stage_cache, load=True)
     strength, checks = build.report["strength"], build.report["checks"]
     assert strength["passed"] is True and "reason" not in strength
     assert strength["parts"] and all(math.isfinite(p["min_safety_factor"]) for p in strength["parts"]
@@ -211,10 +222,10 @@ def test_report_json_writes_null_for_infinite_values():
 
 
 @pytest.mark.slow
-def test_the_api_names_what_was_not_checked() -> None:
+def test_the_api_names_what_was_not_checked(shared_stage_cache) -> None:
     """``Build.not_checked`` says what ``passed`` does not cover (issue 23 item 5)."""
-    unloaded = fabricate.build(fabricate.load(_tables(load=False)))
+    unloaded = _api_build(shared_stage_cache, load=False)
     assert unloaded.passed and unloaded.not_checked == ["strength not checked: " + NO_LOAD,
                                                         "drive not checked: " + DRIVE_NO_LOAD]
-    loaded = fabricate.build(fabricate.load(_tables(load=True)))
+    loaded = _api_build(shared_stage_cache, load=True)
     assert loaded.passed and loaded.not_checked == []

@@ -6,6 +6,7 @@ import hashlib
 import json
 import multiprocessing
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -172,11 +173,13 @@ def test_a_previous_output_is_replaced_but_not_with_a_user_file_in_it(tmp_path):
 
 
 @pytest.mark.slow
-def test_synth_never_replaces_a_build(tmp_path, monkeypatch, capsys):
+def test_synth_never_replaces_a_build(tmp_path, monkeypatch, capsys, built_folder):
     monkeypatch.chdir(tmp_path)
-    assert main(["build", FAST, "-q"]) == 0
-    build = tmp_path / "outputs" / FAST
+    build = tmp_path / "outputs" / FAST  # where `fabricate build NAME` puts it: a copy of the session's build
+    build.parent.mkdir()
+    shutil.copytree(built_folder(FAST, read_only=True).path, build, symlinks=True)
     before = _tree(build)
+    assert json.loads(before["report.json"])["design"]["stage"] == "build"
     assert main(["synth", FAST, "-q"]) == 0  # its own default folder
     assert _tree(build) == before
     assert (tmp_path / "outputs" / f"{FAST}-synth" / "report.json").is_file()

@@ -35,8 +35,18 @@ def installed(tmp_path_factory) -> tuple[Path, Path]:
     return wheel, site
 
 
-def _run(site: Path, cwd: Path, *args: str) -> subprocess.CompletedProcess:
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONSAFEPATH")}
+def _with_cache(cache: Path) -> dict[str, str]:
+    """The environment of a user's run: the stage cache on (the command's default; the suite turns it off), in
+    folder ``cache`` of the test's own, so a run repeated in one test is served by the cache as a user's would be
+    (byte-identical to a cold build: tests/test_cache.py)."""
+    env = {k: v for k, v in os.environ.items() if k != "FABRICATE_NO_CACHE"}
+    env["FABRICATE_CACHE_DIR"] = str(cache)
+    return env
+
+
+def _run(site: Path, cwd: Path, *args: str, cache: Path | None = None) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in (os.environ if cache is None else _with_cache(cache)).items()
+           if k not in ("PYTHONPATH", "PYTHONSAFEPATH")}
     env["PYTHONPATH"] = str(site)
     return subprocess.run([sys.executable, "-m", "fabricate", *args], cwd=cwd, env=env, capture_output=True,
                           text=True, timeout=300)
@@ -69,13 +79,16 @@ def test_installed_it_lists_and_builds_from_a_foreign_folder(installed, tmp_path
         assert (path.stem in listed.stdout) == (not path.name.startswith("process_"))
     for path in sorted((ROOT / "templates" / "sweeps").glob("*.toml")):
         assert f"fabricate sweep {path.stem}" in listed.stdout
-    built = _run(site, foreign, "build", "gear_pair_elliptic", "-q")
+    cache = tmp_path / "cache"  # empty: the first build is the installed copy's own, cold
+    built = _run(site, foreign, "build", "gear_pair_elliptic", "-q", cache=cache)
     assert built.returncode == 0, built.stderr
     report = json.loads((foreign / "outputs" / "gear_pair_elliptic" / "report.json").read_text())
     assert report["design"]["process"] == "sla" and report["checks"]["passed"]
-    # an explicit path to a template outside any checkout, with a process profile found in the wheel
+    # an explicit path to a template outside any checkout, with a process profile found in the wheel (the
+    # template and profile are read as ever; the stages are the first build's, from the cache)
     (foreign / "mine.toml").write_bytes((ROOT / "templates" / "gear_pair_elliptic.toml").read_bytes())
-    explicit = _run(site, tmp_path, "build", str(foreign / "mine.toml"), "-o", str(tmp_path / "o2"), "-q")
+    explicit = _run(site, tmp_path, "build", str(foreign / "mine.toml"), "-o", str(tmp_path / "o2"), "-q",
+                    cache=cache)
     assert explicit.returncode == 0, explicit.stderr
     assert (tmp_path / "o2" / "assembly.3mf").is_file()
 
@@ -100,11 +113,12 @@ def test_init_writes_an_editable_copy_and_never_overwrites(tmp_path, monkeypatch
 
 
 @pytest.fixture(scope="module")
-def built_linkage(tmp_path_factory) -> Path:
-    """A small build (the shipped Stephenson linkage, whose mechanism.toml is exact) to copy from."""
-    out = tmp_path_factory.mktemp("built") / "linkage_stephenson"
-    assert main(["build", "linkage_stephenson", "-o", str(out), "-q"]) == 0
-    return out
+def built_linkage(built_folder) -> Path:
+    """A small build (the shipped Stephenson linkage, whose mechanism.toml is exact) to copy from: the
+    session's, as ``fabricate build`` writes it (shared: only copied here)."""
+    found = built_folder("linkage_stephenson", read_only=True)
+    assert found.exit_code == 0
+    return found.path
 
 
 def _project(built: Path, root: Path) -> Path:
@@ -114,9 +128,9 @@ def _project(built: Path, root: Path) -> Path:
     return folder
 
 
-def _fabricate(cwd: Path, *args: str) -> subprocess.CompletedProcess:
+def _fabricate(cwd: Path, *args: str, cache: Path | None = None) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "fabricate", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=300)
+                          timeout=300, env=None if cache is None else _with_cache(cache))
 
 
 def _files(folder: Path) -> dict[str, bytes]:
@@ -136,7 +150,8 @@ def test_the_outputs_readme_rebuild_recipe_works_as_written(built_linkage, tmp_p
     before = _files(source)
     name = source.name
     template, target = (recipe.group(k).replace("NAME", name) for k in (1, 2))
-    done = _fabricate(tmp_path, "build", template, "-q")
+    cache = tmp_path / "cache"  # as a user runs it: the first build cold, its re-runs served by the cache
+    done = _fabricate(tmp_path, "build", template, "-q", cache=cache)
     assert done.returncode == 0, done.stderr
     rebuilt = tmp_path / target
     assert f"building into {rebuilt}" in done.stderr  # said, with -q too
@@ -145,9 +160,9 @@ def test_the_outputs_readme_rebuild_recipe_works_as_written(built_linkage, tmp_p
     parts = {k: v for k, v in before.items() if k.startswith("parts/") and k.endswith(".stl")}
     assert parts and all(_files(rebuilt)[k] == v for k, v in parts.items())  # the same parts, byte for byte
     assert sorted(p.name for p in (tmp_path / "outputs").iterdir()) == [name, f"{name}-rebuild"]
-    again = _fabricate(tmp_path, "build", template, "-q")  # a plain re-run replaces the rebuild
+    again = _fabricate(tmp_path, "build", template, "-q", cache=cache)  # a plain re-run replaces the rebuild
     assert again.returncode == 0, again.stderr
-    inside = _fabricate(source, "build", "mechanism.toml", "-q")  # the other reading: from inside the folder
+    inside = _fabricate(source, "build", "mechanism.toml", "-q", cache=cache)  # the other reading: from inside
     assert inside.returncode == 0, inside.stderr
     assert _files(source) == before
     assert sorted(p.name for p in (tmp_path / "outputs").iterdir()) == [name, f"{name}-rebuild"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
 import os
@@ -20,7 +21,6 @@ import trimesh
 
 from fabricate.cli import main
 from fabricate.design import load_design
-from fabricate.output import write_output
 from fabricate.pipeline import run_build
 from fabricate.report_schema import SCHEMA_VERSION
 from fabricate.templates import TEMPLATE_DIR
@@ -29,21 +29,25 @@ FAST = "gear_pair_elliptic"
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory, shipped_build) -> Path:
-    out = tmp_path_factory.mktemp("built") / FAST
-    outcome = shipped_build(FAST)
-    assert outcome.exit_code == 0
-    write_output(outcome.files, out)
-    return out
+def built(built_folder, shipped_build) -> Path:
+    """The pair as ``fabricate build`` writes it (cold, once per session); a test copies it before changing it.
+    ``shipped_build`` fills the shared stage cache the checks' rebuilds are served from."""
+    shipped_build(FAST)
+    found = built_folder(FAST, read_only=True)
+    assert found.exit_code == 0
+    return found.path
 
 
-_REBUILDS: dict[tuple[str, str, bool], object] = {}
+_REBUILDS: dict[tuple[str, str, str, bool], object] = {}
 
 
 @pytest.fixture(autouse=True)
-def _one_rebuild_per_template(monkeypatch):
+def _one_rebuild_per_template(monkeypatch, shared_stage_cache):
     """Every check rebuilds its embedded template; most tamperings here share one, so build it once
-    (the real pipeline, only not repeated: a test-time saving of ~5 s a case)."""
+    (the real pipeline, only not repeated: a test-time saving of ~5 s a case). Its stages come from the session's
+    shared stage cache (``shared_stage_cache``, byte-identical to a cold build per tests/test_cache.py): the
+    folders checked here are cold builds of the command (``built_folder``), so a check still compares two
+    builds, while the workers make each design's stages once between them."""
     import fabricate.pipeline as pipeline
 
     real = pipeline.run_build
@@ -54,9 +58,12 @@ def _one_rebuild_per_template(monkeypatch):
         if optional is not None and optional.step_files is not None:  # stand-ins: never cached
             return real(design, progress, optional=optional)
         step = step_available() if optional is None else optional.step
-        key = (Path(design.template).name, design.template_text, step)
+        key = (Path(design.template).name, design.template_text, repr(design.process_override), step)
         if key not in _REBUILDS:
-            _REBUILDS[key] = real(design, progress, optional=optional)
+            # a check's rebuild names its optional outputs; a build that asks step_available (a test that
+            # pretends OCP is missing) runs cold: the cache's keys know the installed OCP, not a patch of it
+            with shared_stage_cache(repr(key)) if optional is not None else contextlib.nullcontext():
+                _REBUILDS[key] = real(design, progress, optional=optional)
         return _REBUILDS[key]
 
     monkeypatch.setattr(pipeline, "run_build", cached)
@@ -248,12 +255,14 @@ def test_a_folder_without_a_report_is_a_usage_error(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_the_verdict_depends_neither_on_the_folder_nor_on_later_edits(tmp_path, monkeypatch, capsys):
+def test_the_verdict_depends_neither_on_the_folder_nor_on_later_edits(tmp_path, monkeypatch, capsys,
+                                                                       shared_stage_cache):
     designs = tmp_path / "designs"
     designs.mkdir()
     (designs / "pair.toml").write_bytes((TEMPLATE_DIR / f"{FAST}.toml").read_bytes())
     monkeypatch.chdir(designs)
-    assert main(["build", "pair.toml", "-o", str(tmp_path / "out"), "-q"]) == 0  # a relative template path
+    with shared_stage_cache():  # the pair's stages, as any build of it (this is about the template's path)
+        assert main(["build", "pair.toml", "-o", str(tmp_path / "out"), "-q"]) == 0  # a relative template path
     report = _report(tmp_path / "out")
     assert report["design"]["template"] == "pair.toml"
     assert report["template_text"] == (designs / "pair.toml").read_text()
@@ -286,16 +295,13 @@ def test_manifest_sizes_and_hashes_are_those_on_disk(built):
 
 
 @pytest.fixture(scope="module")
-def laser_built(tmp_path_factory) -> Path:
-    """The same pair made on the laser: cut/ files (DXF and SVG, kerf-compensated) instead of plates."""
-    src = tmp_path_factory.mktemp("laser_src") / "pair_laser.toml"
-    text = (TEMPLATE_DIR / f"{FAST}.toml").read_text().replace('profile = "sla"', 'profile = "laser"', 1)
-    assert 'profile = "laser"' in text
-    src.write_text(text)
-    out = tmp_path_factory.mktemp("laser") / "out"
-    outcome = run_build(load_design(src))
-    write_output(outcome.files, out)
-    return out
+def laser_built(built_folder, shipped_build) -> Path:
+    """The same pair made on the laser (``--process laser``): cut/ files (DXF and SVG, kerf-compensated) instead
+    of plates. Shared: a test copies it before changing it."""
+    shipped_build(FAST, "laser")  # the checks' rebuilds: from the stage cache it fills
+    found = built_folder(FAST, "laser", read_only=True)
+    assert (found.path / "cut").is_dir() and not (found.path / "plates").exists()
+    return found.path
 
 
 def _laser_copy(laser_built: Path, tmp_path: Path) -> Path:
@@ -643,37 +649,17 @@ def test_the_path_pattern_admits_only_relative_paths_inside_the_folder():
     assert not any(re.search(pattern, p) for p in bad)
 
 
-def _quick_design(path: Path):
-    """A shipped template with fewer poses: the same report sections, a fraction of the build time."""
-    import dataclasses
-
-    design = load_design(path)
-    return dataclasses.replace(design, checks=dataclasses.replace(
-        design.checks, sweep_poses=min(design.checks.sweep_poses, 24)))
-
-
 @pytest.mark.slow
-def test_every_shipped_template_writes_a_report_that_matches_its_schema(monkeypatch):
+def test_every_shipped_template_writes_a_report_that_matches_its_schema(shipped_build):
     import fabricate.pipeline as pipeline
     from fabricate.report_schema import schema_errors
     from fabricate.templates import shipped_templates
 
-    class NoPictures:  # pictures and STEP files add files, not report keys: skip their time
-        def __init__(self, _jobs):
-            pass
-
-        def result(self):
-            return {}
-
-        def cancel(self):
-            pass
-
-    monkeypatch.setattr(pipeline, "Background", NoPictures)
     templates = shipped_templates()
     assert len(templates) >= 8
     metrics = _sweep_metrics()
     for path in templates:
-        outcome = run_build(_quick_design(path))  # the module's own: not the cached rebuild of the fixture
+        outcome = shipped_build(path.stem)  # the shipped report itself: full poses, pictures and STEP files
         report = json.loads(outcome.files["report.json"])
         assert report["parts"] and report["strength"] and report["outputs"]["step"]
         assert next(iter(report)) == "schema_version" and report["schema_version"] == SCHEMA_VERSION
@@ -764,15 +750,9 @@ def test_the_full_builds_match_the_schema_too(built, laser_built):
 
 
 @pytest.fixture(scope="module")
-def built_without_cad(tmp_path_factory) -> Path:
-    """The same pair built as on an install without the `cad` extra (no OCP: STEP skipped)."""
-    from fabricate.pipeline import OptionalOutputs
-
-    out = tmp_path_factory.mktemp("no_cad") / FAST
-    # the pipeline's own switch for an install without OCP, not a patch of fabricate.export.step
-    outcome = run_build(load_design(FAST), optional=OptionalOutputs(step=False))
-    write_output(outcome.files, out)
-    return out
+def built_without_cad(built_folder) -> Path:
+    """The same pair built by the command as on an install without the `cad` extra (no OCP: STEP skipped)."""
+    return built_folder(FAST, step=False, read_only=True).path
 
 
 @pytest.mark.slow

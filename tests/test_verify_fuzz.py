@@ -3,7 +3,7 @@ a built folder. Whatever the folder holds, check ends with its documented exit c
 what fabricate wrote; 2: not a fabricate output at all), never exit 3 ("a bug in fabricate") and never a
 traceback; every edit that changes a byte is caught.
 
-Seeded loops (each case names its seed): one small build per module, copied per case.
+Seeded loops (each case names its seed): one small build per session (``built_folder``), copied per case.
 """
 
 from __future__ import annotations
@@ -23,8 +23,6 @@ from typing import Any
 import pytest
 
 from fabricate.cli import main
-from fabricate.design import load_design
-from fabricate.output import write_output
 from fabricate.pipeline import run_build
 
 FAST = "gear_pair_elliptic"
@@ -35,16 +33,10 @@ FILE_KINDS = ("truncate", "flip", "append", "empty", "directory", "symlink_same_
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory) -> Path:
-    """The pair built once, as without the `cad` extra: STEP export is OCP's own, fuzzed elsewhere, and
-    reading STEP back costs seconds a file."""
-    from fabricate.pipeline import OptionalOutputs
-
-    out = tmp_path_factory.mktemp("fuzz") / FAST
-    # the pipeline's own switch for an install without OCP, not a patch of fabricate.export.step
-    outcome = run_build(load_design(FAST), optional=OptionalOutputs(step=False))
-    write_output(outcome.files, out)
-    return out
+def built(built_folder) -> Path:
+    """The pair built once by the command, as without the `cad` extra: STEP export is OCP's own, fuzzed
+    elsewhere, and reading STEP back costs seconds a file. Shared: each case copies it."""
+    return built_folder(FAST, step=False, read_only=True).path
 
 
 _REBUILDS: dict[tuple, Any] = {}
@@ -52,11 +44,11 @@ _VERDICTS: dict[tuple, list[str]] = {}
 
 
 @pytest.fixture(autouse=True)
-def _fast_and_bounded(monkeypatch):
+def _fast_and_bounded(monkeypatch, shared_stage_cache):
     """No OCP (as the folder was built); one real rebuild per embedded template (a report edit changes the
-    verdict, not the rebuild's work); a file's parse verdict kept by its bytes and expectation (an edit of
-    report.json leaves the files as they were); and a hang (a FIFO opened) fails the case instead of
-    blocking the suite."""
+    verdict, not the rebuild's work), its stages from the session's shared stage cache (the workers make them
+    once between them); a file's parse verdict kept by its bytes and expectation (an edit of report.json
+    leaves the files as they were); and a hang (a FIFO opened) fails the case instead of blocking the suite."""
     import fabricate.export.step as step
     import fabricate.pipeline as pipeline
     import fabricate.verify_files as verify_files
@@ -68,7 +60,8 @@ def _fast_and_bounded(monkeypatch):
         key = (design.template_text, None if override is None else (override.source, override.text),
                optional)
         if key not in _REBUILDS:
-            _REBUILDS[key] = run_build(design, progress, optional=optional)
+            with shared_stage_cache(repr(key)):
+                _REBUILDS[key] = run_build(design, progress, optional=optional)
         return _REBUILDS[key]
 
     monkeypatch.setattr(pipeline, "run_build", cached_build)
