@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
+from shapely import lib as _geos
 
 from fabricate.planar import polygon_area, relative_poses
 
@@ -100,6 +101,7 @@ class Outline:
         self.polygon = shapely.Polygon(oriented[0], oriented[1:])
         shapely.prepare(self.polygon)
         self.bounds = np.asarray(self.polygon.bounds)
+        self.box = tuple(self.bounds.tolist())  # the same four numbers, as Python floats (the per-pose arithmetic)
 
     def posed(self, rel: RelativePoses) -> np.ndarray:
         """This outline moved by every pose of ``rel``: an (n,) array of shapely Polygons."""
@@ -163,7 +165,7 @@ def planar_clearance(a: Outline, b: Outline, rel: RelativePoses, search_mm: floa
         rest = np.nonzero(~meets)[0]
         if len(rest) == 0:
             continue
-        bb = shapely.bounds(polys)
+        bb = shapely.bounds(polys).tolist()
         for k in rest:
             i = lo + int(k)
             guess = previous + moved[i] + 1e-9 if previous_index == i - 1 else math.inf
@@ -177,27 +179,31 @@ def planar_clearance(a: Outline, b: Outline, rel: RelativePoses, search_mm: floa
     return out
 
 
-def _clipped_distance(a: Outline, poly_b: shapely.Polygon, bounds_b: np.ndarray, search: float) -> float:
+def _clipped_distance(a: Outline, poly_b: shapely.Polygon, bounds_b: list[float], search: float) -> float:
     """Distance of ``a`` and ``poly_b`` if at most ``search`` (exact), else a value > ``search``."""
+    # called once per pose: plain floats and shapely's ufuncs (the same GEOS calls as shapely's public
+    # functions, without their argument checks), for a sweep makes tens of thousands of these calls
     # at a distance of exactly ``search`` the closest points can lie on the window's edge, where clipping
     # leaves a zero-area slice that GEOS drops: the window is a hair wider than the search length
     pad = search * (1.0 + 1e-9) + 1e-12
-    lo = np.maximum(a.bounds[:2], bounds_b[:2]) - pad
-    hi = np.minimum(a.bounds[2:], bounds_b[2:]) + pad
+    ax0, ay0, ax1, ay1 = a.box
+    bx0, by0, bx1, by1 = bounds_b
+    lo_x, lo_y = max(ax0, bx0) - pad, max(ay0, by0) - pad
+    hi_x, hi_y = min(ax1, bx1) + pad, min(ay1, by1) + pad
     # boxes 2 x search apart or more on an axis: the parts are farther apart than search (which is > 0);
     # lo == hi would also hand GEOS a degenerate clip window, which it refuses
-    if np.any(lo >= hi):
+    if lo_x >= hi_x or lo_y >= hi_y:
         return math.inf
-    clip_a = shapely.clip_by_rect(a.polygon, lo[0], lo[1], hi[0], hi[1])
-    if clip_a.is_empty:
+    clip_a = _geos.clip_by_rect(a.polygon, lo_x, lo_y, hi_x, hi_y)
+    if _geos.is_empty(clip_a):
         return math.inf
     # B's closest point is within ``search`` of the clipped A (which holds A's closest point)
-    ca = clip_a.bounds
-    clip_b = shapely.clip_by_rect(poly_b, max(lo[0], ca[0] - pad), max(lo[1], ca[1] - pad),
-                                  min(hi[0], ca[2] + pad), min(hi[1], ca[3] + pad))
-    if clip_b.is_empty:
+    cx0, cy0, cx1, cy1 = _geos.bounds(clip_a).tolist()
+    clip_b = _geos.clip_by_rect(poly_b, max(lo_x, cx0 - pad), max(lo_y, cy0 - pad),
+                                min(hi_x, cx1 + pad), min(hi_y, cy1 + pad))
+    if _geos.is_empty(clip_b):
         return math.inf
-    return float(shapely.distance(clip_a, clip_b))
+    return float(_geos.distance(clip_a, clip_b))
 
 
 def overlap_areas(a: Outline, b: Outline, rel: RelativePoses) -> np.ndarray:
