@@ -12,11 +12,12 @@ from __future__ import annotations
 import copy
 import fcntl
 import hashlib
+import io
 import math
 import os
 import shutil
 from collections.abc import Callable, Iterator
-from contextlib import AbstractContextManager, contextmanager
+from contextlib import AbstractContextManager, contextmanager, redirect_stderr, redirect_stdout
 from pathlib import Path
 from typing import NamedTuple
 
@@ -200,10 +201,12 @@ def shared_stage_cache(tmp_path_factory: pytest.TempPathFactory) -> Callable[...
 
 
 class BuiltFolder(NamedTuple):
-    """An output folder as ``fabricate build NAME -o DIR`` wrote it, and that command's exit code."""
+    """An output folder as ``fabricate build NAME -o DIR -q`` wrote it, that command's exit code, and what it
+    printed (standard output, then standard error)."""
 
     path: Path
     exit_code: int
+    output: str
 
 
 #: ``{key: folder}`` of this test process: the session's shared folders it has already seen built.
@@ -245,18 +248,21 @@ def built_folder(tmp_path_factory: pytest.TempPathFactory, _no_stage_cache: None
                     patch.setenv("FABRICATE_NO_CACHE", "1")
                     patch.setattr(pipeline, "run_build", run_build)
                     patch.setattr(step_module, "step_available", _step_available if step else lambda: False)
+                    out, err = io.StringIO(), io.StringIO()
                     try:
-                        code = main(["build", name, "-o", str(home / name), "-q",
-                                     *([] if process is None else ["--process", process])])
+                        with redirect_stdout(out), redirect_stderr(err):
+                            code = main(["build", name, "-o", str(home / name), "-q",
+                                         *([] if process is None else ["--process", process])])
                     finally:
                         patch.undo()
+                    (home / "output").write_text(out.getvalue() + err.getvalue())
                     done.write_text(str(code))
-                _BUILT_FOLDERS[key] = BuiltFolder(home / name, int(done.read_text()))
+                _BUILT_FOLDERS[key] = BuiltFolder(home / name, int(done.read_text()), (home / "output").read_text())
         found = _BUILT_FOLDERS[key]
         if read_only:
             return found
         target = tmp_path_factory.mktemp(key) / name
         shutil.copytree(found.path, target, symlinks=True)
-        return BuiltFolder(target, found.exit_code)
+        return found._replace(path=target)
 
     return get

@@ -343,17 +343,15 @@ def test_a_tampered_step_solid_is_named(copy, capsys):
 
 
 @pytest.mark.slow
-def test_without_ocp_a_build_says_step_was_skipped(tmp_path, monkeypatch, capsys):
-    import fabricate.export.step as step
-
-    monkeypatch.setattr(step, "step_available", lambda: False)
-    assert main(["build", FAST, "-o", str(tmp_path / "out")]) == 0
-    out = capsys.readouterr().out
+def test_without_ocp_a_build_says_step_was_skipped(built_without_cad):
+    # the command's own build with step_available False (built_folder(step=False)), and what it printed
+    out = built_without_cad.output
+    assert built_without_cad.exit_code == 0, out
     assert out.count("STEP skipped") == 1 and "fabricate[cad]" in out
-    report = _report(tmp_path / "out")
+    report = _report(built_without_cad.path)
     assert not any(f.endswith(".step") for f in report["files"])
     assert all(p["step"] is None for p in report["parts"])
-    assert "STEP skipped" in (tmp_path / "out" / "report.md").read_text()
+    assert "STEP skipped" in (built_without_cad.path / "report.md").read_text()
 
 
 # --- check is bounded by the manifest (issue 23, item 3) ---------------------------------------------------
@@ -750,9 +748,12 @@ def test_the_full_builds_match_the_schema_too(built, laser_built):
 
 
 @pytest.fixture(scope="module")
-def built_without_cad(built_folder) -> Path:
-    """The same pair built by the command as on an install without the `cad` extra (no OCP: STEP skipped)."""
-    return built_folder(FAST, step=False, read_only=True).path
+def built_without_cad(built_folder):
+    """The same pair built by the command as on an install without the `cad` extra (no OCP: STEP skipped):
+    a ``BuiltFolder`` (path, exit code, output), shared: a test copies it before changing it."""
+    found = built_folder(FAST, step=False, read_only=True)
+    assert found.exit_code == 0, found.output
+    return found
 
 
 @pytest.mark.slow
@@ -764,7 +765,7 @@ def test_check_gives_the_same_verdict_on_any_install(built, built_without_cad, t
 
     if "cad" in (built_with, checked_with) and not step.step_available():
         pytest.skip("OCP (the cad extra) is not installed here")
-    source = built if built_with == "cad" else built_without_cad
+    source = built if built_with == "cad" else built_without_cad.path
     folder = tmp_path / FAST
     shutil.copytree(source, folder)
     report = _report(folder)
