@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import fcntl
 import os
 import pickle
 import shutil
@@ -358,18 +359,31 @@ RERUN = {"parts": AFTER_PARTS, "process": AFTER_PARTS,
 
 @pytest.fixture(scope="module")
 def warmed(tmp_path_factory) -> tuple[Path, Path]:
-    """A cache folder warmed by a build of the unedited default finger, and that build's output folder."""
+    """A cache folder warmed by a build of the unedited default finger, and that build's output folder.
+
+    Made once per test session: the tests using it are dealt out to both pytest-xdist workers, so the first to ask
+    builds it (under a lock, in the session's folder, which pytest-xdist's per-worker basetemps share) and the
+    other waits and reuses it. The tests only read the two folders (they copy the cache; check writes nothing).
+    """
     from fabricate.pipeline import run_build
 
-    folder = tmp_path_factory.mktemp("warm") / "cache"
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("FABRICATE_CACHE_DIR", str(folder))
-        patch.delenv("FABRICATE_NO_CACHE", raising=False)
-        cache.clear_memory()
-        with cache.use_cache():
-            outcome = run_build(load_design(DEFAULT))
-        cache.clear_memory()
-    return folder, outcome.write(folder.parent / "out")
+    base = tmp_path_factory.getbasetemp()
+    shared = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "test-cache-warm"
+    shared.mkdir(exist_ok=True)
+    folder, out = shared / "cache", shared / "out"
+    with open(shared / "lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        if not (shared / "done").is_file():
+            with pytest.MonkeyPatch.context() as patch:
+                patch.setenv("FABRICATE_CACHE_DIR", str(folder))
+                patch.delenv("FABRICATE_NO_CACHE", raising=False)
+                cache.clear_memory()
+                with cache.use_cache():
+                    outcome = run_build(load_design(DEFAULT))
+                cache.clear_memory()
+            outcome.write(out)
+            (shared / "done").touch()
+    return folder, out
 
 
 @pytest.mark.slow

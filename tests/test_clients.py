@@ -17,7 +17,7 @@ import pytest
 from fabricate.catalogue.printers import PRINTERS, Printer, printer
 from fabricate.design import load_design
 from fabricate.output import write_output
-from fabricate.pipeline import BuildOutcome, run_build
+from fabricate.pipeline import BuildOutcome
 from fabricate.templates import shipped_templates
 
 needs_admesh = pytest.mark.skipif(shutil.which("admesh") is None, reason="admesh not installed")
@@ -189,10 +189,6 @@ def test_prusaslicer_slices_every_plate_of_every_template(template, tmp_path, sh
                   outcome.design.parts.plate_spacing_mm, tmp_path)
 
 
-#: The FDM builds the per-preset test re-lays (built once per test process).
-_FDM_BUILDS: dict[str, BuildOutcome] = {}
-
-
 @needs_prusaslicer
 @pytest.mark.slow
 @pytest.mark.parametrize("preset", sorted(PRINTERS))
@@ -204,11 +200,7 @@ def test_prusaslicer_slices_plates_on_every_printer_preset(preset, tmp_path, shi
     spec = printer(preset)
     same_technique = sorted(name for name in PRINTERS if printer(name).technique == spec.technique)
     template = ("jansen_leg", "finger_watt_six_bar")[same_technique.index(preset) % 2]
-    if spec.technique == "sla":
-        outcome, process = shipped_build(template), None
-    else:
-        if template not in _FDM_BUILDS:
-            _FDM_BUILDS[template] = run_build(load_design(template, "fdm"))
-        outcome, process = _FDM_BUILDS[template], "fdm"
+    process = None if spec.technique == "sla" else "fdm"
+    outcome = shipped_build(template, process)  # the FDM builds too: once per session
     plates, margin = _relaid(outcome, preset, process)
     _slice_plates(plates, spec, outcome.design.process.first_layer_compensation_mm, margin, tmp_path / template)

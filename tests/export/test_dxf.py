@@ -86,14 +86,14 @@ def test_each_sheet_holds_parts_of_one_thickness():
 
 
 @pytest.mark.slow
-def test_the_laser_default_finger_cuts_its_3mm_plate_on_a_3mm_sheet(tmp_path, capsys):
-    """``fabricate build --process laser`` of the default finger: its links are 6 mm, its actuator plate is cut
-    from the 3 mm stock. The build exits 0, the plate is on a sheet of thickness 3 with no 6 mm part, every
-    sheet's parts are as thick as it, and ``fabricate check`` passes on the written folder."""
-    out = tmp_path / "out"
-    code = main(["build", "finger_five_bar_ncg", "--process", "laser", "-o", str(out), "-q"])
-    captured = capsys.readouterr()
-    assert code == 0, captured.out + captured.err
+def test_the_laser_default_finger_cuts_its_3mm_plate_on_a_3mm_sheet(tmp_path, capsys, shipped_build):
+    """``--process laser`` of the default finger (the session's build, shared with test_mount, test_auto and
+    test_bom): its links are 6 mm, its actuator plate is cut from the 3 mm stock. The build exits 0, the plate is on
+    a sheet of thickness 3 with no 6 mm part, every sheet's parts are as thick as it, and ``fabricate check`` passes
+    on the written folder (check rebuilds it from the report's embedded template and profile)."""
+    outcome = shipped_build("finger_five_bar_ncg", "laser")
+    assert outcome.exit_code == 0, outcome.failures
+    out = outcome.write(tmp_path / "out")
     report = json.loads((out / "report.json").read_text())
     thickness = {p["name"]: p["thickness_mm"] for p in report["parts"]}
     assert thickness[MOUNT_PART] == 3.0 and 6.0 in thickness.values()

@@ -14,7 +14,6 @@ import shapely
 from fabricate.design import load_design
 from fabricate.hints import PartHints
 from fabricate.parts.bom import Spacer, bill_of_materials
-from fabricate.pipeline import run_build
 
 
 @pytest.fixture(scope="module")
@@ -23,8 +22,8 @@ def gripper(shipped_build):
 
 
 @pytest.fixture(scope="module")
-def five_bar_laser():
-    return run_build(load_design("finger_five_bar_ncg", "laser"))
+def five_bar_laser(shipped_build):
+    return shipped_build("finger_five_bar_ncg", "laser")  # the session's, shared with test_mount and test_auto
 
 
 @pytest.mark.slow
