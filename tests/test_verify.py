@@ -69,27 +69,30 @@ def _one_rebuild_per_template(monkeypatch, shared_stage_cache):
     monkeypatch.setattr(pipeline, "run_build", cached)
 
 
-_STEP_VERDICTS: dict[tuple, list[str]] = {}
+_VERDICTS: dict[tuple, list[str]] = {}
 
 
 @pytest.fixture(autouse=True)
-def _one_step_reading_per_file(monkeypatch):
-    """Reading STEP back with OCP is most of a check's time (~2.5 s a file); a tampering of another file
-    leaves the STEP files as they were, so their verdict (a function of the bytes and the expectation) is
-    kept by content hash. A changed STEP file has another hash and is read for real."""
+def _one_reading_per_file(monkeypatch):
+    """Reading the files back is most of a check's time once its rebuild is kept (STEP with OCP ~2.5 s a
+    folder, the meshes, drawings and pictures ~1 s more); a tampering of one file leaves the others as they
+    were, so each file's verdict (a function of its name, bytes and expectation, and of whether OCP is there to
+    read STEP) is kept by content hash, as test_verify_fuzz does. A changed file has another hash and is read
+    for real."""
     import hashlib
 
-    import fabricate.export.step_read as step_read
+    import fabricate.export.step as step
+    import fabricate.verify_files as verify_files
 
-    real = step_read.step_problems
+    real = verify_files.content_problems
 
-    def cached(data, expected=None, rel_tol=1e-6):
-        key = (hashlib.sha256(data).hexdigest(), tuple(sorted((expected or {}).items())), rel_tol)
-        if key not in _STEP_VERDICTS:
-            _STEP_VERDICTS[key] = real(data, expected, rel_tol)
-        return list(_STEP_VERDICTS[key])
+    def cached(rel, data, expected):
+        key = (rel, hashlib.sha256(data).hexdigest(), repr(expected), step.step_available())
+        if key not in _VERDICTS:
+            _VERDICTS[key] = real(rel, data, expected)
+        return list(_VERDICTS[key])
 
-    monkeypatch.setattr(step_read, "step_problems", cached)
+    monkeypatch.setattr(verify_files, "content_problems", cached)
 
 
 @pytest.fixture
