@@ -88,25 +88,45 @@ def _face_path(rings: list[np.ndarray]) -> Any:
     return Path(np.asarray(verts), codes)
 
 
+#: One drawn solid: (the z its top ends at, its side quads (k, 4, 2), its top face's rings), in the picture's plane.
+_Solid = tuple[float, np.ndarray, list[np.ndarray]]
+
+
 def guide_pictures(partset: PartSet, motion: Motion, steps: Sequence[GuideStep]) -> dict[str, bytes]:
     """One PNG per step (``assembly/step_NN.png``): the parts, pins and springs in place after it."""
-    from matplotlib.collections import PolyCollection
-    from matplotlib.patches import PathPatch
-
-    from fabricate.plotting import figure, png_bytes
+    from fabricate.plotting import png_bytes
 
     poses = {name: motion.pose(name)[0] for name in motion.body_names}
+    corners: list[np.ndarray] = []  # every drawn point, for the common view of all the steps
+    solids = _part_solids(partset, poses, corners)
+    pins = _pin_segments(partset, poses, corners)
+    springs = _spring_drawings(partset, poses, corners)
+    actuator = _actuator_solids(partset, poses, corners)
+    allpts = np.concatenate(corners) if corners else np.zeros((1, 2))
+    lo, hi = allpts.min(axis=0), allpts.max(axis=0)
+    pad = 0.04 * float(max(hi - lo)) + 1.0
+    return {step.picture: png_bytes(_step_figure(step, solids, pins, springs, actuator, (lo - pad, hi + pad)))
+            for step in steps}
+
+
+def _part_solids(partset: PartSet, poses: dict[str, np.ndarray], corners: list[np.ndarray]) -> dict[str, _Solid]:
+    """Each part as placed at the first pose, by name (its side quads added to ``corners``)."""
     # coarse outlines: a picture of 360 px needs no finer than a few hundredths of the assembly's size
     span = max((float(np.ptp(p.outline.vertices, axis=0).max()) for p in partset.parts), default=10.0)
     tol = max(0.02, span / 300.0)
-    solids: dict[str, tuple[float, np.ndarray, list[np.ndarray]]] = {}
-    corners = []
+    solids: dict[str, _Solid] = {}
     for part in partset.parts:
         pose = poses.get(part.body, np.zeros(3))
         rings = [_world(r, pose) for r in part.polygons(tol)]
         quads, top, _ = _prism(rings, part.z_mm, part.z_mm + part.thickness_mm)
         solids[part.name] = (part.z_mm + part.thickness_mm, quads, top)
         corners.append(quads.reshape(-1, 2))
+    return solids
+
+
+def _pin_segments(partset: PartSet, poses: dict[str, np.ndarray],
+                  corners: list[np.ndarray]) -> dict[str, tuple[float, np.ndarray]]:
+    """Each pin as a segment along its axis, by joint: (the z its top ends at, its two end points (2, 2))."""
     pins = {}
     for pin in partset.pins:
         hole = next((h for p in partset.parts if p.body == pin.bodies[0] for h in p.holes if h.joint == pin.joint),
@@ -117,6 +137,12 @@ def guide_pictures(partset: PartSet, motion: Motion, steps: Sequence[GuideStep])
         seg = np.array([centre + pin.z_mm * OBLIQUE, centre + (pin.z_mm + pin.length_mm) * OBLIQUE])
         pins[pin.joint] = (pin.z_mm + pin.length_mm, seg)
         corners.append(seg)
+    return pins
+
+
+def _spring_drawings(partset: PartSet, poses: dict[str, np.ndarray],
+                     corners: list[np.ndarray]) -> dict[str, tuple[float, list[np.ndarray], list[np.ndarray]]]:
+    """Each torsion spring, by joint: (the z its top ends at, its coils as circles, its two legs as polylines)."""
     springs = {}
     angles = np.linspace(0.0, 2.0 * np.pi, 40)
     circle = np.column_stack([np.cos(angles), np.sin(angles)])
@@ -134,8 +160,12 @@ def guide_pictures(partset: PartSet, motion: Motion, steps: Sequence[GuideStep])
                 np.array([centre + z_far * OBLIQUE, far + z_far * OBLIQUE, far + far_down * OBLIQUE])]
         springs[sp.joint] = (sp.z_mm[1], coils, legs)
         corners += coils
-    # the actuator's body, output and screws (its catalogue solids as placed): drawn from its step on
-    actuator: list[tuple[float, np.ndarray, list[np.ndarray]]] = []
+    return springs
+
+
+def _actuator_solids(partset: PartSet, poses: dict[str, np.ndarray], corners: list[np.ndarray]) -> list[_Solid]:
+    """The actuator's body, output and screws (its catalogue solids as placed): drawn from its step on."""
+    actuator: list[_Solid] = []
     placed = partset.actuator
     if placed is not None:
         for solid in placed.solids:
@@ -144,44 +174,50 @@ def guide_pictures(partset: PartSet, motion: Motion, steps: Sequence[GuideStep])
                                    float(solid.z0), float(solid.z1))
             actuator.append((float(solid.z1), quads, top))
             corners.append(quads.reshape(-1, 2))
-    allpts = np.concatenate(corners) if corners else np.zeros((1, 2))
-    lo, hi = allpts.min(axis=0), allpts.max(axis=0)
-    pad = 0.04 * float(max(hi - lo)) + 1.0
-    files = {}
-    for step in steps:
-        fig = figure(SIZE_IN, DPI)
-        ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
-        ax.set_axis_off()
-        ax.set_aspect("equal")
-        ax.set_xlim(lo[0] - pad, hi[0] + pad)
-        ax.set_ylim(lo[1] - pad, hi[1] + pad)
-        # painter's order: whatever ends lower is drawn first
-        layers: list[tuple[float, int, str, str]] = [(solids[n][0], 0, "part", n) for n in step.placed if n in solids]
-        layers += [(pins[j][0], 1, "pin", j) for j in step.pins if j in pins]
-        layers += [(springs[j][0], 2, "spring", j) for j in step.springs if j in springs]
-        if step.actuator:
-            layers += [(z1, 3, "actuator", str(k)) for k, (z1, _, _) in enumerate(actuator)]
-        for _, _, kind, name in sorted(layers):
-            if kind in ("part", "actuator"):
-                _, quads, top = solids[name] if kind == "part" else actuator[int(name)]
-                new = name in step.new if kind == "part" else step.new_actuator
-                face, side = NEW if new else OLD
-                ax.add_collection(PolyCollection(list(quads), facecolors=side, edgecolors=side, linewidths=0.3))
-                ax.add_patch(PathPatch(_face_path(top), facecolor=face, edgecolor=EDGE, linewidth=0.4))
-            elif kind == "pin":
-                seg = pins[name][1]
-                ax.plot(seg[:, 0], seg[:, 1], color=NEW_PIN if name in step.new_pins else PIN, linewidth=1.6,
-                        solid_capstyle="round")
-            else:
-                _, coils, legs = springs[name]
-                colour = NEW_SPRING if name in step.new_springs else SPRING
-                for ring in coils:
-                    ax.plot(ring[:, 0], ring[:, 1], color=colour, linewidth=0.8)
-                for leg in legs:
-                    ax.plot(leg[:, 0], leg[:, 1], color=colour, linewidth=0.8)
-        fig.text(0.02, 0.97, f"step {step.number}", fontsize=8, va="top", color=EDGE)
-        files[step.picture] = png_bytes(fig)
-    return files
+    return actuator
+
+
+def _step_figure(step: GuideStep, solids: dict[str, _Solid], pins: dict[str, tuple[float, np.ndarray]],
+                 springs: dict[str, tuple[float, list[np.ndarray], list[np.ndarray]]], actuator: list[_Solid],
+                 view: tuple[np.ndarray, np.ndarray]) -> Any:
+    """One step's figure: what is in place after it, in painter's order, what it adds highlighted."""
+    from matplotlib.collections import PolyCollection
+    from matplotlib.patches import PathPatch
+
+    from fabricate.plotting import figure
+
+    fig = figure(SIZE_IN, DPI)
+    ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
+    ax.set_axis_off()
+    ax.set_aspect("equal")
+    ax.set_xlim(view[0][0], view[1][0])
+    ax.set_ylim(view[0][1], view[1][1])
+    # painter's order: whatever ends lower is drawn first
+    layers: list[tuple[float, int, str, str]] = [(solids[n][0], 0, "part", n) for n in step.placed if n in solids]
+    layers += [(pins[j][0], 1, "pin", j) for j in step.pins if j in pins]
+    layers += [(springs[j][0], 2, "spring", j) for j in step.springs if j in springs]
+    if step.actuator:
+        layers += [(z1, 3, "actuator", str(k)) for k, (z1, _, _) in enumerate(actuator)]
+    for _, _, kind, name in sorted(layers):
+        if kind in ("part", "actuator"):
+            _, quads, top = solids[name] if kind == "part" else actuator[int(name)]
+            new = name in step.new if kind == "part" else step.new_actuator
+            face, side = NEW if new else OLD
+            ax.add_collection(PolyCollection(list(quads), facecolors=side, edgecolors=side, linewidths=0.3))
+            ax.add_patch(PathPatch(_face_path(top), facecolor=face, edgecolor=EDGE, linewidth=0.4))
+        elif kind == "pin":
+            seg = pins[name][1]
+            ax.plot(seg[:, 0], seg[:, 1], color=NEW_PIN if name in step.new_pins else PIN, linewidth=1.6,
+                    solid_capstyle="round")
+        else:
+            _, coils, legs = springs[name]
+            colour = NEW_SPRING if name in step.new_springs else SPRING
+            for ring in coils:
+                ax.plot(ring[:, 0], ring[:, 1], color=colour, linewidth=0.8)
+            for leg in legs:
+                ax.plot(leg[:, 0], leg[:, 1], color=colour, linewidth=0.8)
+    fig.text(0.02, 0.97, f"step {step.number}", fontsize=8, va="top", color=EDGE)
+    return fig
 
 
 def motion_check(partset: PartSet, motion: Motion, min_clearance_mm: float | None = None) -> Any:
