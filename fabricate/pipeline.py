@@ -311,6 +311,11 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
     if run.design.parts.link_width_mm == "auto":
         _size_links(run)
     _make_parts(run)
+    if not cache.stored("previews", stage_keys.pictures_key(run.design, "previews")):
+        # the child and this process both draw: matplotlib imported once, here, is the child's too
+        from fabricate.plotting import load_agg
+
+        load_agg()
     # pictures take as long as everything else: draw them in a forked child on the second core
     pictures = Background(_picture_jobs(run))
     try:
@@ -518,16 +523,38 @@ def _plots(run: BuildRun, pictures: Background) -> None:
 
     run.enter("plots")
     assert run.checks is not None and run.strength is not None  # both checks ran
-    strength, drive, checks = run.strength, run.drive, run.checks
+    strength, drive, checks, unit = run.strength, run.drive, run.checks, run.mechanism.input_unit
+    # {path: (cache stage, its key, drawer)}, looked up in the cache here so its counts are this process's
+    plots: dict[str, tuple[str, Any, Callable[[], bytes]]] = {}
     if strength.findings:
-        run.files["plots/strength.png"] = cache.cached("strength_plot", stage_keys.strength_key(run.design), lambda:
-                                                       strength_plot(strength, run.mechanism.input_unit))
+        plots["plots/strength.png"] = ("strength_plot", stage_keys.strength_key(run.design),
+                                       lambda: strength_plot(strength, unit))
     if drive is not None and drive.reason is None:
         from fabricate.drive.plots import drive_plot
 
-        run.files["plots/drive.png"] = cache.cached("drive_plot", stage_keys.drive_key(run.design),
-                                                    lambda: drive_plot(drive))
-    for name, data in sorted(cache.cached("check_figures", stage_keys.checks_key(run.design), checks.figures).items()):
+        plots["plots/drive.png"] = ("drive_plot", stage_keys.drive_key(run.design), lambda: drive_plot(drive))
+    # the picture child is done by now, or nearly: a second child draws these while this process draws the
+    # clearance plot (when it has one to draw)
+    todo = [path for path, (stage, key, _) in plots.items() if not cache.stored(stage, key)]
+
+    def drawing(path: str) -> Callable[[], dict[str, bytes]]:
+        return lambda: {path: plots[path][2]()}
+
+    def taking(path: str, draw: Callable[[], bytes]) -> Callable[[], bytes]:
+        return lambda: drawn[path] if path in drawn else draw()
+
+    child = Background([drawing(path) for path in todo]) \
+        if todo and not cache.stored("check_figures", stage_keys.checks_key(run.design)) else None
+    drawn: dict[str, bytes] = {}
+    try:
+        figures = cache.cached("check_figures", stage_keys.checks_key(run.design), checks.figures)
+        drawn.update(child.result() if child is not None else {})
+    finally:
+        if child is not None:
+            child.cancel()
+    for path, (stage, key, draw) in plots.items():
+        run.files[path] = cache.cached(stage, key, taking(path, draw))
+    for name, data in sorted(figures.items()):
         run.files[f"plots/{name}"] = data
     run.files.update(pictures.result())
 
