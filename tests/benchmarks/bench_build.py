@@ -103,6 +103,9 @@ def _env(code: Path, install: str, blocker: Path, extra: dict[str, str] | None =
     env["MPLBACKEND"] = "Agg"
     env["FABRICATE_NO_CACHE"] = "1"  # every run a cold build: a stage cache (fabricate/cache.py) must not serve it
     env.pop("FABRICATE_SERIAL", None)
+    # an installed package has its compiled modules: let the warm-up run write them (a shell that sets
+    # PYTHONDONTWRITEBYTECODE would otherwise make every counted run recompile fabricate's ~120 modules)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     env.update(extra or {})
     return env
 
