@@ -347,7 +347,16 @@ def _takes_n_workers(client: Any) -> bool:
     return "n_workers" in inspect.signature(client.scheduler_info).parameters
 
 
+#: The event loops' own loggers: tearing a cluster down (after Ctrl-C above all) can make a pending callback
+#: raise, which tornado and asyncio log with a traceback; the sweep's outcome is already recorded by then.
+EVENT_LOOP_LOGGERS = ("tornado.application", "tornado.general", "asyncio")
+
+
 def _close(client: Any, cluster: Any) -> None:
+    # from here on a traceback the loops log is teardown noise, and none may reach the user: kept quiet for the
+    # rest of the process (the loop thread can log after close() returns)
+    for name in EVENT_LOOP_LOGGERS:
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
     for thing in (client, cluster):
         if thing is not None:
             try:
