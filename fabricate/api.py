@@ -22,8 +22,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from fabricate.arguments import path_argument, type_name
 from fabricate.errors import SpecError
-from fabricate.pipeline import BuildOutcome, path_argument, type_name
+from fabricate.pipeline import BuildOutcome
 from fabricate.spec import DesignSpec, check_design_name
 
 if TYPE_CHECKING:
