@@ -105,11 +105,20 @@ def laser_process() -> ProcessSpec:
 _SHIPPED_BUILDS: dict[str, BuildOutcome] = {}
 
 
-def _session_folder(factory: pytest.TempPathFactory) -> Path:
+def session_folder(factory: pytest.TempPathFactory) -> Path:
     """A folder every worker of this test session shares: pytest-xdist gives each worker its own basetemp
     inside one session folder (``pytest-N/popen-gwK``); without xdist the basetemp is the session's."""
     base = factory.getbasetemp()
     return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+@contextmanager
+def locked(path: Path) -> Iterator[None]:
+    """The block under an exclusive lock on file ``path``, across the session's processes: the first worker to
+    need a shared result makes it, the other waits and reads it."""
+    with open(path, "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        yield
 
 
 @pytest.fixture(scope="session")
@@ -127,7 +136,7 @@ def shipped_build(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., Bui
     pipeline's, bound at import, so a module that monkeypatches ``fabricate.pipeline.run_build`` does not
     change what is cached here.
     """
-    shared = _session_folder(tmp_path_factory)
+    shared = session_folder(tmp_path_factory)
     store = shared / "shipped-stage-cache"
     store.mkdir(exist_ok=True)
 
@@ -136,20 +145,8 @@ def shipped_build(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., Bui
         key = name if process is None else f"{name}--process-{process}"
         if key not in _SHIPPED_BUILDS:
             design = load_design(name, process)
-            patch = pytest.MonkeyPatch()
-            patch.setenv("FABRICATE_CACHE_DIR", str(store))
-            patch.delenv("FABRICATE_NO_CACHE", raising=False)
-            stats = copy.deepcopy(cache.stats)
-            try:
-                with open(shared / f"shipped-{key}.lock", "w") as lock:
-                    fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
-                    with cache.use_cache(True):
-                        _SHIPPED_BUILDS[key] = run_build(design)
-            finally:
-                cache.clear_memory()
-                cache.stats.clear()
-                cache.stats.update(stats)
-                patch.undo()
+            with locked(shared / f"shipped-{key}.lock"), _stage_cache_in(store):
+                _SHIPPED_BUILDS[key] = run_build(design)
         return _SHIPPED_BUILDS[key]
 
     return get
@@ -181,7 +178,7 @@ def shared_stage_cache(tmp_path_factory: pytest.TempPathFactory) -> Callable[...
     design wait for one cold build instead of making two. Never for a test that patches a stage (a stage served
     by the cache does not run) or what the keys take from the install (``step_available``: a key holds the
     installed OCP's version, so a build that pretends OCP is missing would be served STEP files)."""
-    shared = _session_folder(tmp_path_factory)
+    shared = session_folder(tmp_path_factory)
     store = shared / "shipped-stage-cache"
     store.mkdir(exist_ok=True)
 
@@ -192,10 +189,8 @@ def shared_stage_cache(tmp_path_factory: pytest.TempPathFactory) -> Callable[...
                 yield
             return
         name = hashlib.sha256(key.encode()).hexdigest()[:16]
-        with open(shared / f"stage-cache-{name}.lock", "w") as lock:
-            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
-            with _stage_cache_in(store):
-                yield
+        with locked(shared / f"stage-cache-{name}.lock"), _stage_cache_in(store):
+            yield
 
     return block
 
@@ -232,7 +227,7 @@ def built_folder(tmp_path_factory: pytest.TempPathFactory, _no_stage_cache: None
     import fabricate.pipeline as pipeline
     from fabricate.cli import main
 
-    shared = _session_folder(tmp_path_factory) / "built-folders"
+    shared = session_folder(tmp_path_factory) / "built-folders"
     shared.mkdir(exist_ok=True)
 
     def get(name: str, process: str | None = None, *, step: bool = True, read_only: bool = False) -> BuiltFolder:
@@ -241,8 +236,7 @@ def built_folder(tmp_path_factory: pytest.TempPathFactory, _no_stage_cache: None
             home = shared / key
             home.mkdir(exist_ok=True)
             done = home / "exit_code"
-            with open(home / "lock", "w") as lock:
-                fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+            with locked(home / "lock"):
                 if not done.exists():
                     patch = pytest.MonkeyPatch()
                     patch.setenv("FABRICATE_NO_CACHE", "1")

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import fcntl
 import os
 import pickle
 import shutil
@@ -22,6 +21,7 @@ import pytest
 from fabricate import cache, stage_keys
 from fabricate.design import design_from_text, load_design
 from fabricate.templates import TEMPLATE_DIR
+from tests.conftest import locked, session_folder
 
 DEFAULT = "finger_five_bar_ncg"
 
@@ -367,12 +367,10 @@ def warmed(tmp_path_factory) -> tuple[Path, Path]:
     """
     from fabricate.pipeline import run_build
 
-    base = tmp_path_factory.getbasetemp()
-    shared = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "test-cache-warm"
+    shared = session_folder(tmp_path_factory) / "test-cache-warm"
     shared.mkdir(exist_ok=True)
     folder, out = shared / "cache", shared / "out"
-    with open(shared / "lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+    with locked(shared / "lock"):
         if not (shared / "done").is_file():
             with pytest.MonkeyPatch.context() as patch:
                 patch.setenv("FABRICATE_CACHE_DIR", str(folder))

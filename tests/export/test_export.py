@@ -7,7 +7,6 @@ through every exporter. Real tools (OpenSCAD, PrusaSlicer) are run when installe
 from __future__ import annotations
 
 import dataclasses
-import fcntl
 import io
 import math
 import os
@@ -51,7 +50,7 @@ from fabricate.parts.build import build_parts
 from fabricate.parts.spec import PartsSpec
 from fabricate.process import ProcessSpec
 from fabricate.templates import shipped_templates
-from tests.conftest import make_four_bar
+from tests.conftest import locked, make_four_bar, session_folder
 from tests.parts.test_build import slider_crank, spur_like, sun_planet_four_bar
 
 SLA = ProcessSpec(name="sla", running_clearance_mm=0.25, hole_compensation_mm=0.2, min_wall_mm=0.8,
@@ -95,8 +94,7 @@ def _share_cases(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
     """Cases are shared by the session's pytest-xdist workers: each test function is parametrised by case and its
     parameters are dealt out to both workers, so without this each worker made every case (pytest-xdist gives a
     worker its own basetemp inside the session's folder; without xdist the basetemp is the session's)."""
-    base = tmp_path_factory.getbasetemp()
-    folder = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "export-cases"
+    folder = session_folder(tmp_path_factory) / "export-cases"
     folder.mkdir(exist_ok=True)
     _SHARED[:] = [folder]
     yield
@@ -111,8 +109,7 @@ def case(name: str) -> SimpleNamespace:
     made by each worker."""
     if not _SHARED:
         return make_case(name)
-    with open(_SHARED[0] / f"{name}.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+    with locked(_SHARED[0] / f"{name}.lock"):
         path = _SHARED[0] / f"{name}.pickle"
         if path.is_file():
             return pickle.loads(path.read_bytes())
