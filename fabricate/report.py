@@ -76,33 +76,11 @@ def _write_json(value: Any, newline: str, out: list[str]) -> None:
         out.append(_encode_str(value))
     elif isinstance(value, Mapping):
         items = {str(k): v for k, v in value.items()}  # jsonable's keys (equal strings collapse as there)
-        if not items:
-            out.append("{}")
-            return
-        inner = newline + "  "
-        out.append("{")
-        first = True
-        for key, item in items.items():
-            out.append(inner if first else "," + inner)
-            first = False
-            out.append(_encode_str(key))
-            out.append(": ")
-            _write_json(item, inner, out)
-        out.append(newline + "}")
+        _write_members([(_encode_str(k) + ": ", v) for k, v in items.items()], "{}", newline, out)
     elif isinstance(value, (list, tuple, np.ndarray)):
         seq = value.tolist() if isinstance(value, np.ndarray) else value
         if isinstance(seq, (list, tuple)):
-            if not seq:
-                out.append("[]")
-                return
-            inner = newline + "  "
-            out.append("[")
-            first = True
-            for item in seq:
-                out.append(inner if first else "," + inner)
-                first = False
-                _write_json(item, inner, out)
-            out.append(newline + "]")
+            _write_members([("", item) for item in seq], "[]", newline, out)
         else:  # a 0-d array's tolist() is a scalar
             _write_json(seq, newline, out)
     elif isinstance(value, (bool, np.bool_)):
@@ -112,10 +90,23 @@ def _write_json(value: Any, newline: str, out: list[str]) -> None:
     elif isinstance(value, (float, np.floating)):
         number = float(value)
         out.append(float.__repr__(float(f"{number:.12g}")) if math.isfinite(number) else "null")
-    elif value is None:
-        out.append("null")
     else:
         raise _NotPlain(type(value).__name__)
+
+
+def _write_members(members: list[tuple[str, Any]], brackets: str, newline: str, out: list[str]) -> None:
+    """An object's or an array's members (each a prefix, ``"key": `` or nothing, and its value) between
+    ``brackets``, one per line at the next indent, as json.dumps(indent=2) writes them (``{}``/``[]`` when empty)."""
+    if not members:
+        out.append(brackets)
+        return
+    inner = newline + "  "
+    out.append(brackets[0])
+    for k, (prefix, item) in enumerate(members):
+        out.append(inner if k == 0 else "," + inner)
+        out.append(prefix)
+        _write_json(item, inner, out)
+    out.append(newline + brackets[1])
 
 
 def _fmt(value: Any, digits: int = 4) -> str:
