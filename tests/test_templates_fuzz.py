@@ -102,12 +102,18 @@ def mutated(draw: st.DrawFn) -> str:
 @settings(max_examples=30, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(text=mutated())
-def test_mutated_templates_exit_with_a_code_and_no_traceback(text: str, tmp_path_factory, capsys) -> None:
+def test_mutated_templates_exit_with_a_code_and_no_traceback(text: str, tmp_path_factory, capsys,
+                                                            shared_stage_cache) -> None:
+    """The build runs as a user's does, with the stage cache on (the session's shared folder, which
+    ``shipped_build`` fills with the unmutated templates): a stage whose inputs a mutation left alone is served
+    (byte-identical to running it, per tests/test_cache.py), the stages that read the mutated value run, and the
+    cache's keys see the hostile values too."""
     work = tmp_path_factory.mktemp("fuzz")
     template = Path(work) / "mutated.toml"
     template.write_text(text, encoding="utf-8")
     start = time.process_time()
-    code = main(["build", str(template), "-o", str(Path(work) / "out"), "-q"])
+    with shared_stage_cache():
+        code = main(["build", str(template), "-o", str(Path(work) / "out"), "-q"])
     elapsed = time.process_time() - start
     captured = capsys.readouterr()
     assert code in (0, 1, 2), captured.err
