@@ -100,18 +100,31 @@ def test_a_bad_process_is_named(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_check_rebuilds_with_the_process_it_was_built_with(tmp_path, capsys):
+def test_check_rebuilds_with_the_process_it_was_built_with(tmp_path, capsys, monkeypatch, shared_stage_cache):
+    """The build's stages go to the session's shared stage cache and check's rebuild is served from it (as in
+    tests/test_verify.py): every stage's key holds the process (fabricate/stage_keys.py), so a rebuild with any
+    other process (the template's own 3 mm SLA, say) misses, runs, and its 3 mm parts differ from the folder's."""
+    import fabricate.pipeline as pipeline
+
     profile = tmp_path / "thick.toml"
     profile.write_text((TEMPLATE_DIR / "process_laser.toml").read_text()
                        .replace("thickness_mm = 3.0", "thickness_mm = 4.0")
                        .replace("build_volume_mm = [790.0, 384.0, 3.0]", "build_volume_mm = [790.0, 384.0, 4.0]"))
     out = tmp_path / "out"
-    code = main(["build", "gear_pair_elliptic", "--process", str(profile), "-o", str(out), "-q"])
+    with shared_stage_cache():
+        code = main(["build", "gear_pair_elliptic", "--process", str(profile), "-o", str(out), "-q"])
     assert code in (0, 1)
     report = json.loads((out / "report.json").read_text())
     assert report["design"]["process_override"] == {"source": "thick.toml", "text": profile.read_text()}
     assert {p["thickness_mm"] for p in report["parts"]} == {4.0}
     profile.unlink()  # check needs nothing but the folder
+    real = pipeline.run_build
+
+    def served(*args, **kwargs):
+        with shared_stage_cache():  # check's own use_cache(False) is outside this block
+            return real(*args, **kwargs)
+
+    monkeypatch.setattr(pipeline, "run_build", served)
     assert main(["check", str(out), "-q"]) == code
     assert "differs" not in capsys.readouterr().out
     assert main(["check", str(out), "--process", "sla"]) == 2
