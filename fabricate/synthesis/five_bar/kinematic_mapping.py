@@ -113,16 +113,25 @@ def dyad_from_vector(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return centre, point
 
 
-def side_condition_forms() -> tuple[np.ndarray, np.ndarray]:
-    """Symmetric 8x8 matrices ``S`` with ``p^T S p`` equal to the two conditions of eq 7."""
+def _forms() -> tuple[np.ndarray, np.ndarray]:
     forms = []
     for terms in _SIDE_CONDITIONS:
         s = np.zeros((8, 8))
         for i, j, c in terms:
             s[i, j] += 0.5 * c
             s[j, i] += 0.5 * c
+        s.setflags(write=False)
         forms.append(s)
     return forms[0], forms[1]
+
+
+#: :func:`side_condition_forms`, built once: :func:`solve_at_kappa` runs hundreds of times per synthesis.
+_FORMS = _forms()
+
+
+def side_condition_forms() -> tuple[np.ndarray, np.ndarray]:
+    """Symmetric 8x8 matrices ``S`` with ``p^T S p`` equal to the two conditions of eq 7 (fresh copies)."""
+    return _FORMS[0].copy(), _FORMS[1].copy()
 
 
 def side_conditions(p: np.ndarray) -> np.ndarray:
@@ -167,22 +176,35 @@ def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
         lead = coefficients[0]
         roots = np.linalg.eigvals(np.array([[-coefficients[1] / lead, -coefficients[2] / lead,
                                              -coefficients[3] / lead], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]))
-    lams = [r.real for r in roots if np.isinf(r) or abs(r.imag) <= 1e-9 * max(1.0, abs(r))]
+    # plain Python numbers from here on: numpy's per-scalar overhead was most of a call's time (the
+    # operations are the same IEEE ones, so the results are the same bits)
+    lams = [r.real for r in roots.tolist() if _isinf(r) or abs(r.imag) <= 1e-9 * max(1.0, abs(r))]
     points: list[np.ndarray] = []
     for lam in lams:
-        member = c2 if np.isinf(lam) else c1 + lam * c2
+        member = c2 if math.isinf(lam) else c1 + lam * c2
         values, vectors = np.linalg.eigh(member)
         order = np.argsort(np.abs(values))
-        values, vectors = values[order], vectors[:, order]
-        if values[1] * values[2] >= 0.0:
+        v1, v2 = values[order[1:]].tolist()
+        vectors = vectors[:, order]
+        if v1 * v2 >= 0.0:
             continue  # a definite (point) or double-line member: try another root
-        w1, w2 = np.sqrt(abs(values[1])), np.sqrt(abs(values[2]))
+        w1, w2 = math.sqrt(abs(v1)), math.sqrt(abs(v2))
         # on the lines c1 = -lam c2: meet them with the conic farther from the member (c1 itself at lam = 0)
         other = c2 if abs(lam) < 1.0 else c1
         for line in (w1 * vectors[:, 1] + w2 * vectors[:, 2], w1 * vectors[:, 1] - w2 * vectors[:, 2]):
             points.extend(_polish(c1, c2, x) for x in line_meets_conic(_line_basis(line), other))
         break
     return [x for x in points if abs(x @ c1 @ x) < 1e-8 and abs(x @ c2 @ x) < 1e-8]
+
+
+def _isinf(r: complex) -> bool:
+    """``np.isinf`` of one root (a float, or a complex: infinite when either part is)."""
+    return math.isinf(r.real) or math.isinf(r.imag)
+
+
+def _norm(x: np.ndarray) -> float:
+    """``np.linalg.norm`` of a 1-D float array, without its argument handling: the same ``sqrt(x . x)``."""
+    return math.sqrt(x.dot(x))
 
 
 def line_meets_conic(basis: np.ndarray, conic: np.ndarray) -> list[np.ndarray]:
@@ -208,17 +230,20 @@ def line_meets_conic(basis: np.ndarray, conic: np.ndarray) -> list[np.ndarray]:
     first, so ``b^2`` neither overflows nor underflows.
     """
     e, f = np.asarray(basis, dtype=np.float64)
-    abc = np.array([e @ conic @ e, e @ conic @ f, f @ conic @ f])
-    scale = np.abs(abc).max()
+    ec = e @ conic
+    abc = (float(ec @ e), float(ec @ f), float((f @ conic) @ f))
+    if any(math.isnan(v) for v in abc):
+        return []  # as np.abs(abc).max() would be NaN below
+    scale = max(abs(v) for v in abc)
     if not scale > 0.0:
         return []  # the line lies in the (degenerate) conic: no isolated points
-    a, b, c = abc / scale
+    a, b, c = (v / scale for v in abc)
     disc = b * b - a * c
     if disc < 0.0:
         return []
     q = -(b + math.copysign(math.sqrt(disc), b))
     roots = [s * e + t * f for s, t in ((q, a), (c, q))]
-    norms = [float(np.linalg.norm(x)) for x in roots]
+    norms = [_norm(x) for x in roots]
     if min(norms) == 0.0:  # q = 0 with a = 0 or c = 0: a double root at e or f, carried by the other pair
         k = int(np.argmax(norms))
         roots, norms = [roots[k]] * 2, [norms[k]] * 2
@@ -227,12 +252,18 @@ def line_meets_conic(basis: np.ndarray, conic: np.ndarray) -> list[np.ndarray]:
 
 def _line_basis(line: np.ndarray) -> np.ndarray:
     """Two orthonormal homogeneous points (2, 3) spanning the projective line ``line . x = 0``."""
-    axis = np.zeros(3)
+    l0, l1, l2 = line.tolist()
+    axis = [0.0, 0.0, 0.0]
     axis[int(np.argmin(np.abs(line)))] = 1.0
-    e = np.cross(line, axis)
-    e = e / np.linalg.norm(e)
-    f = np.cross(line, e)
-    return np.array([e, f / np.linalg.norm(f)])
+    e = _cross(l0, l1, l2, *axis)
+    e = e / _norm(e)
+    f = _cross(l0, l1, l2, *e.tolist())
+    return np.array([e, f / _norm(f)])
+
+
+def _cross(a0: float, a1: float, a2: float, b0: float, b1: float, b2: float) -> np.ndarray:
+    """``np.cross`` of two 3-vectors given by their components: the same products and differences."""
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 def _polish(c1: np.ndarray, c2: np.ndarray, x: np.ndarray, steps: int = 2) -> np.ndarray:
@@ -245,7 +276,7 @@ def _polish(c1: np.ndarray, c2: np.ndarray, x: np.ndarray, steps: int = 2) -> np
         except np.linalg.LinAlgError:  # tangential intersection: keep the unpolished point
             return x
         x = x + step
-        x = x / np.linalg.norm(x)
+        x = x / _norm(x)
     return x
 
 
@@ -289,13 +320,13 @@ def solve_at_kappa(basis4: np.ndarray, kappa: float) -> list[np.ndarray]:
         The four eigenvectors of the smallest eigenvalues.
     kappa : float
     """
-    s1, s2 = side_condition_forms()
+    s1, s2 = _FORMS
     chart = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [kappa, 0.0, 0.0]])
     lift = basis4 @ chart  # (8, 3): p = lift @ (alpha, beta, gamma)
     out = []
     for x in conic_intersections(lift.T @ s1 @ lift, lift.T @ s2 @ lift):
         p = lift @ x
-        out.append(p / np.linalg.norm(p))
+        out.append(p / _norm(p))
     return out
 
 
