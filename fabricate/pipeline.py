@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from fabricate import __version__, cache, stage_keys
+from fabricate import cache, stage_keys
 from fabricate.arguments import path_argument, type_name
 from fabricate.background import Background, in_thread
 from fabricate.bounds import blas_threads
@@ -24,6 +24,7 @@ from fabricate.kinds import KINDS
 from fabricate.mechanism import Mechanism, Motion
 from fabricate.report import SYNTH_ONLY, not_checked_notes, report_json, report_markdown
 from fabricate.report_schema import SCHEMA_VERSION
+from fabricate.report_sections import design_section, mechanism_section
 from fabricate.spec import DesignSpec
 from fabricate.synthesis.base import SynthesisResult
 
@@ -113,44 +114,6 @@ def _quiet(_: str) -> None:
     pass
 
 
-def design_section(design: DesignSpec, stage: str) -> dict[str, Any]:
-    # the template's file name only: a folder in the report would make its bytes depend on where the
-    # build ran (the template itself is embedded as template_text)
-    section: dict[str, Any] = {"name": design.name, "kind": design.kind, "template": Path(design.template).name,
-               "fabricate_version": __version__, "description": design.description,
-               "process": design.process.name, "stage": stage}
-    if design.process.printer:  # the printer the plates are packed for (fabricate.catalogue.printers)
-        from fabricate.catalogue.printers import printer
-
-        section["printer"] = {**printer(design.process.printer).report(),
-                              "first_layer_compensation_mm": design.process.first_layer_compensation_mm}
-    if design.process_override is not None:  # --process: check rebuilds with the same profile
-        section["process_override"] = {"source": design.process_override.source,
-                                       "text": design.process_override.text}
-        if design.process_override.printer:  # --printer
-            section["process_override"]["printer"] = design.process_override.printer
-    return section
-
-
-def mechanism_section(mechanism: Mechanism, motion: Motion) -> dict[str, Any]:
-    """report.json's ``mechanism`` section (fabricate/report_schema.json): every named point at the first
-    pose, bodies with their points."""
-    joints = {}
-    for body in mechanism.bodies:
-        for name in body.points:
-            if name not in joints:
-                joints[name] = motion.point(name, body.name)[0]
-    return {
-        "joints": {k: [float(v[0]), float(v[1])] for k, v in joints.items()},
-        "bodies": {b.name: list(b.points) for b in mechanism.bodies},
-        "input_range_deg": [float(mechanism.input_range[0]), float(mechanism.input_range[1])],
-        "input_unit": mechanism.input_unit,
-        "ground": mechanism.ground,
-        "degrees_of_freedom": mechanism.degrees_of_freedom(),
-        "drivers": len(mechanism.drivers),
-    }
-
-
 def synthesise(design: DesignSpec, progress: Progress = _quiet) -> SynthesisResult:
     progress(f"synthesis ({design.kind})")
     return KINDS[design.kind].synthesise(design)
@@ -230,6 +193,7 @@ class BuildRun:
     report: dict[str, Any]
     progress: Progress = _quiet
     optional: OptionalOutputs | None = None
+    report_only: bool = False  # no pictures, plots or STEP files (:func:`run_build`)
     given: DesignSpec | None = None  # the design the caller gave (the outcome's); None: ``design``
     stage: str = "gears"
     files: dict[str, bytes] = field(default_factory=dict)
@@ -268,10 +232,14 @@ def _kernel_failures() -> tuple[type[BaseException], ...]:
 
 @blas_threads()  # one BLAS thread (fabricate.bounds.blas_threads: a whole build with two took 3x the CPU)
 def run_build(design: DesignSpec, progress: Progress = _quiet, *,
-              optional: OptionalOutputs | None = None) -> BuildOutcome:
+              optional: OptionalOutputs | None = None, report_only: bool = False) -> BuildOutcome:
     """The whole pipeline in memory.
 
     ``optional`` fixes the optional outputs (STEP) instead of making what this install can make.
+    ``report_only`` leaves out the files no report key is computed from: the pictures (synthesis and gear plots,
+    previews, the assembly guide's), the STEP files and the strength, drive and clearance plots. Every section of
+    its report is the full build's but ``files`` and ``manifest`` (the files it made) and ``outputs`` (STEP
+    "skipped"): for a sweep point, which keeps its report's numbers only.
 
     A geometry or numeric kernel failing after synthesis (GEOS, manifold, a singular matrix) is a design
     failure named in the report with the stage it happened in (exit code 1), never a bare exception.
@@ -281,7 +249,7 @@ def run_build(design: DesignSpec, progress: Progress = _quiet, *,
     SpecError, SynthesisError
         Invalid input or nothing feasible (the CLI exits 2 and writes nothing).
     """
-    if (optional is None or (optional.step and optional.step_files is None)) and \
+    if not report_only and (optional is None or (optional.step and optional.step_files is None)) and \
             not cache.stored("step", stage_keys.pictures_key(design, "step")):  # a stored STEP result needs no OCP
         from fabricate.export import prestart_step
 
@@ -290,7 +258,7 @@ def run_build(design: DesignSpec, progress: Progress = _quiet, *,
     if motion is None:
         report["checks"] = {"passed": False, "failures": failures}
         return _finish(design, report, {}, exit_code=1, synthesis=result)
-    run = BuildRun(design, result, motion, report, progress, optional)
+    run = BuildRun(design, result, motion, report, progress, optional, report_only)
     try:
         return _build_stages(run)
     except (SpecError, SynthesisError):
@@ -311,13 +279,13 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
     if run.design.parts.link_width_mm == "auto":
         _size_links(run)
     _make_parts(run)
-    if not cache.stored("previews", stage_keys.pictures_key(run.design, "previews")):
+    if not run.report_only and not cache.stored("previews", stage_keys.pictures_key(run.design, "previews")):
         # the child and this process both draw: matplotlib imported once, here, is the child's too
         from fabricate.plotting import load_agg
 
         load_agg()
     # pictures take as long as everything else: draw them in a forked child on the second core
-    pictures = Background(_picture_jobs(run))
+    pictures = None if run.report_only else Background(_picture_jobs(run))
     try:
         # inside the try: this may import OCP (slow), and a stop signal landing here must cancel the child
         with_step = _record_optional_outputs(run)
@@ -326,9 +294,11 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
         _check_strength(run)
         _check_drive(run)
         _verdict(run)
-        _plots(run, pictures)
+        if pictures is not None:
+            _plots(run, pictures)
     finally:
-        pictures.cancel()
+        if pictures is not None:
+            pictures.cancel()
     assert run.given is not None  # set in __post_init__
     return _finish(run.given, run.report, run.files, exit_code=0 if not run.failures else 1,
                    synthesis=run.synthesis, motion=run.motion, partset=run.partset, gear_pairs=run.gear_pairs,
@@ -413,8 +383,10 @@ def _record_optional_outputs(run: BuildRun) -> bool:
     run.report["notes"] = [] if with_step else [STEP_SKIPPED]
     # optional outputs as written or skipped: `check` rebuilds with the same set, so its verdict does not
     # depend on the checker's install (fabricate/verify.py)
-    run.report["outputs"] = {"step": "written" if with_step else "skipped: OCP is not installed (extra 'cad')"}
-    return with_step
+    run.report["outputs"] = {"step": "written" if with_step and not run.report_only else
+                             "skipped: a report-only build (a sweep point)" if with_step else
+                             "skipped: OCP is not installed (extra 'cad')"}
+    return with_step  # the exports name the STEP files a full build writes: a report-only one's parts are the same
 
 
 def _export(run: BuildRun, with_step: bool) -> None:

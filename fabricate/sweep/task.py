@@ -1,8 +1,10 @@
 """One sweep point, and a batch of them: what a Dask task runs (no Dask in here).
 
-A point is a template like any other: it is validated, synthesised (``stage = "synth"``) or built in full
-(``"build"``), and its report's metrics are read. Whatever happens, the point becomes a row; a bad point is a
-row with its exit code and reason, never an exception out of the task.
+A point is a template like any other: it is validated, synthesised (``stage = "synth"``) or built (``"build"``),
+and its report's metrics are read. A build point makes its report only (``run_build``'s ``report_only``: no
+pictures, plots or STEP files, whose bytes no metric reads), unless a metric reads the list of files
+(:data:`FILE_SECTIONS`); the best points are built again in full (:func:`build_point`). Whatever happens, the
+point becomes a row; a bad point is a row with its exit code and reason, never an exception out of the task.
 
 Points that differ only in fields synthesis does not read (:func:`synthesis_group`) share its result: a batch
 runs with the in-process layer of the stage cache (:mod:`fabricate.cache`, never its disk layer), which lives as
@@ -31,6 +33,17 @@ EXIT_OK, EXIT_FAILED, EXIT_INVALID, EXIT_INTERNAL = 0, 1, 2, 3
 #: Template tables synthesis never reads (:func:`fabricate.stage_keys.synthesis_key`): a point that varies only fields
 #: in these (and ``[checks]`` but its ``sweep_poses``) shares the synthesis of the other points of its group.
 NOT_SYNTHESIS_TABLES = frozenset({"process", "parts", "load"})
+
+#: Report sections where a report-only build (:func:`fabricate.pipeline.run_build`) differs from a full one: the
+#: files it made (``files``, ``manifest``) and its STEP files "skipped" (``outputs``). Every other section is the
+#: full build's; a build sweep with a metric under one of these builds its points in full.
+FILE_SECTIONS = frozenset({"files", "manifest", "outputs"})
+
+
+def report_only(metrics: Sequence[Metric]) -> bool:
+    """Whether a build point's report-only build gives the same ``metrics`` as a full build (none reads a file
+    list)."""
+    return not any(m.section in FILE_SECTIONS for m in metrics)
 
 
 def synthesis_group(fields: Sequence[tuple[str, Sequence[str | int]]], values: Mapping[str, Any]) -> str:
@@ -86,8 +99,8 @@ def _reason(exc: BaseException) -> str:
     return " ".join(str(exc).split())[:2000]
 
 
-def evaluate(text: str, stage: str) -> tuple[int, str, dict[str, Any] | None, Any]:
-    """Validate and run one template text.
+def evaluate(text: str, stage: str, *, lean: bool = False) -> tuple[int, str, dict[str, Any] | None, Any]:
+    """Validate and run one template text (``lean``: a build makes its report only, see :func:`report_only`).
 
     Returns
     -------
@@ -100,7 +113,7 @@ def evaluate(text: str, stage: str) -> tuple[int, str, dict[str, Any] | None, An
 
     try:
         design = design_from_text(text, "point.toml")
-        outcome = (run_build if stage == "build" else run_synth)(design)
+        outcome = run_build(design, report_only=lean) if stage == "build" else run_synth(design)
     except FabricateError as exc:
         return EXIT_INVALID, _reason(exc), None, None
     except MemoryError:
@@ -129,7 +142,7 @@ def run_point(index: int, values: Mapping[str, Any], pid: str, base: Mapping[str
     except (KeyError, TypeError, ValueError) as exc:  # the spec was checked; a value TOML cannot hold
         code, reason, report = EXIT_INVALID, f"cannot write this point's template: {_reason(exc)}", None
     else:
-        code, reason, report, _ = evaluate(text, stage)
+        code, reason, report, _ = evaluate(text, stage, lean=report_only(metrics))
     row: dict[str, Any] = {"point": int(index), "id": pid}
     row.update(values)
     row["exit_code"] = int(code)

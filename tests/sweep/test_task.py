@@ -3,6 +3,8 @@ never one that passed only because nothing was checked."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from fabricate.sweep.task import EXIT_OK, evaluate
@@ -108,3 +110,74 @@ def test_a_build_sweep_synthesises_a_shared_synthesis_once_and_gives_the_same_ro
     assert shared[1] == separate
     name = "min(strength.parts[*].min_safety_factor)"
     assert shared[0][name] > shared[1][name] > 0.0
+
+
+# -- a build point makes its report only (issue 27, item 4) ---------------------------------------------------
+
+#: Metrics over every report section a build sweep may read (FILE_SECTIONS aside).
+BUILD_METRICS = ["synthesis.center_distance_mm", "mechanism.degrees_of_freedom",
+                 "max(gears[*].transmission_error_deg)", "count(parts[*])", "sum(parts[*].volume_mm3)",
+                 "max(parts[*].stl_volume_mm3)", "count(parts[*].step)", "count(bom[*])", "count(hardware.pins[*])",
+                 "count(assembly.steps[*])", "count(simulation.joints[*])", "interference.min_clearance_mm",
+                 "min(interference.pairs[*].min_clearance_mm)", "min(strength.parts[*].min_safety_factor)",
+                 "drive.margin", "checks.passed", "count(checks.failures[*])", "count(notes[*])"]
+
+
+@pytest.mark.slow
+def test_a_build_points_row_is_read_from_a_report_only_build_with_the_full_builds_values(
+        shipped_build, monkeypatch) -> None:
+    """A point that is the shipped elliptic pair (its eccentricity varied over its own value) gives, bit for bit,
+    the metrics of the pair's full build, read from a report-only build (the row's path: no picture, plot or STEP
+    file made)."""
+    import fabricate.pipeline as pipeline
+    from fabricate.sweep.spec import sweep_from_tables
+    from fabricate.sweep.task import run_point
+
+    full = shipped_build("gear_pair_elliptic").report
+    spec = sweep_from_tables({"sweep": {"template": "gear_pair_elliptic", "stage": "build", "metrics": BUILD_METRICS},
+                              "vary": {"gear_pair.eccentricity": [0.2]}})
+    made = []
+    real = pipeline.run_build
+
+    def spy(*args, **kwargs):
+        outcome = real(*args, **kwargs)
+        made.append((kwargs.get("report_only"), sorted(outcome.files)))
+        return outcome
+
+    monkeypatch.setattr(pipeline, "run_build", spy)
+    (values,) = spec.points()
+    row = run_point(0, values, spec.point_id(values), spec.base, spec.field_parts(), "build", list(spec.metrics))
+    ((lean, files),) = made
+    assert lean is True and not [f for f in files if f.endswith((".png", ".gif", ".step"))]
+    assert row["exit_code"] == (0 if full["checks"]["passed"] else 1)
+    for m in spec.metrics:
+        want = m.read(full)
+        assert row[m.name] == want or (math.isnan(want) and math.isnan(row[m.name])), m.name
+    assert not math.isnan(row["min(strength.parts[*].min_safety_factor)"])  # the metrics read real values
+    assert row["count(parts[*])"] >= 4
+
+
+@pytest.mark.parametrize(("metric", "lean"), [("interference.min_clearance_mm", True), ("count(files[*])", False),
+                                              ("sum(manifest[*].bytes)", False), ("count(outputs.step)", False)])
+def test_a_build_point_is_built_in_full_only_when_a_metric_reads_the_file_lists(metric, lean, monkeypatch) -> None:
+    """``files``, ``manifest`` and ``outputs`` are where a report-only build differs: a metric under one of them
+    makes the point a full build (its value as a full build's), any other a report-only one."""
+    import fabricate.pipeline as pipeline
+    from fabricate.errors import SpecError
+    from fabricate.sweep.spec import sweep_from_tables
+    from fabricate.sweep.task import EXIT_INVALID, report_only, run_point
+
+    asked = []
+
+    def stub(design, *args, **kwargs):  # no build: only how the point asked for one
+        asked.append(kwargs.get("report_only", False))
+        raise SpecError("stub", "not built")
+
+    monkeypatch.setattr(pipeline, "run_build", stub)
+    spec = sweep_from_tables({"sweep": {"template": "gear_pair_elliptic", "stage": "build",
+                                        "metrics": ["synthesis.center_distance_mm", metric]},
+                              "vary": {"gear_pair.eccentricity": [0.2]}})
+    assert report_only(spec.metrics) is lean
+    (values,) = spec.points()
+    row = run_point(0, values, spec.point_id(values), spec.base, spec.field_parts(), "build", list(spec.metrics))
+    assert row["exit_code"] == EXIT_INVALID and asked == [lean]
