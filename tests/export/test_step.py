@@ -194,11 +194,16 @@ def test_step_problems_names_a_wrong_volume_and_hole_count() -> None:
 
 # ---------------------------------------------------------------------------------------- determinism
 
+#: The child builds the parts as a build does (``report_only``: no pictures) and writes their STEP files with the
+#: function the build's STEP job calls (fabricate/pipeline.py ``step_files``); a whole build's previews and plots
+#: would be a third of its time. The parent's side is the session's whole build.
 _DIGEST = """
 import hashlib, sys
-from fabricate.pipeline import run_build
 from fabricate.design import load_design
-files = run_build(load_design(sys.argv[1])).files
+from fabricate.export import export_step
+from fabricate.pipeline import run_build
+outcome = run_build(load_design(sys.argv[1]), report_only=True)
+files = export_step(outcome.design, outcome.partset, outcome.motion)
 for path in sorted(p for p in files if p.endswith(".step")):
     print(path, hashlib.sha256(files[path]).hexdigest())
 """
