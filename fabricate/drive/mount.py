@@ -40,6 +40,20 @@ class _Plate:
     solids: list[geo.Solid] = field(default_factory=list)
 
 
+def _off(region: Any, pts: np.ndarray) -> np.ndarray:
+    """Which of ``pts`` (m, 2) are at a distance over 0 from ``region``: ``shapely.distance(region, points) > 0``,
+    the exact distance taken only for the points a prepared ``dwithin`` finds within 1e-6 mm (~40x faster on
+    the finger's 10000 grid points; the others are over 0 whatever rounding the distance has)."""
+    points = shapely.points(pts)
+    if region.is_empty:  # distance is NaN: no point is off it (dwithin would keep every one)
+        return np.asarray(shapely.distance(region, points) > 0.0)
+    shapely.prepare(region)  # a spatial index on the geometry itself: its values do not change
+    near = shapely.dwithin(region, points, 1e-6)
+    off = ~near
+    off[near] = shapely.distance(region, points[near]) > 0.0
+    return off
+
+
 class MountPlacement:
     """The mount plate and standoffs of a rotary actuator (a mixin: see the module docstring)."""
 
@@ -287,7 +301,7 @@ class MountPlacement:
                                    for h in ground.holes]) if ground.holes else shapely.Polygon()
         blocked = shapely.union_all([keep_out, taken])
         pts = pts[~shapely.contains_xy(blocked, pts[:, 0], pts[:, 1])]
-        pts = pts[shapely.distance(blocked, shapely.points(pts)) > 0.0]
+        pts = pts[_off(blocked, pts)]
         order = np.argsort(shapely.distance(body, shapely.points(pts)))
         sites: list[np.ndarray] = []
         arms: list[np.ndarray] = []

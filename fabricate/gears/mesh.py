@@ -171,7 +171,12 @@ def _flank_points_per_step(pair: GearPair) -> int:
 
 def _free_play(pair: GearPair, x_a: np.ndarray, tables: tuple[np.ndarray, ...], return_contacts: bool
                ) -> tuple[np.ndarray, ...]:
-    """:func:`free_play` with its flank tables made (:func:`_flank_tables`)."""
+    """:func:`free_play` with its flank tables made (:func:`_flank_tables`).
+
+    Every value is per point, so only the flank pairs in mesh are posed and only their points within gear b's
+    flank's radii are looked up (compressed arrays, ~1/3 of the window's points for the finger): the others
+    would only be set to inf. The same operations on the same values: the same bits as the full arrays.
+    """
     pitch = pair.pitch_model
     p = np.pi * pair.module
     s = pitch.s_of_x(x_a)
@@ -188,19 +193,21 @@ def _free_play(pair: GearPair, x_a: np.ndarray, tables: tuple[np.ndarray, ...], 
     ok = (ra >= 0) & (ra < len(table_a)) & (rb >= 0) & (rb < len(table_b))
     ra, rb = np.where(ok, ra, 0), np.where(ok, rb, 0)
     ok &= present_a[ra] & present_b[rb]
-    pts = table_a[ra]  # (n, J, K, 2) in gear a's frame
+    pairs = np.flatnonzero(ok)  # (F,) flank pairs in mesh, into the (n, J) window
+    step, row = pairs // count, rb.ravel()[pairs]
+    pts = table_a[ra.ravel()[pairs]]  # (F, K, 2) in gear a's frame
     # gear-a frame -> carrier -> gear-b frame: q = R(-theta_b) (R(x_a) g - (a, 0))
-    ang = (x_a - theta_b)[:, None, None]
-    c, sn = np.cos(ang), np.sin(ang)
-    cb, sb = np.cos(theta_b)[:, None, None], np.sin(theta_b)[:, None, None]
+    ang = x_a - theta_b
+    c, sn = np.cos(ang)[step, None], np.sin(ang)[step, None]
+    cb, sb = np.cos(theta_b)[step, None], np.sin(theta_b)[step, None]
     a = pair.center_distance_mm
     qx = c * pts[..., 0] - sn * pts[..., 1] - a * cb
     qy = sn * pts[..., 0] + c * pts[..., 1] + a * sb
     rho = np.hypot(qx, qy)
-    phi = np.arctan2(qy, qx)
-    lo_r, hi_r = range_b[rb][..., 0:1], range_b[rb][..., 1:2]
-    inside = (rho >= lo_r) & (rho <= hi_r) & ok[..., None] & np.isfinite(rho)
-    key = np.where(inside, rho, lo_r) + rb[..., None] * 1e6
+    inside = (rho >= range_b[row][:, 0:1]) & (rho <= range_b[row][:, 1:2]) & np.isfinite(rho)
+    at = np.flatnonzero(inside)  # (P,) points within their gear-b flank's radii, into (F, K)
+    flank = at // pts.shape[1]
+    key = rho.ravel()[at] + row[flank] * 1e6
     idx = np.clip(np.searchsorted(key_b, key), 1, len(key_b) - 1)
     # a point exactly at a row's lowest radius lands on that row's first key, whose left neighbour is the
     # previous row: interpolate from that key to the next instead (w = 0 gives its angle)
@@ -209,15 +216,18 @@ def _free_play(pair: GearPair, x_a: np.ndarray, tables: tuple[np.ndarray, ...], 
     w = np.clip((key - k0) / np.where(k1 > k0, k1 - k0, 1.0), 0.0, 1.0)
     phi_on_b = phi_b[idx - 1] + w * (phi_b[idx] - phi_b[idx - 1])
     # the interpolation must stay within row rb (the keys of one row are rb*1e6 + radius)
-    same_row = (np.floor(k0 / 1e6) == rb[..., None]) & (np.floor(k1 / 1e6) == rb[..., None])
-    inside &= same_row & np.isfinite(phi_on_b)
-    gap = (phi - phi_on_b + np.pi) % (2 * np.pi) - np.pi
+    keep = (np.floor(k0 / 1e6) == row[flank]) & (np.floor(k1 / 1e6) == row[flank]) & np.isfinite(phi_on_b)
+    at, flank, phi_on_b = at[keep], flank[keep], phi_on_b[keep]
+    gap = (np.arctan2(qy.ravel()[at], qx.ravel()[at]) - phi_on_b + np.pi) % (2 * np.pi) - np.pi
     # even flanks: left flank of an a tooth, gear-b material on the -u side; turning b positively
     # moves its material towards +u, closing these gaps (odd flanks: the reverse)
-    sign = np.where(j % 2 == 0, 1.0, -1.0)[..., None]
-    gap = np.where(inside, sign * gap, np.inf)
-    per_flank = gap.min(axis=2)
     even = (j % 2 == 0)
+    gap = np.where(even.ravel()[pairs][flank], gap, -gap)
+    # each flank pair's least gap (its points are contiguous in ``at``); inf where none is inside
+    per_flank = np.full(ok.shape, np.inf)
+    if len(gap):
+        starts = np.flatnonzero(np.r_[True, flank[1:] != flank[:-1]])
+        per_flank.ravel()[pairs[flank[starts]]] = np.minimum.reduceat(gap, starts)
     plus = np.where(even, per_flank, np.inf).min(axis=1)
     minus = np.where(~even, per_flank, np.inf).min(axis=1)
     # driving flank pairs touching together (within CONTACT_TOLERANCE_RAD of the closest): the teeth in contact.

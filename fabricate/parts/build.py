@@ -537,13 +537,16 @@ def _add_mounting(mechanism: Mechanism, motion: Motion, ground: str,
     steps = np.arange(0.0, 400.0, 0.5)
     centres = (base[None, None, :] + steps[:, None, None] * direction
                + offsets[None, :, None] * side[None, None, :])
-    if swept.is_empty:
-        chosen = centres[0]
-    else:
-        gaps = shapely.distance(shapely.points(centres.reshape(-1, 2)), swept).reshape(len(steps), count)
-        # +0.5 mm: the region is sampled at discrete poses; parts move a little between them
+    chosen = centres[0] if swept.is_empty else centres[-1]
+    # +0.5 mm: the region is sampled at discrete poses; parts move a little between them. Rows in batches of
+    # 16, nearest first: the first row that clears is usually within the first batch (~50x less distance work)
+    for first in range(0, len(steps) if not swept.is_empty else 0, 16):
+        batch = centres[first:first + 16]
+        gaps = shapely.distance(shapely.points(batch.reshape(-1, 2)), swept).reshape(len(batch), count)
         ok = np.all(gaps >= r_mount + clearance_mm + 0.5, axis=1)
-        chosen = centres[int(np.argmax(ok))] if ok.any() else centres[-1]
+        if ok.any():
+            chosen = batch[int(np.argmax(ok))]
+            break
     for k, centre in enumerate(chosen):
         holes[ground].append(Hole(f"mount_{k + 1}", centre, sizes.mount_hole_mm, 0.0, "clearance",
                                   sizes.mount_nominal_mm))

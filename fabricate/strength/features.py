@@ -440,7 +440,11 @@ def local_radius(points: np.ndarray, at: np.ndarray) -> np.ndarray:
     # poses of a 3000-vertex pitch curve (each row's argmin is its own, so the chunk size changes nothing)
     at = np.asarray(at, dtype=np.float64).reshape(-1, 2)
     chunk = max(1, NEAREST_VALUES_PER_CHUNK // max(1, len(p)))
-    nearest = np.concatenate([np.argmin(np.sum((p[None, :, :] - at[i:i + chunk, None, :]) ** 2, axis=2), axis=1)
+    # dx * dx + dy * dy: the bits np.sum(d ** 2, axis=2) gives, without its (chunk, vertices, 2) temporaries and
+    # its slow reduction over an axis of 2 (~4x faster)
+    px, py = p[:, 0], p[:, 1]
+    nearest = np.concatenate([np.argmin(np.square(px[None, :] - at[i:i + chunk, 0:1])
+                                        + np.square(py[None, :] - at[i:i + chunk, 1:2]), axis=1)
                               for i in range(0, len(at), chunk)] or [np.zeros(0, dtype=np.intp)])
     nearest_radius: np.ndarray = radius[nearest]
     return nearest_radius
