@@ -3,6 +3,7 @@ that LibreCAD draws and FreeCAD reads at their true value, and text that prints 
 
 from __future__ import annotations
 
+import functools
 import io
 import itertools
 import math
@@ -29,16 +30,24 @@ def crowded() -> tuple[SimpleNamespace, dict[str, np.ndarray]]:
     return SimpleNamespace(bodies=bodies, joints=joints), poses
 
 
-def drawings():
-    mech = make_four_bar()
-    yield "four_bar", kinematic_dxf(mech, mech.sweep(5).poses_at(2))
-    yield "crowded", kinematic_dxf(*crowded())
+DRAWINGS = ("four_bar", "crowded")
 
 
-@pytest.mark.parametrize(("name", "data"), list(drawings()))
-def test_no_two_labels_or_a_label_and_dimension_text_overlap(name, data):
+@functools.cache
+def drawing(name: str) -> bytes:
+    """Drawing ``name`` of :data:`DRAWINGS`, made when a test first asks (at collection, every worker made each
+    twice, ~0.6 s of CPU, whether or not it ran these tests)."""
+    if name == "four_bar":
+        mech = make_four_bar()
+        return kinematic_dxf(mech, mech.sweep(5).poses_at(2))
+    return kinematic_dxf(*crowded())
+
+
+@pytest.mark.parametrize("name", DRAWINGS)
+def test_no_two_labels_or_a_label_and_dimension_text_overlap(name):
     """Each label's box (ezdxf's font metrics, read back from the file) meets no other label's box and no
     dimension's text; a label standing off its point has a leader line from the point to it."""
+    data = drawing(name)
     msp = ezdxf.read(io.StringIO(data.decode())).modelspace()
     labels = {t.dxf.text: text_box(t) for t in msp.query('TEXT[layer=="LABELS"]')}
     dims = [box for d in msp.query("DIMENSION") for box in dimension_text_boxes(d)]
@@ -74,11 +83,12 @@ def freecad_distance(dim) -> float:
     return float(np.hypot(*(p2 - p1)))
 
 
-@pytest.mark.parametrize(("name", "data"), list(drawings()))
-def test_every_dimension_measures_its_true_value(name, data):
+@pytest.mark.parametrize("name", DRAWINGS)
+def test_every_dimension_measures_its_true_value(name):
     """Every DIMENSION is linear or aligned (no ordinate: LibreCAD 2.2 does not draw them); its measurement
     read back with ezdxf and as FreeCAD's importer computes it equals the geometric distance: a link's length
     between its joints, or a joint's |x| or |y| from the origin."""
+    data = drawing(name)
     msp = ezdxf.read(io.StringIO(data.decode())).modelspace()
     joints = [np.array(c.dxf.center)[:2] for c in msp.query('CIRCLE[layer=="JOINTS"]')]
     links = {tuple(sorted(tuple(np.round(np.array(end)[:2], 9)) for end in (line.dxf.start, line.dxf.end)))
