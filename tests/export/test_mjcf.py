@@ -385,7 +385,7 @@ def test_mjcf_contacts_agree_with_the_interference_proof(shipped_build: Callable
 
 
 @pytest.mark.slow
-def test_mjcf_contacts_find_the_collision_of_the_24_mm_link_six_bar() -> None:
+def test_mjcf_contacts_find_the_collision_of_the_24_mm_link_six_bar(shared_stage_cache) -> None:
     """The Watt six-bar with 24 mm links: fabricate's interference check rejects it (the rocker runs into the
     spacer at d); MuJoCo's collision of the same meshes finds the same two parts in contact, and no penetration
     between convex parts fabricate proves clear. (At 14 mm the proximal link hit spacer_d0 until pressed pins
@@ -399,7 +399,9 @@ def test_mjcf_contacts_find_the_collision_of_the_24_mm_link_six_bar() -> None:
 
     text = find_template("finger_watt_six_bar").read_text(encoding="utf-8")
     text = re.sub(r"^link_width_mm\s*=.*$", "link_width_mm = 24.0", text, count=1, flags=re.M)
-    build = run_build(design_from_text(text, "finger_watt_six_bar.toml"))
+    # the six-bar's synthesis (~1.8 s; its key leaves [parts] out) from the session's build of the template
+    with shared_stage_cache():
+        build = run_build(design_from_text(text, "finger_watt_six_bar.toml"))
     assert build.motion is not None
     collisions = build.report["interference"]["collisions"]
     assert collisions
