@@ -200,7 +200,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     n_workers = tasks = 0
     points_seconds = worker_cpu = 0.0
     if todo:  # a cluster that cannot be had is a usage error: nothing is written
-        client, cluster, n_workers = _start_cluster(workers, scheduler)
+        client, cluster, n_workers = _start_cluster(workers, scheduler, spec.stage)
     out.mkdir(parents=True, exist_ok=True)
     write_file(out / SWEEP_JSON, _json(sweep_record(spec, {"points": len(points), "done": resumed, "complete": False})))
     journal = Journal(out / JOURNAL)
@@ -243,13 +243,13 @@ def _journal_rows(out: Path, spec: SweepSpec, by_id: Mapping[str, int]) -> dict[
             if pid in by_id and row["exit_code"] != EXIT_INTERNAL}
 
 
-def _start_cluster(workers: int | None, scheduler: str | None) -> tuple[Any, Any, int]:
-    """Client and (local) cluster with their workers up and warm, and how many workers; closed again when that
-    fails."""
+def _start_cluster(workers: int | None, scheduler: str | None, stage: str) -> tuple[Any, Any, int]:
+    """Client and (local) cluster with their workers up and warm for ``stage``'s points, and how many workers;
+    closed again when that fails."""
     client, cluster = connect(workers, scheduler)
     try:
         n_workers = _wait_for_workers(client, scheduler)
-        _warm(client)
+        _warm(client, stage)
     except BaseException:
         _close(client, cluster)
         raise
@@ -316,10 +316,10 @@ def _wait_for_workers(client: Any, scheduler: str | None) -> int:
         time.sleep(0.2)
 
 
-def _warm(client: Any) -> None:
-    """Every worker imports the pipeline now, side by side, instead of in its first point."""
+def _warm(client: Any, stage: str) -> None:
+    """Every worker imports what a point of ``stage`` runs now, side by side, instead of in its first point."""
     try:
-        client.run(warm)
+        client.run(warm, stage)
     except Exception:  # noqa: BLE001 - a worker that cannot run it will show why in its first point
         pass
 

@@ -2,10 +2,12 @@
 build sweep, side by side in one run.
 
     pip install -e ".[test]"          # dask distributed and pyarrow are in the test extra (and the sweep one)
-    python tests/benchmarks/bench_sweep.py [--stage synth|build|both] [--points N] [--overhead]
+    python tests/benchmarks/bench_sweep.py [--stage synth|build|both] [--points N] [--overhead] [--full]
 
 The sweeps vary the elliptic gear pair's eccentricity (``gear_pair_elliptic``, 60 poses): every point has its own
-synthesis. Rows, for each stage:
+synthesis. A build point makes its report only (no pictures, plots or STEP files: ``run_build``'s ``report_only``);
+``--full`` adds a metric that reads the file list (``count(files[*])``), so every point is built in full, as a build
+sweep's points were before. Rows, for each stage:
 
 - in-process: the points run one after the other in this process (``run_point``), no Dask: the floor;
 - Dask, 1 worker / 2 workers: ``run_sweep`` on a LocalCluster. ``points/s`` counts the points' own wall time
@@ -41,12 +43,17 @@ CORES: list[str] = []
 DEFAULT_POINTS = {"synth": 48, "build": 16}
 
 
+#: ``--full``: every build point built in full (a metric reading the file list), not report-only.
+FULL = False
+
+
 def _spec(points: int, stage: str, batch_seconds: float) -> Any:
     import numpy as np
 
     from fabricate.sweep.spec import sweep_from_tables
 
-    metrics = ["synthesis.center_distance_mm"] + (["interference.min_clearance_mm"] if stage == "build" else [])
+    metrics = ["synthesis.center_distance_mm"] + (["interference.min_clearance_mm"] if stage == "build" else []) \
+        + (["count(files[*])"] if stage == "build" and FULL else [])
     return sweep_from_tables({
         "sweep": {"template": "gear_pair_elliptic", "stage": stage, "name": "bench",
                   "metrics": metrics, "batch_seconds": batch_seconds},
@@ -130,10 +137,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--stage", choices=("synth", "build", "both"), default="both")
     parser.add_argument("--points", type=int, help=f"points of each sweep (default {DEFAULT_POINTS})")
     parser.add_argument("--overhead", action="store_true", help="also the per-task cost and a no-op round trip")
+    parser.add_argument("--full", action="store_true", help="build points in full (pictures, plots, STEP files)")
     args = parser.parse_args(argv)
+    global FULL
+    FULL = args.full
     stages = ("synth", "build") if args.stage == "both" else (args.stage,)
     print(f"cores available: {len(os.sched_getaffinity(0)) if hasattr(os, 'sched_getaffinity') else os.cpu_count()}"
           f", load average before: {_load()}\n")
+    print(f"build points: {'in full (--full)' if args.full else 'report only'}")
     print("| stage | points | run | points' s | command s | main CPU s | points/s per worker | ratio | load after |\n"
           "|---|---:|---|---:|---:|---:|---:|---|---:|")
     for stage in stages:

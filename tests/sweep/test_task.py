@@ -181,3 +181,14 @@ def test_a_build_point_is_built_in_full_only_when_a_metric_reads_the_file_lists(
     (values,) = spec.points()
     row = run_point(0, values, spec.point_id(values), spec.base, spec.field_parts(), "build", list(spec.metrics))
     assert row["exit_code"] == EXIT_INVALID and asked == [lean]
+
+
+def test_a_build_worker_warms_up_with_modules_that_exist() -> None:
+    """The runner's warm-up swallows a failure (the worker's first point would say why): a module renamed away
+    must fail here instead of silently leaving the imports to the first point."""
+    import sys
+
+    from fabricate.sweep.task import BUILD_MODULES, POINT_MODULES, warm
+
+    warm("build")
+    assert all(name in sys.modules for name in POINT_MODULES + BUILD_MODULES)
