@@ -48,8 +48,8 @@ def _off(region: Any, pts: np.ndarray) -> np.ndarray:
     if region.is_empty:  # distance is NaN: no point is off it (dwithin would keep every one)
         return np.asarray(shapely.distance(region, points) > 0.0)
     shapely.prepare(region)  # a spatial index on the geometry itself: its values do not change
-    near = shapely.dwithin(region, points, 1e-6)
-    off = ~near
+    near = np.asarray(shapely.dwithin(region, points, 1e-6), dtype=bool)
+    off: np.ndarray = ~near
     off[near] = shapely.distance(region, points[near]) > 0.0
     return off
 
