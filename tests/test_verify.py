@@ -73,23 +73,35 @@ _VERDICTS: dict[tuple, list[str]] = {}
 
 
 @pytest.fixture(autouse=True)
-def _one_reading_per_file(monkeypatch):
+def _one_reading_per_file(monkeypatch, tmp_path_factory):
     """Reading the files back is most of a check's time once its rebuild is kept (STEP with OCP ~2.5 s a
     folder, the meshes, drawings and pictures ~1 s more); a tampering of one file leaves the others as they
     were, so each file's verdict (a function of its name, bytes and expectation, and of whether OCP is there to
     read STEP) is kept by content hash, as test_verify_fuzz does. A changed file has another hash and is read
-    for real."""
+    for real. The verdicts are shared by the session's workers (a file per key in the session's folder, made under
+    a lock by the first to ask): both read the same untouched folder, STEP files and all."""
     import hashlib
 
     import fabricate.export.step as step
     import fabricate.verify_files as verify_files
+    from tests.conftest import locked, session_folder
 
     real = verify_files.content_problems
+    shared = session_folder(tmp_path_factory) / "test-verify-verdicts"
+    shared.mkdir(exist_ok=True)
 
     def cached(rel, data, expected):
         key = (rel, hashlib.sha256(data).hexdigest(), repr(expected), step.step_available())
         if key not in _VERDICTS:
-            _VERDICTS[key] = real(rel, data, expected)
+            name = hashlib.sha256(repr(key).encode()).hexdigest()[:32]
+            path = shared / f"{name}.json"
+            with locked(shared / f"{name}.lock"):
+                if path.is_file():
+                    _VERDICTS[key] = json.loads(path.read_text(encoding="utf-8"))
+                else:
+                    _VERDICTS[key] = list(real(rel, data, expected))
+                    path.with_suffix(".part").write_text(json.dumps(_VERDICTS[key]), encoding="utf-8")
+                    path.with_suffix(".part").replace(path)
         return list(_VERDICTS[key])
 
     monkeypatch.setattr(verify_files, "content_problems", cached)
