@@ -145,6 +145,36 @@ _CUBIC_SAMPLES = np.array([-1.0, 0.0, 1.0, 2.0])
 #: Maps det(c1 + t c2) at the four samples to the cubic's coefficients (highest power first).
 _CUBIC_FIT = np.linalg.inv(np.vander(_CUBIC_SAMPLES, 4))
 
+# Batching. The solver below works on stacks: many conic pairs (all kappa samples of a trace), many lines,
+# many points at once, so numpy's per-call overhead is paid once per stack instead of once per sample. Each
+# stacked call is one that numpy evaluates matrix by matrix with the same kernel a single call uses
+# (np.matmul: one BLAS gemm/gemv/dot per matrix; np.linalg det/eigvals/eigh/solve: one LAPACK call per matrix)
+# or element by element (ufuncs), so every sample's result is the same bits as solving it alone.
+
+
+def _dots(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Row-wise ``x[i] @ y[i]`` of (k, n) arrays, each the 1-D dot product numpy computes for one pair."""
+    out: np.ndarray = np.matmul(x[:, None, :], y[:, :, None])[:, 0, 0]
+    return out
+
+
+def _norms(x: np.ndarray) -> np.ndarray:
+    """Row-wise ``np.linalg.norm`` of a (k, n) array: ``sqrt(x . x)`` as numpy computes it for one row."""
+    out: np.ndarray = np.sqrt(_dots(x, x))
+    return out
+
+
+def _vec_mat(x: np.ndarray, mats: np.ndarray) -> np.ndarray:
+    """Row-wise ``x[i] @ mats[i]`` (vector times matrix) of (k, 3) and (k, 3, 3)."""
+    out: np.ndarray = np.matmul(x[:, None, :], mats)[:, 0, :]
+    return out
+
+
+def _mat_vec(mats: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Row-wise ``mats[i] @ x[i]`` (matrix times vector) of (k, m, n) and (k, n)."""
+    out: np.ndarray = np.matmul(mats, x[:, :, None])[:, :, 0]
+    return out
+
 
 def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
     """Real intersection points of two conics ``x^T C x = 0`` in the projective plane.
@@ -166,45 +196,90 @@ def conic_intersections(c1: np.ndarray, c2: np.ndarray) -> list[np.ndarray]:
     ``c1``) in the roots of a quadratic. Each conic is normalised on its own, so the result does not depend
     on their scales.
     """
+    c1 = np.asarray(c1, dtype=np.float64)
+    c2 = np.asarray(c2, dtype=np.float64)
+    return _conic_intersections_many(c1[None], c2[None])[0]
+
+
+def _conic_intersections_many(c1s: np.ndarray, c2s: np.ndarray) -> list[list[np.ndarray]]:
+    """:func:`conic_intersections` of each pair of a stack (k, 3, 3), (k, 3, 3), solved together."""
     # each conic is only defined up to scale: normalise them separately, so that neither looks degenerate
-    c1, c2 = c1 / max(np.abs(c1).max(), 1e-300), c2 / max(np.abs(c2).max(), 1e-300)
+    c1s = c1s / np.maximum(np.abs(c1s).max(axis=(1, 2)), 1e-300)[:, None, None]
+    c2s = c2s / np.maximum(np.abs(c2s).max(axis=(1, 2)), 1e-300)[:, None, None]
     # the cubic through four exact samples of det(c1 + lam c2)
-    coefficients = _CUBIC_FIT @ np.linalg.det(c1[None] + _CUBIC_SAMPLES[:, None, None] * c2[None])
-    if abs(coefficients[0]) < 1e-14:  # c2 itself degenerate: it is the member at infinity
-        roots = np.concatenate([[np.inf], np.roots(coefficients)])
-    else:  # eigenvalues of the companion matrix (np.roots without its overhead)
-        lead = coefficients[0]
-        roots = np.linalg.eigvals(np.array([[-coefficients[1] / lead, -coefficients[2] / lead,
-                                             -coefficients[3] / lead], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]))
-    # plain Python numbers from here on: numpy's per-scalar overhead was most of a call's time (the
-    # operations are the same IEEE ones, so the results are the same bits)
-    lams = [r.real for r in roots.tolist() if _isinf(r) or abs(r.imag) <= 1e-9 * max(1.0, abs(r))]
-    points: list[np.ndarray] = []
-    for lam in lams:
-        member = c2 if math.isinf(lam) else c1 + lam * c2
-        values, vectors = np.linalg.eigh(member)
-        order = np.argsort(np.abs(values))
-        v1, v2 = values[order[1:]].tolist()
-        vectors = vectors[:, order]
-        if v1 * v2 >= 0.0:
-            continue  # a definite (point) or double-line member: try another root
-        w1, w2 = math.sqrt(abs(v1)), math.sqrt(abs(v2))
-        # on the lines c1 = -lam c2: meet them with the conic farther from the member (c1 itself at lam = 0)
-        other = c2 if abs(lam) < 1.0 else c1
-        for line in (w1 * vectors[:, 1] + w2 * vectors[:, 2], w1 * vectors[:, 1] - w2 * vectors[:, 2]):
-            points.extend(_polish(c1, c2, x) for x in line_meets_conic(_line_basis(line), other))
-        break
-    return [x for x in points if abs(x @ c1 @ x) < 1e-8 and abs(x @ c2 @ x) < 1e-8]
+    dets = np.linalg.det(c1s[:, None] + _CUBIC_SAMPLES[None, :, None, None] * c2s[:, None])
+    coefficients = np.matmul(_CUBIC_FIT, dets[:, :, None])[:, :, 0]
+    lead = coefficients[:, 0]
+    at_infinity = np.abs(lead) < 1e-14  # c2 itself degenerate: it is the member at infinity
+    roots: list[list[complex]] = [[] for _ in range(len(c1s))]
+    for i in np.flatnonzero(at_infinity).tolist():
+        roots[i] = np.concatenate([[np.inf], np.roots(coefficients[i])]).tolist()
+    cubic = np.flatnonzero(~at_infinity)
+    if cubic.size:  # eigenvalues of the companion matrices (np.roots without its overhead)
+        top = -coefficients[cubic, 1:] / lead[cubic, None]
+        companion = np.zeros((cubic.size, 3, 3))
+        companion[:, 0] = top
+        companion[:, 1, 0] = companion[:, 2, 1] = 1.0
+        for i, r in zip(cubic.tolist(), np.linalg.eigvals(companion).tolist(), strict=True):
+            roots[i] = r
+    # plain Python numbers for the roots: numpy's per-scalar overhead would dominate
+    lams = [[r.real for r in rs if _isinf(r) or abs(r.imag) <= 1e-9 * max(1.0, abs(r))] for rs in roots]
+    # the first real root of each pair whose member is indefinite (a pair of real lines), tried in rounds
+    chosen: dict[int, tuple[float, np.ndarray, np.ndarray]] = {}
+    tried = {i: 0 for i, ls in enumerate(lams) if ls}
+    while tried:
+        index = list(tried)
+        lam = np.array([lams[i][tried[i]] for i in index])
+        infinite = np.isinf(lam)
+        members = c1s[index] + np.where(infinite, 0.0, lam)[:, None, None] * c2s[index]
+        members[infinite] = c2s[index][infinite]
+        values, vectors = np.linalg.eigh(members)
+        # the two eigenvalues of largest magnitude (np.argsort's order) and their eigenvectors
+        order = np.argsort(np.abs(values), axis=-1)[:, 1:]
+        rows = np.arange(len(index))[:, None]
+        values = values[rows, order]
+        vectors = vectors.transpose(0, 2, 1)[rows, order]
+        indefinite = (~(values[:, 0] * values[:, 1] >= 0.0)).tolist()
+        for k, i in enumerate(index):
+            if indefinite[k]:
+                chosen[i] = (float(lam[k]), values[k], vectors[k])
+                del tried[i]
+            else:  # a definite (point) or double-line member (or NaN): next root
+                tried[i] += 1
+                if tried[i] == len(lams[i]):
+                    del tried[i]
+    pairs = sorted(chosen)
+    if not pairs:
+        return [[] for _ in range(len(c1s))]
+    values = np.array([chosen[i][1] for i in pairs])
+    vectors = np.array([chosen[i][2] for i in pairs])
+    w1, w2 = np.sqrt(np.abs(values[:, 0])), np.sqrt(np.abs(values[:, 1]))
+    v1, v2 = w1[:, None] * vectors[:, 0], w2[:, None] * vectors[:, 1]
+    # two lines per pair, the "+" line first; on the lines c1 = -lam c2: meet them with the conic farther
+    # from the member (c1 itself at lam = 0)
+    lines = np.stack([v1 + v2, v1 - v2], axis=1).reshape(-1, 3)
+    owner = np.repeat(pairs, 2)
+    far = np.array([abs(chosen[i][0]) < 1.0 for i in pairs]).repeat(2)
+    others = np.where(far[:, None, None], c2s[owner], c1s[owner])
+    basis = _line_bases(lines)
+    met = _lines_meet_conics(basis[:, 0], basis[:, 1], others)
+    start = [x for found in met for x in found]
+    if not start:
+        return [[] for _ in range(len(c1s))]
+    point_owner = np.repeat(owner, [len(found) for found in met])
+    p1, p2 = c1s[point_owner], c2s[point_owner]
+    x = _polish_many(p1, p2, np.array(start))
+    ok = (np.abs(_dots(_vec_mat(x, p1), x)) < 1e-8) & (np.abs(_dots(_vec_mat(x, p2), x)) < 1e-8)
+    out: list[list[np.ndarray]] = [[] for _ in range(len(c1s))]
+    for i, row, good in zip(point_owner.tolist(), x, ok.tolist(), strict=True):
+        if good:
+            out[i].append(row)
+    return out
 
 
 def _isinf(r: complex) -> bool:
     """``np.isinf`` of one root (a float, or a complex: infinite when either part is)."""
     return math.isinf(r.real) or math.isinf(r.imag)
-
-
-def _norm(x: np.ndarray) -> float:
-    """``np.linalg.norm`` of a 1-D float array, without its argument handling: the same ``sqrt(x . x)``."""
-    return math.sqrt(x.dot(x))
 
 
 def line_meets_conic(basis: np.ndarray, conic: np.ndarray) -> list[np.ndarray]:
@@ -230,53 +305,102 @@ def line_meets_conic(basis: np.ndarray, conic: np.ndarray) -> list[np.ndarray]:
     first, so ``b^2`` neither overflows nor underflows.
     """
     e, f = np.asarray(basis, dtype=np.float64)
-    ec = e @ conic
-    abc = (float(ec @ e), float(ec @ f), float((f @ conic) @ f))
-    if any(math.isnan(v) for v in abc):
-        return []  # as np.abs(abc).max() would be NaN below
-    scale = max(abs(v) for v in abc)
-    if not scale > 0.0:
-        return []  # the line lies in the (degenerate) conic: no isolated points
-    a, b, c = (v / scale for v in abc)
-    disc = b * b - a * c
-    if disc < 0.0:
-        return []
-    q = -(b + math.copysign(math.sqrt(disc), b))
-    roots = [s * e + t * f for s, t in ((q, a), (c, q))]
-    norms = [_norm(x) for x in roots]
-    if min(norms) == 0.0:  # q = 0 with a = 0 or c = 0: a double root at e or f, carried by the other pair
-        k = int(np.argmax(norms))
-        roots, norms = [roots[k]] * 2, [norms[k]] * 2
-    return [x / n for x, n in zip(roots, norms, strict=True)]
+    return _lines_meet_conics(e[None], f[None], np.asarray(conic, dtype=np.float64)[None])[0]
+
+
+def _lines_meet_conics(e: np.ndarray, f: np.ndarray, conics: np.ndarray) -> list[list[np.ndarray]]:
+    """:func:`line_meets_conic` of each line (bases ``e``, ``f``: (k, 3)) and conic (k, 3, 3) of a stack."""
+    ec = _vec_mat(e, conics)
+    abc = np.stack([_dots(ec, e), _dots(ec, f), _dots(_vec_mat(f, conics), f)], axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):  # the rows these would touch are dropped below
+        scale = np.abs(abc).max(axis=1)  # NaN when a coefficient is
+        # scale > 0: else the line lies in the (degenerate) conic: no isolated points
+        a, b, c = (abc / scale[:, None]).T
+        disc = b * b - a * c
+        live = (scale > 0.0) & ~(disc < 0.0)
+        q = -(b + np.copysign(np.sqrt(disc), b))
+    out: list[list[np.ndarray]] = [[] for _ in range(len(e))]
+    rows = np.flatnonzero(live)
+    if not rows.size:
+        return out
+    e, f, a, c, q = e[rows], f[rows], a[rows, None], c[rows, None], q[rows, None]
+    first, second = q * e + a * f, c * e + q * f
+    n1, n2 = _norms(first), _norms(second)
+    # q = 0 with a = 0 or c = 0: a double root at e or f, carried by the other pair
+    double = np.where(n2 < n1, n2, n1) == 0.0  # min(n1, n2) == 0, NaN included as min() treats it
+    if double.any():
+        use_second = double & ((n2 > n1) | (np.isnan(n2) & ~np.isnan(n1)))  # np.argmax: the first maximum
+        use_first = double & ~use_second
+        first[use_second], n1[use_second] = second[use_second], n2[use_second]
+        second[use_first], n2[use_first] = first[use_first], n1[use_first]
+    x1, x2 = first / n1[:, None], second / n2[:, None]
+    for k, i in enumerate(rows.tolist()):
+        out[i] = [x1[k], x2[k]]
+    return out
 
 
 def _line_basis(line: np.ndarray) -> np.ndarray:
     """Two orthonormal homogeneous points (2, 3) spanning the projective line ``line . x = 0``."""
-    l0, l1, l2 = line.tolist()
-    axis = [0.0, 0.0, 0.0]
-    axis[int(np.argmin(np.abs(line)))] = 1.0
-    e = _cross(l0, l1, l2, *axis)
-    e = e / _norm(e)
-    f = _cross(l0, l1, l2, *e.tolist())
-    return np.array([e, f / _norm(f)])
+    basis: np.ndarray = _line_bases(np.asarray(line, dtype=np.float64)[None])[0]
+    return basis
 
 
-def _cross(a0: float, a1: float, a2: float, b0: float, b1: float, b2: float) -> np.ndarray:
-    """``np.cross`` of two 3-vectors given by their components: the same products and differences."""
-    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+def _line_bases(lines: np.ndarray) -> np.ndarray:
+    """:func:`_line_basis` of each row of (k, 3): (k, 2, 3)."""
+    axis = np.zeros_like(lines)
+    axis[np.arange(len(lines)), np.argmin(np.abs(lines), axis=1)] = 1.0
+    e = _cross(lines, axis)
+    e = e / _norms(e)[:, None]
+    f = _cross(lines, e)
+    return np.stack([e, f / _norms(f)[:, None]], axis=1)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise ``np.cross`` of (k, 3) arrays: the same products and differences, without its argument handling."""
+    a0, a1, a2 = a.T
+    b0, b1, b2 = b.T
+    out = np.empty_like(a)
+    out[:, 0] = a1 * b2 - a2 * b1
+    out[:, 1] = a2 * b0 - a0 * b2
+    out[:, 2] = a0 * b1 - a1 * b0
+    return out
 
 
 def _polish(c1: np.ndarray, c2: np.ndarray, x: np.ndarray, steps: int = 2) -> np.ndarray:
     """Newton steps on ``x^T c1 x = x^T c2 x = 0`` with the step orthogonal to ``x`` (unit sphere)."""
+    c1, c2 = np.asarray(c1, dtype=np.float64), np.asarray(c2, dtype=np.float64)
+    polished: np.ndarray = _polish_many(c1[None], c2[None], np.asarray(x, dtype=np.float64)[None], steps)[0]
+    return polished
+
+
+def _polish_many(c1: np.ndarray, c2: np.ndarray, x: np.ndarray, steps: int = 2) -> np.ndarray:
+    """:func:`_polish` of each point (k, 3) on its own conics (k, 3, 3): the points step together."""
+    x = x.copy()
+    active = np.arange(len(x))  # points still stepping: a tangential one keeps its last estimate
     for _ in range(steps):
-        g1, g2 = c1 @ x, c2 @ x
-        jac = np.array([2.0 * g1, 2.0 * g2, x])
+        xa, a1, a2 = x[active], c1[active], c2[active]
+        g1, g2 = _mat_vec(a1, xa), _mat_vec(a2, xa)
+        jac = np.empty((len(xa), 3, 3))
+        jac[:, 0], jac[:, 1], jac[:, 2] = 2.0 * g1, 2.0 * g2, xa
+        rhs = np.zeros((len(xa), 3))
+        rhs[:, 0], rhs[:, 1] = -_dots(xa, g1), -_dots(xa, g2)
         try:
-            step = np.linalg.solve(jac, [-(x @ g1), -(x @ g2), 0.0])
-        except np.linalg.LinAlgError:  # tangential intersection: keep the unpolished point
-            return x
-        x = x + step
-        x = x / _norm(x)
+            step = np.linalg.solve(jac, rhs[:, :, None])[:, :, 0]
+        except np.linalg.LinAlgError:  # some tangential intersection: find which, one by one
+            solved: list[np.ndarray | None] = []
+            for k in range(len(active)):
+                try:
+                    solved.append(np.linalg.solve(jac[k], rhs[k]))
+                except np.linalg.LinAlgError:
+                    solved.append(None)
+            keep = [k for k, s in enumerate(solved) if s is not None]
+            active = active[keep]
+            if not keep:
+                break
+            xa = xa[keep]
+            step = np.array([solved[k] for k in keep])
+        xa = xa + step
+        x[active] = xa / _norms(xa)[:, None]
     return x
 
 
@@ -320,13 +444,26 @@ def solve_at_kappa(basis4: np.ndarray, kappa: float) -> list[np.ndarray]:
         The four eigenvectors of the smallest eigenvalues.
     kappa : float
     """
+    return _solve_many(basis4, [kappa])[0]
+
+
+def _solve_many(basis4: np.ndarray, kappas: list[float]) -> list[list[np.ndarray]]:
+    """:func:`solve_at_kappa` at each of ``kappas``, solved together (the same bits as one by one)."""
     s1, s2 = _FORMS
-    chart = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [kappa, 0.0, 0.0]])
-    lift = basis4 @ chart  # (8, 3): p = lift @ (alpha, beta, gamma)
-    out = []
-    for x in conic_intersections(lift.T @ s1 @ lift, lift.T @ s2 @ lift):
-        p = lift @ x
-        out.append(p / _norm(p))
+    charts = np.zeros((len(kappas), 4, 3))
+    charts[:, 0, 0] = charts[:, 1, 1] = charts[:, 2, 2] = 1.0
+    charts[:, 3, 0] = kappas
+    lift = np.matmul(basis4, charts)  # (k, 8, 3): p = lift @ (alpha, beta, gamma)
+    lift_t = lift.transpose(0, 2, 1)
+    found = _conic_intersections_many(lift_t @ s1 @ lift, lift_t @ s2 @ lift)
+    owner = np.repeat(np.arange(len(found)), [len(xs) for xs in found])
+    out: list[list[np.ndarray]] = [[] for _ in found]
+    if not owner.size:
+        return out
+    p = _mat_vec(lift[owner], np.array([x for xs in found for x in xs]))
+    p = p / _norms(p)[:, None]
+    for i, row in zip(owner.tolist(), p, strict=True):
+        out[i].append(row)
     return out
 
 
@@ -362,9 +499,9 @@ def trace_family(basis4: np.ndarray, samples: int, min_centre_weight: float = 1e
     kappas, branches, ps = [], [], []
     previous: list[tuple[np.ndarray, int]] = []
     next_branch = 0
-    for omega in omegas:
-        kappa = float(np.cos(omega) / np.sin(omega))
-        found = [p for p in solve_at_kappa(basis4, kappa) if abs(p[0]) >= min_centre_weight]
+    sample_kappas = [float(np.cos(omega) / np.sin(omega)) for omega in omegas]
+    for kappa, solutions in zip(sample_kappas, _solve_many(basis4, sample_kappas), strict=True):
+        found = [p for p in solutions if abs(p[0]) >= min_centre_weight]
         labels = _match_branches(found, previous)
         current = []
         for p, label in zip(found, labels, strict=True):
@@ -415,9 +552,9 @@ def refine_family(basis4: np.ndarray, family: DyadFamily, measure, keep: np.ndar
                 continue
             count = min(max_inserts, int(np.ceil(gap / max_step)) - 1)
             reference = fam.p[j]
-            for t in np.linspace(0.0, 1.0, count + 2)[1:-1]:
-                kappa = (1.0 - t) * fam.kappa[j] + t * fam.kappa[k]
-                solutions = solve_at_kappa(basis4, kappa)
+            kappas = [(1.0 - t) * fam.kappa[j] + t * fam.kappa[k] for t in np.linspace(0.0, 1.0, count + 2)[1:-1]]
+            # solved together; those past a lost branch (below) are not used
+            for kappa, solutions in zip(kappas, _solve_many(basis4, kappas), strict=True):
                 if not solutions:
                     break
                 p = max(solutions, key=lambda q: abs(float(q @ reference)))
@@ -445,9 +582,13 @@ def _take(family: DyadFamily, index: np.ndarray) -> DyadFamily:
 
 
 def bisect_on_branch(basis4: np.ndarray, func, k0: float, p0: np.ndarray, k1: float, p1: np.ndarray,
-                     iterations: int = 48) -> tuple[float, np.ndarray]:
+                     iterations: int = 48, lookahead: int = 4) -> tuple[float, np.ndarray]:
     """Root of ``func(p)`` between two samples ``(k0, p0)``, ``(k1, p1)`` of one branch, by bisection
     in kappa; at each step the solution nearest (in direction) to the last one keeps the branch.
+
+    The midpoints of the next ``lookahead`` steps, whichever way they go (``2**lookahead - 1`` kappas), are
+    solved together and the steps then walk that tree: the same steps as one solve per step, for fewer
+    solver calls.
 
     Returns
     -------
@@ -456,16 +597,32 @@ def bisect_on_branch(basis4: np.ndarray, func, k0: float, p0: np.ndarray, k1: fl
     """
     f0, f1 = func(p0), func(p1)
     reference = p0
-    for _ in range(iterations):
-        k_mid = 0.5 * (k0 + k1)
-        solutions = solve_at_kappa(basis4, k_mid)
-        if not solutions:
-            break
-        p_mid = max(solutions, key=lambda q: abs(float(q @ reference)))
-        f_mid = func(p_mid)
-        if np.sign(f_mid) == np.sign(f0):
-            k0, p0, f0 = k_mid, p_mid, f_mid
-        else:
-            k1, p1, f1 = k_mid, p_mid, f_mid
-        reference = p_mid
+    done = 0
+    while done < iterations:
+        depth = max(1, min(lookahead, iterations - done))
+        # the midpoint tree in heap order: node n's bracket halves into nodes 2n (lower) and 2n + 1 (upper)
+        brackets = [(k0, k1)]
+        kappas = []
+        for lo, hi in brackets:
+            mid = 0.5 * (lo + hi)
+            kappas.append(mid)
+            if len(brackets) < 2 ** depth - 1:
+                brackets.extend([(lo, mid), (mid, hi)])
+        solved = _solve_many(basis4, kappas)
+        node = 0
+        for _ in range(depth):
+            solutions = solved[node]
+            if not solutions:
+                return (k0, p0) if abs(f0) <= abs(f1) else (k1, p1)
+            k_mid = kappas[node]
+            p_mid = max(solutions, key=lambda q: abs(float(q @ reference)))
+            f_mid = func(p_mid)
+            if np.sign(f_mid) == np.sign(f0):
+                k0, p0, f0 = k_mid, p_mid, f_mid
+                node = 2 * node + 2
+            else:
+                k1, p1, f1 = k_mid, p_mid, f_mid
+                node = 2 * node + 1
+            reference = p_mid
+        done += depth
     return (k0, p0) if abs(f0) <= abs(f1) else (k1, p1)

@@ -74,11 +74,31 @@ def gear_law(knots_a: np.ndarray, knots_b: np.ndarray, centre_distance: float) -
     law = CubicSpline(knots_a[order], knots_b[order])
     x = np.linspace(knots_a[order[0]], knots_a[order[-1]], LAW_SAMPLES)
     a = centre_distance
+    # the four calls below evaluate the spline and its derivatives at x sixteen times over: once each is enough
+    once = _EvaluatedOnce(law, x)
     with np.errstate(divide="ignore", invalid="ignore"):
-        r_a = pitch_radii(law, a, x, "a")[0]
-        r_b = pitch_radii(law, a, x, "b")[0]
+        r_a = pitch_radii(once, a, x, "a")[0]
+        r_b = pitch_radii(once, a, x, "b")[0]
         # signed radius of curvature, positive where convex
-        rho_a = 1.0 / pitch_frames(law, a, x, "a").curvature
-        rho_b = 1.0 / pitch_frames(law, a, x, "b").curvature
-    return GearLaw(law=law, knots_a=knots_a, knots_b=knots_b, centre_distance=a, x=x, ratio=-law(x, 1),
+        rho_a = 1.0 / pitch_frames(once, a, x, "a").curvature
+        rho_b = 1.0 / pitch_frames(once, a, x, "b").curvature
+    return GearLaw(law=law, knots_a=knots_a, knots_b=knots_b, centre_distance=a, x=x, ratio=-np.asarray(once(x, 1)),
                    r_a=r_a, r_b=r_b, rho_a=rho_a, rho_b=rho_b)
+
+
+class _EvaluatedOnce:
+    """``law(x, nu)`` that evaluates each derivative at the one array ``x`` (the same object) only once.
+
+    The results are shared between callers, which only read them (the pitch functions build new arrays).
+    """
+
+    def __init__(self, law: CubicSpline, x: np.ndarray) -> None:
+        self._law, self._x = law, x
+        self._values: dict[int, np.ndarray] = {}
+
+    def __call__(self, x: np.ndarray | float, nu: int = 0) -> np.ndarray | float:
+        if x is not self._x:
+            return np.asarray(self._law(x, nu))
+        if nu not in self._values:
+            self._values[nu] = np.asarray(self._law(x, nu))
+        return self._values[nu]
