@@ -130,10 +130,14 @@ def refine(seeds: np.ndarray, template: SixBarBatch, theta_positions: np.ndarray
     cost = np.einsum("ij,ij->i", r, r)
     h = 1e-5
     eye = np.eye(p.shape[1])
+    # the eight forward differences of every seed in one call of _residuals (its rows do not depend on
+    # each other): the per-call numpy overhead was most of the time for few seeds
+    shifts = (h * eye)[:, None, :]
+    stacked_args = (np.tile(anchor, (p.shape[1], 1)),) + args[1:]
     for _ in range(iterations):
-        jac = np.empty(r.shape + (p.shape[1],))
-        for k in range(p.shape[1]):
-            jac[:, :, k] = (_residuals(p + h * eye[k], *args) - r) / h
+        shifted = _residuals((p[None] + shifts).reshape(-1, p.shape[1]), *stacked_args)
+        jac = np.empty(r.shape + (p.shape[1],))  # (N, residuals, 8) in memory, as the sums below expect
+        jac[...] = ((shifted.reshape((p.shape[1],) + r.shape) - r) / h).transpose(1, 2, 0)
         jtj = np.einsum("nik,nil->nkl", jac, jac)
         jtr = np.einsum("nik,ni->nk", jac, r)
         diag = np.einsum("nkk->nk", jtj)
