@@ -403,7 +403,7 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
     def fill() -> None:
         want = 2 * workers_now()
         while todo and len(in_flight) < want:
-            n = min(batch_size, len(todo))
+            n = batch_share(batch_size, len(todo), want)
             submit([todo.popleft() for _ in range(n)])
 
     fill()
@@ -455,6 +455,13 @@ def next_batch_size(seconds: list[float], target: float) -> int:
         return 1
     typical = max(recent[len(recent) // 2], 1e-6)
     return int(min(MAX_BATCH, max(1, round(target / typical))))
+
+
+def batch_share(batch_size: int, left: int, slots: int) -> int:
+    """Points in the next task: ``batch_size``, but no more than an even share of the ``left`` points over the
+    ``slots`` tasks kept in flight, so a sweep's last points are spread over every worker instead of one worker
+    running a long last batch while the others wait."""
+    return max(1, min(batch_size, -(-left // max(1, slots))))
 
 
 def _error_row(spec: SweepSpec, item: tuple[int, Any, str], exc: BaseException) -> dict[str, Any]:

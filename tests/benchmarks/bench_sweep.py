@@ -39,8 +39,9 @@ sys.path.insert(0, str(ROOT))
 PEAKS: list[str] = []
 #: Per Dask run: the cores its workers had (CPU seconds over the points' wall time) and points per CPU second.
 CORES: list[str] = []
-#: Default points per stage (a synthesis point takes ~0.2 s, a build point of 60 poses ~1.5 s on an idle core).
-DEFAULT_POINTS = {"synth": 48, "build": 16}
+#: Default points per stage (a synthesis point takes ~0.2 s, a report-only build point of 60 poses ~1.2 s on an idle
+#: core): enough that the last task's wait (one worker done, the other on its last point) is a small part of the run.
+DEFAULT_POINTS = {"synth": 48, "build": 32}
 
 
 #: ``--full``: every build point built in full (a metric reading the file list), not report-only.

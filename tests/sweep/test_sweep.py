@@ -191,6 +191,16 @@ def test_tasks_are_batched_to_about_the_target_time():
     assert next_batch_size([0.5] * 100 + [0.01] * 64, 1.0) == 100  # the recent points count
 
 
+def test_the_last_points_are_spread_over_every_task_in_flight():
+    from fabricate.sweep.runner import batch_share
+
+    assert batch_share(8, 100, 4) == 8  # plenty left: the timed batch
+    assert batch_share(8, 12, 4) == 3  # 12 left, 4 tasks in flight (2 workers): 3 each, not 8 + 4
+    assert batch_share(8, 13, 4) == 4
+    assert batch_share(8, 3, 4) == 1 and batch_share(1, 0, 4) == 1  # never an empty task
+    assert batch_share(5, 100, 0) == 5
+
+
 def test_a_bad_point_is_a_row_with_its_reason():
     spec = sweep_from_tables(gear_tables(eccentricities=(1.5,), modules=(1.0,)))
     (values,) = spec.points()
