@@ -285,8 +285,9 @@ def model_3mf(objects: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str)
     bytes."""
     resources, items = [], []
     for k, (name, vertices, faces) in enumerate(objects, start=1):
-        vert_xml = "".join(f'<vertex x="{x:.6f}" y="{y:.6f}" z="{z:.6f}"/>' for x, y, z in vertices)
-        tri_xml = "".join(f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in faces)
+        # one %-format over plain Python numbers: the text f"{x:.6f}" and f"{a}" give per numpy scalar, ~5x faster
+        vert_xml = ('<vertex x="%.6f" y="%.6f" z="%.6f"/>' * len(vertices)) % tuple(np.ravel(vertices).tolist())
+        tri_xml = ('<triangle v1="%d" v2="%d" v3="%d"/>' * len(faces)) % tuple(np.ravel(faces).tolist())
         resources.append(f'<object id="{k}" name="{_xml_escape(name)}" type="model"><mesh>'
                          f"<vertices>{vert_xml}</vertices><triangles>{tri_xml}</triangles></mesh></object>")
         items.append(f'<item objectid="{k}"/>')
