@@ -771,3 +771,67 @@ def test_polish_does_two_newton_steps_by_default():
     three = newton_on_sphere(c1, c2, two)
     assert np.linalg.norm(two - three) > 1e-9
     assert np.allclose(km._polish(c1, c2, start), two, rtol=0, atol=1e-14)
+
+
+# -- batching: a stack of samples solves each sample exactly as it would be solved alone ---------------------
+
+
+def test_a_stack_of_kappas_gives_each_kappa_the_bits_it_gets_alone():
+    """trace_family and refine_family solve many kappas in one stacked call; every sample must come out
+    bit for bit as a call with that kappa alone (np.array_equal, not a tolerance: the shipped builds are
+    byte-identical only if no stacked operation mixes samples). Checked on the hand-built problem and on a
+    generic orthonormal basis, in stacks with the same kappa at different places."""
+    rng = np.random.default_rng(3)
+    bases = [four_pose_problem()[2], np.linalg.qr(rng.normal(size=(8, 4)))[0]]
+    kappas = list(np.linspace(-4.0, 4.0, 37)) + [true_kappa(), 0.0, 1e-9, -250.0]
+    for basis4 in bases:
+        alone = [km.solve_at_kappa(basis4, k) for k in kappas]
+        assert sum(len(found) for found in alone) > 40  # the stacks below hold real solutions
+        for order in (np.arange(len(kappas)), rng.permutation(len(kappas))):
+            stacked = km._solve_many(basis4, [kappas[i] for i in order])
+            for i, found in zip(order, stacked, strict=True):
+                assert len(found) == len(alone[i])
+                assert all(np.array_equal(p, q) for p, q in zip(found, alone[i], strict=True))
+
+
+def test_looking_ahead_does_not_change_the_bisection():
+    """bisect_on_branch solves the midpoints of its next steps together (a tree of 2^lookahead - 1 kappas) and
+    walks the tree: for every lookahead and iteration count the result is bit for bit that of plain bisection
+    (lookahead 1, one solve per step), and the function is evaluated at the same points in the same order."""
+    _, _, basis4 = four_pose_problem()
+    fam = km.trace_family(basis4, 80)
+    lo, hi = bracket_of_true_dyad(fam)
+    for iterations in (0, 1, 3, 7, 48):
+        runs = []
+        for lookahead in (1, 2, 4, 5):
+            seen: list[float] = []
+
+            def func(p: np.ndarray, seen: list[float] = seen) -> float:
+                seen.append(centre_x_error(p))
+                return seen[-1]
+
+            kappa, p = km.bisect_on_branch(basis4, func, fam.kappa[lo], fam.p[lo], fam.kappa[hi], fam.p[hi],
+                                           iterations=iterations, lookahead=lookahead)
+            runs.append((kappa, p, seen))
+        kappa, p, seen = runs[0]
+        assert len(seen) == 2 + iterations
+        for other in runs[1:]:
+            assert other[0] == kappa and np.array_equal(other[1], p) and other[2] == seen
+
+
+def test_polishing_a_stack_keeps_each_point_as_if_polished_alone():
+    """_polish_many steps many points together; a point whose Newton system is singular (here c2 = c1, and
+    c2 = 0) keeps its last estimate as _polish does, and does not disturb the others (bitwise)."""
+    rng = np.random.default_rng(4)
+    c1 = rng.normal(size=(6, 3, 3))
+    c1 = c1 + c1.transpose(0, 2, 1)
+    c2 = rng.normal(size=(6, 3, 3))
+    c2 = c2 + c2.transpose(0, 2, 1)
+    c2[1], c2[4] = c1[1], 0.0
+    x = rng.normal(size=(6, 3))
+    x /= np.linalg.norm(x, axis=1)[:, None]
+    many = km._polish_many(c1, c2, x)
+    for i in range(6):
+        assert np.array_equal(many[i], km._polish(c1[i], c2[i], x[i]))
+    assert np.array_equal(many[1], x[1]) and np.array_equal(many[4], x[4])  # singular from the first step
+    assert not np.array_equal(many[0], x[0])
