@@ -260,6 +260,10 @@ def test_local_cluster_sweep_equals_the_points_one_by_one(tmp_path):
     assert best["values"] == {"gear_pair.eccentricity": 0.1, "gears.module_mm": 0.8}
     report = json.loads((out / best["folder"] / "report.json").read_text())
     assert report["design"]["kind"] == "gear_pair"
+    # built in full, never report-only (as a build sweep's points are): its pictures are there
+    assert {"previews/assembly.png", "plots/strength.png"} <= set(report["files"])
+    assert (out / best["folder"] / "previews" / "assembly.png").is_file()
+    assert report["outputs"]["step"] in ("written", "skipped: OCP is not installed (extra 'cad')")
     # the full build is judged like any build (its checks may fail where synthesis passed); the sweep says so
     assert best["build_exit_code"] == (0 if report["checks"]["passed"] else 1)
     assert report["synthesis"]["center_distance_mm"] == pytest.approx(  # a build's report rounds to 1e-9 mm
