@@ -543,28 +543,33 @@ def refine_family(basis4: np.ndarray, family: DyadFamily, measure, keep: np.ndar
     fam = _take(family, order)
     keep = np.asarray(keep)[order]
     pos = measure(fam.p)
-    new_k, new_b, new_p = [], [], []
-    for branch in np.unique(fam.branch):
+    # the gaps to fill and their kappas first, all solved in one stack; those past a lost branch are not used
+    gaps: list[tuple[int, int, list[float]]] = []
+    for branch in np.unique(fam.branch).tolist():
         idx = np.flatnonzero(fam.branch == branch)
         for j, k in zip(idx[:-1], idx[1:], strict=True):
             gap = float(np.linalg.norm(pos[k] - pos[j]))
             if not (keep[j] or keep[k]) or gap <= max_step:
                 continue
             count = min(max_inserts, int(np.ceil(gap / max_step)) - 1)
-            reference = fam.p[j]
-            kappas = [(1.0 - t) * fam.kappa[j] + t * fam.kappa[k] for t in np.linspace(0.0, 1.0, count + 2)[1:-1]]
-            # solved together; those past a lost branch (below) are not used
-            for kappa, solutions in zip(kappas, _solve_many(basis4, kappas), strict=True):
-                if not solutions:
-                    break
-                p = max(solutions, key=lambda q: abs(float(q @ reference)))
-                if abs(float(p @ reference)) < 0.99 or abs(p[0]) < 1e-9:
-                    break  # lost the branch (a turning point between the samples)
-                p = p if float(p @ reference) > 0 else -p
-                new_k.append(kappa)
-                new_b.append(branch)
-                new_p.append(p)
-                reference = p
+            gaps.append((branch, j, [(1.0 - t) * fam.kappa[j] + t * fam.kappa[k]
+                                     for t in np.linspace(0.0, 1.0, count + 2)[1:-1]]))
+    solved = iter(_solve_many(basis4, [kappa for _, _, kappas in gaps for kappa in kappas]))
+    new_k, new_b, new_p = [], [], []
+    for branch, j, kappas in gaps:
+        reference = fam.p[j]
+        found = [next(solved) for _ in kappas]
+        for kappa, solutions in zip(kappas, found, strict=True):
+            if not solutions:
+                break
+            p = max(solutions, key=lambda q: abs(float(q @ reference)))
+            if abs(float(p @ reference)) < 0.99 or abs(p[0]) < 1e-9:
+                break  # lost the branch (a turning point between the samples)
+            p = p if float(p @ reference) > 0 else -p
+            new_k.append(kappa)
+            new_b.append(branch)
+            new_p.append(p)
+            reference = p
     if not new_k:
         return fam
     p_all = np.vstack([fam.p, np.array(new_p)])
