@@ -1,10 +1,8 @@
 """Meshes for SLA printing: binary STL per part, the print plate, and a 3MF of the assembly.
 
-Solids come from the manifold3d adapter (:mod:`fabricate.parts.solids`). STL is encoded and read back here
-with numpy, as trimesh does it (the same operations, so the same bytes and volumes; trimesh's import is not
-on a build's path, ~0.1 s); trimesh reads the 3MF objects a check validates. Every encoder returns bytes and
-is deterministic (no timestamps, no random ids): the 3MF container is written here with fixed zip dates and
-ids numbered in part order.
+Solids come from the manifold3d adapter (:mod:`fabricate.parts.solids`); trimesh only encodes and
+validates. Every encoder returns bytes and is deterministic (no timestamps, no random ids): the 3MF
+container is written here with fixed zip dates and ids numbered in part order.
 """
 
 from __future__ import annotations
@@ -12,24 +10,14 @@ from __future__ import annotations
 import io
 import zipfile
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any, cast
+from typing import Any, cast
 
 import numpy as np
+import trimesh
 
 from fabricate.export.layout import Placement, pack
 from fabricate.parts.model import Part
 from fabricate.parts.solids import mesh_arrays, part_solid, posed
-
-if TYPE_CHECKING:
-    import trimesh
-
-#: Binary STL: an 80-byte header and the triangle count, then per triangle its normal, corners and 2 spare bytes.
-_STL_HEADER = np.dtype([("header", np.void, 80), ("face_count", "<u4")])
-_STL_TRIANGLE = np.dtype([("normals", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attributes", "<u2")])
-#: trimesh's zero length (``trimesh.util.TOL_ZERO``): a normal of a shorter cross product is written as 0.
-_TOL_ZERO = float(np.finfo(np.float64).resolution * 100)
-#: trimesh's vertex merge on reading (``tol.merge`` 1e-8 mm: coordinates rounded to 8 decimals).
-_MERGE_DIGITS = 8
 
 #: Fixed zip entry date so the 3MF bytes do not depend on when they were written.
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)
@@ -66,60 +54,17 @@ class SolidCache:
 
 
 def _mesh(vertices: np.ndarray, faces: np.ndarray) -> trimesh.Trimesh:
-    import trimesh
-
     return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
 
 
-def _triangles(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Corners (m, 3, 3) and the cross products of two edges (m, 3) of each triangle: trimesh's
-    ``Trimesh.triangles`` and ``triangles_cross`` (float64 C-order vertices, int64 faces)."""
-    triangles = np.ascontiguousarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64)]
-    vectors = triangles[:, 1:, :] - triangles[:, :2, :]
-    return triangles, np.cross(vectors[:, 0], vectors[:, 1])
-
-
 def stl_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
-    """Binary STL of a triangle mesh (80-byte zero header, float32 normals and corners): the bytes
-    ``trimesh.exchange.stl.export_stl`` writes (its unit normals, operation for operation; 0 where degenerate)."""
-    triangles, crosses = _triangles(vertices, faces)
-    header = np.zeros(1, dtype=_STL_HEADER)
-    header["face_count"] = len(triangles)
-    packed = np.zeros(len(triangles), dtype=_STL_TRIANGLE)
-    if len(triangles):
-        norm = np.sqrt(np.dot(crosses * crosses, [1.0] * 3))
-        valid = norm > _TOL_ZERO
-        norm[valid] **= -1
-        normals = np.zeros((len(triangles), 3))
-        normals[valid] = (crosses * norm.reshape((-1, 1)))[valid]
-        packed["normals"] = normals
-        packed["vertices"] = triangles
-    return header.tobytes() + packed.tobytes()
+    """Binary STL of a triangle mesh (80-byte zero header, float32 normals and corners)."""
+    return trimesh.exchange.stl.export_stl(_mesh(vertices, faces))
 
 
 def mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
-    """Enclosed volume (mm^3) of a closed triangle mesh, vertices (n, 3) mm and triangles (m, 3): trimesh's
-    ``Trimesh.volume`` (the divergence theorem's sum, in its order)."""
-    triangles, crosses = _triangles(vertices, faces)
-    f1 = triangles[:, 0, :] + triangles[:, 1, :] + triangles[:, 2, :]
-    integral = np.zeros((1, len(triangles)))
-    integral[0] = crosses[:, 0] * f1[:, 0]
-    return float(integral.sum(axis=1)[0] / np.float64(6))
-
-
-def _closed_problems(faces: np.ndarray) -> list[str]:
-    """"not watertight" unless every edge is in exactly two triangles; "inconsistent winding" unless the two
-    run opposite ways (trimesh's ``graph.is_watertight``)."""
-    edges = faces[:, [0, 1, 1, 2, 2, 0]].reshape((-1, 2))
-    ends = np.sort(edges, axis=1)
-    # each undirected edge as one integer (vertex indices are far below 2^31): a 1-d unique, ~10x faster
-    _, inverse, counts = np.unique(ends[:, 0] * (1 << 31) + ends[:, 1], return_inverse=True, return_counts=True)
-    paired = np.flatnonzero(counts[inverse] == 2)  # the edges whose undirected edge appears exactly twice
-    problems = [] if len(paired) == len(edges) else ["not watertight"]
-    pairs = paired[np.argsort(inverse[paired], kind="stable")].reshape((-1, 2))  # the two of each, in order
-    if not np.array_equal(edges[pairs[:, 0], 1], edges[pairs[:, 1], 0]):
-        problems.append("inconsistent winding")
-    return problems
+    """Enclosed volume (mm^3) of a closed triangle mesh, vertices (n, 3) mm and triangles (m, 3)."""
+    return float(_mesh(vertices, faces).volume)
 
 
 def part_stl(part: Part, cache: SolidCache) -> bytes:
@@ -129,7 +74,7 @@ def part_stl(part: Part, cache: SolidCache) -> bytes:
 
 def validate_stl(data: bytes, expected_volume_mm3: float | None = None,
                  rel_tol: float = 1e-3) -> list[str]:
-    """Problems found by reading binary STL bytes back as trimesh reads them (an empty list means a valid solid).
+    """Problems found by reading binary STL bytes back with trimesh (an empty list means a valid solid).
 
     Parameters
     ----------
@@ -154,37 +99,29 @@ def validate_stl(data: bytes, expected_volume_mm3: float | None = None,
     if len(data) != 84 + 50 * count:
         return [f"truncated or not a binary STL: {len(data)} bytes, its header announces {count} triangles "
                 f"({84 + 50 * count} bytes)"]
-    # read as trimesh.load(..., process=True) reads it: triangles with a non-finite corner dropped, corners
-    # merged where equal to 8 decimals (the first one's coordinates kept)
-    corners = np.frombuffer(data, dtype=_STL_TRIANGLE, count=count, offset=84)["vertices"].astype(np.float64)
-    corners = corners[np.isfinite(corners).all(axis=(1, 2))].reshape((-1, 3))
-    if len(corners) == 0:
+    try:
+        mesh = trimesh.load(io.BytesIO(data), file_type="stl", process=True)
+    except Exception as exc:  # noqa: BLE001 - any decoder failure is a finding
+        return [f"cannot be read back: {exc}"]
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         return ["no triangles"]
-    keys = np.round(corners * (10 ** _MERGE_DIGITS)).astype(np.int64)
-    # rows as 24-byte strings: equal rows are equal strings (a 1-d unique, much faster than axis=0)
-    _, first, inverse = np.unique(np.ascontiguousarray(keys).view(np.dtype((np.void, 24))).ravel(), return_index=True,
-                                  return_inverse=True)
-    faces = inverse.reshape((-1, 3))
-    return _solid_problems(corners[first], faces, expected_volume_mm3, rel_tol)
-
-
-def _solid_problems(vertices: np.ndarray, faces: np.ndarray, expected_volume_mm3: float | None,
-                    rel_tol: float) -> list[str]:
-    """What makes a triangle mesh not a closed solid of the expected volume (see :func:`validate_stl`)."""
-    problems = _closed_problems(faces)
-    volume = mesh_volume(vertices, faces)
-    if not volume > 0:
-        problems.append(f"volume {volume:.6g} mm^3 is not positive")
-    if expected_volume_mm3 is not None and abs(volume - expected_volume_mm3) > rel_tol * abs(expected_volume_mm3):
-        problems.append(f"volume {volume:.6g} mm^3 differs from {expected_volume_mm3:.6g} mm^3")
-    return problems
+    return mesh_problems(mesh, expected_volume_mm3, rel_tol)
 
 
 def mesh_problems(mesh: trimesh.Trimesh, expected_volume_mm3: float | None = None,
                   rel_tol: float = 1e-3) -> list[str]:
     """What makes ``mesh`` not a closed solid of the expected volume (see :func:`validate_stl`)."""
-    return _solid_problems(np.asarray(mesh.vertices), np.asarray(mesh.faces, dtype=np.int64), expected_volume_mm3,
-                           rel_tol)
+    problems = []
+    if not mesh.is_watertight:
+        problems.append("not watertight")
+    if not mesh.is_winding_consistent:
+        problems.append("inconsistent winding")
+    volume = float(mesh.volume)
+    if not volume > 0:
+        problems.append(f"volume {volume:.6g} mm^3 is not positive")
+    if expected_volume_mm3 is not None and abs(volume - expected_volume_mm3) > rel_tol * abs(expected_volume_mm3):
+        problems.append(f"volume {volume:.6g} mm^3 differs from {expected_volume_mm3:.6g} mm^3")
+    return problems
 
 
 def read_3mf(data: bytes) -> tuple[dict[str, trimesh.Trimesh], list[str]]:
