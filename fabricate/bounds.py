@@ -20,6 +20,7 @@ from __future__ import annotations
 import ast
 import contextlib
 import ctypes
+import gc
 import os
 import sys
 from collections.abc import Iterator
@@ -288,6 +289,31 @@ def blas_threads(count: int = 1) -> Iterator[None]:
     finally:
         for put, before in restore:
             put(before)
+
+
+#: The cyclic garbage collector's thresholds during a build (:func:`rare_collections`): a young collection
+#: every 10 000 allocations instead of Python's 700, an older one every 20 of those.
+BUILD_GC_THRESHOLDS = (10_000, 20, 20)
+
+
+@contextlib.contextmanager
+def rare_collections(thresholds: tuple[int, int, int] = BUILD_GC_THRESHOLDS) -> Iterator[None]:
+    """Run the block (or, as a decorator, the function) with the cyclic garbage collector's ``thresholds``,
+    then restore the caller's.
+
+    A build allocates millions of short-lived small objects (numpy scalars, shapely geometries, dict rows)
+    while matplotlib, ezdxf and scipy hold hundreds of thousands of long-lived ones: with Python's default
+    thresholds the default finger's serial build ran 464 collections, the full ones walking every live
+    object, 0.285 s of CPU; with these, 29 collections and 0.083 s, for ~12 MB more peak memory. Reference
+    counting still frees everything that is not in a cycle at once; the collector only runs less often.
+    Results never depend on it (builds are byte-identical either way).
+    """
+    before = gc.get_threshold()
+    gc.set_threshold(*thresholds)
+    try:
+        yield
+    finally:
+        gc.set_threshold(*before)
 
 
 def _openblas_controls() -> list[tuple[Any, Any]]:

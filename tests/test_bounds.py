@@ -410,3 +410,32 @@ def test_the_exact_form_of_the_largest_tables_is_a_valid_template() -> None:
     assert rebuilt.kind == "linkage"
     with pytest.raises(SpecError, match=r"linkage\.drivers.*4001 samples in all|linkage\.drivers\[0\]\.input"):
         design_from_text(dumps(tables(MAX_LINKAGE_TABLE + 1)), "too_large.toml")
+
+
+def test_rare_collections_sets_the_thresholds_inside_and_restores_the_callers():
+    import gc
+
+    from fabricate.bounds import BUILD_GC_THRESHOLDS, rare_collections
+
+    before = gc.get_threshold()
+    with rare_collections():
+        assert gc.get_threshold() == BUILD_GC_THRESHOLDS
+    assert gc.get_threshold() == before
+    with pytest.raises(ZeroDivisionError), rare_collections((5000, 5, 5)):
+        assert gc.get_threshold() == (5000, 5, 5)
+        1 / 0  # noqa: B018 - an exception in the block still restores the thresholds
+    assert gc.get_threshold() == before
+
+
+def test_a_build_runs_with_rare_collections_and_leaves_the_thresholds_as_they_were(monkeypatch):
+    import gc
+
+    from fabricate import pipeline
+    from fabricate.bounds import BUILD_GC_THRESHOLDS
+
+    seen = []
+    monkeypatch.setattr(pipeline, "_synthesis_stage", lambda *a: (seen.append(gc.get_threshold()), 1 / 0))
+    before = gc.get_threshold()
+    with pytest.raises(ZeroDivisionError):
+        pipeline.run_build(load_design("gear_pair_elliptic"), optional=pipeline.OptionalOutputs(step=False))
+    assert seen == [BUILD_GC_THRESHOLDS] and gc.get_threshold() == before
