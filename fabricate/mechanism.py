@@ -317,7 +317,13 @@ class Motion:
 
 
 class _System:
-    """Residuals and Jacobian of a mechanism's constraints in the free bodies' poses."""
+    """Residuals and Jacobian of a mechanism's constraints in the free bodies' poses.
+
+    The solver calls :meth:`jacobian` thousands of times per sweep on systems of a dozen or two unknowns, where
+    numpy's per-call overhead is most of the cost: the constraint layout is precomputed here, and the
+    arithmetic of the small blocks runs on Python floats (the same IEEE operations in the same order as
+    elementwise numpy, so the results are bit-identical; sines and cosines stay numpy's).
+    """
 
     def __init__(self, mech: Mechanism) -> None:
         self.mech = mech
@@ -347,23 +353,55 @@ class _System:
         self.rev_const[2 * rows + 1, cols + 1] = self.rev_sign
         self.rev_flat_x = (2 * rows) * self.n + cols + 2
         self.rev_flat_y = (2 * rows + 1) * self.n + cols + 2
+        # the same layout as Python lists for the float loop of _revolute_block: per joint, both ends'
+        # (body index or -1 for the ground, local x, local y); the Jacobian's angle entries in the order of
+        # rev_flat_x / rev_flat_y (side a of every joint, then side b), as (end, sign)
+        self._rev_ends = [(int(self.rev_body[0, i]), float(self.rev_local[0, i, 0]), float(self.rev_local[0, i, 1]),
+                           int(self.rev_body[1, i]), float(self.rev_local[1, i, 0]), float(self.rev_local[1, i, 1]))
+                          for i in range(k)]
+        self._rev_entries = [(side * k + i, float(sign[side, 0])) for side in (0, 1) for i in range(k)
+                             if free[side, i]]
+        self._n_rev = 2 * k
+        # the angle drivers without a law in a mechanism of degrees, and the linear laws: their values are
+        # computed here on floats (numpy's radians is the product with pi/180 too, and LinearLaw's the
+        # product and sum)
+        self._deg = self.mech.input_unit == "deg"
 
-    def _revolute_block(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Residuals (2k,) and Jacobian rows (2k, n) of the k revolute joints."""
-        poses = np.vstack([q.reshape(-1, 3), np.zeros((1, 3))])[self.rev_body]  # (2, k, 3); -1 is the ground
-        c, s = np.cos(poses[..., 2]), np.sin(poses[..., 2])
-        local = self.rev_local
-        wx = c * local[..., 0] - s * local[..., 1]
-        wy = s * local[..., 0] + c * local[..., 1]
-        res = np.empty(2 * local.shape[1])
-        res[0::2] = (wx + poses[..., 0])[0] - (wx + poses[..., 0])[1]
-        res[1::2] = (wy + poses[..., 1])[0] - (wy + poses[..., 1])[1]
-        jac = self.rev_const.copy()
+    def _revolute_floats(self, q: np.ndarray) -> tuple[list[float], list[float], list[float]]:
+        """Residuals of the revolute joints and the world offsets (x, y) of every joint end from its body's
+        origin, ends ordered side a of every joint then side b."""
+        # the ground (index -1, last) has pose 0: cos 0 = 1 and sin 0 = 0 exactly, as numpy gives them
+        th = q[2::3]
+        cos = np.cos(th).tolist() + [1.0]
+        sin = np.sin(th).tolist() + [0.0]
+        flat = q.tolist()
+        px = flat[0::3] + [0.0]
+        py = flat[1::3] + [0.0]
+        res: list[float] = []
+        wxa: list[float] = []
+        wya: list[float] = []
+        wxb: list[float] = []
+        wyb: list[float] = []
+        for ba, lxa, lya, bb, lxb, lyb in self._rev_ends:
+            ca, sa, cb, sb = cos[ba], sin[ba], cos[bb], sin[bb]
+            xa = ca * lxa - sa * lya
+            ya = sa * lxa + ca * lya
+            xb = cb * lxb - sb * lyb
+            yb = sb * lxb + cb * lyb
+            res.append((xa + px[ba]) - (xb + px[bb]))
+            res.append((ya + py[ba]) - (yb + py[bb]))
+            wxa.append(xa)
+            wya.append(ya)
+            wxb.append(xb)
+            wyb.append(yb)
+        return res, wxa + wxb, wya + wyb
+
+    def _revolute_entries(self, jac: np.ndarray, wx: list[float], wy: list[float]) -> None:
+        """Write the revolute rows' angle entries into ``jac`` (its first 2k rows hold ``rev_const``)."""
         flat = jac.reshape(-1)
         # the two ends of one joint are different bodies: no entry is written twice
-        flat[self.rev_flat_x] = -self.rev_sign * wy[self.rev_free]
-        flat[self.rev_flat_y] = self.rev_sign * wx[self.rev_free]
-        return res, jac
+        flat[self.rev_flat_x] = [-sign * wy[e] for e, sign in self._rev_entries]
+        flat[self.rev_flat_y] = [sign * wx[e] for e, sign in self._rev_entries]
 
     def _pose(self, q: np.ndarray, name: str) -> np.ndarray:
         k = self.index.get(name)
@@ -371,18 +409,23 @@ class _System:
 
     def _driver_value(self, d: Driver, s: float) -> tuple[float, float]:
         if d.law is not None:
+            if type(d.law) is LinearLaw:  # slope * s + offset on floats: LinearLaw's own operations
+                return float(d.law.slope * float(s) + d.law.offset), float(d.law.slope)
             return float(d.law(s)), float(d.law(s, 1))
-        if d.kind == "angle" and self.mech.input_unit == "deg":
-            return float(np.radians(s)), float(np.pi / 180.0)
+        if d.kind == "angle" and self._deg:
+            return float(s) * (np.pi / 180.0), float(np.pi / 180.0)
         return float(s), 1.0
 
     def jacobian(self, q: np.ndarray, s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Residual vector (m,), Jacobian (m, n) and d(residual)/ds (m,) at poses ``q``."""
+        rev_res, wx, wy = self._revolute_floats(q)
         rows = _Rows(self, q)
-        rev_res, rev_jac = self._revolute_block(q)
-        rows.rows.extend(rev_jac)
-        rows.res.extend(rev_res)
-        rows.dres_ds.extend([0.0] * len(rev_res))
+        index = self.index
+        flat = q.tolist()
+
+        def theta(body: str) -> float:
+            k = index.get(body)
+            return 0.0 if k is None else flat[3 * k + 2]
         for j in self.others:  # sliders: relative rotation locked, point b on a's line
             rows.angle_row(j.body_b, j.body_a)
             rows.res.append(self._pose(q, j.body_b)[2] - self._pose(q, j.body_a)[2] - j.angle)
@@ -393,29 +436,38 @@ class _System:
                             self.bodies[j.body_b].point(j.name), np.array([-axis[1], axis[0]]))
             rows.dres_ds.append(0.0)
         for g in self.mech.gears:
-            thc = self._pose(q, g.carrier)[2]
-            xa = self._pose(q, g.gear_a)[2] - thc
-            xb = self._pose(q, g.gear_b)[2] - thc
+            thc = theta(g.carrier)
+            xa = theta(g.gear_a) - thc
+            xb = theta(g.gear_b) - thc
             slope = float(g.law(xa, 1))
             r = rows.row()
             for body, coef in ((g.gear_b, 1.0), (g.gear_a, -slope), (g.carrier, slope - 1.0)):
-                if body in self.index:
-                    r[3 * self.index[body] + 2] += coef
+                if body in index:
+                    r[3 * index[body] + 2] += coef
             rows.res.append(xb - float(g.law(xa)))
             rows.dres_ds.append(0.0)
         for d in self.mech.drivers:
             value, dvalue = self._driver_value(d, s)
             if d.kind == "angle":
                 rows.angle_row(d.body, d.reference)
-                rows.res.append(self._pose(q, d.body)[2] - self._pose(q, d.reference)[2] - value)
+                rows.res.append(theta(d.body) - theta(d.reference) - value)
             else:
                 slider = next(j for j in self.mech.joints if j.name == d.joint and isinstance(j, Slider))
                 rows.projection(d.reference, d.body, self.bodies[d.reference].point(d.joint),
                                 self.bodies[d.body].point(d.joint), np.asarray(slider.axis, dtype=np.float64))
                 rows.res[-1] -= value
             rows.dres_ds.append(-dvalue)
-        jac = np.array(rows.rows).reshape(len(rows.res), self.n)
-        return np.asarray(rows.res), jac, np.asarray(rows.dres_ds)
+        k2 = self._n_rev
+        m = k2 + len(rows.res)
+        jac = np.empty((m, self.n))
+        jac[:k2] = self.rev_const
+        if rows.rows:
+            jac[k2:] = rows.rows
+        self._revolute_entries(jac, wx, wy)
+        res = np.array(rev_res + [float(v) for v in rows.res], dtype=np.float64)
+        dres_ds = np.zeros(m)
+        dres_ds[k2:] = rows.dres_ds
+        return res, jac, dres_ds
 
     def newton(self, q: np.ndarray, s: float, max_iter: int = 30) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
         """Gauss-Newton from ``q``.
@@ -431,11 +483,11 @@ class _System:
         tol = ASSEMBLY_TOLERANCE * self.scale
         for _ in range(max_iter):
             res, jac, ds = self.jacobian(q, s)
-            if res.size == 0 or float(np.max(np.abs(res))) < tol:
+            if res.size == 0 or float(np.abs(res).max()) < tol:
                 return q, True, jac, ds
             step = np.linalg.lstsq(jac, -res, rcond=None)[0] if jac.shape[0] != jac.shape[1] \
                 else _solve_square(jac, -res)
-            if not np.all(np.isfinite(step)):
+            if not np.isfinite(step).all():
                 return q, False, jac, ds
             q = q + step
         res, jac, ds = self.jacobian(q, s)
@@ -456,13 +508,15 @@ class _System:
         # a step is suspicious when a body turns more than 0.3 rad or moves more than 30 % of the
         # mechanism's size: the predictor landed near another branch rather than following this one
         d = (q_new - q_old).reshape(-1, 3)
-        return bool(np.all(np.abs(d[:, 2]) < 0.3) and np.all(np.hypot(d[:, 0], d[:, 1]) < 0.3 * self.scale))
+        return bool((np.abs(d[:, 2]) < 0.3).all() and (np.hypot(d[:, 0], d[:, 1]) < 0.3 * self.scale).all())
 
     @staticmethod
     def _orientation(jac: np.ndarray) -> float:
         if jac.shape[0] != jac.shape[1]:
             return 0.0
-        return float(np.sign(np.linalg.det(jac)))
+        det = float(np.linalg.det(jac))
+        # np.sign's values, without its call: +-1, 0, or nan for a nan
+        return 1.0 if det > 0.0 else -1.0 if det < 0.0 else det if det != det else 0.0
 
     def continue_to(self, q: np.ndarray, s0: float, s1: float) -> np.ndarray:
         """Follow the branch from (q at s0) to s1 with an adaptive step; raise at lock-up."""
