@@ -11,6 +11,7 @@ import dataclasses
 import os
 import pickle
 import shutil
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -358,12 +359,18 @@ RERUN = {"parts": AFTER_PARTS, "process": AFTER_PARTS,
 
 
 @pytest.fixture(scope="module")
-def warmed(tmp_path_factory) -> tuple[Path, Path]:
+def warmed(tmp_path_factory, shared_stage_cache) -> tuple[Path, Path]:
     """A cache folder warmed by a build of the unedited default finger, and that build's output folder.
 
     Made once per test session: the tests using it are dealt out to both pytest-xdist workers, so the first to ask
     builds it (under a lock, in the session's folder, which pytest-xdist's per-worker basetemps share) and the
     other waits and reuses it. The tests only read the two folders (they copy the cache; check writes nothing).
+
+    The build runs on the session's shared stage cache (``shared_stage_cache``), where ``shipped_build`` has
+    usually built the default finger already (else it is built cold there now), and the folder gets the entries
+    that build read or wrote: a read or a write sets an entry's time (fabricate/cache.py), the picture child's
+    too. Those are the entries a cold build into an empty folder writes, as the tests need; the shared folder's
+    other entries (other designs, maybe written by the other worker meanwhile) may come along and are never read.
     """
     from fabricate.pipeline import run_build
 
@@ -372,13 +379,18 @@ def warmed(tmp_path_factory) -> tuple[Path, Path]:
     folder, out = shared / "cache", shared / "out"
     with locked(shared / "lock"):
         if not (shared / "done").is_file():
-            with pytest.MonkeyPatch.context() as patch:
-                patch.setenv("FABRICATE_CACHE_DIR", str(folder))
-                patch.delenv("FABRICATE_NO_CACHE", raising=False)
-                cache.clear_memory()
-                with cache.use_cache():
-                    outcome = run_build(load_design(DEFAULT))
-                cache.clear_memory()
+            store = session_folder(tmp_path_factory) / "shipped-stage-cache"  # conftest's shared_stage_cache folder
+            start = time.time() - 2.0  # file times come from a coarser clock than time.time()
+            cache.clear_memory()
+            with shared_stage_cache(f"tests/test_cache warmed {DEFAULT}"):
+                assert cache.cache_dir() == store
+                outcome = run_build(load_design(DEFAULT))
+            touched = [p for p in entries(store) if p.stat().st_mtime >= start]
+            assert touched
+            for path in touched:
+                target = folder / path.relative_to(store)
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(path, target)
             outcome.write(out)
             (shared / "done").touch()
     return folder, out
