@@ -507,9 +507,11 @@ def _plots(run: BuildRun, pictures: Background) -> None:
         from fabricate.drive.plots import drive_plot
 
         plots["plots/drive.png"] = ("drive_plot", stage_keys.drive_key(run.design), lambda: drive_plot(drive))
-    # the picture child is done by now, or nearly: a second child draws these while this process draws the
-    # clearance plot (when it has one to draw)
     todo = [path for path, (stage, key, _) in plots.items() if not cache.stored(stage, key)]
+    # the picture child is done by now, or nearly: a second child draws these while this process draws the
+    # clearance plot, or, where that is cached (a rebuild after a [load] or [checks] edit), the first of them
+    mine = todo[:1] if cache.stored("check_figures", stage_keys.checks_key(run.design)) else []
+    theirs = todo[len(mine):]
 
     def drawing(path: str) -> Callable[[], dict[str, bytes]]:
         return lambda: {path: plots[path][2]()}
@@ -517,11 +519,15 @@ def _plots(run: BuildRun, pictures: Background) -> None:
     def taking(path: str, draw: Callable[[], bytes]) -> Callable[[], bytes]:
         return lambda: drawn[path] if path in drawn else draw()
 
-    child = Background([drawing(path) for path in todo]) \
-        if todo and not cache.stored("check_figures", stage_keys.checks_key(run.design)) else None
+    if theirs:
+        from fabricate.plotting import load_agg
+
+        load_agg()  # matplotlib imported once, before the fork, for the child and this process
+    child = Background([drawing(path) for path in theirs]) if theirs else None
     drawn: dict[str, bytes] = {}
     try:
         figures = cache.cached("check_figures", stage_keys.checks_key(run.design), checks.figures)
+        drawn.update({path: plots[path][2]() for path in mine})
         drawn.update(child.result() if child is not None else {})
     finally:
         if child is not None:

@@ -25,6 +25,11 @@ What it measures, in one run:
   a build starts early: all its CPU is in the STEP row). Peak memory per stage is the process's resident
   high-water mark over that stage (``/proc/self/clear_refs`` resets it at each mark; Linux only), or the
   STEP worker's where that is larger;
+- ``--rebuilds``: edit, rebuild, see. The default template's rebuild after an edit of one table, with the stage
+  cache on (a private cache folder, warmed by one build of the unedited template): each round runs the floor, then
+  one rebuild per edit of :data:`REBUILD_EDITS` (``[load]``, ``[checks]``, ``[parts]``, ``[process]``) and of the
+  unedited template. Each round writes a value no earlier round used, so every rebuild misses exactly the stages
+  its table reaches and is served the others (what a user who edits one value sees); ratio to the floor per round;
 - ``--vs PATH``: the same builds on another checkout's code (``PYTHONPATH=PATH``), run alternately with this
   checkout's (A B A B ...), and the ratio A/B (median of the pairs).
 
@@ -73,6 +78,17 @@ sys.meta_path.insert(0, _NoOCP())
 '''
 
 INSTALLS = ("core", "cad")
+
+#: ``--rebuilds``: one edit of the default template per table, ``(text in the template, its replacement)``; ``{k}``
+#: is the round's number, so each round's value is new to the cache (tests/test_cache.py's edits of the same tables,
+#: whose byte-identity to a cold build it proves; a screw size of its own cannot vary by round).
+REBUILD_EDITS = {
+    "[load]": ("tip_force_N = 1.5", "tip_force_N = 1.2{k:03d}"),
+    "[checks]": ("sweep_poses = 360 ", "min_safety_factor = 2.5{k:03d}\nsweep_poses = 360 "),
+    "[parts]": ("[checks]\n", "[parts]\nplate_spacing_mm = 4.0{k:03d}\n\n[checks]\n"),
+    "[process]": ("thickness_mm = 6.0 ", "hole_compensation_mm = 0.15{k:03d}\nthickness_mm = 6.0 "),
+    "none (unchanged)": ("", ""),
+}
 
 
 @dataclass
@@ -321,6 +337,59 @@ def measure(templates: Sequence[str], installs: Sequence[str], runs: int, other_
     return rows, floors, profiles
 
 
+def measure_rebuilds(install: str, runs: int, work: Path, log=print) -> tuple[dict[str, Series], Series]:  # noqa: ANN001
+    """Rebuilds of the default template after each edit of :data:`REBUILD_EDITS`, cache on; and the floor runs of
+    the same rounds. Returns ``({edit: series}, floor)``."""
+    from fabricate.templates import find_template
+
+    blocker = work / "no_ocp"
+    blocker.mkdir(exist_ok=True)
+    (blocker / "sitecustomize.py").write_text(_NO_OCP, encoding="utf-8")
+    original = find_template(DEFAULT_TEMPLATE).read_text(encoding="utf-8")
+    folder = work / "rebuilds"
+    folder.mkdir(exist_ok=True)
+    env = _env(ROOT, install, blocker)
+    env.pop("FABRICATE_NO_CACHE")
+    env["FABRICATE_CACHE_DIR"] = str(work / f"cache_{install}")
+    template = folder / f"{DEFAULT_TEMPLATE}.toml"
+    template.write_text(original, encoding="utf-8")
+    warm = _run(_build_argv(str(template), folder / "out"), env, work)  # fills the cache with every stage
+    if warm.code not in (0, 1):
+        raise RuntimeError(f"the warm-up build exited {warm.code}")
+    series = {edit: Series() for edit in REBUILD_EDITS}
+    floor = Series()
+    for k in range(runs):
+        floor.samples.append(_run(_floor_argv(install), _env(ROOT, install, blocker), work))
+        for edit, (old, new) in REBUILD_EDITS.items():
+            if old and old not in original:
+                raise RuntimeError(f"{DEFAULT_TEMPLATE}: {old!r} is not in the template ({edit} edit)")
+            template.write_text(original.replace(old, new.format(k=k), 1) if old else original, encoding="utf-8")
+            series[edit].samples.append(_run(_build_argv(str(template), folder / "out"), env, work))
+    log(f"  rebuilds {install}: " + ", ".join(f"{e} {v.median('wall'):.2f} s" for e, v in series.items())
+        + f", floor {floor.median('wall'):.2f} s")
+    return series, floor
+
+
+def print_rebuilds(results: dict[str, tuple[dict[str, Series], Series]], out=sys.stdout) -> None:  # noqa: ANN001
+    print("### Rebuild after an edit (stage cache on, default template)", file=out)
+    print(file=out)
+    print("| install | edit | runs | wall s | CPU s | peak MB | x floor | x floor CPU |", file=out)
+    print("|---|---|---|---|---|---|---|---|", file=out)
+    for install, (series, floor) in results.items():
+        print(f"| {install} | floor (imports only) | {len(floor.samples)} | {_fmt(floor.median('wall'))} | "
+              f"{_fmt(floor.median('cpu'))} | {_fmt(floor.median('rss_mb'), 0)} | 1.00 | 1.00 |", file=out)
+        for edit, row in series.items():
+            codes = "" if all(s.code in (0, 1) for s in row.samples) else \
+                " (exit codes: " + ",".join(str(s.code) for s in row.samples) + ")"
+            print(f"| {install} | {edit}{codes} | {len(row.samples)} | {_fmt(row.median('wall'))} | "
+                  f"{_fmt(row.median('cpu'))} | {_fmt(row.median('rss_mb'), 0)} | {_fmt(_ratio(row, floor))} | "
+                  f"{_fmt(_ratio(row, floor, 'cpu'))} |", file=out)
+    print(file=out)
+    print("Each round: the floor, then one rebuild per edit, each edit with a value no earlier round used (so the "
+          "stages its table reaches run, the others are served by the cache); x floor: median of the per-round "
+          "ratios.", file=out)
+
+
 def _fmt(x: float, digits: int = 2) -> str:
     return "n/a" if x != x else f"{x:.{digits}f}"
 
@@ -408,6 +477,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--vs", type=Path, metavar="PATH", help="another checkout to compare with (paired runs)")
     parser.add_argument("--no-stages", action="store_true", help="skip the per-stage profiles")
     parser.add_argument("--json", type=Path, help="also write every sample here")
+    parser.add_argument("--rebuilds", action="store_true",
+                        help="only the default template's cached rebuilds after an edit of each table (--runs rounds)")
     parser.add_argument("--stage-profile", metavar="TEMPLATE", help=argparse.SUPPRESS)  # the per-stage child
     args = parser.parse_args(argv)
     if args.stage_profile:
@@ -424,6 +495,13 @@ def main(argv: list[str] | None = None) -> int:
     vs = args.vs.resolve() if args.vs else None
     if vs is not None and not (vs / "fabricate" / "__init__.py").is_file():
         parser.error(f"--vs {vs}: not a fabricate checkout (no fabricate/__init__.py)")
+    if args.rebuilds:
+        with tempfile.TemporaryDirectory(prefix="bench_build_") as tmp:
+            results = {install: measure_rebuilds(install, args.runs, Path(tmp),
+                                                 log=lambda text: print(text, file=sys.stderr, flush=True))
+                       for install in installs}
+        print_rebuilds(results)
+        return 0
     with tempfile.TemporaryDirectory(prefix="bench_build_") as tmp:
         rows, floors, profiles = measure(templates, installs, args.runs, args.other_runs, vs, not args.no_stages,
                                          Path(tmp), log=lambda text: print(text, file=sys.stderr, flush=True))
