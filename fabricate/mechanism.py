@@ -366,6 +366,22 @@ class _System:
         # computed here on floats (numpy's radians is the product with pi/180 too, and LinearLaw's the
         # product and sum)
         self._deg = self.mech.input_unit == "deg"
+        # the sliders' and slide drivers' joint points and unit directions (fixed in body_a / the reference)
+        self._slider_terms = []
+        for j in self.others:
+            axis = np.asarray(j.axis, dtype=np.float64)
+            normal = np.array([-axis[1], axis[0]])  # the slide axis turned +90 deg
+            self._slider_terms.append((self.bodies[j.body_a].point(j.name), self.bodies[j.body_b].point(j.name),
+                                       normal / np.hypot(*normal)))
+        self._driver_terms: list[tuple[np.ndarray, np.ndarray, np.ndarray] | None] = []
+        for d in self.mech.drivers:
+            if d.kind == "angle":
+                self._driver_terms.append(None)
+                continue
+            slider = next(j for j in self.mech.joints if j.name == d.joint and isinstance(j, Slider))
+            axis = np.asarray(slider.axis, dtype=np.float64)
+            self._driver_terms.append((self.bodies[d.reference].point(d.joint), self.bodies[d.body].point(d.joint),
+                                       axis / np.hypot(*axis)))
 
     def _revolute_floats(self, q: np.ndarray) -> tuple[list[float], list[float], list[float]]:
         """Residuals of the revolute joints and the world offsets (x, y) of every joint end from its body's
@@ -426,14 +442,13 @@ class _System:
         def theta(body: str) -> float:
             k = index.get(body)
             return 0.0 if k is None else flat[3 * k + 2]
-        for j in self.others:  # sliders: relative rotation locked, point b on a's line
+        for j, (pa_local, pb_local, normal) in zip(self.others, self._slider_terms, strict=True):
+            # sliders: relative rotation locked, point b on a's line
             rows.angle_row(j.body_b, j.body_a)
-            rows.res.append(self._pose(q, j.body_b)[2] - self._pose(q, j.body_a)[2] - j.angle)
+            rows.res.append(theta(j.body_b) - theta(j.body_a) - j.angle)
             rows.dres_ds.append(0.0)
             # (pb - pa) . n = 0 with n the slide axis turned +90 deg, fixed in body_a
-            axis = np.asarray(j.axis, dtype=np.float64)
-            rows.projection(j.body_a, j.body_b, self.bodies[j.body_a].point(j.name),
-                            self.bodies[j.body_b].point(j.name), np.array([-axis[1], axis[0]]))
+            rows.projection(j.body_a, j.body_b, pa_local, pb_local, normal)
             rows.dres_ds.append(0.0)
         for g in self.mech.gears:
             thc = theta(g.carrier)
@@ -446,15 +461,13 @@ class _System:
                     r[3 * index[body] + 2] += coef
             rows.res.append(xb - float(g.law(xa)))
             rows.dres_ds.append(0.0)
-        for d in self.mech.drivers:
+        for d, terms in zip(self.mech.drivers, self._driver_terms, strict=True):
             value, dvalue = self._driver_value(d, s)
-            if d.kind == "angle":
+            if terms is None:
                 rows.angle_row(d.body, d.reference)
                 rows.res.append(theta(d.body) - theta(d.reference) - value)
             else:
-                slider = next(j for j in self.mech.joints if j.name == d.joint and isinstance(j, Slider))
-                rows.projection(d.reference, d.body, self.bodies[d.reference].point(d.joint),
-                                self.bodies[d.body].point(d.joint), np.asarray(slider.axis, dtype=np.float64))
+                rows.projection(d.reference, d.body, *terms)
                 rows.res[-1] -= value
             rows.dres_ds.append(-dvalue)
         k2 = self._n_rev
@@ -591,10 +604,10 @@ class _Rows:
         return r
 
     def projection(self, body_a: str, body_b: str, pa_local: np.ndarray, pb_local: np.ndarray,
-                   direction: np.ndarray) -> None:
-        """Row and value of (p_b - p_a) . u, u a unit direction fixed in body_a."""
+                   unit_local: np.ndarray) -> None:
+        """Row and value of (p_b - p_a) . u, u the unit direction ``unit_local`` fixed in body_a."""
         index = self.system.index
-        u_world = rotation(self.system._pose(self.q, body_a)[2]) @ (direction / np.hypot(*direction))
+        u_world = rotation(self.system._pose(self.q, body_a)[2]) @ unit_local
         pa, pb = self.world(body_a, pa_local), self.world(body_b, pb_local)
         r = self.row()
         grad = [np.zeros(self.n), np.zeros(self.n)]

@@ -11,6 +11,8 @@ import numpy as np
 def rotation(theta: float | np.ndarray) -> np.ndarray:
     """Rotation matrix (or stack of them) for angle(s) ``theta`` in radians; shape (2, 2) or (n, 2, 2)."""
     c, s = np.cos(theta), np.sin(theta)
+    if isinstance(theta, float):  # one angle (np.float64 too): the same matrix without three stack calls
+        return np.array([[c, -s], [s, c]])
     return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
 
 

@@ -7,6 +7,7 @@ followed silently onto the other assembly branch.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -442,3 +443,19 @@ def test_geared_five_bar_velocity_matches_finite_differences():
     motion = mech.sweep(7)
     np.testing.assert_allclose(motion.pose("right")[:, 2], law(np.radians(motion.inputs)), atol=1e-9)
     _velocity_matches_finite_differences(mech, count=7, h=1e-4, atol=1e-6)
+
+
+@pytest.mark.parametrize("unit", ["deg", "mm"])
+def test_driver_values_are_the_laws_own_to_the_bit(unit):
+    """The solver evaluates linear laws and the degree conversion on floats, not through the law: its values
+    must be exactly the law's (float(law(s)), float(law(s, 1))) and numpy's radians, or builds would move."""
+    from fabricate.mechanism import _System
+
+    law = LinearLaw(slope=0.37, offset=-1.3)
+    mech = dataclasses.replace(make_four_bar(), drivers=(Driver("angle", "crank", "ground", law=law),), input_unit=unit)
+    plain = dataclasses.replace(make_four_bar(), input_unit=unit)
+    linear, identity = _System(mech), _System(plain)
+    for s in np.random.default_rng(3).uniform(-400, 400, 200):
+        assert linear._driver_value(mech.drivers[0], s) == (float(law(s)), float(law(s, 1)))
+        want = (float(np.radians(s)), float(np.pi / 180)) if unit == "deg" else (float(s), 1.0)
+        assert identity._driver_value(plain.drivers[0], s) == want
