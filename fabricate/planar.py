@@ -11,9 +11,15 @@ import numpy as np
 def rotation(theta: float | np.ndarray) -> np.ndarray:
     """Rotation matrix (or stack of them) for angle(s) ``theta`` in radians; shape (2, 2) or (n, 2, 2)."""
     c, s = np.cos(theta), np.sin(theta)
-    if isinstance(theta, float):  # one angle (np.float64 too): the same matrix without three stack calls
+    if isinstance(theta, float):  # one angle (np.float64 too): the same matrix without np.stack's overhead
         return np.array([[c, -s], [s, c]])
-    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+    # the entries placed into one array: the values np.stack([[c, -s], [s, c]]) gives, a few times faster
+    out = np.empty(np.shape(c) + (2, 2), dtype=np.result_type(c, s))
+    out[..., 0, 0] = c
+    out[..., 0, 1] = -s
+    out[..., 1, 0] = s
+    out[..., 1, 1] = c
+    return out
 
 
 def unit(theta: float | np.ndarray) -> np.ndarray:
