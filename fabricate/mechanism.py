@@ -366,6 +366,10 @@ class _System:
         # computed here on floats (numpy's radians is the product with pi/180 too, and LinearLaw's the
         # product and sum)
         self._deg = self.mech.input_unit == "deg"
+        # where the last assembly or continuation ended: (q, s, Jacobian, d(residual)/ds, orientation) there.
+        # A sweep's next continuation starts from that very q and s: it reuses them instead of computing the
+        # same Jacobian and determinant again
+        self._end: tuple[np.ndarray, float, np.ndarray, np.ndarray, float] | None = None
         # the sliders' and slide drivers' joint points and unit directions (fixed in body_a / the reference)
         self._slider_terms = []
         for j in self.others:
@@ -512,9 +516,10 @@ class _System:
             if name not in self.mech.assembly:
                 raise SpecError(f"mechanism.assembly.{name}", "missing assembly guess for body")
             guess.extend(np.asarray(self.mech.assembly[name], dtype=np.float64))
-        q, ok, _, _ = self.newton(np.asarray(guess), s)
+        q, ok, jac, ds = self.newton(np.asarray(guess), s)
         if not ok:
             raise LockupError(s, f"{self.mech.name}: cannot assemble the first pose")
+        self._end = (q, s, jac, ds, self._orientation(jac))
         return q
 
     def _step_ok(self, q_old: np.ndarray, q_new: np.ndarray) -> bool:
@@ -534,8 +539,13 @@ class _System:
     def continue_to(self, q: np.ndarray, s0: float, s1: float) -> np.ndarray:
         """Follow the branch from (q at s0) to s1 with an adaptive step; raise at lock-up."""
         s = s0
-        _, jac, ds = self.jacobian(q, s)
-        sign0 = self._orientation(jac)
+        end = self._end
+        if end is not None and end[0] is q and end[1] == s0:
+            jac, ds, sign0 = end[2], end[3], end[4]
+        else:
+            _, jac, ds = self.jacobian(q, s)
+            sign0 = self._orientation(jac)
+        sign_end = sign0
         direction = 1.0 if s1 >= s0 else -1.0
         h_mag = abs(s1 - s0)
         min_h = abs(s1 - s0) * 1e-6 + 1e-12
@@ -554,12 +564,13 @@ class _System:
                 if sign0 != 0.0 and sign != 0.0 and sign != sign0:
                     raise LockupError(s + h, f"{self.mech.name}: the motion passes a singular pose "
                                              "(branch change)")
-                q, s, jac, ds = q_new, s + h, jac_new, ds_new
+                q, s, jac, ds, sign_end = q_new, s + h, jac_new, ds_new, sign
                 h_mag *= 1.5
                 continue
             h_mag *= 0.5
             if h_mag < min_h:
                 raise LockupError(s, f"{self.mech.name}: lock-up, no assembly beyond this input")
+        self._end = (q, s, jac, ds, sign_end)
         return q
 
 

@@ -459,3 +459,32 @@ def test_driver_values_are_the_laws_own_to_the_bit(unit):
         assert linear._driver_value(mech.drivers[0], s) == (float(law(s)), float(law(s, 1)))
         want = (float(np.radians(s)), float(np.pi / 180)) if unit == "deg" else (float(s), 1.0)
         assert identity._driver_value(plain.drivers[0], s) == want
+
+
+def test_continuation_reusing_the_end_jacobian_equals_fresh_starts():
+    """A sweep's continuation starts from where the previous one ended and reuses that end's Jacobian: the
+    poses must be exactly those of a system that computes every start afresh (and a start elsewhere, or at
+    another input, must not reuse it)."""
+    from fabricate.mechanism import _System
+
+    mech = make_four_bar()
+    inputs = np.linspace(*mech.input_range, 73)
+    reused = _System(mech)
+    q = reused.assemble(inputs[0])
+    want = q
+    for a, b in zip(inputs[:-1], inputs[1:], strict=True):
+        q = reused.continue_to(q, a, b)
+        fresh = _System(mech)
+        want = fresh.continue_to(want.copy(), a, b)
+        assert np.array_equal(q, want)
+    # the start is not recomputed where the last one ended ...
+    calls: list[float] = []
+    jacobian = reused.jacobian
+    reused.jacobian = lambda q_, s_: (calls.append(s_), jacobian(q_, s_))[1]  # type: ignore[method-assign]
+    on = reused.continue_to(q, inputs[-1], inputs[-2])
+    assert calls[0] != inputs[-1]
+    # ... but the same q object at another input is: the end's d(residual)/ds would be the wrong one
+    calls.clear()
+    back = reused.continue_to(on, inputs[-1], inputs[-3])
+    assert calls[0] == inputs[-1]
+    assert np.array_equal(back, _System(mech).continue_to(on.copy(), inputs[-1], inputs[-3]))
