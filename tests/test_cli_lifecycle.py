@@ -135,6 +135,42 @@ def test_a_signal_leaves_no_process_no_temporary_and_the_previous_output(tmp_pat
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".out.")] == []
 
 
+# A library on the build's path swallows the stop: the exports stage sends SIGTERM to its own process while it
+# sleeps inside a try that catches BaseException (trimesh catches BaseException in its own code), so the Stopped
+# the handler raises never reaches the command line's handler.
+SWALLOWED = """
+import os, signal, sys, time
+import fabricate.pipeline as pipeline
+real = pipeline._export
+def swallowing(run, with_step):
+    try:
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(60)  # the handler raises Stopped out of the sleep at once
+    except BaseException:
+        pass
+    return real(run, with_step)
+pipeline._export = swallowing
+from fabricate.cli import main
+sys.exit(main(["build", "gear_pair_elliptic", "-o", sys.argv[1], "-q"]))
+"""
+
+
+@pytest.mark.slow
+def test_a_stop_a_library_swallowed_still_stops_the_run_before_anything_is_written(tmp_path):
+    out = tmp_path / "out"
+    write_output(_previous_output(), out)
+    env = {k: v for k, v in os.environ.items() if k != "FABRICATE_SERIAL"}
+    run = subprocess.run([sys.executable, "-c", SWALLOWED, str(out)], cwd=tmp_path, env=env, capture_output=True,
+                         text=True, timeout=600, start_new_session=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGTERM, signal.SIG_DFL))
+    assert run.returncode == 143, (run.stdout, run.stderr)
+    # the next stage's start raised it again: not "as the run ended (its result is complete)"
+    assert run.stderr.strip().splitlines() == ["fabricate: terminated (SIGTERM); nothing was written (a previous "
+                                               "output is unchanged)"]
+    assert _tree(out) == _previous_output()
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".out.")] == []
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux's")
 def test_the_picture_child_dies_with_a_killed_parent_and_frees_its_output(tmp_path):
