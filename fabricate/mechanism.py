@@ -43,6 +43,8 @@ class LinearLaw:
     offset: float = 0.0
 
     def __call__(self, x: np.ndarray | float, nu: int = 0) -> np.ndarray | float:
+        if isinstance(x, float):  # one value (the solver's every step): the same product and sum on floats
+            return self.slope * x + self.offset if nu == 0 else float(self.slope) if nu == 1 else 0.0
         x = np.asarray(x, dtype=np.float64)
         if nu == 0:
             return self.slope * x + self.offset
@@ -346,14 +348,13 @@ class _System:
         free = self.rev_body >= 0
         rows = np.broadcast_to(np.arange(k), (2, k))[free]
         cols = 3 * self.rev_body[free]
-        self.rev_free = free
-        self.rev_sign = np.broadcast_to(sign, (2, k))[free]
+        rev_sign = np.broadcast_to(sign, (2, k))[free]
         self.rev_const = np.zeros((2 * k, self.n))
-        self.rev_const[2 * rows, cols] = self.rev_sign
-        self.rev_const[2 * rows + 1, cols + 1] = self.rev_sign
+        self.rev_const[2 * rows, cols] = rev_sign
+        self.rev_const[2 * rows + 1, cols + 1] = rev_sign
         self.rev_flat_x = (2 * rows) * self.n + cols + 2
         self.rev_flat_y = (2 * rows + 1) * self.n + cols + 2
-        # the same layout as Python lists for the float loop of _revolute_block: per joint, both ends'
+        # the same layout as Python lists for the float loop of _revolute_floats: per joint, both ends'
         # (body index or -1 for the ground, local x, local y); the Jacobian's angle entries in the order of
         # rev_flat_x / rev_flat_y (side a of every joint, then side b), as (end, sign)
         self._rev_ends = [(int(self.rev_body[0, i]), float(self.rev_local[0, i, 0]), float(self.rev_local[0, i, 1]),
@@ -362,9 +363,8 @@ class _System:
         self._rev_entries = [(side * k + i, float(sign[side, 0])) for side in (0, 1) for i in range(k)
                              if free[side, i]]
         self._n_rev = 2 * k
-        # the angle drivers without a law in a mechanism of degrees, and the linear laws: their values are
-        # computed here on floats (numpy's radians is the product with pi/180 too, and LinearLaw's the
-        # product and sum)
+        # the angle drivers without a law in a mechanism of degrees: their values are computed on floats
+        # (numpy's radians is the product with pi/180 too)
         self._deg = self.mech.input_unit == "deg"
         # where the last assembly or continuation ended: (q, s, Jacobian, d(residual)/ds, orientation) there.
         # A sweep's next continuation starts from that very q and s: it reuses them instead of computing the
@@ -429,8 +429,6 @@ class _System:
 
     def _driver_value(self, d: Driver, s: float) -> tuple[float, float]:
         if d.law is not None:
-            if type(d.law) is LinearLaw:  # slope * s + offset on floats: LinearLaw's own operations
-                return float(d.law.slope * float(s) + d.law.offset), float(d.law.slope)
             return float(d.law(s)), float(d.law(s, 1))
         if d.kind == "angle" and self._deg:
             return float(s) * (np.pi / 180.0), float(np.pi / 180.0)

@@ -9,12 +9,13 @@ from fabricate.parts.model import BulgePath
 
 def _toothed_path(rng: np.random.Generator) -> BulgePath:
     """A closed path of 240 pieces round a circle, alternately straight and arcs of either sense (a gear-like
-    outline, concave and convex), with some zero-length pieces."""
+    outline, concave and convex; two of them more than half circles), with some zero-length pieces."""
     angles = np.sort(rng.uniform(0.0, 2.0 * np.pi, 240))
     radii = 20.0 + 1.5 * (np.arange(240) % 4 < 2)
     vertices = np.column_stack([radii * np.cos(angles), radii * np.sin(angles)])
     vertices[7] = vertices[6]  # a zero-length piece
     bulges = np.where(np.arange(240) % 3 == 0, rng.uniform(-0.6, 0.6, 240), 0.0)
+    bulges[[30, 90]] = 1.8, -2.5  # two arcs of more than a half circle
     return BulgePath(vertices, bulges)
 
 
