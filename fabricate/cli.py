@@ -193,7 +193,7 @@ def _progress(quiet: bool, received: list[int]) -> Callable[[str], None]:
 
     A stop signal's :class:`Stopped` can be caught on its way by a library that catches BaseException (trimesh
     does, its mesh visuals' code included): the signal is still in ``received``, so the run stops at the next
-    stage instead of finishing as if nothing was asked (the signal tests saw it about once in ten suites)."""
+    stage instead of finishing as if nothing was asked (a Ctrl-C test failed so in two suite runs of 2026-11-26)."""
     start = time.perf_counter()
     show = not (quiet or sys.stderr is None or not sys.stderr.isatty())
 

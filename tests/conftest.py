@@ -13,6 +13,7 @@ import copy
 import fcntl
 import hashlib
 import io
+import json
 import math
 import os
 import shutil
@@ -137,8 +138,7 @@ def shipped_build(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., Bui
     change what is cached here.
     """
     shared = session_folder(tmp_path_factory)
-    store = shared / "shipped-stage-cache"
-    store.mkdir(exist_ok=True)
+    store = stage_cache_folder(tmp_path_factory)
 
     def get(name: str, process: str | None = None) -> BuildOutcome:
         """``process``: a shipped profile's name, as ``--process`` gives it (``"laser"``, ``"fdm"``)."""
@@ -150,6 +150,50 @@ def shipped_build(tmp_path_factory: pytest.TempPathFactory) -> Callable[..., Bui
         return _SHIPPED_BUILDS[key]
 
     return get
+
+
+def stage_cache_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The stage cache folder ``shipped_build`` fills and ``shared_stage_cache`` uses, shared by the session's
+    workers."""
+    store = session_folder(tmp_path_factory) / "shipped-stage-cache"
+    store.mkdir(exist_ok=True)
+    return store
+
+
+#: ``keep_verdicts``' verdicts in this process, by (file name, sha256 of its bytes, expectation, OCP there).
+_VERDICTS: dict[tuple[str, str, str, bool], list[str]] = {}
+
+
+def keep_verdicts(monkeypatch: pytest.MonkeyPatch, shared: Path | None = None) -> None:
+    """``fabricate.verify_files.content_problems`` kept by content for the session: a check's reading of a file
+    back (STEP with OCP, meshes, drawings, pictures) is most of its time once its rebuild is kept, and a
+    tampering of one file leaves the others as they were. A file's verdict is a function of its name, bytes and
+    expectation, and of whether OCP is there to read STEP; a changed file has another hash and is read for real.
+    ``shared``: a folder where the verdicts are also kept for the session's other workers (a JSON file per key,
+    made under a lock by the first to ask)."""
+    import fabricate.export.step as step
+    import fabricate.verify_files as verify_files
+
+    real = verify_files.content_problems
+
+    def kept(rel: str, data: bytes, expected: object) -> list[str]:
+        key = (rel, hashlib.sha256(data).hexdigest(), repr(expected), step.step_available())
+        if key not in _VERDICTS:
+            if shared is None:
+                _VERDICTS[key] = list(real(rel, data, expected))
+            else:
+                name = hashlib.sha256(repr(key).encode()).hexdigest()[:32]
+                path = shared / f"{name}.json"
+                with locked(shared / f"{name}.lock"):
+                    if path.is_file():
+                        _VERDICTS[key] = json.loads(path.read_text(encoding="utf-8"))
+                    else:
+                        _VERDICTS[key] = list(real(rel, data, expected))
+                        path.with_suffix(".part").write_text(json.dumps(_VERDICTS[key]), encoding="utf-8")
+                        path.with_suffix(".part").replace(path)
+        return list(_VERDICTS[key])
+
+    monkeypatch.setattr(verify_files, "content_problems", kept)
 
 
 @contextmanager
@@ -179,8 +223,7 @@ def shared_stage_cache(tmp_path_factory: pytest.TempPathFactory) -> Callable[...
     by the cache does not run) or what the keys take from the install (``step_available``: a key holds the
     installed OCP's version, so a build that pretends OCP is missing would be served STEP files)."""
     shared = session_folder(tmp_path_factory)
-    store = shared / "shipped-stage-cache"
-    store.mkdir(exist_ok=True)
+    store = stage_cache_folder(tmp_path_factory)
 
     @contextmanager
     def block(key: str | None = None) -> Iterator[None]:

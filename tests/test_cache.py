@@ -22,7 +22,7 @@ import pytest
 from fabricate import cache, stage_keys
 from fabricate.design import design_from_text, load_design
 from fabricate.templates import TEMPLATE_DIR
-from tests.conftest import locked, session_folder
+from tests.conftest import locked, session_folder, stage_cache_folder
 
 DEFAULT = "finger_five_bar_ncg"
 
@@ -379,7 +379,7 @@ def warmed(tmp_path_factory, shared_stage_cache) -> tuple[Path, Path]:
     folder, out = shared / "cache", shared / "out"
     with locked(shared / "lock"):
         if not (shared / "done").is_file():
-            store = session_folder(tmp_path_factory) / "shipped-stage-cache"  # conftest's shared_stage_cache folder
+            store = stage_cache_folder(tmp_path_factory)
             start = time.time() - 2.0  # file times come from a coarser clock than time.time()
             cache.clear_memory()
             with shared_stage_cache(f"tests/test_cache warmed {DEFAULT}"):

@@ -175,7 +175,11 @@ def test_a_previous_output_is_replaced_but_not_with_a_user_file_in_it(tmp_path):
 @pytest.mark.slow
 def test_synth_never_replaces_a_build(tmp_path, monkeypatch, capsys, built_folder):
     monkeypatch.chdir(tmp_path)
-    build = tmp_path / "outputs" / FAST  # where `fabricate build NAME` puts it: a copy of the session's build
+    from fabricate.cli import _default_output
+    from fabricate.templates import find_template
+
+    # where `fabricate build NAME` puts it (its design is named as its template): a copy of the session's build
+    build = tmp_path / _default_output(FAST, find_template(FAST), "build")
     build.parent.mkdir()
     shutil.copytree(built_folder(FAST, read_only=True).path, build, symlinks=True)
     before = _tree(build)

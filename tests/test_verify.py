@@ -69,42 +69,15 @@ def _one_rebuild_per_template(monkeypatch, shared_stage_cache):
     monkeypatch.setattr(pipeline, "run_build", cached)
 
 
-_VERDICTS: dict[tuple, list[str]] = {}
-
-
 @pytest.fixture(autouse=True)
 def _one_reading_per_file(monkeypatch, tmp_path_factory):
-    """Reading the files back is most of a check's time once its rebuild is kept (STEP with OCP ~2.5 s a
-    folder, the meshes, drawings and pictures ~1 s more); a tampering of one file leaves the others as they
-    were, so each file's verdict (a function of its name, bytes and expectation, and of whether OCP is there to
-    read STEP) is kept by content hash, as test_verify_fuzz does. A changed file has another hash and is read
-    for real. The verdicts are shared by the session's workers (a file per key in the session's folder, made under
-    a lock by the first to ask): both read the same untouched folder, STEP files and all."""
-    import hashlib
+    """Each file's verdict kept by content (conftest.keep_verdicts; reading STEP back with OCP is ~2.5 s a
+    folder), shared by the session's workers: both read the same untouched folder, STEP files and all."""
+    from tests.conftest import keep_verdicts, session_folder
 
-    import fabricate.export.step as step
-    import fabricate.verify_files as verify_files
-    from tests.conftest import locked, session_folder
-
-    real = verify_files.content_problems
     shared = session_folder(tmp_path_factory) / "test-verify-verdicts"
     shared.mkdir(exist_ok=True)
-
-    def cached(rel, data, expected):
-        key = (rel, hashlib.sha256(data).hexdigest(), repr(expected), step.step_available())
-        if key not in _VERDICTS:
-            name = hashlib.sha256(repr(key).encode()).hexdigest()[:32]
-            path = shared / f"{name}.json"
-            with locked(shared / f"{name}.lock"):
-                if path.is_file():
-                    _VERDICTS[key] = json.loads(path.read_text(encoding="utf-8"))
-                else:
-                    _VERDICTS[key] = list(real(rel, data, expected))
-                    path.with_suffix(".part").write_text(json.dumps(_VERDICTS[key]), encoding="utf-8")
-                    path.with_suffix(".part").replace(path)
-        return list(_VERDICTS[key])
-
-    monkeypatch.setattr(verify_files, "content_problems", cached)
+    keep_verdicts(monkeypatch, shared)
 
 
 @pytest.fixture
@@ -455,20 +428,31 @@ def test_a_zip_bomb_3mf_is_rejected_without_inflating(copy, tmp_path):
 
 @pytest.mark.slow
 def test_a_zip_bomb_within_the_manifest_size_is_never_inflated(copy, capsys, monkeypatch):
+    import zipfile
+
     import fabricate.export.stl as stl
 
     manifest_bytes = {m["path"]: m["bytes"] for m in _report(copy)["manifest"]}["assembly.3mf"]
     bomb = _zip_bomb(64)
     assert len(bomb) <= manifest_bytes  # so it is read (its hash differs) and parsed to say how it differs
+    # every zip member opened (to be inflated) from here on, by its declared size
+    opened: list[int] = []
+    real_open = zipfile.ZipFile.open
+
+    def spying(self, name, *args, **kwargs):
+        opened.append((name if isinstance(name, zipfile.ZipInfo) else self.getinfo(name)).file_size)
+        return real_open(self, name, *args, **kwargs)
+
+    monkeypatch.setattr(zipfile.ZipFile, "open", spying)
+    stl.read_3mf((copy / "assembly.3mf").read_bytes())  # the spy sees a real 3MF's model being read
+    assert opened
     (copy / "assembly.3mf").write_bytes(bomb)
-    inflated = []
-    real = stl.read_3mf
-    monkeypatch.setattr(stl, "read_3mf", lambda data: inflated.append(data == bomb) or real(data))
+    opened.clear()
     code, out = _check(copy, capsys)
     assert code == 1
     assert f"assembly.3mf: {len(bomb)} bytes on disk, {manifest_bytes} bytes in the manifest" in out
     assert "assembly.3mf: member '3D/3dmodel.model' declares 67108864 bytes" in out
-    assert True not in inflated
+    assert 64 * 2**20 not in opened  # the bomb's member was never opened: judged by its declared size
 
 
 @pytest.mark.slow

@@ -8,7 +8,6 @@ Seeded loops (each case names its seed): one small build per session (``built_fo
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import os
@@ -24,6 +23,7 @@ import pytest
 
 from fabricate.cli import main
 from fabricate.pipeline import run_build
+from tests.conftest import keep_verdicts
 
 FAST = "gear_pair_elliptic"
 #: Cases of each kind: ~0.1-0.3 s each once the module's build and first parse are done.
@@ -40,7 +40,6 @@ def built(built_folder) -> Path:
 
 
 _REBUILDS: dict[tuple, Any] = {}
-_VERDICTS: dict[tuple, list[str]] = {}
 
 
 @pytest.fixture(autouse=True)
@@ -51,7 +50,6 @@ def _fast_and_bounded(monkeypatch, shared_stage_cache):
     leaves the files as they were); and a hang (a FIFO opened) fails the case instead of blocking the suite."""
     import fabricate.export.step as step
     import fabricate.pipeline as pipeline
-    import fabricate.verify_files as verify_files
 
     monkeypatch.setattr(step, "step_available", lambda: False)
 
@@ -72,15 +70,7 @@ def _fast_and_bounded(monkeypatch, shared_stage_cache):
         return _REBUILDS[key]
 
     monkeypatch.setattr(pipeline, "run_build", cached_build)
-    real_content = verify_files.content_problems
-
-    def cached_content(rel, data, expected):
-        key = (rel, hashlib.sha256(data).hexdigest(), repr(expected))
-        if key not in _VERDICTS:
-            _VERDICTS[key] = real_content(rel, data, expected)
-        return list(_VERDICTS[key])
-
-    monkeypatch.setattr(verify_files, "content_problems", cached_content)
+    keep_verdicts(monkeypatch)
 
     def hung(_signum, _frame):
         raise TimeoutError("check blocked for 120 s (a FIFO or device opened?)")
