@@ -266,7 +266,13 @@ def interference_areas(pair: GearPair, x_a: np.ndarray) -> np.ndarray:
     half = 3.5 * np.pi * m
     win_a = shapely.clip_by_rect(polys_a, -3.0 * m, -half, 3.0 * m, half)
     win_b = shapely.clip_by_rect(polys_b, -3.0 * m, -half, 3.0 * m, half)
-    return np.asarray(shapely.area(shapely.intersection(win_a, win_b)), dtype=np.float64)
+    # the overlay only where the windows meet: disjoint ones overlap by 0.0 (an empty intersection's area), and
+    # the predicate costs ~1/8 of the overlay (a sound pair meets at no step: 720 intersections were 0.038 s)
+    area = np.zeros(len(x_a), dtype=np.float64)
+    meet = np.flatnonzero(shapely.intersects(win_a, win_b))
+    if len(meet):
+        area[meet] = shapely.area(shapely.intersection(win_a[meet], win_b[meet]))
+    return area
 
 
 def mesh_check(pair: GearPair, x_a_values: np.ndarray | None = None, steps: int | None = None) -> MeshResult:

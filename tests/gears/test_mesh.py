@@ -10,11 +10,14 @@ and every gap is a difference of angles chosen here.
 
 from __future__ import annotations
 
+import dataclasses
 from functools import cache
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import shapely
+import shapely.affinity
 
 from fabricate.gears import GearSpec, make_gear_pair
 from fabricate.gears import mesh as mesh_module
@@ -231,3 +234,35 @@ def test_free_play_from_outlines_of_a_small_driven_gear():
     dense_plus, dense_minus = free_play(pair, x)
     np.testing.assert_allclose(dense_plus, expected, rtol=0, atol=5e-6)
     np.testing.assert_allclose(dense_minus, expected, rtol=0, atol=5e-6)
+
+
+# -- interference_areas ----------------------------------------------------------------------------------------
+def test_interference_areas_are_the_overlap_where_teeth_meet_and_zero_elsewhere():
+    """48/12 spur gears with gear b turned towards gear a by up to twice the backlash's angle, by an amount that
+    varies with x: some steps overlap and some keep clear. Where they overlap the area is that of the posed
+    outlines' intersection within the window (to rounding); elsewhere exactly 0. Fails if the overlay is skipped
+    at a step where the teeth meet (interference_areas runs it only where the windows intersect)."""
+    pair = spur_48_12()
+    x = np.linspace(0.0, 2 * np.pi / 48, 40, endpoint=False)
+    turn = 2.0 * 0.1 / 12 * np.sin(np.linspace(0.0, 3 * np.pi, len(x)))
+
+    def turned(v, *order):
+        return pair.law(v, *order) if order else np.asarray(pair.law(v)) + np.interp(v, x, turn)
+
+    shifted = dataclasses.replace(pair, law=turned)
+    areas = mesh_module.interference_areas(shifted, x)
+    m, half = pair.module, 3.5 * np.pi * pair.module
+    window = shapely.box(-3.0 * m, -half, 3.0 * m, half)
+    reference = []
+    for xa in x:
+        r_a = float(pair.pitch_model.radii(np.array([xa]), "a")[0][0])
+        a = shapely.affinity.translate(shapely.affinity.rotate(shapely.Polygon(pair.outline_a), xa, (0, 0), True),
+                                       -r_a)
+        b = shapely.affinity.translate(shapely.affinity.rotate(shapely.Polygon(pair.outline_b),
+                                                               float(turned(np.array([xa]))[0]), (0, 0), True),
+                                       pair.center_distance_mm - r_a)
+        reference.append(a.intersection(b).intersection(window).area)
+    reference = np.array(reference)
+    assert np.count_nonzero(reference > 1e-9) >= 5 and np.count_nonzero(reference == 0.0) >= 5
+    np.testing.assert_allclose(areas, reference, rtol=1e-9, atol=1e-12)
+    assert np.all(areas[reference == 0.0] == 0.0)
