@@ -224,6 +224,32 @@ def figure(size: tuple[float, float], dpi: float) -> Any:
     return fig
 
 
+def rounded_xy(x: Any, y: Any) -> list[float]:
+    """``[x0, y0, x1, y1, ...]``, each ``round(float(v), 2)``: pixel coordinates for Pillow's drawing, vectorised.
+
+    The same floats as Python's ``round`` (a GIF's bytes depend on them): ``rint(100 v) / 100`` is that
+    value wherever ``100 v`` is computed on the same side of a half as its exact value; the few that lie
+    within a millionth of a half are rounded by Python's (correctly rounded) ``round`` instead.
+
+    Parameters
+    ----------
+    x, y : array_like
+        Coordinates (pixels), one value per point.
+    """
+    import numpy as np
+
+    values = np.column_stack([np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)]).ravel()
+    if len(values) <= 16:  # a point or a few (a hole's centre): Python's round itself is quicker than numpy's calls
+        return [round(v, 2) for v in values.tolist()]
+    scaled = values * 100.0
+    out = np.rint(scaled) / 100.0
+    near = np.flatnonzero(np.abs(scaled - np.floor(scaled) - 0.5) < 1e-6)
+    flat = out.tolist()
+    for k in near.tolist():
+        flat[k] = round(float(values[k]), 2)
+    return flat
+
+
 def gif_bytes(images: list[Any], frame_ms: int, **options: Any) -> bytes:
     """Animated GIF (looping) of Pillow images."""
     buffer = io.BytesIO()

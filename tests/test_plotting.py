@@ -17,6 +17,7 @@ from fabricate.plotting import (
     legend,
     palette,
     png_bytes,
+    rounded_xy,
     series_colours,
     series_styles,
 )
@@ -149,3 +150,19 @@ def test_gear_law_plot_has_a_legend_naming_both_curves():
     texts = [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
     assert any("driven angle" in t for t in texts) and any("ratio" in t for t in texts)
     assert figure_problems(fig) == []
+
+
+def test_rounded_xy_gives_pythons_round_of_every_coordinate():
+    # the GIFs' bytes depend on these floats: numpy's rint(100 v) / 100 differs from round(v, 2) where 100 v
+    # rounds across a half (2.675 * 100 = 267.49999999999997; 1.005, 0.285 ...): every such value is here, and
+    # long arrays (the vectorised route) as well as a single point
+    rng = np.random.default_rng(7)
+    halves = np.arange(0, 40000) / 100.0 + 0.005  # k.kk5: the ties in decimal, none exact in binary
+    for x in (halves, rng.uniform(-20.0, 500.0, 5000), np.array([2.675]), np.array([-0.004, 1.005])):
+        y = x[::-1] * 0.5
+        got = rounded_xy(x, y)
+        want = [v for a, b in zip(x, y, strict=True) for v in (round(float(a), 2), round(float(b), 2))]
+        assert got == want
+        assert all(type(v) is float for v in got)
+    # the float products and numpy's own rounding do disagree on some of them (the case handled above)
+    assert np.any(np.rint(halves * 100.0) / 100.0 != np.array([round(float(v), 2) for v in halves]))

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from fabricate.plotting import figure, gif_bytes, legend, palette, png_bytes
+from fabricate.plotting import figure, gif_bytes, legend, palette, png_bytes, rounded_xy
 
 if TYPE_CHECKING:
     from fabricate.gears.pair import GearPair
@@ -102,27 +102,30 @@ def pair_gif(pair: GearPair, frames: int, size_px: int = 384, frame_ms: int = 80
     scale = size_px / float(pair.center_distance_mm + 2.0 * reach)
     width, height = size_px, max(16, int(round(2.0 * reach * scale)))
 
-    def pixels(points: np.ndarray) -> list[tuple[float, float]]:
+    def pixels(points: np.ndarray) -> list[float]:
         x = (points[:, 0] - lo_xy[0]) * scale
         y = height - (points[:, 1] - lo_xy[1]) * scale  # image y points down
-        return [(round(float(a), 2), round(float(b), 2)) for a, b in zip(x, y, strict=True)]
+        return rounded_xy(x, y)  # flat [x0, y0, ...]: what Pillow makes of a list of (x, y) pairs
 
     # index 0 white, 1 dark outline, 2 gear a, 3 gear b
     palette = [255, 255, 255, 40, 40, 40, 76, 114, 176, 221, 132, 82]
     palette += [0] * (768 - len(palette))
+    # one blank frame on the palette and one font for every frame (a copy carries the palette: the same frames)
+    blank = Image.new("P", (width, height), 0)
+    blank.putpalette(palette)
+    font = label_font()
     images = []
     for x in xs:
         out_a, out_b, _, _ = _placed(pair, float(x))
-        image = Image.new("P", (width, height), 0)
-        image.putpalette(palette)
+        image = blank.copy()
         draw = ImageDraw.Draw(image)
         draw.polygon(pixels(out_a), fill=2, outline=1)
         draw.polygon(pixels(out_b), fill=3, outline=1)
         for centre, bore in ((np.zeros(2), pair.bore_a_mm), (centre_b, pair.bore_b_mm)):
-            (cx, cy), = pixels(centre[None, :])
+            cx, cy = pixels(centre[None, :])
             r = 0.5 * bore * scale
             draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=0, outline=1)
-        draw.text((4, 4), f"gear a {np.degrees(x):.1f} deg", fill=1, font=label_font())
+        draw.text((4, 4), f"gear a {np.degrees(x):.1f} deg", fill=1, font=font)
         images.append(image)
     return gif_bytes(images, frame_ms, optimize=False, disposal=1)
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from fabricate.parts.model import Part, circle_polygon
 from fabricate.planar import transform_points
-from fabricate.plotting import DISTINCT_HEX, figure, gif_bytes, legend, palette_rgb255, png_bytes
+from fabricate.plotting import DISTINCT_HEX, figure, gif_bytes, legend, palette_rgb255, png_bytes, rounded_xy
 
 if TYPE_CHECKING:
     from fabricate.mechanism import Motion
@@ -196,19 +196,22 @@ def motion_gif(parts: Sequence[Part], motion: Motion, frames: int = 24, size_px:
     width = max(16, int(round((hi[0] - lo[0]) * scale)))
     height = max(16, int(round((hi[1] - lo[1]) * scale)))
 
-    def pixels(points: np.ndarray) -> list[tuple[float, float]]:
+    def pixels(points: np.ndarray) -> list[float]:
         x = (points[:, 0] - lo[0]) * scale
         y = height - (points[:, 1] - lo[1]) * scale  # image y points down
-        return [(round(float(a), 2), round(float(b), 2)) for a, b in zip(x, y, strict=True)]
+        return rounded_xy(x, y)  # flat [x0, y0, ...]: what Pillow makes of a list of (x, y) pairs
 
     # a fixed palette: index 0 white, 1 outline grey, 2.. the layer colours (no per-frame quantising)
     # (the first ten colours always, so a GIF of up to ten parts keeps the bytes it had with a 10-colour palette)
     palette = [255, 255, 255, 40, 40, 40] + [c for rgb in PALETTE[:max(10, len(parts))] for c in rgb]
     palette += [0] * (768 - len(palette))
+    # one blank frame on the palette and one font for every frame (a copy carries the palette: the same frames)
+    blank = Image.new("P", (width, height), 0)
+    blank.putpalette(palette)
+    font = label_font()
     images = []
     for i in indices:
-        image = Image.new("P", (width, height), 0)
-        image.putpalette(palette)
+        image = blank.copy()
         draw = ImageDraw.Draw(image)
         body_poses = motion.poses_at(i)
         for part, outline, holes in shapes:
@@ -216,15 +219,15 @@ def motion_gif(parts: Sequence[Part], motion: Motion, frames: int = 24, size_px:
             colour = 2 + part_colour[part.name]
             ring = pixels(transform_points(pose, outline))
             if part.role in SEE_THROUGH_ROLES:  # its outline only: a filled mount plate hid the parts under it
-                draw.line([*ring, ring[0]], fill=colour, width=2)
+                draw.line([*ring, *ring[:2]], fill=colour, width=2)
                 continue
             draw.polygon(ring, fill=colour, outline=1)
             for centre, radius in holes:
                 if radius > 0:
-                    (cx, cy), = pixels(transform_points(pose, centre)[None, :])
+                    cx, cy = pixels(transform_points(pose, centre)[None, :])
                     r = radius * scale
                     draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=0)
-        draw.text((4, 4), frame_label(motion.inputs[i], unit), fill=1, font=label_font())
+        draw.text((4, 4), frame_label(motion.inputs[i], unit), fill=1, font=font)
         images.append(image)
     sequence = images + images[-2:0:-1]
     return gif_bytes(sequence, frame_ms, optimize=False, disposal=1)
