@@ -94,14 +94,39 @@ def document_bytes(doc: Any) -> bytes:
     return stream.getvalue().encode("utf-8")
 
 
+#: The latest parts' cut paths, by (id of the part, kerf): (the part, its outline, holes and slots). The part is
+#: kept with its paths, so its id names no other object while the entry lives; parts are frozen.
+_CUT_PATHS: OrderedDict[tuple[int, float], tuple[Part, BulgePath, list[tuple[np.ndarray, float]], list[BulgePath]]] \
+    = OrderedDict()
+#: Entries kept: a laser build asks for each part's path some eight times (its files, its sheet's, its areas).
+_CUT_PATHS_KEPT = 64
+
+
 def cut_geometry(part: Part, kerf_mm: float) -> tuple[BulgePath, list[tuple[np.ndarray, float]], list[BulgePath]]:
     """The laser path of a part: outline offset out by kerf/2, holes (centre, diameter) shrunk by the kerf,
-    slots offset in by kerf/2. With no kerf this is the part's exact geometry."""
-    half = 0.5 * kerf_mm
-    outline = offset_path(part.outline, half)
-    holes = [(np.asarray(h.centre, dtype=np.float64), h.diameter_mm - kerf_mm) for h in part.holes]
-    slots = [offset_path(s, -half) for s in getattr(part, "slots", ())]
-    return outline, holes, slots
+    slots offset in by kerf/2. With no kerf this is the part's exact geometry.
+
+    The offsets are worked out once per part and kerf (the latest :data:`_CUT_PATHS_KEPT`); every call returns
+    new lists of the same (frozen) paths."""
+    key = (id(part), float(kerf_mm))
+    kept = _CUT_PATHS.get(key)
+    if kept is None or kept[0] is not part:
+        half = 0.5 * kerf_mm
+        holes = [(_frozen(h.centre), h.diameter_mm - kerf_mm) for h in part.holes]
+        slots = [offset_path(s, -half) for s in getattr(part, "slots", ())]
+        kept = (part, offset_path(part.outline, half), holes, slots)
+        _CUT_PATHS[key] = kept
+        if len(_CUT_PATHS) > _CUT_PATHS_KEPT:
+            _CUT_PATHS.popitem(last=False)
+    _, outline, holes, slots = kept
+    return outline, list(holes), list(slots)
+
+
+def _frozen(point: Any) -> np.ndarray:
+    """A read-only float copy of a point (shared by every caller of :func:`cut_geometry`)."""
+    out = np.array(point, dtype=np.float64)
+    out.setflags(write=False)
+    return out
 
 
 def cut_area(part: Part, kerf_mm: float) -> float:
@@ -191,9 +216,7 @@ def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None =
     for path in [outline] + slots:
         if style.arcs == "segments":
             path = BulgePath.polyline(path.polygon(style.chord_tolerance_mm))
-        xy = place(path.vertices)
-        msp.add_lwpolyline([(float(x), float(y), float(b)) for (x, y), b in zip(xy, path.bulges, strict=True)],
-                           format="xyb", close=True, dxfattribs={"layer": "CUT"})
+        add_closed_polyline(msp, place(path.vertices), "CUT", path.bulges)
     for centre, diameter in holes:
         c = place(centre[None, :])[0]
         msp.add_circle((float(c[0]), float(c[1])), float(diameter) / 2.0, dxfattribs={"layer": "CUT"})
@@ -203,9 +226,7 @@ def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None =
         engraved = label if isinstance(label, Label) else engraved_label(part, style, label)
         if engraved is not None:
             for ring in engraved.polygons():
-                xy = place(ring)
-                msp.add_lwpolyline([(float(x), float(y)) for x, y in xy], format="xy", close=True,
-                                   dxfattribs={"layer": "ENGRAVE"})
+                add_closed_polyline(msp, place(ring), "ENGRAVE")
         return
     label = label if label is not None else part.name
     spot, height = _label_spot(part, label)
@@ -214,6 +235,22 @@ def add_part(msp: Any, part: Part, kerf_mm: float, placement: Placement | None =
     spot = place(spot[None, :])[0]
     text = msp.add_text(label, height=height, dxfattribs={"layer": "ENGRAVE"})
     text.set_placement((float(spot[0]), float(spot[1])), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
+
+
+def add_closed_polyline(msp: Any, xy: np.ndarray, layer: str, bulges: np.ndarray | None = None) -> Any:
+    """A closed LWPOLYLINE through the points ``xy`` (n, 2), with ``bulges`` (n,) (none: straight), on ``layer``.
+
+    The entity ``msp.add_lwpolyline(points, format="xyb", close=True)`` makes, its vertices given to ezdxf's
+    vertex array at once (x, y, start width, end width, bulge: what ezdxf stores a point as): ezdxf's
+    ``add_lwpolyline`` appends them one by one, copying the array at each (quadratic in the points: a text
+    outline has hundreds). tests/export/test_dxf.py holds the two to the same bytes."""
+    polyline = msp.add_lwpolyline((), format="xyb", close=True, dxfattribs={"layer": layer})
+    values = np.zeros((len(xy), 5))
+    values[:, :2] = xy
+    if bulges is not None:
+        values[:, 4] = bulges
+    polyline.lwpoints.extend(values)
+    return polyline
 
 
 def hole_label(part: Part, hole: Hole) -> str:

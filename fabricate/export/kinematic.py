@@ -8,9 +8,8 @@ leader. Labels are placed where their box, measured with ezdxf's font metrics, m
 
 from __future__ import annotations
 
-import itertools
 import math
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from typing import TYPE_CHECKING, Any
 
 import ezdxf
@@ -98,8 +97,9 @@ def kinematic_dxf(mechanism: Mechanism, poses: Mapping[str, np.ndarray]) -> byte
                 dim = msp.add_aligned_dim(p1=tuple(pa), p2=tuple(pb), distance=distance, dimstyle=DIMSTYLE,
                                           dxfattribs={"layer": "DIMENSIONS"})
                 dim.render()
-                obstacles += _dimension_marks(dim.dimension)
-                dimension_texts += dimension_text_boxes(dim.dimension)
+                texts, lines = _dimension_shapes(dim.dimension)
+                obstacles += texts + lines
+                dimension_texts += texts
     # points at one spot (a compound hinge) get one label and one pair of coordinate dimensions
     spots: dict[tuple[float, float], list[str]] = {}
     for name in sorted(world):
@@ -118,9 +118,10 @@ def kinematic_dxf(mechanism: Mechanism, poses: Mapping[str, np.ndarray]) -> byte
         drawn_low = np.min([np.array(list(world.values())).min(axis=0)]
                            + [np.array(g.bounds[:2]) for g in obstacles], axis=0)
         obstacles += _coordinate_dimensions(msp, np.array(joints), drawn_low - 2.0 * text_h, text_h)
-    for names, p, radius, _ in circles:
-        # a label keeps a text height clear of every other point, so that it is read as its own point's
-        others = [shapely.Point(q).buffer(r + text_h, quad_segs=4) for _, q, r, _ in circles if q is not p]
+    # a label keeps a text height clear of every other point, so that it is read as its own point's
+    clear = [shapely.Point(q).buffer(r + text_h, quad_segs=4) for _, q, r, _ in circles]  # each point's, once
+    for k, (names, p, radius, _) in enumerate(circles):
+        others = clear[:k] + clear[k + 1:]
         _place_label(msp, f"{', '.join(names)} ({p[0]:.3f}, {p[1]:.3f})", p, radius, text_h, obstacles,
                      shapely.union_all(others) if others else shapely.Polygon())
     return document_bytes(doc)
@@ -169,19 +170,27 @@ def _coordinate_dimensions(msp: Any, joints: np.ndarray, low: np.ndarray, text_h
 
 def dimension_text_boxes(dimension: Any) -> list[shapely.Polygon]:
     """Boxes (shapely, model space) of the text a rendered DIMENSION shows."""
-    boxes = []
+    return _dimension_shapes(dimension)[0]
+
+
+def _dimension_shapes(dimension: Any) -> tuple[list[shapely.Polygon], list[shapely.LineString]]:
+    """What a rendered DIMENSION draws, as shapes a label must keep off: its text boxes and its lines (from one
+    pass over its virtual entities: each pass renders the dimension's block again)."""
+    boxes, lines = [], []
     for entity in dimension.virtual_entities():
-        if entity.dxftype() in ("MTEXT", "TEXT"):
+        kind = entity.dxftype()
+        if kind in ("MTEXT", "TEXT"):
             extents = ezdxf.bbox.extents([entity])
             boxes.append(shapely.box(extents.extmin.x, extents.extmin.y, extents.extmax.x, extents.extmax.y))
-    return boxes
+        elif kind == "LINE":
+            lines.append(shapely.LineString([tuple(entity.dxf.start)[:2], tuple(entity.dxf.end)[:2]]))
+    return boxes, lines
 
 
 def _dimension_marks(dimension: Any) -> list[Any]:
     """What a rendered DIMENSION draws, as shapes a label must keep off: its text boxes and its lines."""
-    lines = [shapely.LineString([tuple(e.dxf.start)[:2], tuple(e.dxf.end)[:2]])
-             for e in dimension.virtual_entities() if e.dxftype() == "LINE"]
-    return dimension_text_boxes(dimension) + lines
+    boxes, lines = _dimension_shapes(dimension)
+    return boxes + lines
 
 
 def text_box(text: Any) -> shapely.Polygon:
@@ -201,33 +210,22 @@ def _place_label(msp: Any, label: str, p: np.ndarray, radius: float, text_h: flo
     x0, y0, x1, y1 = box.bounds
     half = np.array([0.5 * (x1 - x0), 0.5 * (y1 - y0)])
     centre_offset = np.array([0.5 * (x0 + x1), 0.5 * (y0 + y1)])  # the box centre from the insert point
-    margin = 0.25 * text_h
     tree = shapely.STRtree(obstacles)
-    best = None
-    # first a spot whose leader crosses no text; failing that (a point inside a crowd of texts) any free box
-    for strict, ring, angle in itertools.product((True, False), _RINGS, _DIRECTIONS):
-        u = np.array([math.cos(angle), math.sin(angle)])
-        # the box's centre so that its nearest side stands `ring` text heights beyond the circle along u
-        reach = radius + ring * text_h + min(half[0] / max(abs(u[0]), 1e-9), half[1] / max(abs(u[1]), 1e-9))
-        centre = p + u * reach
-        candidate = shapely.box(*(centre - half), *(centre + half))
-        if (len(tree.query(candidate.buffer(margin, join_style="mitre"), predicate="intersects"))
-                or candidate.intersects(others)):
-            continue
+    best = first_free = None
+    # first a spot whose leader crosses no text; failing that (a point inside a crowd of texts) the first free box
+    for index, centre, candidate in _free_boxes(p, radius, half, text_h, tree, others):
+        ring, u = _CANDIDATE_RINGS[index], np.array(_CANDIDATE_DIRECTIONS[index])
         leader = None
         if ring > 1.5:
             near = shapely.ops.nearest_points(candidate, shapely.Point(p))[0]
             # from just outside the point's own circle (an obstacle too) to the box's nearest point
             leader = shapely.LineString([p + u * (radius + 0.1 * text_h), (near.x, near.y)])
-            # a leader may cross lines and the circles of close points, never a text box (a rectangle)
-            # unless it starts inside one (a dimension's text over the point: no leader avoids it)
-            start = shapely.Point(leader.coords[0])
-            if strict and any(obstacles[i].geom_type == "Polygon" and len(obstacles[i].exterior.coords) == 5
-                              and not obstacles[i].contains(start)
-                              for i in tree.query(leader, predicate="intersects")):
-                continue
-        best = (centre, leader, candidate)
-        break
+        if first_free is None:
+            first_free = (centre, leader, candidate)
+        if leader is None or not _crosses_text(leader, obstacles, tree):
+            best = (centre, leader, candidate)
+            break
+    best = best or first_free
     if best is None:  # the outermost ring lies beyond everything drawn: cannot happen
         raise GeometryError(f"kinematic drawing: no room for the label {label!r}")
     centre, leader, candidate = best
@@ -238,3 +236,40 @@ def _place_label(msp: Any, label: str, p: np.ndarray, radius: float, text_h: flo
         msp.add_line(tuple(a), tuple(b), dxfattribs={"layer": "LABELS"})
         obstacles.append(leader)
     obstacles.append(candidate)
+
+
+#: The label candidates in the order they are tried, ring by ring: each one's ring and direction (cos, sin).
+_CANDIDATE_RINGS = tuple(ring for ring in _RINGS for _ in _DIRECTIONS)
+_CANDIDATE_DIRECTIONS = tuple((math.cos(a), math.sin(a)) for _ in _RINGS for a in _DIRECTIONS)
+#: Candidates tested at once: two rings (most labels find room within the first few rings).
+_CHUNK = 2 * len(_DIRECTIONS)
+
+
+def _free_boxes(p: np.ndarray, radius: float, half: np.ndarray, text_h: float, tree: shapely.STRtree,
+                others: Any) -> Iterator[tuple[int, np.ndarray, shapely.Polygon]]:
+    """The candidate label boxes (half size ``half``) round point ``p`` whose box, with a margin of a quarter
+    text height, meets no obstacle in ``tree`` and not ``others``, in candidate order: (index, box centre,
+    box). Each box's centre puts its nearest side its ring's text heights beyond the circle along its
+    direction. A chunk of candidates is tested at once (shapely's array functions, the same arithmetic and
+    predicates as one at a time)."""
+    margin = 0.25 * text_h
+    rings, directions = np.array(_CANDIDATE_RINGS), np.array(_CANDIDATE_DIRECTIONS)
+    for start in range(0, len(rings), _CHUNK):
+        ring, u = rings[start:start + _CHUNK], directions[start:start + _CHUNK]
+        reach = radius + ring * text_h + np.minimum(half[0] / np.maximum(np.abs(u[:, 0]), 1e-9),
+                                                    half[1] / np.maximum(np.abs(u[:, 1]), 1e-9))
+        centres = p + u * reach[:, None]
+        low, high = centres - half, centres + half
+        boxes = shapely.box(low[:, 0], low[:, 1], high[:, 0], high[:, 1])
+        blocked = shapely.intersects(boxes, others)
+        blocked[tree.query(shapely.buffer(boxes, margin, join_style="mitre"), predicate="intersects")[0]] = True
+        for k in np.flatnonzero(~blocked):
+            yield start + int(k), centres[k], boxes[k]
+
+
+def _crosses_text(leader: shapely.LineString, obstacles: list[Any], tree: shapely.STRtree) -> bool:
+    """Whether a leader crosses a text box (a rectangle) it does not start inside (a dimension's text over the
+    point: no leader avoids it); crossing lines and the circles of close points is allowed."""
+    start = shapely.Point(leader.coords[0])
+    return any(obstacles[i].geom_type == "Polygon" and len(obstacles[i].exterior.coords) == 5
+               and not obstacles[i].contains(start) for i in tree.query(leader, predicate="intersects"))

@@ -108,3 +108,48 @@ def test_the_laser_default_finger_cuts_its_3mm_plate_on_a_3mm_sheet(tmp_path, ca
     captured = capsys.readouterr()
     assert code == 0, captured.out + captured.err
     assert "Traceback" not in captured.out + captured.err
+
+
+@pytest.mark.parametrize("bulged", [True, False])
+def test_add_closed_polyline_writes_what_add_lwpolyline_writes(bulged):
+    """The polyline whose vertices go to ezdxf's vertex array at once is byte for byte the one ezdxf's
+    ``add_lwpolyline`` makes point by point: the same document bytes (bulges of either sign and none)."""
+    from fabricate.export.dxf import add_closed_polyline, document_bytes, new_document
+
+    angle = np.linspace(0.0, 2.0 * np.pi, 40, endpoint=False)
+    xy = np.column_stack([10.0 * np.cos(angle) + 0.1, 4.0 * np.sin(3.0 * angle) - 1.0 / 3.0])
+    bulges = np.where(np.arange(40) % 3 == 0, 0.0, np.sin(angle) * 0.4) if bulged else None
+    ours, theirs = new_document(), new_document()
+    add_closed_polyline(ours.modelspace(), xy, "CUT", bulges)
+    points = [(float(x), float(y), float(b)) for (x, y), b in zip(xy, bulges if bulged else np.zeros(40),
+                                                                   strict=True)]
+    theirs.modelspace().add_lwpolyline(points, format="xyb", close=True, dxfattribs={"layer": "CUT"})
+    data = document_bytes(ours)
+    assert data == document_bytes(theirs)
+    (polyline,) = _msp(data).query("LWPOLYLINE")
+    assert polyline.closed and len(polyline) == 40
+    assert np.allclose([b for *_, b in polyline.get_points("xyseb")], bulges if bulged else 0.0)
+
+
+def test_cut_geometry_is_worked_out_once_per_part_and_kerf(parts, monkeypatch):
+    """A part's cut path is offset once per kerf, and every call gets it in lists of its own (a caller that
+    appends to one changes no other's); the hole centres shared between calls cannot be written."""
+    from fabricate.export import dxf
+    from fabricate.parts.profiles import offset_path
+
+    calls = []
+    monkeypatch.setattr(dxf, "offset_path", lambda path, d: calls.append(d) or offset_path(path, d))
+    part = next(p for p in parts if p.holes)
+    first = dxf.cut_geometry(part, 0.2)
+    made = len(calls)
+    second = dxf.cut_geometry(part, 0.2)
+    assert len(calls) == made > 0  # nothing offset again
+    assert second[0] is first[0] and second[1] == first[1] and second[1] is not first[1]
+    assert np.array_equal(first[0].vertices, offset_path(part.outline, 0.1).vertices)
+    assert [d for _, d in first[1]] == pytest.approx([h.diameter_mm - 0.2 for h in part.holes])
+    first[1].clear()
+    assert len(dxf.cut_geometry(part, 0.2)[1]) == len(part.holes)
+    with pytest.raises(ValueError):
+        second[1][0][0][0] = 1.0
+    other = dxf.cut_geometry(part, 0.3)  # another kerf: worked out for itself
+    assert len(calls) > made and not np.array_equal(other[0].vertices, first[0].vertices)

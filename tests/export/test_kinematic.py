@@ -119,3 +119,32 @@ def test_text_prints_on_white_paper():
     assert all(e.dxf.color == 256 for e in msp)
     style = doc.dimstyles.get("FABRICATE")
     assert style.dxf.get("dimclrt", 0) in (0, 256) and style.dxf.get("dimclrd", 0) in (0, 256)
+
+
+def test_label_candidates_tested_a_chunk_at_a_time_are_those_tested_one_at_a_time():
+    """``_free_boxes`` (shapely's array functions over a chunk of candidates) yields exactly the candidates,
+    centres and boxes the one-at-a-time test finds free: the same floats, the same predicates. Obstacles are
+    set so that some candidates of the first ring are blocked and some free, and ``others`` blocks more."""
+    from fabricate.export import kinematic as kin
+
+    p, radius, text_h, half = np.array([3.0, -2.0]), 0.9, 1.5, np.array([6.2, 0.75])
+    obstacles = [shapely.box(4.0, -1.0, 12.0, 3.0), shapely.LineString([(-20.0, -6.0), (20.0, -4.5)]),
+                 shapely.Point(-4.0, 1.0).buffer(2.0, quad_segs=4)]
+    others = shapely.Point(3.0, 9.0).buffer(3.0, quad_segs=4)
+    tree = shapely.STRtree(obstacles)
+    expected = []
+    for index, (ring, direction) in enumerate(zip(kin._CANDIDATE_RINGS, kin._CANDIDATE_DIRECTIONS, strict=True)):
+        u = np.array(direction)
+        reach = radius + ring * text_h + min(half[0] / max(abs(u[0]), 1e-9), half[1] / max(abs(u[1]), 1e-9))
+        centre = p + u * reach
+        box = shapely.box(*(centre - half), *(centre + half))
+        if not (len(tree.query(box.buffer(0.25 * text_h, join_style="mitre"), predicate="intersects"))
+                or box.intersects(others)):
+            expected.append((index, centre, box))
+    found = list(kin._free_boxes(p, radius, half, text_h, tree, others))
+    assert 0 < len(found) < len(kin._CANDIDATE_RINGS)
+    assert expected[0][0] > 0  # the first candidate is blocked
+    assert [k for k, _, _ in found] == [k for k, _, _ in expected]
+    for (_, centre, box), (_, want_centre, want_box) in zip(found, expected, strict=True):
+        assert np.array_equal(centre, want_centre)
+        assert shapely.equals_exact(box, want_box, tolerance=0.0)
