@@ -127,6 +127,14 @@ def _child(jobs: list[Callable[[], dict[str, bytes]]], conn: Any, parent: int = 
         conn.close()
 
 
+def can_fork() -> bool:
+    """Whether :class:`Background` forks here: not where ``fork`` is unavailable, ``FABRICATE_SERIAL`` is set, or
+    this process is a daemon (e.g. a Dask worker: daemons may not have children)."""
+    if os.environ.get("FABRICATE_SERIAL") or "fork" not in multiprocessing.get_all_start_methods():
+        return False
+    return not multiprocessing.current_process().daemon
+
+
 class Background:
     """Run jobs returning ``{path: bytes}`` in a forked child process while the caller goes on.
 
@@ -135,20 +143,30 @@ class Background:
     the outcome never depends on it. Call :meth:`cancel` in a ``finally``: the child is killed and reaped
     however the caller ends; on Linux it also dies with its parent (a SIGKILL of the parent included) and
     never holds the parent's stdout or stderr.
+
+    Parameters
+    ----------
+    jobs : list of callables
+        Each returns ``{path: bytes}``; :meth:`result` merges them in this order.
+    fork : bool
+        False: no child, the jobs run when :meth:`result` is asked for (a job whose result is stored).
+    hand_over : bool
+        Whether the child takes the workers :func:`prestart` started (for the job that calls them); False
+        keeps them for a later child.
     """
 
-    def __init__(self, jobs: list[Callable[[], dict[str, bytes]]]) -> None:
+    def __init__(self, jobs: list[Callable[[], dict[str, bytes]]], *, fork: bool = True,
+                 hand_over: bool = True) -> None:
         self.jobs = jobs
         self._process = None
         self._handed: list[Any] = []
-        if os.environ.get("FABRICATE_SERIAL") or "fork" not in multiprocessing.get_all_start_methods():
-            return
-        if multiprocessing.current_process().daemon:  # e.g. a Dask worker: daemons may not have children
+        if not fork or not can_fork():
             return
         ctx = multiprocessing.get_context("fork")
         before = {id(proc) for proc in _HANDED}
         self._conn, sender = ctx.Pipe(duplex=False)
         self._process = ctx.Process(target=_child, args=(jobs, sender, os.getpid(), self._conn), daemon=True)
+        _KEEP_WORKERS[0] = not hand_over
         try:
             self._process.start()
             # the workers this fork handed over are this child's: reaped with it, not with another child
@@ -157,7 +175,13 @@ class Background:
             self._process = None
             self._conn.close()
         finally:
+            _KEEP_WORKERS[0] = False
             sender.close()
+
+    @property
+    def forked(self) -> bool:
+        """Whether a child runs the jobs (else :meth:`result` runs them here)."""
+        return self._process is not None
 
     def result(self) -> dict[str, bytes]:
         if self._process is not None:
@@ -207,6 +231,8 @@ def _reap_handed(kill: bool, procs: list[Any] | None = None) -> None:
 _WARM: dict[str, tuple[Any, int]] = {}
 #: Workers handed to a forked child, kept here until they end (so they are reaped, not warned about).
 _HANDED: list[Any] = []
+#: Set while :class:`Background` forks a child that must not take the waiting workers.
+_KEEP_WORKERS = [False]
 
 
 def _start_worker(preload: str = "", warm_up: str = "") -> Any:
@@ -243,7 +269,10 @@ def prestart(module: str, warm_up: str = "") -> None:
 
 
 def _hand_over() -> None:
-    """After a fork, in the parent: the waiting workers are the child's now (their pipes closed here)."""
+    """After a fork, in the parent: the waiting workers are the child's now (their pipes closed here), unless
+    that child was forked with ``hand_over=False``."""
+    if _KEEP_WORKERS[0]:
+        return
     for proc, _ in _WARM.values():
         for pipe in (proc.stdin, proc.stdout):
             with contextlib.suppress(OSError):

@@ -8,20 +8,30 @@ and the template text itself, so ``fabricate check DIR`` can verify the files an
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
-from collections.abc import Callable, Mapping
+import pickle
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from fabricate import cache, stage_keys
 from fabricate.arguments import path_argument, type_name
-from fabricate.background import Background, in_thread
+from fabricate.background import Background, can_fork, in_thread
 from fabricate.bounds import blas_threads, rare_collections
+from fabricate.build_stages import BuildRun, OptionalOutputs, Progress, _quiet, export_files
+from fabricate.build_stages import check as _check
+from fabricate.build_stages import check_drive as _check_drive
+from fabricate.build_stages import check_strength as _check_strength
+from fabricate.build_stages import export as _export
+from fabricate.build_stages import make_gears as _make_gears
+from fabricate.build_stages import make_parts as _make_parts
+from fabricate.build_stages import record_optional_outputs as _record_optional_outputs
+from fabricate.build_stages import size_links as _size_links
+from fabricate.build_stages import verdict as _verdict
 from fabricate.errors import FabricateError, LockupError, SpecError, SynthesisError
 from fabricate.kinds import KINDS
-from fabricate.mechanism import Mechanism, Motion
+from fabricate.mechanism import Motion
 from fabricate.report import SYNTH_ONLY, not_checked_notes, report_json, report_markdown
 from fabricate.report_schema import SCHEMA_VERSION
 from fabricate.report_sections import design_section, mechanism_section
@@ -30,12 +40,8 @@ from fabricate.synthesis.base import SynthesisResult
 
 if TYPE_CHECKING:
     from fabricate.checks import CheckReport
-    from fabricate.drive.check import DriveResult
     from fabricate.gears.pair import GearPair
     from fabricate.parts.partset import PartSet
-    from fabricate.strength.check import StrengthResult
-
-Progress = Callable[[str], None]
 
 
 @dataclass(frozen=True)
@@ -110,10 +116,6 @@ class BuildOutcome:
         return write_output(self.files, out, force=force, stage=stage, protect=protect)
 
 
-def _quiet(_: str) -> None:
-    pass
-
-
 def synthesise(design: DesignSpec, progress: Progress = _quiet) -> SynthesisResult:
     progress(f"synthesis ({design.kind})")
     return KINDS[design.kind].synthesise(design)
@@ -145,26 +147,6 @@ def _synthesis_and_motion(design: DesignSpec, progress: Progress
         return result, None, str(exc)
 
 
-@dataclass(frozen=True)
-class OptionalOutputs:
-    """Which optional outputs a build makes, when not what this install can make.
-
-    ``fabricate check`` rebuilds a folder with the outputs its build recorded (``report.outputs``), so its
-    verdict does not depend on the checker's install.
-
-    Attributes
-    ----------
-    step : bool
-        Write the STEP files (``parts/*.step``, ``assembly.step``) and report them as written.
-    step_files : mapping of str to bytes, optional
-        Files to hand over in place of a STEP export (the folder's own, verified against its manifest,
-        where the checker has no OCP); None exports them.
-    """
-
-    step: bool
-    step_files: Mapping[str, bytes] | None = None
-
-
 @blas_threads()  # one BLAS thread: fabricate's systems are small, and threads only wait on busy cores
 @rare_collections()
 def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
@@ -178,46 +160,6 @@ def run_synth(design: DesignSpec, progress: Progress = _quiet) -> BuildOutcome:
                                         for name in ("interference", "gear mesh", "printability", "strength",
                                                      "drive")]}
     return _finish(design, report, files, exit_code=1 if failures else 0, synthesis=result, motion=motion)
-
-
-@dataclass
-class BuildRun:
-    """One build in progress after synthesis: the stage running, and what the stages before it made.
-
-    Each step of :func:`_build_stages` reads what earlier steps left here and adds its own part (report
-    sections, files); :attr:`stage` names the step running, so a kernel failure inside it is reported with it.
-    """
-
-    design: DesignSpec  # the design being built: link sizing replaces it with the width it chose
-    synthesis: SynthesisResult
-    motion: Motion
-    report: dict[str, Any]
-    progress: Progress = _quiet
-    optional: OptionalOutputs | None = None
-    report_only: bool = False  # no pictures, plots or STEP files (:func:`run_build`)
-    given: DesignSpec | None = None  # the design the caller gave (the outcome's); None: ``design``
-    stage: str = "gears"
-    files: dict[str, bytes] = field(default_factory=dict)
-    gear_pairs: list[GearPair] = field(default_factory=list)
-    sizing: dict[str, Any] | None = None
-    partset: PartSet | None = None
-    checks: CheckReport | None = None
-    strength: StrengthResult | None = None
-    drive: DriveResult | None = None
-    failures: list[str] = field(default_factory=list)
-
-    def __post_init__(self) -> None:
-        if self.given is None:
-            self.given = self.design
-
-    @property
-    def mechanism(self) -> Mechanism:
-        return self.synthesis.mechanism
-
-    def enter(self, stage: str) -> None:
-        """Start ``stage``: it names any failure from here on, and the progress line shows it."""
-        self.stage = stage
-        self.progress(stage)
 
 
 def _kernel_failures() -> tuple[type[BaseException], ...]:
@@ -276,223 +218,142 @@ def run_build(design: DesignSpec, progress: Progress = _quiet, *,
 
 
 def _build_stages(run: BuildRun) -> BuildOutcome:
-    """Gears, parts, then exports and checks while a forked child draws the pictures (and exports STEP)."""
-    _make_gears(run)
-    if run.design.parts.link_width_mm == "auto":
-        _size_links(run)
-    _make_parts(run)
-    if not run.report_only and not cache.stored("previews", stage_keys.pictures_key(run.design, "previews")):
-        # the child and this process both draw: matplotlib imported once, here, is the child's too
-        from fabricate.plotting import load_agg
+    """Gears, parts, exports and checks, while forked children draw the pictures on the second core.
 
-        load_agg()
-    # pictures take as long as everything else: draw them in a forked child on the second core
-    pictures = None if run.report_only else Background(_picture_jobs(run))
+    This process runs the stages one after another; the second core takes each picture job as soon as what it
+    draws exists (the method's figures after synthesis, the gear pictures after the gears) and, after the parts,
+    one child makes the exports, then the previews and STEP files while this process runs the checks and draws
+    their plots and the guide's pictures (the two halves take about as long: bench_build's per-stage table).
+    report.json's sections keep the order of a serial build.
+    """
+    jobs = _picture_jobs(run)
+    children: list[Background | None] = []
+    exports: Background | None = None
     try:
-        # inside the try: this may import OCP (slow), and a stop signal landing here must cancel the child
+        children.append(_start(run, jobs[:1], "synthesis_plots", stage_keys.synthesis_key(run.design)))
+        _make_gears(run)
+        children.append(_start(run, jobs[1:2], "gear_pictures", stage_keys.pictures_key(run.design, "gear_pictures"),
+                               bool(run.gear_pairs)))
+        if run.design.parts.link_width_mm == "auto":
+            _size_links(run)
+        _make_parts(run)
+        # inside the try: this may import OCP (slow), and a stop signal landing here must cancel the children
         with_step = _record_optional_outputs(run)
-        _export(run, with_step)
+        exports, exporting = _start_exports(run, with_step, jobs[2:4])
+        before_checks = set(run.report)
         _check(run)
         _check_strength(run)
         _check_drive(run)
         _verdict(run)
-        if pictures is not None:
-            _plots(run, pictures)
+        if not run.report_only:
+            _plots(run)
+            run.files.update(jobs[4]())  # the guide's pictures
+        pictures = _collect_exports(run, with_step, exports, exporting, before_checks)
+        run.stage = "plots"
+        for child in children:
+            run.files.update(child.result() if child is not None else {})
+        run.files.update(pictures)
     finally:
-        if pictures is not None:
-            pictures.cancel()
+        for child in [*children, exports]:
+            if child is not None:
+                child.cancel()
     assert run.given is not None  # set in __post_init__
     return _finish(run.given, run.report, run.files, exit_code=0 if not run.failures else 1,
                    synthesis=run.synthesis, motion=run.motion, partset=run.partset, gear_pairs=run.gear_pairs,
                    checks=run.checks)
 
 
-def _make_gears(run: BuildRun) -> None:
-    """One cut, checked gear pair per gear coupling: report.json's ``gears``."""
-    from fabricate.gears import build_gear_pairs
-    from fabricate.gears.auto import module_limits
+def _start(run: BuildRun, jobs: list[Callable[[], dict[str, bytes]]], stage: str, key: Any,
+           draws: bool = True) -> Background | None:
+    """``jobs`` forked now, or (their result stored, or nothing to draw) run when their result is asked for;
+    None in a report-only build (no pictures)."""
+    if run.report_only:
+        return None
+    fork = draws and not cache.stored(stage, key)
+    if fork and can_fork():
+        from fabricate.plotting import load_agg
 
-    run.enter("gears")
-    # gears.module_mm = "auto": the smallest standard module the process makes and the load allows
-    run.gear_pairs = cache.cached("gears", stage_keys.gears_key(run.design), lambda: build_gear_pairs(
-        run.mechanism, run.design.gears, run.design.process.chord_tolerance_mm,
-        lambda: module_limits(run.design, run.mechanism, run.motion, run.synthesis.parts)))
-    run.report["gears"] = [pair.report() for pair in run.gear_pairs]
-
-
-def _size_links(run: BuildRun) -> None:
-    """``parts.link_width_mm = "auto"``: the width the strength check asks for replaces it in the design."""
-    from fabricate.parts.build import build_parts
-    from fabricate.strength.sizing import size_link_width
-
-    run.enter("sizing")
-    design, mechanism, motion, gear_pairs, hints = run.design, run.mechanism, run.motion, run.gear_pairs, \
-        run.synthesis.parts
-    width, tried = cache.cached("sizing", stage_keys.sizing_key(design), lambda: size_link_width(
-        design, mechanism, motion, gear_pairs, hints, lambda d: build_parts(d, mechanism, motion, gear_pairs, hints)))
-    run.design = dataclasses.replace(design, parts=dataclasses.replace(design.parts, link_width_mm=width))
-    run.sizing = {"link_width_mm": width, "tried": [{"link_width_mm": w, "least_safety_factor": sf}
-                                                    for w, sf in tried]}
-
-
-def _make_parts(run: BuildRun) -> None:
-    """Every body as parts (plates, gears fused on), pins, spacers and the bill of materials."""
-    from fabricate.parts.build import build_parts
-
-    run.enter("parts")
-    run.partset = cache.cached("parts", stage_keys.parts_key(run.design), lambda: build_parts(
-        run.design, run.mechanism, run.motion, run.gear_pairs, run.synthesis.parts))
+        load_agg()  # matplotlib imported once, before the fork: the child's and this process's plots'
+    return Background(jobs, fork=fork, hand_over=False)
 
 
 def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
-    """The slow outputs, for the forked child: the method's plots, gear pictures, previews, STEP files."""
+    """The slow outputs, for the forked children: the method's plots, gear pictures, previews, STEP files and the
+    guide's pictures. Each reads ``run`` when it runs (a child reads it as it was at the fork): the synthesis
+    plots need the synthesis, the gear pictures the gear pairs, the others the part set."""
     from fabricate.export import export_previews, export_step
+    from fabricate.export.guide import guide_picture_files
 
-    assert run.partset is not None  # the parts stage ran
-    result, gear_pairs, design, partset, motion = run.synthesis, run.gear_pairs, run.design, run.partset, run.motion
-    optional = run.optional
+    def partset() -> PartSet:
+        assert run.partset is not None  # the parts stage ran before this job's child was forked
+        return run.partset
 
     def step_files() -> dict[str, bytes]:
-        return cache.cached("step", stage_keys.pictures_key(design, "step"),
-                            lambda: export_step(design, partset, motion))
+        return cache.cached("step", stage_keys.pictures_key(run.design, "step"),
+                            lambda: export_step(run.design, partset(), run.motion))
 
     def step_job() -> dict[str, bytes]:
-        if optional is None:
+        if run.optional is None:
             return step_files()
-        if not optional.step:
+        if not run.optional.step:
             return {}
-        return dict(optional.step_files) if optional.step_files is not None else step_files()
-
-    from fabricate.export.guide import guide_picture_files
+        return dict(run.optional.step_files) if run.optional.step_files is not None else step_files()
 
     # each job's result is a cache entry (fabricate.cache; the synthesis plots are the result's own figures')
     # the STEP job mostly waits on its own process (export_step): in a thread, the pictures are drawn meanwhile
-    return [lambda: synthesis_plots(result),
-            lambda: cache.cached("gear_pictures", stage_keys.pictures_key(design, "gear_pictures"),
-                                 lambda: gear_pictures(gear_pairs)),
-            lambda: cache.cached("previews", stage_keys.pictures_key(design, "previews"),
-                                 lambda: export_previews(design, partset, motion)), in_thread(step_job),
-            lambda: cache.cached("guide_pictures", stage_keys.pictures_key(design, "guide_pictures"),
-                                 lambda: guide_picture_files(partset, motion))]
+    return [lambda: synthesis_plots(run.synthesis),
+            lambda: cache.cached("gear_pictures", stage_keys.pictures_key(run.design, "gear_pictures"),
+                                 lambda: gear_pictures(run.gear_pairs)),
+            lambda: cache.cached("previews", stage_keys.pictures_key(run.design, "previews"),
+                                 lambda: export_previews(run.design, partset(), run.motion)), in_thread(step_job),
+            lambda: cache.cached("guide_pictures", stage_keys.pictures_key(run.design, "guide_pictures"),
+                                 lambda: guide_picture_files(partset(), run.motion))]
 
 
-def _record_optional_outputs(run: BuildRun) -> bool:
-    """Whether STEP files are made, recorded in report.json (``notes``, ``outputs``); returned."""
-    from fabricate.export import STEP_SKIPPED
-    from fabricate.export.step import step_available
-
-    with_step = step_available() if run.optional is None else run.optional.step
-    run.report["notes"] = [] if with_step else [STEP_SKIPPED]
-    # optional outputs as written or skipped: `check` rebuilds with the same set, so its verdict does not
-    # depend on the checker's install (fabricate/verify.py)
-    run.report["outputs"] = {"step": "written" if with_step and not run.report_only else
-                             "skipped: a report-only build (a sweep point)" if with_step else
-                             "skipped: OCP is not installed (extra 'cad')"}
-    return with_step  # the exports name the STEP files a full build writes: a report-only one's parts are the same
+#: The export child's answer under this name (never a file's path): :func:`export_files`' result, pickled.
+_EXPORTED = "\0exports"
 
 
-def _export(run: BuildRun, with_step: bool) -> None:
-    """Part files, drawings, plates or sheets, the BOM and assembly, motion.csv and mechanism.toml."""
-    from fabricate.export import assembly_csv, export_all, motion_csv
-    from fabricate.export.guide import guide_markdown, guide_steps
-    from fabricate.parts.assembly import assembly_steps, guide_report, pin_stacks, stacks_report
-    from fabricate.parts.hardware_report import hardware_report
-    from fabricate.parts.spring_rows import springs_report
-    from fabricate.synthesis.linkage.exact import mechanism_toml
+def _start_exports(run: BuildRun, with_step: bool, pictures: list[Callable[[], dict[str, bytes]]]
+                   ) -> tuple[Background | None, bool]:
+    """A child making the exports, then the part set's pictures (previews, STEP, the guide's): ``(child, True)``;
+    or the exports made here now (their result stored, no fork here, a report-only build) and a child for the
+    pictures: ``(child, False)``, no child in a report-only build."""
+    stored = cache.stored("exports", stage_keys.exports_key(run.design, with_step))
+    if run.report_only or stored or not can_fork():
+        _export(run, with_step)
+        return _start(run, pictures, "previews", stage_keys.pictures_key(run.design, "previews")), False
+    from fabricate.plotting import load_agg
 
     run.enter("exports")
-    assert run.partset is not None  # the parts stage ran
-    partset = run.partset
+    load_agg()  # the child's labels (TextPath) and pictures, and this process's plots
 
-    def make() -> tuple[dict[str, bytes], list[dict[str, Any]], Any]:
-        sections: dict[str, Any] = {}  # a cut process adds its "cut" section: part of the cached result
-        files, parts = export_all(run.design, partset, run.mechanism, run.motion, previews=False, step=False,
-                                  with_step=with_step, sections=sections)
-        return files, parts, sections.get("cut")
+    def exports_job() -> dict[str, bytes]:
+        return {_EXPORTED: pickle.dumps(export_files(run, with_step), protocol=pickle.HIGHEST_PROTOCOL)}
 
-    exported, parts_report, cut = cache.cached("exports", stage_keys.exports_key(run.design, with_step), make)
-    if cut is not None:
-        run.report["cut"] = cut
-    run.files.update(exported)
-    run.report["parts"] = parts_report
-    run.report["bom"] = list(getattr(run.partset, "bom", []))
-    run.report["hardware"] = hardware_report(run.partset, run.design.process)  # pins, fits, what to measure
-    if getattr(run.partset, "springs", ()):
-        run.report["springs"] = springs_report(run.partset.springs)
-    stacks = pin_stacks(run.partset)
-    guide = guide_steps(run.partset, run.motion)  # assembly.md; its pictures are drawn by _picture_jobs
-    run.report["assembly"] = {"pins": stacks_report(stacks), "steps": assembly_steps(stacks, run.partset.copies),
-                              "guide": guide_report(guide)}
-    run.files["assembly.md"] = guide_markdown(guide, run.design.name, run.partset.copies).encode("utf-8")
-    run.files["assembly.csv"] = assembly_csv(stacks)
-    run.files["motion.csv"] = motion_csv(run.mechanism, run.motion)
-    run.files["mechanism.toml"] = mechanism_toml(run.design, run.mechanism, run.synthesis.parts)
-    # the MuJoCo model: its meshes are the part STL files just exported (fabricate/export/mjcf.py)
-    from fabricate.export.mjcf import mechanism_mjcf, simulation_section
-
-    stl = {part.name: run.files[f"parts/{part.name}.stl"] for part in run.partset.parts}
-    run.files["mechanism.xml"] = mechanism_mjcf(run.design, run.partset, run.mechanism, run.motion, run.gear_pairs,
-                                                stl)
-    run.report["simulation"] = simulation_section(run.design, run.partset, run.mechanism, run.motion)
+    return Background([exports_job, *pictures]), True
 
 
-def _check(run: BuildRun) -> None:
-    """Interference, gear mesh and printability (report.json's ``interference``), and the gear pairs' own."""
-    from fabricate.checks import run_checks
-
-    run.enter("checks")
-    assert run.partset is not None  # the parts stage ran
-    partset = run.partset
-    run.checks = cache.cached("checks", stage_keys.checks_key(run.design), lambda: run_checks(
-        run.design, partset, run.mechanism, run.motion, run.gear_pairs))
-    run.report["interference"] = run.checks.interference
-    run.failures = list(run.checks.failures)
-    for pair in run.gear_pairs:
-        run.failures += [f"gear {pair.name}: {text}" for text in pair.failures()]
-
-
-def _check_strength(run: BuildRun) -> None:
-    """Every part and pin at the design load: report.json's ``strength`` (with the link sizing, if any)."""
-    from fabricate.strength.check import run_strength
-
-    run.enter("strength")
-    assert run.partset is not None  # the parts stage ran
-    partset = run.partset
-    run.strength = cache.cached("strength", stage_keys.strength_key(run.design), lambda: run_strength(
-        run.design, partset, run.mechanism, run.motion, run.gear_pairs, run.synthesis.parts))
-    run.report["strength"] = run.strength.report()
-    if run.sizing is not None:
-        run.report["strength"]["sizing"] = run.sizing
-    run.failures += run.strength.failures()
+def _collect_exports(run: BuildRun, with_step: bool, child: Background | None, exporting: bool,
+                     before_checks: set[str]) -> dict[str, bytes]:
+    """The pictures ``child`` drew; where it made the exports too, those are stored and reported here, their
+    report sections before the checks' (where a serial build has them)."""
+    if child is None:
+        return {}
+    if not exporting:
+        return child.result()
+    run.stage = "exports"  # a failure from here on is the exports' (the child failed: its jobs run here)
+    files = child.result()
+    made = files.pop(_EXPORTED)
+    checks = [key for key in run.report if key not in before_checks]
+    _export(run, with_step, made=lambda: pickle.loads(made))
+    for key in checks:
+        run.report[key] = run.report.pop(key)
+    return files
 
 
-def _check_drive(run: BuildRun) -> None:
-    """The actuator against the input effort the statics compute at every pose: report.json's ``drive``."""
-    from fabricate.drive.check import rate_mount, run_drive
-
-    run.enter("drive")
-    assert run.partset is not None  # the parts stage ran
-    run.drive = run_drive(run.design, run.mechanism, run.motion, run.synthesis.parts, run.strength,
-                          copies=run.partset.copies)
-    rate_mount(run.drive, run.partset, run.design)  # the mount plate's holes against the reaction torque
-    run.report["drive"] = run.drive.report()
-    run.failures += run.drive.failures()
-
-
-def _verdict(run: BuildRun) -> None:
-    """report.json's ``checks``: passed is over the checks that ran; those that could not run are listed,
-    never passed."""
-    assert run.checks is not None and run.strength is not None  # both checks ran
-    not_checked = [dict(entry) for entry in run.checks.not_checked]
-    if run.strength.reason is not None:
-        not_checked.append({"check": "strength", "reason": run.strength.reason})
-    if run.drive is not None and run.drive.reason is not None:
-        not_checked.append({"check": "drive", "reason": run.drive.reason})
-    run.report["checks"] = {"passed": not run.failures, "failures": run.failures, "not_checked": not_checked}
-
-
-def _plots(run: BuildRun, pictures: Background) -> None:
-    """The strength and clearance plots, then the pictures the child drew."""
+def _plots(run: BuildRun) -> None:
+    """The strength, drive and clearance plots."""
     from fabricate.strength.plots import strength_plot
 
     run.enter("plots")
@@ -536,7 +397,6 @@ def _plots(run: BuildRun, pictures: Background) -> None:
         run.files[path] = cache.cached(stage, key, taking(path, draw))
     for name, data in sorted(figures.items()):
         run.files[f"plots/{name}"] = data
-    run.files.update(pictures.result())
 
 
 def synthesis_plots(result: SynthesisResult) -> dict[str, bytes]:

@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from fabricate.background import run_isolated
+from fabricate.background import Background, run_isolated
 
 
 def _loaded(name: str) -> bool:
@@ -109,3 +109,21 @@ def test_a_fork_hands_the_prestarted_worker_to_the_child():
     assert pid == worker.pid and value == 4.0
     background._reap_handed(kill=False)
     assert worker.returncode == 0  # the parent reaped it: its time and memory are counted as the caller's
+
+
+def test_a_fork_without_hand_over_leaves_the_prestarted_worker_for_a_later_child():
+    from fabricate import background
+
+    background.prestart("tests.test_background")
+    worker = background._WARM["tests.test_background"][0]
+    first = Background([lambda: {"a": b"1"}], hand_over=False)
+    assert first.forked
+    assert background._WARM["tests.test_background"][0] is worker  # still this process's to hand on
+    assert first.result() == {"a": b"1"}
+    second = Background([lambda: {"b": b"2"}])
+    try:
+        assert background._WARM == {}  # a default child takes it
+        assert second.result() == {"b": b"2"}
+    finally:
+        second.cancel()
+    assert worker.poll() is not None  # reaped with the child it was handed to

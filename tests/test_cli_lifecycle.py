@@ -142,13 +142,13 @@ SWALLOWED = """
 import os, signal, sys, time
 import fabricate.pipeline as pipeline
 real = pipeline._export
-def swallowing(run, with_step):
+def swallowing(run, with_step, **kw):
     try:
         os.kill(os.getpid(), signal.SIGTERM)
         time.sleep(60)  # the handler raises Stopped out of the sleep at once
     except BaseException:
         pass
-    return real(run, with_step)
+    return real(run, with_step, **kw)
 pipeline._export = swallowing
 from fabricate.cli import main
 sys.exit(main(["build", "gear_pair_elliptic", "-o", sys.argv[1], "-q"]))
