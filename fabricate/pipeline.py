@@ -371,7 +371,7 @@ def _plots(run: BuildRun) -> None:
     todo = [path for path, (stage, key, _) in plots.items() if not cache.stored(stage, key)]
     # the picture child is done by now, or nearly: a second child draws these while this process draws the
     # clearance plot, or, where that is cached (a rebuild after a [load] or [checks] edit), the first of them
-    mine = todo[:1] if cache.stored("check_figures", stage_keys.checks_key(run.design)) else []
+    mine = todo[:1] if cache.stored("check_figures", stage_keys.clearance_key(run.design)) else []
     theirs = todo[len(mine):]
 
     def drawing(path: str) -> Callable[[], dict[str, bytes]]:
@@ -387,7 +387,7 @@ def _plots(run: BuildRun) -> None:
     child = Background([drawing(path) for path in theirs]) if theirs else None
     drawn: dict[str, bytes] = {}
     try:
-        figures = cache.cached("check_figures", stage_keys.checks_key(run.design), checks.figures)
+        figures = cache.cached("check_figures", stage_keys.clearance_key(run.design), checks.figures)
         drawn.update({path: plots[path][2]() for path in mine})
         drawn.update(child.result() if child is not None else {})
     finally:

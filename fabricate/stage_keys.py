@@ -49,39 +49,66 @@ def gears_key(design: DesignSpec) -> tuple[Any, ...]:
     return key
 
 
+#: ``[parts]`` fields only the plate or sheet layout reads: the exports' plates and sheets, and the checks' test that
+#: each part fits on one. A part set, its pictures and its strength are the same whatever they are.
+LAYOUT_FIELDS = ("plate_spacing_mm", "sheet_margin_mm", "sheet_spacing_mm")
+#: ``[parts]`` fields only the previews read.
+PREVIEW_FIELDS = ("preview_poses", "gif_frames")
+
+
+def _parts_fields(design: DesignSpec, names: tuple[str, ...] | None) -> Any:
+    """``[parts]``' ``(field, value)`` pairs named in ``names``, or (None) every other but the layout's and the
+    previews'; None for a design without a ``[parts]`` table (a test's stand-in)."""
+    parts = getattr(design, "parts", None)
+    if parts is None:
+        return None
+    left_out = LAYOUT_FIELDS + PREVIEW_FIELDS
+    return tuple((f.name, getattr(parts, f.name)) for f in dataclasses.fields(parts)
+                 if (f.name in names if names is not None else f.name not in left_out))
+
+
 def parts_key(design: DesignSpec) -> tuple[Any, ...]:
     """The part set (``pipeline._make_parts``), of the design after link sizing.
 
-    Reads: the gear pairs (and through them the synthesis), ``parts``, ``process`` (thickness, clearances,
-    compensation, retention, materials), ``gears`` (hub diameter), ``actuator`` (its mount and interface parts)
-    and ``name``/``kind``. Not ``[load]`` or ``[checks]`` (only the link sizing reads them, and its width is in
-    ``parts``).
+    Reads: the gear pairs (and through them the synthesis), ``parts`` but its layout and preview fields
+    (:data:`LAYOUT_FIELDS`, :data:`PREVIEW_FIELDS`), ``process`` (thickness, clearances, compensation, retention,
+    materials), ``gears`` (hub diameter), ``actuator`` (its mount and interface parts) and ``name``/``kind``. Not
+    ``[load]`` or ``[checks]`` (only the link sizing reads them, and its width is in ``parts``).
     """
-    return (gears_key(design), design.parts, design.process, design.gears, design.actuator, design.name,
-            design.kind)
+    return (gears_key(design), _parts_fields(design, None), design.process, design.gears, design.actuator,
+            design.name, design.kind)
 
 
 def exports_key(design: DesignSpec, with_step: bool) -> tuple[Any, ...]:
-    """The part files, drawings and plates (``export_all`` in ``pipeline._export``): the part set's inputs and
-    whether STEP files are listed; the report's ``cut`` section is part of the result."""
-    return (parts_key(design), bool(with_step))
+    """The part files, drawings and plates (``export_all`` in ``pipeline._export``): the part set's inputs, the
+    layout's fields and whether STEP files are listed; the report's ``cut`` section is part of the result."""
+    return (parts_key(design), _parts_fields(design, LAYOUT_FIELDS), bool(with_step))
 
 
 def checks_key(design: DesignSpec) -> tuple[Any, ...]:
-    """Interference, gear mesh and printability (``pipeline._check``) and the clearance plot: the part set and
-    gear pairs, ``checks.min_clearance_mm`` (``sweep_poses`` is the motion's, in the synthesis key), ``process``
-    and ``parts`` (the plate layout; in the part set's key). Not ``checks.min_safety_factor`` (strength's) or
-    ``[load]``."""
+    """Interference, gear mesh and printability (``pipeline._check``): the part set and gear pairs,
+    ``checks.min_clearance_mm`` (``sweep_poses`` is the motion's, in the synthesis key), ``process`` (in the part
+    set's key) and the layout's fields (each part must fit on a plate or sheet). Not ``checks.min_safety_factor``
+    (strength's) or ``[load]``."""
+    return (clearance_key(design), _parts_fields(design, LAYOUT_FIELDS))
+
+
+def clearance_key(design: DesignSpec) -> tuple[Any, ...]:
+    """The clearance plot (``pipeline._plots``): the interference sweep's inputs, the part set's and
+    ``checks.min_clearance_mm``; not the layout (which only the printability check reads)."""
     return (parts_key(design), design.checks.min_clearance_mm)
 
 
 def pictures_key(design: DesignSpec, job: str, extra: Any = None) -> tuple[Any, ...]:
-    """A picture job of the forked child (``pipeline._picture_jobs``): the synthesis figures read the synthesis
-    only, the gear pictures the gear pairs, the previews, guide pictures and STEP files the part set."""
+    """A picture job of the forked children (``pipeline._picture_jobs``): the synthesis figures read the synthesis
+    only, the gear pictures the gear pairs, the guide pictures and STEP files the part set, the previews the part
+    set and :data:`PREVIEW_FIELDS`."""
     if job == "synthesis_plots":
         return (synthesis_key(design),)
     if job == "gear_pictures":
         return (gears_key(design),)
+    if job == "previews":
+        return (parts_key(design), _parts_fields(design, PREVIEW_FIELDS), extra)
     return (parts_key(design), extra)
 
 

@@ -21,6 +21,7 @@ import pytest
 
 from fabricate import cache, stage_keys
 from fabricate.design import design_from_text, load_design
+from fabricate.parts.spec import PartsSpec
 from fabricate.templates import TEMPLATE_DIR
 from tests.conftest import locked, session_folder, stage_cache_folder
 
@@ -289,7 +290,10 @@ def reads_covered(log: set[str], key_fields: set[str]) -> set[str]:
 SYNTHESIS = {"name", "kind", "method", "checks.sweep_poses", "gears", "actuator"}
 GEARS = SYNTHESIS | {"gears", "process.chord_tolerance_mm"}
 GEARS_CHOSEN = GEARS | {"process", "load", "checks", "parts", "actuator"}
-PARTS_OF = {"parts", "process", "gears", "actuator", "name", "kind"}
+PARTS_OF = ({f"parts.{f.name}" for f in dataclasses.fields(PartsSpec)} - {f"parts.{name}" for name in
+            stage_keys.LAYOUT_FIELDS + stage_keys.PREVIEW_FIELDS}) | {"process", "gears", "actuator", "name", "kind"}
+LAYOUT = {f"parts.{name}" for name in stage_keys.LAYOUT_FIELDS}
+PREVIEWS = {f"parts.{name}" for name in stage_keys.PREVIEW_FIELDS}
 
 
 @pytest.mark.slow
@@ -315,7 +319,7 @@ def test_every_stage_reads_only_what_its_key_holds(variant):
         step(run)
         assert reads_covered(log, fields) == set(), stage
     run.design = design
-    for name, index, fields in (("gear pictures", 1, gears), ("previews", 2, parts), ("guide", 4, parts)):
+    for name, index, fields in (("gear pictures", 1, gears), ("previews", 2, parts | PREVIEWS), ("guide", 4, parts)):
         log = set()
         run.design = traced(design, "", log)
         pipeline._picture_jobs(run)[index]()
@@ -325,8 +329,8 @@ def test_every_stage_reads_only_what_its_key_holds(variant):
     log = set()
     export_all(traced(design, "", log), run.partset, run.mechanism, run.motion, previews=False, step=False,
                with_step=False, sections={})
-    assert reads_covered(log, parts) == set()
-    for stage, step, fields in (("checks", pipeline._check, parts | {"checks.min_clearance_mm"}),
+    assert reads_covered(log, parts | LAYOUT) == set()
+    for stage, step, fields in (("checks", pipeline._check, parts | LAYOUT | {"checks.min_clearance_mm"}),
                                 ("strength", pipeline._check_strength, parts | {"load", "checks.min_safety_factor"})):
         log = set()
         run.design = traced(design, "", log)
@@ -345,6 +349,9 @@ def _laser():
 #: One real edit per table of the default finger, and which stages its cached rebuild must reuse.
 EDITS = {
     "parts": (("[checks]\n", "[parts]\nmounting_hole_mm = 2.5\n\n[checks]\n"), {"synthesis", "gears"}),
+    # the plate layout only: every part, its pictures, the interference sweep and the strength stay
+    "parts layout": (("[checks]\n", "[parts]\nplate_spacing_mm = 4.5\n\n[checks]\n"),
+                     {"synthesis", "gears", "parts", "check_figures", "strength", "strength_plot", "drive_plot"}),
     "process": (("thickness_mm = 6.0 ", "hole_compensation_mm = 0.15\nthickness_mm = 6.0 "), {"synthesis", "gears"}),
     "load": (("tip_force_N = 1.5", "tip_force_N = 1.2"),
              {"synthesis", "gears", "parts", "exports", "checks", "check_figures"}),
@@ -354,7 +361,7 @@ EDITS = {
 PARENT = {"synthesis", "gears", "sizing", "parts", "exports", "checks", "check_figures", "strength", "strength_plot",
           "drive_plot"}
 AFTER_PARTS = {"parts", "exports", "checks", "check_figures", "strength", "strength_plot", "drive_plot"}
-RERUN = {"parts": AFTER_PARTS, "process": AFTER_PARTS,
+RERUN = {"parts": AFTER_PARTS, "process": AFTER_PARTS, "parts layout": {"exports", "checks"},
          "load": {"strength", "strength_plot", "drive_plot"}, "checks": {"strength", "strength_plot", "drive_plot"}}
 
 
