@@ -205,16 +205,24 @@ def _box_room(centres: np.ndarray, segments: np.ndarray, half_w: float, half_h: 
     sx, sy = segments[:, 0, 0] / half_w, segments[:, 0, 1] / half_h
     dx, dy = segments[:, 1, 0] / half_w - sx, segments[:, 1, 1] / half_h - sy
     cx, cy = centres[:, 0] / half_w, centres[:, 1] / half_h
+    # where x(t) = y(t) and x(t) = -y(t): t = -(x0 - y0) / (dx - dy), t = -(x0 + y0) / (dx + dy); a segment
+    # along that diagonal (|den| <= 1e-15) has no such point: dividing by infinity makes its t zero, its start
+    dens = [np.where(np.abs(den) > 1e-15, den, np.inf) for den in (dx - dy, dx + dy)]
     for start in range(0, len(centres), 64):  # bounded memory: 64 centres x every segment at a time
         ax = sx[None, :] - cx[start:start + 64, None]
         ay = sy[None, :] - cy[start:start + 64, None]
-        # the ends, then where x(t) = y(t) and x(t) = -y(t)
+        # the ends, then the two diagonal points (in place: the same operations, fewer arrays)
         best = np.minimum(np.maximum(np.abs(ax), np.abs(ay)), np.maximum(np.abs(ax + dx), np.abs(ay + dy)))
-        for sign in (1.0, -1.0):
-            den = dx - sign * dy
-            with np.errstate(divide="ignore", invalid="ignore"):
-                t = np.clip(np.where(np.abs(den) > 1e-15, -(ax - sign * ay) / den, 0.0), 0.0, 1.0)
-            best = np.minimum(best, np.maximum(np.abs(ax + t * dx), np.abs(ay + t * dy)))
+        t, x, y = np.empty_like(ax), np.empty_like(ax), np.empty_like(ax)
+        for diagonal, den in enumerate(dens):
+            if diagonal == 0:
+                np.subtract(ay, ax, out=t)  # -(x0 - y0)
+            else:
+                np.negative(np.add(ax, ay, out=t), out=t)  # -(x0 + y0)
+            np.minimum(np.maximum(np.divide(t, den, out=t), 0.0, out=t), 1.0, out=t)
+            np.abs(np.add(np.multiply(t, dx, out=x), ax, out=x), out=x)
+            np.abs(np.add(np.multiply(t, dy, out=y), ay, out=y), out=y)
+            np.minimum(best, np.maximum(x, y, out=x), out=best)
         out[start:start + 64] = best.min(axis=1)
     return out
 

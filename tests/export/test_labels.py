@@ -235,3 +235,37 @@ def assert_shop_ready(out, report, process) -> None:
         assert min(box.extmin.x, box.extmin.y) >= 0.0 and box.extmax.x <= w and box.extmax.y <= h, sheet["file"]
     assert report["interference"]["shop"]["parts_checked"] == len(report["parts"])
 
+
+
+def _box_room_reference(centres, segments, half_w, half_h):
+    """``_box_room`` written plainly, one centre at a time: the ends and the two diagonal points of each segment."""
+    out = []
+    for cx, cy in centres:
+        best = np.inf
+        for (x0, y0), (x1, y1) in segments:
+            ax, ay = x0 / half_w - cx / half_w, y0 / half_h - cy / half_h
+            dx, dy = x1 / half_w - x0 / half_w, y1 / half_h - y0 / half_h
+            best = min(best, max(abs(ax), abs(ay)), max(abs(ax + dx), abs(ay + dy)))
+            for sign in (1.0, -1.0):
+                den = dx - sign * dy
+                t = min(max(-(ax - sign * ay) / den, 0.0), 1.0) if abs(den) > 1e-15 else 0.0
+                best = min(best, max(abs(ax + t * dx), abs(ay + t * dy)))
+        out.append(best)
+    return np.array(out)
+
+
+def test_box_room_is_the_plain_computation_to_the_last_bit():
+    """The in-place array arithmetic gives the very floats of the plain computation (a label's height and place
+    are rounded from them into the cut files), segments along either diagonal of the box and centres on a
+    segment's end included, for more than one chunk of 64 centres."""
+    from fabricate.export.labels import _box_room
+
+    rng = np.random.default_rng(7)
+    segments = rng.normal(size=(40, 2, 2)) * 12.0
+    segments[::4, 1] = segments[::4, 0] + np.array([2.0, 1.0])  # along the box's diagonal (half_w = 2 half_h)
+    segments[1::4, 1] = segments[1::4, 0] + np.array([-2.0, 1.0])  # along the other one
+    segments[2::4, 1, 1] = segments[2::4, 0, 1]  # level
+    centres = np.vstack([rng.normal(size=(90, 2)) * 10.0, segments[:5, 0]])
+    room = _box_room(centres, segments, 2.0, 1.0)
+    assert np.array_equal(room, _box_room_reference(centres, segments, 2.0, 1.0))
+    assert np.all(room[-5:] == 0.0) and np.all(room[:-5] > 0.0)
