@@ -81,11 +81,13 @@ def _prism(rings: list[np.ndarray], z0: float, z1: float) -> tuple[np.ndarray, l
 def _face_path(rings: list[np.ndarray]) -> Any:
     from matplotlib.path import Path
 
-    verts, codes = [], []
-    for ring in rings:
-        verts += [*ring.tolist(), ring[0].tolist()]
-        codes += [Path.MOVETO] + [Path.LINETO] * (len(ring) - 1) + [Path.CLOSEPOLY]
-    return Path(np.asarray(verts), codes)
+    # each ring closed by its first point again (the CLOSEPOLY vertex), as arrays: the same vertices and codes
+    verts = np.concatenate([np.concatenate([ring, ring[:1]]) for ring in rings])
+    codes = np.full(len(verts), Path.LINETO, dtype=Path.code_type)
+    starts = np.cumsum([0] + [len(ring) + 1 for ring in rings[:-1]])
+    codes[starts] = Path.MOVETO
+    codes[starts + np.array([len(ring) for ring in rings])] = Path.CLOSEPOLY
+    return Path(verts, codes)
 
 
 #: One drawn solid: (the z its top ends at, its side quads (k, 4, 2), its top face's rings), in the picture's plane.
@@ -105,12 +107,17 @@ def guide_pictures(partset: PartSet, motion: Motion, steps: Sequence[GuideStep])
     allpts = np.concatenate(corners) if corners else np.zeros((1, 2))
     lo, hi = allpts.min(axis=0), allpts.max(axis=0)
     pad = 0.04 * float(max(hi - lo)) + 1.0
-    # one figure for every step (the same frame): each step's artists are drawn on it and removed after its
-    # PNG, the same pixels as a new figure per step without building the figure and its axes again
+    # one figure for every step (the same frame), and each part's, pin's and spring's artists made once per look
+    # (new or placed before): each step adds its artists in painter's order, draws, and removes them again, the
+    # same pixels as a new figure of new artists per step without building them all again. add_artist: the view
+    # is fixed (_frame), so the data-limit passes of add_collection, add_patch (every segment of a face's
+    # outline) and plot only cost time
+    scene = _Scene(solids, pins, springs, actuator)
     fig, ax = _frame((lo - pad, hi + pad))
     pictures = {}
     for step in steps:
-        drawn = _draw_step(fig, ax, step, solids, pins, springs, actuator)
+        drawn = [ax.add_artist(artist) for layer in scene.layers(step) for artist in scene.artists(*layer)]
+        drawn.append(fig.text(0.02, 0.97, f"step {step.number}", fontsize=8, va="top", color=EDGE))
         pictures[step.picture] = png_bytes(fig)
         for artist in drawn:
             artist.remove()
@@ -198,46 +205,64 @@ def _frame(view: tuple[np.ndarray, np.ndarray]) -> tuple[Any, Any]:
     return fig, ax
 
 
-def _draw_step(fig: Any, ax: Any, step: GuideStep, solids: dict[str, _Solid],
-               pins: dict[str, tuple[float, np.ndarray]],
-               springs: dict[str, tuple[float, list[np.ndarray], list[np.ndarray]]],
-               actuator: list[_Solid]) -> list[Any]:
-    """Draw one step on the guide's :func:`_frame`: what is in place after it, in painter's order, what it adds
-    highlighted. Returns the artists added (the caller removes them for the next step)."""
-    from matplotlib.collections import PolyCollection
-    from matplotlib.patches import PathPatch
+class _Scene:
+    """What the guide draws, as placed at the first pose, and the artists made of it.
 
-    drawn: list[Any] = []
-    # painter's order: whatever ends lower is drawn first
-    layers: list[tuple[float, int, str, str]] = [(solids[n][0], 0, "part", n) for n in step.placed if n in solids]
-    layers += [(pins[j][0], 1, "pin", j) for j in step.pins if j in pins]
-    layers += [(springs[j][0], 2, "spring", j) for j in step.springs if j in springs]
-    if step.actuator:
-        layers += [(z1, 3, "actuator", str(k)) for k, (z1, _, _) in enumerate(actuator)]
-    for _, _, kind, name in sorted(layers):
+    Parameters
+    ----------
+    solids : dict
+        Each part's :data:`_Solid`, by name.
+    pins : dict
+        Each pin's (top z, end points (2, 2)), by joint.
+    springs : dict
+        Each spring's (top z, coils, legs), by joint.
+    actuator : list
+        The actuator's solids.
+    """
+
+    def __init__(self, solids: dict[str, _Solid], pins: dict[str, tuple[float, np.ndarray]],
+                 springs: dict[str, tuple[float, list[np.ndarray], list[np.ndarray]]], actuator: list[_Solid]) -> None:
+        self.solids, self.pins, self.springs, self.actuator = solids, pins, springs, actuator
+        self._made: dict[tuple[str, str, bool], list[Any]] = {}
+
+    def layers(self, step: GuideStep) -> list[tuple[str, str, bool]]:
+        """``(kind, name, new)`` of everything in place after ``step``, in painter's order (whatever ends lower
+        first); ``new``: fitted in this step (drawn highlighted)."""
+        solids, pins, springs = self.solids, self.pins, self.springs
+        layers: list[tuple[float, int, str, str]] = [(solids[n][0], 0, "part", n) for n in step.placed if n in solids]
+        layers += [(pins[j][0], 1, "pin", j) for j in step.pins if j in pins]
+        layers += [(springs[j][0], 2, "spring", j) for j in step.springs if j in springs]
+        if step.actuator:
+            layers += [(z1, 3, "actuator", str(k)) for k, (z1, _, _) in enumerate(self.actuator)]
+        new = {"part": set(step.new), "pin": set(step.new_pins), "spring": set(step.new_springs)}
+        return [(kind, name, step.new_actuator if kind == "actuator" else name in new[kind])
+                for _, _, kind, name in sorted(layers)]
+
+    def artists(self, kind: str, name: str, new: bool) -> list[Any]:
+        """The artists of one layer (made on first use; not yet on any axes)."""
+        key = (kind, name, new)
+        if key not in self._made:
+            self._made[key] = self._make(kind, name, new)
+        return self._made[key]
+
+    def _make(self, kind: str, name: str, new: bool) -> list[Any]:
+        from matplotlib.collections import PolyCollection
+        from matplotlib.lines import Line2D
+        from matplotlib.patches import PathPatch
+
         if kind in ("part", "actuator"):
-            _, quads, top = solids[name] if kind == "part" else actuator[int(name)]
-            new = name in step.new if kind == "part" else step.new_actuator
+            _, quads, top = self.solids[name] if kind == "part" else self.actuator[int(name)]
             face, side = NEW if new else OLD
-            # the view is fixed (_frame), so nothing needs the data limits: add_collection's autolim and
-            # add_patch's limit pass (every segment of a face's outline) only cost time; the quads as one
-            # (k, 4, 2) array take PolyCollection's one-template-path route (the same paths)
-            drawn.append(ax.add_collection(PolyCollection(quads, facecolors=side, edgecolors=side, linewidths=0.3),
-                                           autolim=False))
-            drawn.append(ax.add_artist(PathPatch(_face_path(top), facecolor=face, edgecolor=EDGE, linewidth=0.4)))
-        elif kind == "pin":
-            seg = pins[name][1]
-            drawn += ax.plot(seg[:, 0], seg[:, 1], color=NEW_PIN if name in step.new_pins else PIN, linewidth=1.6,
-                             solid_capstyle="round")
-        else:
-            _, coils, legs = springs[name]
-            colour = NEW_SPRING if name in step.new_springs else SPRING
-            for ring in coils:
-                drawn += ax.plot(ring[:, 0], ring[:, 1], color=colour, linewidth=0.8)
-            for leg in legs:
-                drawn += ax.plot(leg[:, 0], leg[:, 1], color=colour, linewidth=0.8)
-    drawn.append(fig.text(0.02, 0.97, f"step {step.number}", fontsize=8, va="top", color=EDGE))
-    return drawn
+            # the quads as one (k, 4, 2) array take PolyCollection's one-template-path route (the same paths)
+            return [PolyCollection(quads, facecolors=side, edgecolors=side, linewidths=0.3),
+                    PathPatch(_face_path(top), facecolor=face, edgecolor=EDGE, linewidth=0.4)]
+        # the lines Axes.plot made of the same points and style
+        if kind == "pin":
+            seg = self.pins[name][1]
+            return [Line2D(seg[:, 0], seg[:, 1], color=NEW_PIN if new else PIN, linewidth=1.6, solid_capstyle="round")]
+        _, coils, legs = self.springs[name]
+        colour = NEW_SPRING if new else SPRING
+        return [Line2D(line[:, 0], line[:, 1], color=colour, linewidth=0.8) for line in [*coils, *legs]]
 
 
 def motion_check(partset: PartSet, motion: Motion, min_clearance_mm: float | None = None) -> Any:
