@@ -137,6 +137,8 @@ def swept_region(outlines: Mapping[str, BulgePath], motion: Motion, poses: int =
     shapes = []
     for body, path in outlines.items():
         outline = path.polygon(CONFLICT_CHORD_MM)
-        for pose in motion.pose(body)[pick]:
-            shapes.append(shapely.Polygon(outline @ rotation(pose[2]).T + pose[:2]))
+        # each pose's ring as before; the polygons made in one shapely call (was a Polygon object a pose)
+        rings = [outline @ rotation(pose[2]).T + pose[:2] for pose in motion.pose(body)[pick]]
+        if rings:
+            shapes.extend(shapely.polygons(np.stack(rings)).tolist())
     return shapely.union_all(shapes) if shapes else shapely.Polygon()
