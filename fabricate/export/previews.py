@@ -139,9 +139,11 @@ def assembly_figure(parts: Sequence[Part], motion: Motion, poses: int = 4, tip_p
             for centre, radius in holes:
                 if radius > 0:
                     holes_xy.append(transform_points(pose, circle_polygon(centre, 2 * radius, PREVIEW_CHORD_MM)))
-        # one collection per panel: add_patch per shape costs more than the drawing
-        ax.add_collection(PolyCollection(plates, facecolors=faces, edgecolors=edges, linewidths=0.6))
-        ax.add_collection(PolyCollection(holes_xy, facecolors="white", edgecolors="0.3", linewidths=0.4))
+        # one collection per panel: add_patch per shape costs more than the drawing; no data limits (autolim):
+        # the view is set below, from the same extent for every panel
+        ax.add_collection(PolyCollection(plates, facecolors=faces, edgecolors=edges, linewidths=0.6), autolim=False)
+        ax.add_collection(PolyCollection(holes_xy, facecolors="white", edgecolors="0.3", linewidths=0.4),
+                          autolim=False)
         if trace is not None:
             ax.plot(trace[:, 0], trace[:, 1], color="black", linewidth=0.6, linestyle="--")
         ax.set_xlim(lo[0], hi[0])
@@ -312,6 +314,10 @@ def exploded_figure(parts: Sequence[Part], poses: Mapping[str, np.ndarray], stac
     ax.autoscale_view()
     ax.set_aspect("equal")
     ax.set_axis_off()
+    # hidden axis artists too: the title's placement otherwise measured the y axis (its ticks made, located and
+    # labelled) for an offset text that an axes drawn without axes never shows
+    ax.xaxis.set_visible(False)
+    ax.yaxis.set_visible(False)
     ax.set_title(f"{title} exploded along the pins (z stretched x{stretch:.2g})" if title else "exploded",
                  fontsize=9)
     fig.subplots_adjust(left=0.02, right=0.98, bottom=0.02, top=0.94)
