@@ -74,32 +74,7 @@ def kinematic_dxf(mechanism: Mechanism, poses: Mapping[str, np.ndarray]) -> byte
     doc.dimstyles.new(DIMSTYLE, dxfattribs=dict(sizes))  # ezdxf adds its name to the dict it is given
     for variable, value in sizes.items():
         doc.header[f"${variable.upper()}"] = value
-    # link dimensions are tried out in a scratch document (a dimension's text box is known once rendered)
-    scratch = new_document(("DIMENSIONS",), dimensions=True)
-    scratch.dimstyles.new(DIMSTYLE, dxfattribs=dict(sizes))
-    obstacles: list[shapely.Geometry] = []  # what a label must not touch
-    dimension_texts: list[shapely.Geometry] = []  # what a link dimension's text must not touch
-    drawn: set[tuple[str, ...]] = set()
-    for body in mechanism.bodies:
-        names = [n for n in body.points if n in joint_names] or list(body.points)
-        for i, a in enumerate(names):
-            for b in names[i + 1:]:
-                key = tuple(sorted((a, b)))
-                pa = transform_points(poses[body.name], body.point(a))
-                pb = transform_points(poses[body.name], body.point(b))
-                length = float(np.hypot(*(pb - pa)))
-                if key in drawn or length < 1e-6:
-                    continue
-                drawn.add(key)
-                msp.add_line(tuple(pa), tuple(pb), dxfattribs={"layer": "LINKS"})
-                obstacles.append(shapely.LineString([pa, pb]))
-                distance = _link_dimension_offset(scratch.modelspace(), pa, pb, text_h, dimension_texts)
-                dim = msp.add_aligned_dim(p1=tuple(pa), p2=tuple(pb), distance=distance, dimstyle=DIMSTYLE,
-                                          dxfattribs={"layer": "DIMENSIONS"})
-                dim.render()
-                texts, lines = _dimension_shapes(dim.dimension)
-                obstacles += texts + lines
-                dimension_texts += texts
+    obstacles = _draw_links(msp, mechanism, poses, joint_names, text_h, sizes)  # what a label must not touch
     # points at one spot (a compound hinge) get one label and one pair of coordinate dimensions
     spots: dict[tuple[float, float], list[str]] = {}
     for name in sorted(world):
@@ -125,6 +100,40 @@ def kinematic_dxf(mechanism: Mechanism, poses: Mapping[str, np.ndarray]) -> byte
         _place_label(msp, f"{', '.join(names)} ({p[0]:.3f}, {p[1]:.3f})", p, radius, text_h, obstacles,
                      shapely.union_all(others) if others else shapely.Polygon())
     return document_bytes(doc)
+
+
+def _draw_links(msp: Any, mechanism: Mechanism, poses: Mapping[str, np.ndarray], joint_names: set[str],
+                text_h: float, sizes: dict[str, float]) -> list[shapely.Geometry]:
+    """Each link's centre line between every two of its body's joints (every two points of a body without
+    joints) and its aligned length dimension, each pair once; returns what they draw (lines, dimension text
+    boxes and lines) for the labels to keep off."""
+    # link dimensions are tried out in a scratch document (a dimension's text box is known once rendered)
+    scratch = new_document(("DIMENSIONS",), dimensions=True)
+    scratch.dimstyles.new(DIMSTYLE, dxfattribs=dict(sizes))
+    obstacles: list[shapely.Geometry] = []
+    dimension_texts: list[shapely.Geometry] = []  # what a link dimension's text must not touch
+    drawn: set[tuple[str, ...]] = set()
+    for body in mechanism.bodies:
+        names = [n for n in body.points if n in joint_names] or list(body.points)
+        for i, a in enumerate(names):
+            for b in names[i + 1:]:
+                key = tuple(sorted((a, b)))
+                pa = transform_points(poses[body.name], body.point(a))
+                pb = transform_points(poses[body.name], body.point(b))
+                length = float(np.hypot(*(pb - pa)))
+                if key in drawn or length < 1e-6:
+                    continue
+                drawn.add(key)
+                msp.add_line(tuple(pa), tuple(pb), dxfattribs={"layer": "LINKS"})
+                obstacles.append(shapely.LineString([pa, pb]))
+                distance = _link_dimension_offset(scratch.modelspace(), pa, pb, text_h, dimension_texts)
+                dim = msp.add_aligned_dim(p1=tuple(pa), p2=tuple(pb), distance=distance, dimstyle=DIMSTYLE,
+                                          dxfattribs={"layer": "DIMENSIONS"})
+                dim.render()
+                texts, lines = _dimension_shapes(dim.dimension)
+                obstacles += texts + lines
+                dimension_texts += texts
+    return obstacles
 
 
 def _link_dimension_offset(scratch: Any, pa: np.ndarray, pb: np.ndarray, text_h: float,
