@@ -22,6 +22,34 @@ def _figure(size: tuple[float, float] = (6.0, 4.0), dpi: int = 100) -> tuple[Any
     return fig, fig.add_subplot(1, 1, 1)
 
 
+def fill(ax: Any, x: np.ndarray, y: np.ndarray, **style: Any) -> Any:
+    """What ``ax.fill(x, y, **style)`` adds for one outline (the same polygon and properties), without its data
+    limit pass.
+
+    ``Axes.add_patch`` takes a patch's data limits from every segment as a Bézier curve with its extrema, a
+    Python loop that cost a third of a gear pair's picture (about a thousand segments per outline); a straight
+    polygon's extrema are its vertices, so the limits are updated from them: the same box.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    x, y : (n,) arrays
+        The outline, unclosed (as ``ax.fill`` takes it).
+    **style
+        As ``ax.fill``'s keywords (its aliases: ``lw``, ``ec``, ...), applied in the same order.
+    """
+    from matplotlib.cbook import normalize_kwargs
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Polygon
+
+    # Axes.fill: Line2D's aliases normalised, a Polygon with no face colour of its own, then the keywords set
+    poly = Polygon(np.column_stack((x, y)), facecolor=None, fill=True, closed=True)
+    poly.set(**normalize_kwargs(style, Line2D))
+    ax.add_artist(poly)
+    ax.update_datalim(poly.get_path().vertices)
+    return poly
+
+
 def _placed(pair: GearPair, x_a: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Outlines and pitch curves of both gears at driving angle ``x_a`` in the carrier frame."""
     from fabricate.planar import rotation
@@ -36,10 +64,10 @@ def _placed(pair: GearPair, x_a: float) -> tuple[np.ndarray, np.ndarray, np.ndar
 def _draw_pair(ax: Any, pair: GearPair, x_a: float, zoom: bool) -> None:
     out_a, out_b, pitch_a, pitch_b = _placed(pair, x_a)
     teeth = pair.report()["teeth"]
-    ax.fill(out_a[:, 0], out_a[:, 1], color="#4c72b0", alpha=0.55, lw=0.6, ec="#1f3b63",
-            label=f"gear a, z = {teeth[0]}")
-    ax.fill(out_b[:, 0], out_b[:, 1], color="#dd8452", alpha=0.55, lw=0.6, ec="#7a3d17",
-            label=f"gear b, z = {teeth[1]}")
+    fill(ax, out_a[:, 0], out_a[:, 1], color="#4c72b0", alpha=0.55, lw=0.6, ec="#1f3b63",
+         label=f"gear a, z = {teeth[0]}")
+    fill(ax, out_b[:, 0], out_b[:, 1], color="#dd8452", alpha=0.55, lw=0.6, ec="#7a3d17",
+         label=f"gear b, z = {teeth[1]}")
     # both pitch curves in one dark grey: the fill says whose each is, the legend what the dashes are
     ax.plot(pitch_a[:, 0], pitch_a[:, 1], "--", color="0.25", lw=0.5, label="pitch curves")
     ax.plot(pitch_b[:, 0], pitch_b[:, 1], "--", color="0.25", lw=0.5)
