@@ -191,7 +191,7 @@ def mechanism_mjcf(design: DesignSpec, partset: PartSet, mechanism: Mechanism, m
     bodies = _Bodies.of(design, partset, mechanism, motion, stl)
     lines = _header_lines(design, partset)
     lines += bodies.worldbody()
-    equalities, fits, targets = _equality_lines(mechanism, motion, bodies.tree)
+    equalities, fits, targets = _equality_lines(mechanism, motion, bodies.tree, bodies.coordinates)
     lines += equalities
     lines += _actuator_lines(design, mechanism, bodies.tree, targets, max(1, int(partset.copies)))
     lines += _gear_fit_lines(fits)
@@ -337,10 +337,11 @@ class _Bodies:
         return out
 
 
-def _equality_lines(mechanism: Mechanism, motion: Motion,
-                    tree: Tree) -> tuple[list[str], list[GearFit], list[tuple[str, float, np.ndarray]]]:
+def _equality_lines(mechanism: Mechanism, motion: Motion, tree: Tree, coordinates: dict[str, np.ndarray]
+                    ) -> tuple[list[str], list[GearFit], list[tuple[str, float, np.ndarray]]]:
     """``<equality>``: the loops' connects, the gear laws' segments and the drivers' (inactive) equalities;
-    with the gear fits and the drivers' targets the rest of the document reads."""
+    with the gear fits and the drivers' targets the rest of the document reads. ``coordinates``: every tree
+    joint's ``qpos`` over the motion (:func:`joint_coordinates`)."""
     lines = ['  <equality>']
     for j in tree.loops:
         if isinstance(j, Slider):
@@ -359,7 +360,7 @@ def _equality_lines(mechanism: Mechanism, motion: Motion,
             active = "" if s == start else ' active="false"'
             lines.append(f'    <joint name={quoteattr(f"gear_{g.name}_{s}")} joint1={quoteattr(fit.joint_b)} '
                          f'joint2={quoteattr(fit.joint_a)} polycoef="{_vec(coef, 17)}"{active}/>')
-    targets = driver_targets(mechanism, motion, tree)
+    targets = driver_targets(mechanism, motion, tree, coordinates)
     for k, (joint, _, _) in enumerate(targets):
         lines.append(f'    <joint name="drive_{k}" joint1={quoteattr(joint)} polycoef="0 0 0 0 0" active="false"/>')
     lines.append('  </equality>')

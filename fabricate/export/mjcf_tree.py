@@ -154,15 +154,19 @@ def kinematic_tree(mechanism: Mechanism, spring_joints: Sequence[str] = ()) -> T
     return Tree(tuple(tree), tuple(loops), unreached)
 
 
-def _slide_coordinate(mechanism: Mechanism, motion: Motion, j: Slider, i: int = 0) -> float:
-    """(p_b - p_a) . u at pose ``i`` (mm), u the slider's unit axis fixed in body_a."""
+def _slide_coordinates(motion: Motion, j: Slider) -> np.ndarray:
+    """(p_b - p_a) . u at every pose of the motion (mm), u the slider's unit axis fixed in body_a.
+
+    The points and body_a's angle are taken over the motion once (a pose's row of them is the same), the axis
+    turned and the dot product made per pose as before (math.cos and a 2-vector product: the same floats)."""
     axis = np.asarray(j.axis, dtype=np.float64) / math.hypot(*j.axis)
-    theta_a = float(motion.pose(j.body_a)[i, 2])
-    u = np.array([math.cos(theta_a) * axis[0] - math.sin(theta_a) * axis[1],
-                  math.sin(theta_a) * axis[0] + math.cos(theta_a) * axis[1]])
-    pa = motion.point(j.name, j.body_a)[i]
-    pb = motion.point(j.name, j.body_b)[i]
-    return float((pb - pa) @ u)
+    pa, pb = motion.point(j.name, j.body_a), motion.point(j.name, j.body_b)
+    out = np.empty(len(pa))
+    for i, theta_a in enumerate(motion.pose(j.body_a)[:, 2].tolist()):
+        u = np.array([math.cos(theta_a) * axis[0] - math.sin(theta_a) * axis[1],
+                      math.sin(theta_a) * axis[0] + math.cos(theta_a) * axis[1]])
+        out[i] = (pb[i] - pa[i]) @ u
+    return out
 
 
 def joint_coordinates(mechanism: Mechanism, motion: Motion, tree: Tree) -> dict[str, np.ndarray]:
@@ -172,17 +176,20 @@ def joint_coordinates(mechanism: Mechanism, motion: Motion, tree: Tree) -> dict[
     for tj in tree.joints:
         j = by_name[tj.name]
         if isinstance(j, Slider):
-            values = np.array([_slide_coordinate(mechanism, motion, j, i) for i in range(len(motion.inputs))]) * MM
+            values = _slide_coordinates(motion, j) * MM
         else:
             values = motion.relative_angle(j.body_b, j.body_a)
         out[tj.name] = tj.sign * np.asarray(values, dtype=np.float64)
     return out
 
 
-def driver_targets(mechanism: Mechanism, motion: Motion, tree: Tree) -> list[tuple[str, float, np.ndarray]]:
+def driver_targets(mechanism: Mechanism, motion: Motion, tree: Tree,
+                   coordinates: dict[str, np.ndarray] | None = None) -> list[tuple[str, float, np.ndarray]]:
     """Per driver: its MuJoCo joint, the sign from the driver's coordinate to that joint's ``qpos``, and the
-    ``qpos`` the driver sets at each input of the motion."""
-    coordinates = joint_coordinates(mechanism, motion, tree)
+    ``qpos`` the driver sets at each input of the motion. ``coordinates``: :func:`joint_coordinates`' answer
+    where the caller has it already."""
+    if coordinates is None:
+        coordinates = joint_coordinates(mechanism, motion, tree)
     out = []
     for d in mechanism.drivers:
         j = driver_joint(mechanism, d)
