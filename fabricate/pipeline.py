@@ -264,9 +264,9 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
 
 
 def _start(run: BuildRun, jobs: list[Callable[[], dict[str, bytes]]], stage: str, key: Any,
-           draws: bool = True) -> Background | None:
+           draws: bool = True, hand_over: bool = False) -> Background | None:
     """``jobs`` forked now, or (their result stored, or nothing to draw) run when their result is asked for;
-    None in a report-only build (no pictures)."""
+    None in a report-only build (no pictures). ``hand_over``: the child makes the STEP files (Background)."""
     if run.report_only:
         return None
     fork = draws and not cache.stored(stage, key)
@@ -274,7 +274,7 @@ def _start(run: BuildRun, jobs: list[Callable[[], dict[str, bytes]]], stage: str
         from fabricate.plotting import load_agg
 
         load_agg()  # matplotlib imported once, before the fork: the child's and this process's plots'
-    return Background(jobs, fork=fork, hand_over=False)
+    return Background(jobs, fork=fork, hand_over=hand_over)
 
 
 def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
@@ -322,7 +322,7 @@ def _start_exports(run: BuildRun, with_step: bool, pictures: list[Callable[[], d
     stored = cache.stored("exports", stage_keys.exports_key(run.design, with_step))
     if run.report_only or stored or not can_fork():
         _export(run, with_step)
-        return _start(run, pictures, "previews", stage_keys.pictures_key(run.design, "previews")), False
+        return _start(run, pictures, "previews", stage_keys.pictures_key(run.design, "previews"), hand_over=True), False
     from fabricate.plotting import load_agg
 
     run.enter("exports")
