@@ -48,10 +48,10 @@ class BulgePath:
             Polygon vertices (closed implicitly), on the exact curve. A new array at every call.
         """
         # parts, checks, strength and exports ask a path for its chords again and again (the finger: 179 calls
-        # for 48 paths, 0.057 s): made once per tolerance (the path is immutable), handed out as copies (a caller
+        # for 48 paths, 0.021 s CPU): made once per tolerance (the path is immutable), handed out as copies (a caller
         # may write into its array). Kept outside the dataclass fields: equality, the stage keys and pickles
         # (__getstate__) never see it
-        memo = self.__dict__.setdefault("_chords", {})
+        memo: dict[float, np.ndarray] = self.__dict__.setdefault("_chords", {})
         found = memo.get(float(chord_tolerance_mm))
         if found is None:
             found = memo[float(chord_tolerance_mm)] = self._polygon(chord_tolerance_mm)
