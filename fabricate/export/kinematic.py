@@ -141,14 +141,16 @@ def _link_dimension_offset(scratch: Any, pa: np.ndarray, pb: np.ndarray, text_h:
     """How far (mm, signed: which side) a link's aligned dimension stands off the link: 3 text heights on its
     left unless its text would then meet another dimension's; then the first of further offsets, either
     side, where it meets none (3 text heights when none is free)."""
-    tree = shapely.STRtree(texts) if texts else None
+    if not texts:  # no other dimension's text to meet: the first offset, without rendering a trial
+        return 3.0 * text_h
+    tree = shapely.STRtree(texts)
     for steps in (3.0, -3.0, 4.5, -4.5, 6.0, -6.0, 8.0, -8.0, 10.0, -10.0, 12.5, -12.5):
         trial = scratch.add_aligned_dim(p1=tuple(pa), p2=tuple(pb), distance=steps * text_h, dimstyle=DIMSTYLE)
         trial.render()
         boxes = dimension_text_boxes(trial.dimension)
         scratch.delete_entity(trial.dimension)
-        if tree is None or not any(len(tree.query(box.buffer(0.2 * text_h, join_style="mitre"),
-                                                  predicate="intersects")) for box in boxes):
+        if not any(len(tree.query(box.buffer(0.2 * text_h, join_style="mitre"), predicate="intersects"))
+                   for box in boxes):
             return steps * text_h
     return 3.0 * text_h
 
