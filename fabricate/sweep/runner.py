@@ -119,9 +119,15 @@ def connect(workers: int | None, scheduler: str | None) -> tuple[Any, Any]:
 
     # Dask starts its workers with MALLOC_TRIM_THRESHOLD_=65536, which turns glibc's dynamic mmap threshold off: a
     # point's large numpy arrays are mapped and unmapped again every time (6x the page faults), and a build point
-    # took 6-7 % more CPU in a worker than in this process. Unset for the local cluster's workers (distributed is
-    # imported above, so the context restores its setting; peak memory is the same)
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+    # took 6-7 % more CPU in a worker than in this process. The local cluster's workers get a build's own thresholds
+    # instead (fabricate.bounds.ROOMY_HEAP, as glibc's environment variables; distributed is imported above, so the
+    # context restores Dask's setting)
+    from fabricate.bounds import M_MMAP_THRESHOLD, M_TRIM_THRESHOLD, ROOMY_HEAP
+
+    heap = dict(ROOMY_HEAP)
+    environ = {"MALLOC_TRIM_THRESHOLD_": str(heap[M_TRIM_THRESHOLD]),
+               "MALLOC_MMAP_THRESHOLD_": str(heap[M_MMAP_THRESHOLD])}
+    with dask.config.set({f"distributed.nanny.pre-spawn-environ.{name}": value for name, value in environ.items()}):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                silence_logs=logging.ERROR)
     client = Client(cluster)
