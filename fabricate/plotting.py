@@ -244,7 +244,7 @@ def rounded_xy(x: Any, y: Any) -> list[float]:
     scaled = values * 100.0
     out = np.rint(scaled) / 100.0
     near = np.flatnonzero(np.abs(scaled - np.floor(scaled) - 0.5) < 1e-6)
-    flat = out.tolist()
+    flat: list[float] = out.tolist()
     for k in near.tolist():
         flat[k] = round(float(values[k]), 2)
     return flat

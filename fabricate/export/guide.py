@@ -253,8 +253,9 @@ class _Scene:
         if kind in ("part", "actuator"):
             _, quads, top = self.solids[name] if kind == "part" else self.actuator[int(name)]
             face, side = NEW if new else OLD
-            # the quads as one (k, 4, 2) array take PolyCollection's one-template-path route (the same paths)
-            return [PolyCollection(quads, facecolors=side, edgecolors=side, linewidths=0.3),
+            # the quads as one (k, 4, 2) array take PolyCollection's one-template-path route (the same paths;
+            # matplotlib's stubs name only a sequence of polygons, its code takes the array first)
+            return [PolyCollection(quads, facecolors=side, edgecolors=side, linewidths=0.3),  # type: ignore[arg-type]
                     PathPatch(_face_path(top), facecolor=face, edgecolor=EDGE, linewidth=0.4)]
         # the lines Axes.plot made of the same points and style
         if kind == "pin":
