@@ -425,3 +425,41 @@ def test_every_error_is_one_line(tmp_path, monkeypatch, capsys):
     assert main(["list"]) == 3
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("fabricate: internal error: RuntimeError: two\\nlines")
+
+
+# The exports fail with a geometry kernel's error wherever they run: in the export child the build forks after the
+# parts, then again here where the parent redoes the child's jobs. Each call leaves its process id in a folder.
+EXPORTS_FAIL = """
+import os, pathlib, sys
+import fabricate.export
+from fabricate.errors import GeometryError
+def failing(*args, **kwargs):
+    (pathlib.Path(sys.argv[1]) / str(os.getpid())).touch()
+    raise GeometryError("the plate outline self-intersects")
+fabricate.export.export_all = failing
+from fabricate.cli import main
+sys.exit(main(["build", "gear_pair_elliptic", "-o", sys.argv[2], "-q"]))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_a_kernel_failure_in_the_export_child_is_a_design_failure_with_no_traceback_or_process_left(tmp_path):
+    calls, out = tmp_path / "calls", tmp_path / "out"
+    calls.mkdir()
+    env = {k: v for k, v in os.environ.items() if k != "FABRICATE_SERIAL"}
+    run = subprocess.Popen([sys.executable, "-c", EXPORTS_FAIL, str(calls), str(out)], cwd=tmp_path, env=env,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    stdout, stderr = run.communicate(timeout=600)
+    assert run.returncode == 1, (stdout, stderr)
+    assert "Traceback" not in stderr and "Traceback" not in stdout
+    failure = "exports: this design cannot be made (the plate outline self-intersects)"
+    assert failure in stdout + stderr
+    # the child failed (its pid), then this process redid its jobs and failed the same way
+    assert len(list(calls.iterdir())) == 2 and str(run.pid) in {p.name for p in calls.iterdir()}
+    report = json.loads((out / "report.json").read_text(encoding="utf-8"))
+    assert report["checks"]["failures"] == [failure] and not report["checks"]["passed"]
+    # as a serial build's: it fails in the exports, before any check ran
+    assert not {"interference", "strength", "drive", "parts"} & set(report)
+    assert sorted(p.name for p in out.iterdir()) == ["report.json", "report.md"]
+    assert _wait_until_gone(run.pid) == {}  # the children and the STEP workers went with the build

@@ -3,6 +3,9 @@ full build's report without the files no report key is computed from (issue 27, 
 
 from __future__ import annotations
 
+import os
+import sys
+
 import pytest
 
 from fabricate.background import Background
@@ -88,3 +91,91 @@ def test_the_forked_schedule_makes_the_serial_builds_bytes(monkeypatch):
     assert list(forked.report) == list(serial.report)
     assert sorted(forked.files) == sorted(serial.files)
     assert [rel for rel in forked.files if forked.files[rel] != serial.files[rel]] == []
+
+
+def _kernel_failure_in(stage: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Make ``stage`` ("exports" or "checks") raise a GeometryError, in this process and in any child forked after."""
+    import fabricate.checks
+    import fabricate.export
+    from fabricate.errors import GeometryError
+
+    def failing(*args, **kwargs):
+        raise GeometryError(f"no {stage} for this design")
+
+    monkeypatch.setattr(fabricate.export if stage == "exports" else fabricate.checks,
+                        "export_all" if stage == "exports" else "run_checks", failing)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stage", ["exports", "checks"])
+def test_a_kernel_failure_reports_the_same_whether_the_exports_were_forked(stage, monkeypatch):
+    """A geometry kernel failing in the exports (made by a forked child while this process runs the checks) or in
+    the checks (while the child makes the exports) is the serial build's design failure: the stage a serial build
+    fails in named, exit code 1, no exception, and report.json's bytes the serial build's (no check section where
+    the exports failed; the exports' sections where the checks did)."""
+    import fabricate.pipeline as pipeline
+    from fabricate.build_stages import OptionalOutputs
+
+    forks: list[bool] = []
+
+    def spied(*args, **kwargs):
+        child = Background(*args, **kwargs)
+        if child.jobs and child.jobs[0].__name__ == "exports_job":
+            forks.append(child.forked)
+        return child
+
+    monkeypatch.setattr(pipeline, "Background", spied)
+    _kernel_failure_in(stage, monkeypatch)
+    design = load_design("gear_pair_elliptic")
+    no_step = OptionalOutputs(step=False)  # no OCP worker left computing after the failure
+    forked = run_build(design, optional=no_step)
+    assert forks == [True]  # the exports child forked
+    monkeypatch.setenv("FABRICATE_SERIAL", "1")
+    serial = run_build(design, optional=no_step)
+    assert forked.exit_code == serial.exit_code == 1
+    assert forked.failures == serial.failures == [f"{stage}: this design cannot be made (no {stage} for this design)"]
+    assert "interference" not in forked.report and ("parts" in forked.report) == (stage == "checks")
+    assert list(forked.report) == list(serial.report)
+    assert forked.files == serial.files  # report.json's bytes included
+
+
+def _waiting_workers() -> list[int]:
+    """The pids of this process's live children that are :func:`fabricate.background.run_isolated` workers."""
+    from pathlib import Path
+
+    found = []
+    for entry in Path("/proc").iterdir():
+        try:
+            stat = (entry / "stat").read_text()
+            command = (entry / "cmdline").read_bytes()
+        except OSError:  # not a process, or it ended while we looked
+            continue
+        state, ppid = stat[stat.rindex(")") + 2:].split()[:2]
+        if int(ppid) == os.getpid() and state not in ("Z", "X") and b"_isolated_main" in command:
+            found.append(int(entry.name))
+    return found
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_only_the_child_that_makes_the_step_files_takes_the_prestarted_worker(monkeypatch):
+    """The STEP worker ``run_build`` prestarts goes to the one child whose jobs include the STEP job (the early
+    children and the plots' child leave it: a child that takes it kills it when collected, and the STEP job would
+    start a cold one), and after the build no worker is left waiting or unreaped."""
+    import fabricate.pipeline as pipeline
+    from fabricate import background
+
+    made: list[tuple[bool, bool]] = []  # each child's hand_over, and whether its jobs make the STEP files
+
+    def spied(jobs, **kwargs):
+        made.append((kwargs.get("hand_over", True), any(isinstance(job, background._Threaded) for job in jobs)))
+        return Background(jobs, **kwargs)
+
+    monkeypatch.setattr(pipeline, "Background", spied)
+    monkeypatch.delenv("FABRICATE_SERIAL", raising=False)
+    outcome = run_build(load_design("gear_pair_elliptic"))
+    assert outcome.exit_code == 0
+    assert len(made) == 4 and sum(step for _, step in made) == 1  # two early children, the exports, the plots
+    assert [hand_over for hand_over, _ in made] == [step for _, step in made]
+    assert background._WARM == {} and background._HANDED == []
+    assert _waiting_workers() == []
