@@ -463,3 +463,50 @@ def test_a_kernel_failure_in_the_export_child_is_a_design_failure_with_no_traceb
     assert not {"interference", "strength", "drive", "parts"} & set(report)
     assert sorted(p.name for p in out.iterdir()) == ["report.json", "report.md"]
     assert _wait_until_gone(run.pid) == {}  # the children and the STEP workers went with the build
+
+
+# As HOLD_IN_CHILD, but in the child that makes the exports after the parts (it also takes the prestarted STEP
+# worker): this process runs the checks meanwhile, then waits for that child.
+HOLD_IN_EXPORT_CHILD = """
+import os, pathlib, sys, time
+import fabricate.export
+parent = os.getpid()
+real = fabricate.export.export_all
+def held(*args, **kwargs):
+    if os.getpid() != parent:
+        marker = pathlib.Path(sys.argv[1])
+        marker.with_suffix('.part').write_text(str(os.getpid()))
+        marker.with_suffix('.part').rename(marker)
+        time.sleep(600)
+    return real(*args, **kwargs)
+fabricate.export.export_all = held
+from fabricate.cli import main
+sys.exit(main(["build", "gear_pair_elliptic", "-o", sys.argv[2]]))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_a_signal_while_the_export_child_works_leaves_no_process_and_the_previous_output(tmp_path):
+    out, marker = tmp_path / "out", tmp_path / "child.pid"
+    write_output(_previous_output(), out)
+    env = {k: v for k, v in os.environ.items() if k != "FABRICATE_SERIAL"}
+    run = subprocess.Popen([sys.executable, "-c", HOLD_IN_EXPORT_CHILD, str(marker), str(out)], cwd=tmp_path, env=env,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                           preexec_fn=lambda: signal.signal(signal.SIGTERM, signal.SIG_DFL))
+    deadline = time.monotonic() + 300
+    while not marker.exists():
+        if run.poll() is not None or time.monotonic() > deadline:
+            run.kill()
+            pytest.fail(f"the export child never started: {run.communicate()}")
+        time.sleep(0.05)
+    child = int(marker.read_text())
+    assert child != run.pid and _group(run.pid).get(child) not in (None, "Z")
+    os.kill(run.pid, signal.SIGTERM)  # only the parent hears it: it must kill the child (and the STEP worker)
+    stdout, stderr = run.communicate(timeout=600)
+    assert run.returncode == 143, (stdout, stderr)
+    assert stderr.strip().splitlines() == ["fabricate: terminated (SIGTERM); nothing was written (a previous output "
+                                           "is unchanged)"]
+    assert _wait_until_gone(run.pid) == {}
+    assert child not in _group(run.pid)  # reaped, not even a zombie
+    assert _tree(out) == _previous_output()
