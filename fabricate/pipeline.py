@@ -241,13 +241,20 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
         with_step = _record_optional_outputs(run)
         exports, exporting = _start_exports(run, with_step, jobs[2:4])
         before_checks = set(run.report)
-        _check(run)
-        _check_strength(run)
-        _check_drive(run)
-        _verdict(run)
-        if not run.report_only:
-            _plots(run)
-            run.files.update(jobs[4]())  # the guide's pictures
+        try:
+            _check(run)
+            _check_strength(run)
+            _check_drive(run)
+            _verdict(run)
+            if not run.report_only:
+                _plots(run)
+                run.files.update(jobs[4]())  # the guide's pictures
+        except Exception:
+            if exporting:  # a serial build made the exports first: their failure wins, their sections come first
+                stage = run.stage
+                _collect_exports(run, with_step, exports, exporting, before_checks)
+                run.stage = stage
+            raise
         pictures = _collect_exports(run, with_step, exports, exporting, before_checks)
         run.stage = "plots"
         for child in children:
@@ -343,10 +350,15 @@ def _collect_exports(run: BuildRun, with_step: bool, child: Background | None, e
     if not exporting:
         return child.result()
     run.stage = "exports"  # a failure from here on is the exports' (the child failed: its jobs run here)
-    files = child.result()
-    made = files.pop(_EXPORTED)
     checks = [key for key in run.report if key not in before_checks]
-    _export(run, with_step, made=lambda: pickle.loads(made))
+    try:
+        files = child.result()
+        made = files.pop(_EXPORTED)
+        _export(run, with_step, made=lambda: pickle.loads(made))
+    except BaseException:
+        for key in checks:  # a serial build fails before the checks: its report has none of theirs
+            run.report.pop(key, None)
+        raise
     for key in checks:
         run.report[key] = run.report.pop(key)
     return files
@@ -384,7 +396,8 @@ def _plots(run: BuildRun) -> None:
         from fabricate.plotting import load_agg
 
         load_agg()  # matplotlib imported once, before the fork, for the child and this process
-    child = Background([drawing(path) for path in theirs]) if theirs else None
+    # hand_over=False: a prestarted STEP worker waiting here (the exports stored) is for the pictures job, not these
+    child = Background([drawing(path) for path in theirs], hand_over=False) if theirs else None
     drawn: dict[str, bytes] = {}
     try:
         figures = cache.cached("check_figures", stage_keys.clearance_key(run.design), checks.figures)
