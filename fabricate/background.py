@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import multiprocessing
 import os
+import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -36,8 +37,6 @@ def in_thread(job: Callable[[], dict[str, bytes]]) -> Callable[[], dict[str, byt
 
 
 def _run_jobs(jobs: list[Callable[[], dict[str, bytes]]]) -> dict[str, bytes]:
-    import threading
-
     answers: dict[int, tuple[bool, Any]] = {}
 
     def run(k: int, job: Callable[[], dict[str, bytes]]) -> None:
@@ -46,14 +45,17 @@ def _run_jobs(jobs: list[Callable[[], dict[str, bytes]]]) -> dict[str, bytes]:
         except BaseException as exc:  # noqa: BLE001 - raised in the caller's thread, in the job's turn
             answers[k] = (False, exc)
 
-    # daemon: a job raising first ends the caller; the thread's own process (if any) dies with it
     threads = {k: threading.Thread(target=run, args=(k, job), daemon=True)
                for k, job in enumerate(jobs) if isinstance(job, _Threaded)}
     for thread in threads.values():
         thread.start()
-    for k, job in enumerate(jobs):
-        if k not in threads:
-            answers[k] = (True, job())
+    try:
+        for k, job in enumerate(jobs):
+            if k not in threads:
+                answers[k] = (True, job())
+    except BaseException:  # nobody will read the threads' results: stop their processes before raising
+        _abandon(list(threads.values()))
+        raise
     for k, thread in threads.items():
         thread.join()
         ok, value = answers[k]
@@ -63,6 +65,36 @@ def _run_jobs(jobs: list[Callable[[], dict[str, bytes]]]) -> dict[str, bytes]:
     for k in range(len(jobs)):  # in the jobs' order, whichever finished first
         files.update(answers[k][1])
     return files
+
+
+class Abandoned(Exception):
+    """Raised in a thread of :func:`_run_jobs` whose result is no longer wanted (another job raised)."""
+
+
+#: Threads whose job :func:`_run_jobs` gave up on: their :func:`run_isolated` calls end instead of starting over.
+_ABANDONED: set[int] = set()
+#: The worker serving each thread's :func:`run_isolated` call now, by thread: killed when the thread is abandoned.
+_SERVING: dict[int, Any] = {}
+_SERVING_LOCK = threading.Lock()
+
+
+def _abandon(threads: list[threading.Thread]) -> None:
+    """End ``threads`` (their jobs' results unwanted): each worker serving one is killed, so the thread's
+    :func:`run_isolated` returns (:class:`Abandoned`) instead of waiting on it; then each is joined, so no
+    thread or worker outlives the failure (an API caller's process would keep them running)."""
+    for thread in threads:
+        with _SERVING_LOCK:
+            if thread.ident is None:
+                continue
+            _ABANDONED.add(thread.ident)
+            proc = _SERVING.get(thread.ident)
+        if proc is not None:
+            with contextlib.suppress(OSError):
+                proc.kill()
+    for thread in threads:
+        thread.join()
+        with _SERVING_LOCK:
+            _ABANDONED.discard(thread.ident or 0)
 
 
 def _die_with_parent(parent: int) -> None:
@@ -304,16 +336,34 @@ def run_isolated(module: str, function: str, *args: Any) -> Any:
     """
     import importlib
 
+    me = threading.get_ident()
     entry = _WARM.pop(module, None)
     for proc in ([entry[0]] if entry is not None else []) + [None]:
+        if me in _ABANDONED:  # (the worker it had was killed for it): no other worker, no call here
+            break
         proc = proc if proc is not None else _start_worker()
         if proc is None:
             break
-        ok, value = _call(proc, module, function, args)
+        with _SERVING_LOCK:  # registered, or abandoned before it could be: never both unseen
+            abandoned = me in _ABANDONED
+            if not abandoned:
+                _SERVING[me] = proc
+        if abandoned:
+            with contextlib.suppress(OSError):
+                proc.kill()
+            proc.wait()
+            break
+        try:
+            ok, value = _call(proc, module, function, args)
+        finally:
+            with _SERVING_LOCK:
+                _SERVING.pop(me, None)
         if ok:
             return value
         if ok is False:  # the call raised: it raises here too
             break
+    if me in _ABANDONED:
+        raise Abandoned(f"{module}.{function}: its result is no longer wanted")
     return getattr(importlib.import_module(module), function)(*args)
 
 

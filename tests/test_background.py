@@ -127,3 +127,40 @@ def test_a_fork_without_hand_over_leaves_the_prestarted_worker_for_a_later_child
     finally:
         second.cancel()
     assert worker.poll() is not None  # reaped with the child it was handed to
+
+
+def _sleep_then(value: float) -> float:
+    import time
+
+    time.sleep(600)
+    return value
+
+
+def test_a_job_that_raises_stops_the_threaded_jobs_worker_before_the_error_leaves():
+    """A threaded job waits on its worker (the STEP files); when another job raises, nobody will read its result:
+    _run_jobs kills that worker and joins the thread before raising, so an API caller's process keeps no thread
+    or process of a failed build (without this the worker slept on for ten minutes)."""
+    import threading
+    import time
+
+    from fabricate import background
+    from fabricate.background import in_thread
+
+    serving: list = []
+
+    def waiting() -> dict[str, bytes]:
+        run_isolated("tests.test_background", "_sleep_then", 1.0)
+        return {}
+
+    def failing() -> dict[str, bytes]:
+        while not background._SERVING:  # the thread's worker is serving its call: the kill is what ends it
+            time.sleep(0.01)
+        serving.extend(background._SERVING.values())
+        raise RuntimeError("this design cannot be made")
+
+    threads = threading.active_count()
+    with pytest.raises(RuntimeError, match="cannot be made"):
+        background._run_jobs([in_thread(waiting), failing])
+    assert len(serving) == 1 and serving[0].poll() is not None  # killed and reaped
+    assert threading.active_count() == threads
+    assert background._SERVING == {} and background._ABANDONED == set()
