@@ -27,7 +27,8 @@ What it measures, in one run:
   STEP worker's where that is larger;
 - ``--rebuilds``: edit, rebuild, see. The default template's rebuild after an edit of one table, with the stage
   cache on (a private cache folder, warmed by one build of the unedited template): each round runs the floor, then
-  one rebuild per edit of :data:`REBUILD_EDITS` (``[load]``, ``[checks]``, ``[parts]``, ``[process]``) and of the
+  one rebuild per edit of :data:`REBUILD_EDITS` (``[load]``, ``[checks]``, ``[parts]`` (the plate layout: the exports
+  and checks run again; a boss wall: everything from the parts on), ``[process]``) and of the
   unedited template. Each round writes a value no earlier round used, so every rebuild misses exactly the stages
   its table reaches and is served the others (what a user who edits one value sees); ratio to the floor per round;
 - ``--vs PATH``: the same builds on another checkout's code (``PYTHONPATH=PATH``), run alternately with this
@@ -85,7 +86,8 @@ INSTALLS = ("core", "cad")
 REBUILD_EDITS = {
     "[load]": ("tip_force_N = 1.5", "tip_force_N = 1.2{k:03d}"),
     "[checks]": ("sweep_poses = 360 ", "min_safety_factor = 2.5{k:03d}\nsweep_poses = 360 "),
-    "[parts]": ("[checks]\n", "[parts]\nplate_spacing_mm = 4.0{k:03d}\n\n[checks]\n"),
+    "[parts] layout": ("[checks]\n", "[parts]\nplate_spacing_mm = 4.0{k:03d}\n\n[checks]\n"),
+    "[parts] geometry": ("[checks]\n", "[parts]\nboss_wall_mm = 2.0{k:03d}\n\n[checks]\n"),
     "[process]": ("thickness_mm = 6.0 ", "hole_compensation_mm = 0.15{k:03d}\nthickness_mm = 6.0 "),
     "none (unchanged)": ("", ""),
 }
