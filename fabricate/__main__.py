@@ -1,10 +1,35 @@
-"""``python -m fabricate``."""
+"""``python -m fabricate`` and the ``fabricate`` command (:func:`entry`)."""
 
 from __future__ import annotations
 
+import os
 import sys
+import threading
 
 from fabricate.cli import main
 
+
+def entry() -> None:
+    """Run :func:`fabricate.cli.main` as a program, then leave without tearing the interpreter down.
+
+    A build leaves millions of objects (matplotlib's, the stages' results) that an ordinary exit frees one by
+    one and walks with the garbage collector: ~0.2 s after the last file is written and the result printed,
+    15 % of a cached rebuild. Once :func:`main` has returned, every file is written and closed, every child
+    reaped and both streams flushed here, so nothing is left for that teardown to do. A process with other
+    threads, or with Dask loaded (``sweep``: its client and cluster close in their own exit hooks), exits the
+    ordinary way; so does an exception (argparse's ``--help`` and usage errors).
+    """
+    code = main()
+    try:
+        for stream in (sys.stdout, sys.stderr):  # None where the stream was not open at all
+            if stream is not None:
+                stream.flush()
+    except (OSError, ValueError):  # a stream gone: the ordinary exit deals with it as it always did
+        sys.exit(code)
+    if threading.active_count() > 1 or "distributed" in sys.modules:
+        sys.exit(code)
+    os._exit(code)
+
+
 if __name__ == "__main__":  # a spawned worker process (Dask, multiprocessing) may import this module
-    sys.exit(main())
+    entry()
