@@ -324,11 +324,13 @@ def test_every_stage_reads_only_what_its_key_holds(variant):
         run.design = traced(design, "", log)
         pipeline._picture_jobs(run)[index]()
         assert reads_covered(log, fields) == set(), name
-    from fabricate.export import export_all
+    from fabricate.export import export_layout, export_part_files
 
+    log = set()  # the part files: an entry keyed by the part set's inputs alone (no layout field)
+    made = export_part_files(traced(design, "", log), run.partset, run.mechanism, run.motion)
+    assert reads_covered(log, parts) == set()
     log = set()
-    export_all(traced(design, "", log), run.partset, run.mechanism, run.motion, previews=False, step=False,
-               with_step=False, sections={})
+    export_layout(traced(design, "", log), run.partset, made, False, {})
     assert reads_covered(log, parts | LAYOUT) == set()
     for stage, step, fields in (("checks", pipeline._check, parts | LAYOUT | {"checks.min_clearance_mm"}),
                                 ("strength", pipeline._check_strength, parts | {"load", "checks.min_safety_factor"})):
@@ -426,6 +428,29 @@ def test_a_cached_rebuild_after_an_edit_is_the_cold_build(table, warmed, cache_d
     hits = {stage for stage, counts in cache.stats.items() if counts["hits"] and stage in PARENT}
     missed = {stage for stage, counts in cache.stats.items() if counts["misses"] and stage in PARENT}
     assert hits == reused and missed == RERUN[table]
+
+
+@pytest.mark.slow
+def test_a_layout_edit_reuses_the_part_files_and_makes_only_the_plates(warmed, cache_dir, tmp_path, monkeypatch):
+    """After a plate-spacing edit the exports stage runs again, but its part files (every part's STL and drawings,
+    assembly.3mf, the kinematic drawing, bom.csv: no layout field read) are served; only the plates are made.
+    In this process (FABRICATE_SERIAL: the exports are made here, so their cache counts are this process's)."""
+    from fabricate.pipeline import run_build
+
+    shutil.copytree(warmed[0], cache_dir)
+    (old, new), _ = EDITS["parts layout"]
+    path = tmp_path / f"{DEFAULT}.toml"
+    path.write_text(edited(old, new), encoding="utf-8")
+    monkeypatch.setenv("FABRICATE_SERIAL", "1")
+    cache.stats.clear()
+    with cache.use_cache():
+        warm = run_build(load_design(path))
+    assert cache.stats["part_files"] == {"hits": 1, "misses": 0, "stores": 0}
+    assert cache.stats["exports"]["misses"] == 1
+    plates = [rel for rel in warm.files if rel.startswith("plates/")]
+    base = warmed[1]
+    moved = [rel for rel in warm.files if (base / rel).is_file() and (base / rel).read_bytes() != warm.files[rel]]
+    assert plates and set(plates) <= set(moved)  # the plates moved (a real layout edit) and came from this build
 
 
 @pytest.mark.slow

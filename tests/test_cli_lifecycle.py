@@ -436,7 +436,7 @@ from fabricate.errors import GeometryError
 def failing(*args, **kwargs):
     (pathlib.Path(sys.argv[1]) / str(os.getpid())).touch()
     raise GeometryError("the plate outline self-intersects")
-fabricate.export.export_all = failing
+fabricate.export.export_part_files = failing
 from fabricate.cli import main
 sys.exit(main(["build", "gear_pair_elliptic", "-o", sys.argv[2], "-q"]))
 """
@@ -471,7 +471,7 @@ HOLD_IN_EXPORT_CHILD = """
 import os, pathlib, sys, time
 import fabricate.export
 parent = os.getpid()
-real = fabricate.export.export_all
+real = fabricate.export.export_part_files
 def held(*args, **kwargs):
     if os.getpid() != parent:
         marker = pathlib.Path(sys.argv[1])
@@ -479,7 +479,7 @@ def held(*args, **kwargs):
         marker.with_suffix('.part').rename(marker)
         time.sleep(600)
     return real(*args, **kwargs)
-fabricate.export.export_all = held
+fabricate.export.export_part_files = held
 from fabricate.cli import main
 sys.exit(main(["build", "gear_pair_elliptic", "-o", sys.argv[2]]))
 """

@@ -103,7 +103,7 @@ def _kernel_failure_in(stage: str, monkeypatch: pytest.MonkeyPatch) -> None:
         raise GeometryError(f"no {stage} for this design")
 
     monkeypatch.setattr(fabricate.export if stage == "exports" else fabricate.checks,
-                        "export_all" if stage == "exports" else "run_checks", failing)
+                        "export_part_files" if stage == "exports" else "run_checks", failing)
 
 
 @pytest.mark.slow

@@ -133,41 +133,101 @@ def export_all(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motio
     GeometryError
         When a written STL does not read back as a closed solid (a bug, never a design finding).
     """
-    from fabricate.export.kinematic import kinematic_dxf
     from fabricate.export.step import step_available
-    from fabricate.export.stl import SolidCache, assembly_3mf
 
     if with_step is None:  # optional extra `cad` (OCP); without it no STEP files, "step": None
         with_step = step_available()
-    making = _Making.of(design, partset)
-    cache = SolidCache(partset.chord_tolerance_mm)
+    from fabricate.export.stl import SolidCache
+
+    solids = SolidCache(partset.chord_tolerance_mm)  # the parts' meshes, for their files and the plates
+    made = export_part_files(design, partset, mechanism, motion, solids)
+    files = dict(made.files)
+    layout, entries = export_layout(design, partset, made, with_step, sections, solids)
+    files.update(layout)
+    if with_step and step:
+        files.update(export_step(design, partset, motion))
+    if previews:
+        files.update(export_previews(design, partset, motion))
+    return files, entries
+
+
+@dataclass(frozen=True)
+class PartFiles:
+    """What :func:`export_part_files` makes: everything but the plate or sheet layout.
+
+    Attributes
+    ----------
+    files : dict[str, bytes]
+        Every part's STL and drawing (and a cut process's cut path), assembly.3mf, the kinematic drawing, bom.csv.
+    made : dict[str, tuple[list[str], float]]
+        Per part: its STL's problems (always none: a bad STL raises) and the polygonised solid's volume (mm^3).
+    labels : dict[str, PartLabel]
+        A cut process's label of every part (none for a printer).
+    """
+
+    files: dict[str, bytes]
+    made: dict[str, tuple[list[str], float]]
+    labels: dict[str, PartLabel]
+
+
+def export_part_files(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motion: Motion,
+                      solids: SolidCache | None = None) -> PartFiles:
+    """The exports that do not depend on the plate or sheet layout (``[parts]``' layout fields are not read: a
+    layout edit reuses them, see :func:`export_layout`). ``solids``: the parts' meshes, shared with the layout."""
+    from fabricate.export.kinematic import kinematic_dxf
+    from fabricate.export.stl import SolidCache, assembly_3mf
+
+    making = _Making.of(design, partset, layout=False)
+    cache = solids if solids is not None else SolidCache(partset.chord_tolerance_mm)
     parts = list(partset.parts)
-    # every copy of every part is made: a three-finger gripper prints or cuts three finger sets
-    made = [part for part in parts for _ in range(making.copies)]
-    placements, sheets = _lay_out(made, making, cache)
     labels = _labels(parts, making)
-    where: dict[str, list[Placement]] = {}
-    for part, placement in zip(made, placements, strict=True):
-        where.setdefault(part.name, []).append(placement)
     files: dict[str, bytes] = {}
-    entries: list[dict[str, Any]] = []
+    made: dict[str, tuple[list[str], float]] = {}
     for part in parts:
         part_files, problems, stl_volume = _part_files(part, making, cache, labels.get(part.name))
         files.update(part_files)
-        entries.append(_part_entry(part, problems, stl_volume, where[part.name], making, with_step,
-                                   getattr(partset, "warnings", ()), sheets))
-    files.update(_layout_files(made, placements, making, cache, design.name, sheets, labels))
-    if sections is not None and making.cut:
-        sections["cut"] = cut_section(sheets, labels)
+        made[part.name] = (problems, stl_volume)
     first = motion.poses_at(0)
     files["assembly.3mf"] = assembly_3mf(parts, cache, first, title=design.name)
-    if with_step and step:
-        files.update(export_step(design, partset, motion))
     files["drawings/kinematic.dxf"] = kinematic_dxf(mechanism, first)
-    if previews:
-        files.update(export_previews(design, partset, motion))
     files["bom.csv"] = _bom_csv(list(partset.bom))
+    return PartFiles(files, made, labels)
+
+
+def export_layout(design: DesignSpec, partset: PartSet, made: PartFiles, with_step: bool,
+                  sections: dict[str, Any] | None = None, solids: SolidCache | None = None
+                  ) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
+    """The plates or sheets of every copy of every part, and the report's ``parts`` entries (where each copy
+    went); a cut process's ``cut`` section into ``sections``. ``made``: :func:`export_part_files`' result."""
+    from fabricate.export.stl import SolidCache
+
+    making = _Making.of(design, partset)
+    cache = solids if solids is not None else SolidCache(partset.chord_tolerance_mm)
+    parts = list(partset.parts)
+    # every copy of every part is made: a three-finger gripper prints or cuts three finger sets
+    copies = [part for part in parts for _ in range(making.copies)]
+    placements, sheets = _lay_out(copies, making, cache)
+    where: dict[str, list[Placement]] = {}
+    for part, placement in zip(copies, placements, strict=True):
+        where.setdefault(part.name, []).append(placement)
+    entries = [_part_entry(part, *made.made[part.name], where[part.name], making, with_step,
+                           getattr(partset, "warnings", ()), sheets) for part in parts]
+    files = _layout_files(copies, placements, making, cache, design.name, sheets, made.labels)
+    if sections is not None and making.cut:
+        sections["cut"] = cut_section(sheets, made.labels)
     return files, entries
+
+
+@dataclass(frozen=True)
+class _NoLayout:
+    """``[parts]``' layout fields for :meth:`_Making.of` when the exports at hand lay nothing out."""
+
+    sheet_margin_mm: float = 0.0
+    plate_spacing_mm: float = 0.0
+    sheet_spacing_mm: float = 0.0
+
+
+_NO_LAYOUT = _NoLayout()
 
 
 @dataclass(frozen=True)
@@ -216,10 +276,13 @@ class _Making:
     label_margin_mm: float = 0.5
 
     @classmethod
-    def of(cls, design: DesignSpec, partset: PartSet) -> _Making:
+    def of(cls, design: DesignSpec, partset: PartSet, layout: bool = True) -> _Making:
+        """The making of ``design``'s parts; ``layout=False`` leaves ``[parts]``' layout fields unread (margin
+        and spacing 0: for the exports that do not lay parts out)."""
         from fabricate.export.dxf import DxfStyle
 
-        process, spec = design.process, design.parts
+        process = design.process
+        spec = design.parts if layout else _NO_LAYOUT
         sheets = process.layout == "sheet"
         tol, min_text = partset.chord_tolerance_mm, float(process.min_text_mm)
         return cls(cut=process.technique == "cut", sheets=sheets, kerf_mm=process.kerf_mm, min_text_mm=min_text,
