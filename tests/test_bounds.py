@@ -467,7 +467,8 @@ def test_a_roomy_heap_spares_the_gear_stage_most_of_its_page_faults():
     """The gear stage's mesh check works in chunks of steps; with glibc's default thresholds each chunk's arrays are
     mapped, unmapped and faulted in again (~39k minor faults for the elliptic pair), with ROOMY_HEAP they are reused
     (~3k). Page faults count memory traffic, not time: the same on a busy machine. Bound: a third."""
-    env = {**os.environ, "FABRICATE_NO_CACHE": "1"}
+    # glibc's own defaults in the first process: no MALLOC_* variable (a Dask nanny in this process may have set one)
+    env = {**{k: v for k, v in os.environ.items() if not k.startswith("MALLOC_")}, "FABRICATE_NO_CACHE": "1"}
     counts = {}
     for mode in ("default", "roomy"):
         run = subprocess.run([sys.executable, "-c", GEAR_STAGE_FAULTS, mode], capture_output=True, text=True,

@@ -127,9 +127,18 @@ def connect(workers: int | None, scheduler: str | None) -> tuple[Any, Any]:
     heap = dict(ROOMY_HEAP)
     environ = {"MALLOC_TRIM_THRESHOLD_": str(heap[M_TRIM_THRESHOLD]),
                "MALLOC_MMAP_THRESHOLD_": str(heap[M_MMAP_THRESHOLD])}
-    with dask.config.set({f"distributed.nanny.pre-spawn-environ.{name}": value for name, value in environ.items()}):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=logging.ERROR)
+    kept = {name: os.environ.get(name) for name in environ}  # the nanny sets them in this process's environment
+    try:
+        with dask.config.set({f"distributed.nanny.pre-spawn-environ.{name}": value
+                              for name, value in environ.items()}):
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   silence_logs=logging.ERROR)
+    finally:
+        for name, value in kept.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
     client = Client(cluster)
     return client, cluster
 

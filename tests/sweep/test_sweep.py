@@ -553,6 +553,7 @@ def test_a_local_clusters_workers_keep_freed_memory_as_a_build_does():
     from fabricate.sweep.runner import connect
 
     before = dask.config.get("distributed.nanny.pre-spawn-environ")
+    environ = {name: value for name, value in os.environ.items() if name.startswith("MALLOC_")}
     client, cluster = connect(1, None)
     try:
         seen = client.run(lambda: (os.environ.get("MALLOC_TRIM_THRESHOLD_"), os.environ.get("MALLOC_MMAP_THRESHOLD_")))
@@ -562,3 +563,5 @@ def test_a_local_clusters_workers_keep_freed_memory_as_a_build_does():
     heap = dict(ROOMY_HEAP)
     assert list(seen.values()) == [(str(heap[M_TRIM_THRESHOLD]), str(heap[M_MMAP_THRESHOLD]))]
     assert dask.config.get("distributed.nanny.pre-spawn-environ") == before
+    # this process's environment as it was (the nanny writes the variables into it to pass them on)
+    assert {name: value for name, value in os.environ.items() if name.startswith("MALLOC_")} == environ
