@@ -19,7 +19,8 @@ from fabricate import cache, stage_keys
 from fabricate.arguments import path_argument, type_name
 from fabricate.background import Background, can_fork, in_thread
 from fabricate.bounds import blas_threads, rare_collections
-from fabricate.build_stages import BuildRun, OptionalOutputs, Progress, _quiet, export_files
+from fabricate.build_stages import BuildRun, Progress, _quiet, export_files
+from fabricate.build_stages import OptionalOutputs as OptionalOutputs  # run_build's argument: public here
 from fabricate.build_stages import check as _check
 from fabricate.build_stages import check_drive as _check_drive
 from fabricate.build_stages import check_strength as _check_strength
