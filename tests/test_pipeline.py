@@ -61,6 +61,7 @@ def test_a_report_only_build_has_the_full_builds_report_without_pictures_or_step
     assert [m["path"] for m in lean.report["manifest"]] == sorted(made - {"report.json"})
 
 
+@pytest.mark.slow
 def test_the_forked_schedule_makes_the_serial_builds_bytes(monkeypatch):
     """A build forks children while it runs its stages (the method's figures after synthesis, the gear pictures
     after the gears, the exports and the part set's pictures after the parts: ``pipeline._build_stages``); every
