@@ -322,8 +322,13 @@ def rare_collections(thresholds: tuple[int, int, int] = BUILD_GC_THRESHOLDS) -> 
 #: blocks are freed) gave the default finger's build ~86k page faults, the gear mesh check's chunked arrays
 #: mapped, unmapped and faulted in again chunk after chunk: with these, ~37k, the gears stage 0.24 -> 0.17 s and
 #: the checks 0.27 -> 0.23 s of CPU, the same peak memory (helper measurement, 5 paired builds).
-M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
-ROOMY_HEAP = ((M_TRIM_THRESHOLD, 64 << 20), (M_MMAP_THRESHOLD, 32 << 20))
+#: Each as glibc's environment variable (for a process about to start) -> (its ``mallopt`` code, bytes).
+ROOMY_HEAP = {"MALLOC_TRIM_THRESHOLD_": (-1, 64 << 20), "MALLOC_MMAP_THRESHOLD_": (-3, 32 << 20)}
+
+
+def roomy_heap_environ() -> dict[str, str]:
+    """:data:`ROOMY_HEAP` as environment variables, for processes fabricate starts (the sweep's local workers)."""
+    return {name: str(size) for name, (_, size) in ROOMY_HEAP.items()}
 
 
 def roomy_heap() -> bool:
@@ -338,7 +343,7 @@ def roomy_heap() -> bool:
         mallopt = ctypes.CDLL(None).mallopt
     except (OSError, AttributeError):  # no mallopt in this C library
         return False
-    return all(mallopt(code, value) == 1 for code, value in ROOMY_HEAP)
+    return all(mallopt(code, size) == 1 for code, size in ROOMY_HEAP.values())
 
 
 def _openblas_controls() -> list[tuple[Any, Any]]:

@@ -148,18 +148,15 @@ def record_optional_outputs(run: BuildRun) -> bool:
 
 def export_files(run: BuildRun, with_step: bool) -> Exported:
     """What :func:`export` computes, without the cache: run here or in the forked export child."""
-    from fabricate.export import export_layout, export_part_files
-    from fabricate.export.stl import SolidCache
+    from fabricate.export import export_all
 
     assert run.partset is not None  # the parts stage ran
-    design, partset = run.design, run.partset
-    solids = SolidCache(partset.chord_tolerance_mm)  # the parts' meshes, for their files and the plates
-    # the part files read no layout field: an entry of their own, reused after a layout edit
-    made = cache.cached("part_files", stage_keys.parts_key(design), lambda: export_part_files(
-        design, partset, run.mechanism, run.motion, solids))
     sections: dict[str, Any] = {}  # a cut process adds its "cut" section: part of the cached result
-    layout, parts = export_layout(design, partset, made, with_step, sections, solids)
-    return {**made.files, **layout}, parts, sections.get("cut")
+    # the part files read no layout field: an entry of their own, reused after a layout edit
+    files, parts = export_all(run.design, run.partset, run.mechanism, run.motion, previews=False, step=False,
+                              with_step=with_step, sections=sections,
+                              keep=lambda make: cache.cached("part_files", stage_keys.parts_key(run.design), make))
+    return files, parts, sections.get("cut")
 
 
 def export(run: BuildRun, with_step: bool, made: Callable[[], Exported] | None = None) -> None:

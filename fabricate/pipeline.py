@@ -331,15 +331,14 @@ def _start_exports(run: BuildRun, with_step: bool, pictures: list[Callable[[], d
     if run.report_only or stored or not can_fork():
         _export(run, with_step)
         return _start(run, pictures, "previews", stage_keys.pictures_key(run.design, "previews"), hand_over=True), False
-    from fabricate.plotting import load_agg
-
     run.enter("exports")
-    load_agg()  # the child's labels (TextPath) and pictures, and this process's plots
 
     def exports_job() -> dict[str, bytes]:
         return {_EXPORTED: pickle.dumps(export_files(run, with_step), protocol=pickle.HIGHEST_PROTOCOL)}
 
-    return Background([exports_job, *pictures]), True
+    # matplotlib imported before the fork (_start): the child's labels (TextPath) and pictures, this process's plots
+    return _start(run, [exports_job, *pictures], "exports", stage_keys.exports_key(run.design, with_step),
+                  hand_over=True), True
 
 
 def _collect_exports(run: BuildRun, with_step: bool, child: Background | None, exporting: bool,

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -92,8 +92,9 @@ def motion_csv(mechanism: Mechanism, motion: Motion) -> bytes:
 
 
 def export_all(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motion: Motion, previews: bool = True,
-               step: bool = True, with_step: bool | None = None,
-               sections: dict[str, Any] | None = None) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
+               step: bool = True, with_step: bool | None = None, sections: dict[str, Any] | None = None,
+               keep: Callable[[Callable[[], PartFiles]], PartFiles] | None = None
+               ) -> tuple[dict[str, bytes], list[dict[str, Any]]]:
     """Every export of a part set.
 
     Parameters
@@ -116,6 +117,9 @@ def export_all(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motio
     sections : dict, optional
         The report: a cut process adds its ``cut`` section to it (:func:`cut_section`: sheets and their
         utilisation, every part's number and label, the parts left unlabelled).
+    keep : callable, optional
+        Given the function that makes :func:`export_part_files`' result, returns that result: the pipeline's
+        stage cache (the part files read no layout field, so a layout edit is served them). Default: make it.
 
     Returns
     -------
@@ -134,13 +138,12 @@ def export_all(design: DesignSpec, partset: PartSet, mechanism: Mechanism, motio
         When a written STL does not read back as a closed solid (a bug, never a design finding).
     """
     from fabricate.export.step import step_available
+    from fabricate.export.stl import SolidCache
 
     if with_step is None:  # optional extra `cad` (OCP); without it no STEP files, "step": None
         with_step = step_available()
-    from fabricate.export.stl import SolidCache
-
     solids = SolidCache(partset.chord_tolerance_mm)  # the parts' meshes, for their files and the plates
-    made = export_part_files(design, partset, mechanism, motion, solids)
+    made = (keep or (lambda make: make()))(lambda: export_part_files(design, partset, mechanism, motion, solids))
     files = dict(made.files)
     layout, entries = export_layout(design, partset, made, with_step, sections, solids)
     files.update(layout)

@@ -122,11 +122,9 @@ def connect(workers: int | None, scheduler: str | None) -> tuple[Any, Any]:
     # took 6-7 % more CPU in a worker than in this process. The local cluster's workers get a build's own thresholds
     # instead (fabricate.bounds.ROOMY_HEAP, as glibc's environment variables; distributed is imported above, so the
     # context restores Dask's setting)
-    from fabricate.bounds import M_MMAP_THRESHOLD, M_TRIM_THRESHOLD, ROOMY_HEAP
+    from fabricate.bounds import roomy_heap_environ
 
-    heap = dict(ROOMY_HEAP)
-    environ = {"MALLOC_TRIM_THRESHOLD_": str(heap[M_TRIM_THRESHOLD]),
-               "MALLOC_MMAP_THRESHOLD_": str(heap[M_MMAP_THRESHOLD])}
+    environ = roomy_heap_environ()
     kept = {name: os.environ.get(name) for name in environ}  # the nanny sets them in this process's environment
     try:
         with dask.config.set({f"distributed.nanny.pre-spawn-environ.{name}": value

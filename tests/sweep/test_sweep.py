@@ -549,7 +549,7 @@ def test_a_local_clusters_workers_keep_freed_memory_as_a_build_does():
     arrays again and again); Dask's own setting is restored after the cluster starts."""
     import dask
 
-    from fabricate.bounds import M_MMAP_THRESHOLD, M_TRIM_THRESHOLD, ROOMY_HEAP
+    from fabricate.bounds import roomy_heap_environ
     from fabricate.sweep.runner import connect
 
     before = dask.config.get("distributed.nanny.pre-spawn-environ")
@@ -560,8 +560,8 @@ def test_a_local_clusters_workers_keep_freed_memory_as_a_build_does():
     finally:
         client.close()
         cluster.close()
-    heap = dict(ROOMY_HEAP)
-    assert list(seen.values()) == [(str(heap[M_TRIM_THRESHOLD]), str(heap[M_MMAP_THRESHOLD]))]
+    heap = roomy_heap_environ()
+    assert list(seen.values()) == [(heap["MALLOC_TRIM_THRESHOLD_"], heap["MALLOC_MMAP_THRESHOLD_"])]
     assert dask.config.get("distributed.nanny.pre-spawn-environ") == before
     # this process's environment as it was (the nanny writes the variables into it to pass them on)
     assert {name: value for name, value in os.environ.items() if name.startswith("MALLOC_")} == environ
