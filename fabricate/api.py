@@ -185,7 +185,7 @@ def _check_assembly(mechanism: Mechanism) -> None:
 
 
 def build(design: DesignSpec | str | Path | Mapping[str, Any], process: str | Path | None = None, *,
-          cache: bool = False) -> Build:
+          cache: bool = False, pictures: bool = True) -> Build:
     """Run the whole pipeline in memory.
 
     Parameters
@@ -199,6 +199,9 @@ def build(design: DesignSpec | str | Path | Mapping[str, Any], process: str | Pa
         Reuse (and store) stage results in the stage cache, as ``fabricate build`` does (:mod:`fabricate.cache`:
         an edit of one table reruns only the stages that read it; the files are the same bytes either way).
         Off by default here: a library call writes nothing to the user's cache folder unless asked.
+    pictures : bool
+        Draw the pictures and plots (PNG, GIF); False leaves them out, as ``fabricate build --no-pictures``
+        does (every other file the same bytes but report.json, report.md and assembly.md).
 
     Raises
     ------
@@ -222,10 +225,11 @@ def build(design: DesignSpec | str | Path | Mapping[str, Any], process: str | Pa
 
         override = process_override(str(path_argument(process, "process", '"sla", "laser" or a process profile file')))
         design = design_from_text(design.template_text, design.template, override)
-    if not isinstance(cache, bool):
-        raise SpecError("cache", f"expected True or False, got {type_name(cache)}")
+    for name, flag in (("cache", cache), ("pictures", pictures)):
+        if not isinstance(flag, bool):
+            raise SpecError(name, f"expected True or False, got {type_name(flag)}")
     with use_cache(cache):
-        return run_build(design)
+        return run_build(design, pictures=pictures)
 
 
 #: Deepest nesting of a dict of tables (a template's deepest is a few levels; a cycle would recurse forever).

@@ -69,6 +69,7 @@ class BuildRun:
     progress: Progress = _quiet
     optional: OptionalOutputs | None = None
     report_only: bool = False  # no pictures, plots or STEP files (:func:`run_build`)
+    pictures: bool = True  # False: no pictures or plots, the rest a full build's (``build --no-pictures``)
     given: DesignSpec | None = None  # the design the caller gave (the outcome's); None: ``design``
     stage: str = "gears"
     files: dict[str, bytes] = field(default_factory=dict)
@@ -83,6 +84,11 @@ class BuildRun:
     def __post_init__(self) -> None:
         if self.given is None:
             self.given = self.design
+
+    @property
+    def draws(self) -> bool:
+        """Whether this build draws its pictures and plots (neither report-only nor without pictures)."""
+        return self.pictures and not self.report_only
 
     @property
     def mechanism(self) -> Mechanism:
@@ -131,18 +137,25 @@ def make_parts(run: BuildRun) -> None:
         run.design, run.mechanism, run.motion, run.gear_pairs, run.synthesis.parts))
 
 
+#: report.json's note (and the command's) for a build without its pictures.
+PICTURES_SKIPPED = ("pictures skipped: built with --no-pictures (plots/, previews/, the gear pictures and "
+                    "assembly/ step pictures are drawn by a build without it)")
+
+
 def record_optional_outputs(run: BuildRun) -> bool:
     """Whether STEP files are made, recorded in report.json (``notes``, ``outputs``); returned."""
     from fabricate.export import STEP_SKIPPED
     from fabricate.export.step import step_available
 
     with_step = step_available() if run.optional is None else run.optional.step
-    run.report["notes"] = [] if with_step else [STEP_SKIPPED]
+    run.report["notes"] = ([] if with_step else [STEP_SKIPPED]) + ([] if run.pictures else [PICTURES_SKIPPED])
     # optional outputs as written or skipped: `check` rebuilds with the same set, so its verdict does not
     # depend on the checker's install (fabricate/verify.py)
+    report_only = "skipped: a report-only build (a sweep point)"
     run.report["outputs"] = {"step": "written" if with_step and not run.report_only else
-                             "skipped: a report-only build (a sweep point)" if with_step else
-                             "skipped: OCP is not installed (extra 'cad')"}
+                             report_only if with_step else "skipped: OCP is not installed (extra 'cad')",
+                             "pictures": "written" if run.draws else report_only if run.pictures else
+                             "skipped: built with --no-pictures"}
     return with_step  # the exports name the STEP files a full build writes: a report-only one's parts are the same
 
 
@@ -189,7 +202,8 @@ def export(run: BuildRun, with_step: bool, made: Callable[[], Exported] | None =
     guide = guide_steps(run.partset, run.motion)  # assembly.md; its pictures are drawn by _picture_jobs
     run.report["assembly"] = {"pins": stacks_report(stacks), "steps": assembly_steps(stacks, run.partset.copies),
                               "guide": guide_report(guide)}
-    run.files["assembly.md"] = guide_markdown(guide, run.design.name, run.partset.copies).encode("utf-8")
+    run.files["assembly.md"] = guide_markdown(guide, run.design.name, run.partset.copies,
+                                              pictures=run.pictures).encode("utf-8")
     run.files["assembly.csv"] = assembly_csv(stacks)
     run.files["motion.csv"] = motion_csv(run.mechanism, run.motion)
     run.files["mechanism.toml"] = mechanism_toml(run.design, run.mechanism, run.synthesis.parts)

@@ -215,6 +215,8 @@ def _parser() -> argparse.ArgumentParser:
     b = sub.add_parser("build", help="the whole pipeline into an output folder")
     b.add_argument("template", nargs="?", default=DEFAULT_TEMPLATE,
                    help=f"template path or shipped name (default {DEFAULT_TEMPLATE})")
+    b.add_argument("--no-pictures", action="store_true",
+                   help="draw no pictures or plots (quicker, to iterate on the parts; the other files are the same)")
     s = sub.add_parser("synth", help="synthesis only: report.json and plots")
     s.add_argument("template")
     for cmd, default in ((b, "outputs/<design name>/"), (s, "outputs/<design name>-synth/")):
@@ -355,7 +357,9 @@ def _build(args: argparse.Namespace) -> int:
     out = check_output_dir(target, force=args.force, stage=stage, protect=protect)
     roomy_heap()  # this process is the build's: fewer page faults (fabricate.bounds.ROOMY_HEAP)
     with use_cache(not args.no_cache):  # stage results reused across runs (fabricate/cache.py)
-        outcome = (run_build if stage == "build" else run_synth)(design, _progress(args.quiet, args.received))
+        progress = _progress(args.quiet, args.received)
+        outcome = run_build(design, progress, pictures=not args.no_pictures) if stage == "build" else \
+            run_synth(design, progress)
     if args.received:  # never write a result the user stopped (see _progress)
         raise Stopped(args.received[0])
     write_output(outcome.files, out, force=args.force, stage=stage, protect=protect,
@@ -404,34 +408,8 @@ def _check(args: argparse.Namespace) -> int:
     return EXIT_OK if not failures else EXIT_FAILED
 
 
-def _value(text: str, where: str, many: bool) -> Any:
-    """A command-line value: TOML (``[1, 2]``, ``0.5``, ``"x"``), else ``a,b,c`` or a bare word."""
-    from fabricate.templates import parse_toml
-
-    try:
-        return parse_toml(f"v = {text}", where)["v"]
-    except SpecError:
-        pass
-    if many and ":" not in text and "," in text:
-        return [_value(part.strip(), where, False) for part in text.split(",")]
-    return text
-
-
-def _assignments(items: list[str], flag: str, many: bool) -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for item in items:
-        key, sep, text = item.partition("=")
-        if not sep or not key.strip() or not text.strip():
-            raise SpecError(flag, f'expected FIELD=VALUE{"S" if many else ""}, got "{item}"')
-        value = _value(text.strip(), f"{flag} {key.strip()}", many)
-        if many and not isinstance(value, list) and not (isinstance(value, str) and ":" in value):
-            value = [value]
-        out[key.strip()] = value
-    return out
-
-
 def _sweep(args: argparse.Namespace) -> int:
-    from fabricate.sweep.spec import find_sweep, sweep_from_tables
+    from fabricate.sweep.spec import assignments, find_sweep, sweep_from_tables
     from fabricate.templates import parse_toml, read_text
 
     source = find_sweep(args.spec)
@@ -443,7 +421,7 @@ def _sweep(args: argparse.Namespace) -> int:
         base_dir = None
     tables = {k: dict(v) if isinstance(v, dict) else v for k, v in tables.items()}
     sweep = tables.setdefault("sweep", {})
-    given = {"vary": _assignments(args.vary, "--vary", True), "set": _assignments(args.set or [], "--set", False)}
+    given = {"vary": assignments(args.vary, "--vary", True), "set": assignments(args.set or [], "--set", False)}
     for table, entries in given.items():
         if entries:
             if not isinstance(tables.setdefault(table, {}), dict):

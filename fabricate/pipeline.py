@@ -177,14 +177,18 @@ def _kernel_failures() -> tuple[type[BaseException], ...]:
 @blas_threads()  # one BLAS thread (fabricate.bounds.blas_threads: a whole build with two took 3x the CPU)
 @rare_collections()  # fewer garbage collections (fabricate.bounds.rare_collections: 0.29 -> 0.08 s CPU)
 def run_build(design: DesignSpec, progress: Progress = _quiet, *,
-              optional: OptionalOutputs | None = None, report_only: bool = False) -> BuildOutcome:
+              optional: OptionalOutputs | None = None, report_only: bool = False, pictures: bool = True
+              ) -> BuildOutcome:
     """The whole pipeline in memory.
 
     ``optional`` fixes the optional outputs (STEP) instead of making what this install can make.
     ``report_only`` leaves out the files no report key is computed from: the pictures (synthesis and gear plots,
     previews, the assembly guide's), the STEP files and the strength, drive and clearance plots. Every section of
     its report is the full build's but ``files`` and ``manifest`` (the files it made) and ``outputs`` (STEP
-    "skipped"): for a sweep point, which keeps its report's numbers only.
+    "skipped"): for a sweep point, which keeps its report's numbers only. ``pictures=False`` leaves out the
+    pictures and plots only (``fabricate build --no-pictures``, for a quicker edit loop): every other file is the
+    full build's, but report.json/report.md (``outputs.pictures``, a note, the file list) and assembly.md (no
+    step pictures).
 
     A geometry or numeric kernel failing after synthesis (GEOS, manifold, a singular matrix) is a design
     failure named in the report with the stage it happened in (exit code 1), never a bare exception.
@@ -203,7 +207,7 @@ def run_build(design: DesignSpec, progress: Progress = _quiet, *,
     if motion is None:
         report["checks"] = {"passed": False, "failures": failures}
         return _finish(design, report, {}, exit_code=1, synthesis=result)
-    run = BuildRun(design, result, motion, report, progress, optional, report_only)
+    run = BuildRun(design, result, motion, report, progress, optional, report_only, pictures=pictures)
     try:
         return _build_stages(run)
     except (SpecError, SynthesisError):
@@ -235,19 +239,21 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
         _make_gears(run)
         children.append(_start(run, jobs[1:2], "gear_pictures", stage_keys.pictures_key(run.design, "gear_pictures"),
                                bool(run.gear_pairs)))
+        # without pictures (--no-pictures), the exports' child makes the exports and the STEP files only
+        part_jobs = jobs[2:4] if run.draws else jobs[3:4]
         if run.design.parts.link_width_mm == "auto":
             _size_links(run)
         _make_parts(run)
         # inside the try: this may import OCP (slow), and a stop signal landing here must cancel the children
         with_step = _record_optional_outputs(run)
-        exports, exporting = _start_exports(run, with_step, jobs[2:4])
+        exports, exporting = _start_exports(run, with_step, part_jobs)
         before_checks = set(run.report)
         try:
             _check(run)
             _check_strength(run)
             _check_drive(run)
             _verdict(run)
-            if not run.report_only:
+            if run.draws:
                 _plots(run)
                 run.files.update(jobs[4]())  # the guide's pictures
         except Exception:
@@ -274,11 +280,12 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
 def _start(run: BuildRun, jobs: list[Callable[[], dict[str, bytes]]], stage: str, key: Any,
            draws: bool = True, hand_over: bool = False) -> Background | None:
     """``jobs`` forked now, or (their result stored, or nothing to draw) run when their result is asked for;
-    None in a report-only build (no pictures). ``hand_over``: the child makes the STEP files (Background)."""
-    if run.report_only:
+    None in a report-only build (no pictures), and for a picture job of a build without pictures. ``hand_over``:
+    the child makes the STEP files (Background)."""
+    if run.report_only or not (run.pictures or hand_over):
         return None
     fork = draws and not cache.stored(stage, key)
-    if fork and can_fork():
+    if fork and can_fork() and run.pictures:  # without pictures, an export child imports what its labels need
         from fabricate.plotting import load_agg
 
         load_agg()  # matplotlib imported once, before the fork: the child's and this process's plots'

@@ -234,6 +234,14 @@ def _recorded_step(report: Mapping[str, Any]) -> bool | None:
     return any(str(m.get("path")).endswith(".step") for m in report.get("manifest", []) if isinstance(m, dict))
 
 
+def _recorded_pictures(report: Mapping[str, Any]) -> bool:
+    """Whether the folder's build drew its pictures (``outputs.pictures``; a report written before it was recorded
+    came from a build that always drew them)."""
+    outputs = report.get("outputs")
+    pictures = outputs.get("pictures") if isinstance(outputs, dict) else None
+    return not isinstance(pictures, str) or pictures.startswith("written")
+
+
 def _folder_step_files(folder: OutputFolder, report: Mapping[str, Any]) -> dict[str, bytes]:
     """The folder's STEP files that match their manifest entries (stand-ins for a rebuild without OCP)."""
     entries, _problems = _manifest(report)
@@ -281,7 +289,8 @@ def _rebuild(folder: OutputFolder, report: Mapping[str, Any], raw: bytes, progre
     try:
         if runner is run_build and step_written is not None:
             # the optional outputs the folder's build made, whatever this install can make
-            outcome = run_build(design, progress, optional=OptionalOutputs(step_written, stand_ins))
+            outcome = run_build(design, progress, optional=OptionalOutputs(step_written, stand_ins),
+                                pictures=_recorded_pictures(report))
         else:
             outcome = runner(design, progress)
     except FabricateError as exc:  # the embedded template no longer builds (nothing feasible, a bound)

@@ -133,7 +133,7 @@ def test_build_takes_a_process_like_the_cli(monkeypatch):
     import fabricate.pipeline
 
     seen = []
-    monkeypatch.setattr(fabricate.pipeline, "run_build", lambda design: seen.append(design) or
+    monkeypatch.setattr(fabricate.pipeline, "run_build", lambda design, pictures=True: seen.append(design) or
                         fabricate.pipeline.BuildOutcome(exit_code=0, report={}, files={}, design=design))
     design = fabricate.load("gear_pair_elliptic")
     assert design.process.name == "sla"

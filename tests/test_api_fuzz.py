@@ -63,7 +63,7 @@ def no_pipeline(monkeypatch):
     """run_build is a stub: a valid design returns a Build at once."""
     import fabricate.pipeline
 
-    def stub(design: DesignSpec) -> Any:
+    def stub(design: DesignSpec, pictures: bool = True) -> Any:
         assert isinstance(design, DesignSpec)
         return SimpleNamespace(exit_code=0, report={"checks": {"failures": []}}, files={"a.txt": b"a"})
 

@@ -343,7 +343,7 @@ def test_an_ignored_signal_stays_ignored(monkeypatch):
 # -- -q, check of a missing target, --help, out of memory ---------------------------------------------------------
 
 def _fake_build(passed: bool):
-    def run_build(design, progress=None):
+    def run_build(design, progress=None, *, pictures=True):
         failures = [] if passed else ["strength: link too thin"]
         report = {"design": {"name": design.name, "fabricate_version": "test", "stage": "build"},
                   "checks": {"passed": passed, "failures": failures}, "files": ["report.json"]}

@@ -38,7 +38,7 @@ def built(built_folder, shipped_build) -> Path:
     return found.path
 
 
-_REBUILDS: dict[tuple[str, str, str, bool], object] = {}
+_REBUILDS: dict[tuple[str, str, str, bool, bool], object] = {}
 
 
 @pytest.fixture(autouse=True)
@@ -52,18 +52,18 @@ def _one_rebuild_per_template(monkeypatch, shared_stage_cache):
 
     real = pipeline.run_build
 
-    def cached(design, progress=lambda _m: None, *, optional=None):
+    def cached(design, progress=lambda _m: None, *, optional=None, pictures=True):
         from fabricate.export.step import step_available
 
         if optional is not None and optional.step_files is not None:  # stand-ins: never cached
-            return real(design, progress, optional=optional)
+            return real(design, progress, optional=optional, pictures=pictures)
         step = step_available() if optional is None else optional.step
-        key = (Path(design.template).name, design.template_text, repr(design.process_override), step)
+        key = (Path(design.template).name, design.template_text, repr(design.process_override), step, pictures)
         if key not in _REBUILDS:
             # a check's rebuild names its optional outputs; a build that asks step_available (a test that
             # pretends OCP is missing) runs cold: the cache's keys know the installed OCP, not a patch of it
             with shared_stage_cache(repr(key)) if optional is not None else contextlib.nullcontext():
-                _REBUILDS[key] = real(design, progress, optional=optional)
+                _REBUILDS[key] = real(design, progress, optional=optional, pictures=pictures)
         return _REBUILDS[key]
 
     monkeypatch.setattr(pipeline, "run_build", cached)

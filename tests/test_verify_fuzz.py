@@ -53,17 +53,17 @@ def _fast_and_bounded(monkeypatch, shared_stage_cache):
 
     monkeypatch.setattr(step, "step_available", lambda: False)
 
-    def cached_build(design, progress=lambda _m: None, *, optional=None):
+    def cached_build(design, progress=lambda _m: None, *, optional=None, pictures=True):
         override = design.process_override
         key = (design.template_text, None if override is None else (override.source, override.text),
-               optional)
+               optional, pictures)
         if key not in _REBUILDS:
             # the hang bound is for reading the folder: a rebuild, and the wait for the other worker's under the
             # lock, take tens of seconds on busy cores (and no FIFO), so the bound pauses for it
             left = signal.alarm(0) if hasattr(signal, "SIGALRM") else 0
             try:
                 with shared_stage_cache(repr(key)):
-                    _REBUILDS[key] = run_build(design, progress, optional=optional)
+                    _REBUILDS[key] = run_build(design, progress, optional=optional, pictures=pictures)
             finally:
                 if left:
                     signal.alarm(left)

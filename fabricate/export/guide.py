@@ -35,25 +35,29 @@ PIN, NEW_PIN = "#555555", "#d9480f"
 SPRING, NEW_SPRING = "#5f6b76", "#d9480f"
 
 
-def guide_markdown(steps: Sequence[GuideStep], name: str, copies: int = 1) -> str:
+def guide_markdown(steps: Sequence[GuideStep], name: str, copies: int = 1, pictures: bool = True) -> str:
     """assembly.md: the numbered steps, each with its picture, the parts and hardware it fits, what to do
     and the tool.
 
     The "Parts and hardware" lines read ``- N × `item` (kind)``, N per copy (``shared`` items: in all); over
-    the whole guide they add up to the bill of materials.
+    the whole guide they add up to the bill of materials. ``pictures=False`` (a build without its pictures)
+    links no step picture and says so.
     """
     tools = list(dict.fromkeys(s.tool for s in steps if s.tool and s.tool not in ("none", "as above",
                                                                                  "as the parts need")))
     per = (f"Quantities are for one copy: the design has {copies} identical copies (the BOM's quantities are "
            "for all of them); items marked shared are bought once for all copies." if copies > 1 else
            "Quantities are for the whole design.")
+    seen = ("Each picture shows the assembly after its step at the first pose, seen from above; the step's new "
+            "parts are orange." if pictures else "This build was made without its pictures (--no-pictures): build "
+            "again without that option for a picture of each step.")
     out = [f"# Assembly: {name}", "",
-           "Follow the steps in order. Each picture shows the assembly after its step at the first pose, seen "
-           "from above; the step's new parts are orange. Every part and every piece of hardware of the bill of "
+           f"Follow the steps in order. {seen} Every part and every piece of hardware of the bill of "
            "materials (`bom.csv`) is fitted in exactly one step.", "", per, "",
            "Tools: " + "; ".join(tools) + ".", ""]
     for step in steps:
-        out += [f"## Step {step.number}. {step.title}", "", f"![step {step.number}]({step.picture})", ""]
+        out += [f"## Step {step.number}. {step.title}", ""]
+        out += [f"![step {step.number}]({step.picture})", ""] if pictures else []
         if step.items:
             out += ["Parts and hardware:", ""]
             out += [f"- {i.qty} × `{i.item}` ({i.kind}{', shared' if i.shared else ''})" for i in step.items]

@@ -533,3 +533,30 @@ def load_sweep(path: str | Path) -> SweepSpec:
     if source is None:
         raise SpecError("", f"sweep spec not found: {path} (a TOML file with a [sweep] table)")
     return sweep_from_tables(parse_toml(read_text(source), str(source)), source.parent)
+
+
+def _value(text: str, where: str, many: bool) -> Any:
+    """A command-line value: TOML (``[1, 2]``, ``0.5``, ``"x"``), else ``a,b,c`` or a bare word."""
+    from fabricate.templates import parse_toml
+
+    try:
+        return parse_toml(f"v = {text}", where)["v"]
+    except SpecError:
+        pass
+    if many and ":" not in text and "," in text:
+        return [_value(part.strip(), where, False) for part in text.split(",")]
+    return text
+
+
+def assignments(items: list[str], flag: str, many: bool) -> dict[str, Any]:
+    """``--vary``/``--set`` items (``FIELD=VALUE``; ``many``: ``FIELD=VALUES``, a list or ``lo:hi:n``) as a table."""
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        if not sep or not key.strip() or not text.strip():
+            raise SpecError(flag, f'expected FIELD=VALUE{"S" if many else ""}, got "{item}"')
+        value = _value(text.strip(), f"{flag} {key.strip()}", many)
+        if many and not isinstance(value, list) and not (isinstance(value, str) and ":" in value):
+            value = [value]
+        out[key.strip()] = value
+    return out

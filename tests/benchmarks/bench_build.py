@@ -43,6 +43,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shlex
 import statistics
 import subprocess
 import sys
@@ -145,8 +146,8 @@ def _floor_argv(install: str) -> list[str]:
             + "".join(f"import {m}\n" for m in modules)]
 
 
-def _build_argv(template: str, out: Path) -> list[str]:
-    return [sys.executable, "-m", "fabricate", "build", template, "-o", str(out), "--force", "-q"]
+def _build_argv(template: str, out: Path, extra: Sequence[str] = ()) -> list[str]:
+    return [sys.executable, "-m", "fabricate", "build", template, "-o", str(out), "--force", "-q", *extra]
 
 
 def ocp_installed() -> bool:
@@ -300,9 +301,10 @@ def _ratio(num: Series, den: Series, what: str = "wall") -> float:
 
 
 def measure(templates: Sequence[str], installs: Sequence[str], runs: int, other_runs: int, vs: Path | None,
-            stages: bool, work: Path, log=print) -> tuple[list[Row], dict[str, Series], dict]:  # noqa: ANN001
+            stages: bool, work: Path, log=print, extra: Sequence[str] = ()  # noqa: ANN001
+            ) -> tuple[list[Row], dict[str, Series], dict]:
     """Every build and floor run; the stage profiles. Rounds alternate this code (A), the other (B) and the
-    floor, so that each ratio compares runs made side by side."""
+    floor, so that each ratio compares runs made side by side. ``extra``: more arguments of every build."""
     blocker = work / "no_ocp"
     blocker.mkdir(exist_ok=True)
     (blocker / "sitecustomize.py").write_text(_NO_OCP, encoding="utf-8")
@@ -321,7 +323,8 @@ def measure(templates: Sequence[str], installs: Sequence[str], runs: int, other_
                     row.floor.samples.append(floor)
                     floors[install].samples.append(floor)
                 for key, code in codes.items():
-                    sample = _run(_build_argv(template, work / f"out_{key}"), _env(code, install, blocker), work)
+                    sample = _run(_build_argv(template, work / f"out_{key}", extra), _env(code, install, blocker),
+                                  work)
                     if counted:
                         (row.a if key == "A" else row.b).samples.append(sample)
             log(f"  {template} {install}: A {row.a.median('wall'):.2f} s"
@@ -339,9 +342,10 @@ def measure(templates: Sequence[str], installs: Sequence[str], runs: int, other_
     return rows, floors, profiles
 
 
-def measure_rebuilds(install: str, runs: int, work: Path, log=print) -> tuple[dict[str, Series], Series]:  # noqa: ANN001
+def measure_rebuilds(install: str, runs: int, work: Path, log=print,  # noqa: ANN001
+                     extra: Sequence[str] = ()) -> tuple[dict[str, Series], Series]:
     """Rebuilds of the default template after each edit of :data:`REBUILD_EDITS`, cache on; and the floor runs of
-    the same rounds. Returns ``({edit: series}, floor)``."""
+    the same rounds (``extra``: more arguments of every build). Returns ``({edit: series}, floor)``."""
     from fabricate.templates import find_template
 
     blocker = work / "no_ocp"
@@ -355,7 +359,7 @@ def measure_rebuilds(install: str, runs: int, work: Path, log=print) -> tuple[di
     env["FABRICATE_CACHE_DIR"] = str(work / f"cache_{install}")
     template = folder / f"{DEFAULT_TEMPLATE}.toml"
     template.write_text(original, encoding="utf-8")
-    warm = _run(_build_argv(str(template), folder / "out"), env, work)  # fills the cache with every stage
+    warm = _run(_build_argv(str(template), folder / "out", extra), env, work)  # fills the cache with every stage
     if warm.code not in (0, 1):
         raise RuntimeError(f"the warm-up build exited {warm.code}")
     series = {edit: Series() for edit in REBUILD_EDITS}
@@ -366,14 +370,16 @@ def measure_rebuilds(install: str, runs: int, work: Path, log=print) -> tuple[di
             if old and old not in original:
                 raise RuntimeError(f"{DEFAULT_TEMPLATE}: {old!r} is not in the template ({edit} edit)")
             template.write_text(original.replace(old, new.format(k=k), 1) if old else original, encoding="utf-8")
-            series[edit].samples.append(_run(_build_argv(str(template), folder / "out"), env, work))
+            series[edit].samples.append(_run(_build_argv(str(template), folder / "out", extra), env, work))
     log(f"  rebuilds {install}: " + ", ".join(f"{e} {v.median('wall'):.2f} s" for e, v in series.items())
         + f", floor {floor.median('wall'):.2f} s")
     return series, floor
 
 
-def print_rebuilds(results: dict[str, tuple[dict[str, Series], Series]], out=sys.stdout) -> None:  # noqa: ANN001
-    print("### Rebuild after an edit (stage cache on, default template)", file=out)
+def print_rebuilds(results: dict[str, tuple[dict[str, Series], Series]], out=sys.stdout,  # noqa: ANN001
+                   extra: Sequence[str] = ()) -> None:
+    given = f", `{shlex.join(extra)}`" if extra else ""
+    print(f"### Rebuild after an edit (stage cache on, default template{given})", file=out)
     print(file=out)
     print("| install | edit | runs | wall s | CPU s | peak MB | x floor | x floor CPU |", file=out)
     print("|---|---|---|---|---|---|---|---|", file=out)
@@ -397,7 +403,7 @@ def _fmt(x: float, digits: int = 2) -> str:
 
 
 def print_tables(rows: list[Row], floors: dict[str, Series], profiles: dict, vs: Path | None,
-                 out=sys.stdout) -> None:  # noqa: ANN001
+                 out=sys.stdout, extra: Sequence[str] = ()) -> None:  # noqa: ANN001
     def p(text: str = "") -> None:
         print(text, file=out)
 
@@ -412,7 +418,7 @@ def print_tables(rows: list[Row], floors: dict[str, Series], profiles: dict, vs:
     p()
     p(f"core set: {', '.join(FLOOR_MODULES)}")
     p()
-    p("### Whole-process builds (`fabricate build T -o DIR --force -q`)")
+    p(f"### Whole-process builds (`fabricate build T -o DIR --force -q{''.join(' ' + a for a in extra)}`)")
     p()
     head = "| template | install | runs | wall s | CPU s | peak MB | x floor | x floor CPU |"
     rule = "|---|---|---|---|---|---|---|---|"
@@ -481,6 +487,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", type=Path, help="also write every sample here")
     parser.add_argument("--rebuilds", action="store_true",
                         help="only the default template's cached rebuilds after an edit of each table (--runs rounds)")
+    parser.add_argument("--build-args", default="", metavar="ARGS",
+                        help="more arguments of every build, e.g. --build-args=--no-pictures (split like a shell)")
     parser.add_argument("--stage-profile", metavar="TEMPLATE", help=argparse.SUPPRESS)  # the per-stage child
     args = parser.parse_args(argv)
     if args.stage_profile:
@@ -495,19 +503,22 @@ def main(argv: list[str] | None = None) -> int:
         print("OCP is not installed here: the cad rows are skipped", file=sys.stderr)
         installs.remove("cad")
     vs = args.vs.resolve() if args.vs else None
+    extra = shlex.split(args.build_args)
     if vs is not None and not (vs / "fabricate" / "__init__.py").is_file():
         parser.error(f"--vs {vs}: not a fabricate checkout (no fabricate/__init__.py)")
     if args.rebuilds:
         with tempfile.TemporaryDirectory(prefix="bench_build_") as tmp:
             results = {install: measure_rebuilds(install, args.runs, Path(tmp),
-                                                 log=lambda text: print(text, file=sys.stderr, flush=True))
+                                                 log=lambda text: print(text, file=sys.stderr, flush=True),
+                                                 extra=extra)
                        for install in installs}
-        print_rebuilds(results)
+        print_rebuilds(results, extra=extra)
         return 0
     with tempfile.TemporaryDirectory(prefix="bench_build_") as tmp:
         rows, floors, profiles = measure(templates, installs, args.runs, args.other_runs, vs, not args.no_stages,
-                                         Path(tmp), log=lambda text: print(text, file=sys.stderr, flush=True))
-    print_tables(rows, floors, profiles, vs)
+                                         Path(tmp), log=lambda text: print(text, file=sys.stderr, flush=True),
+                                         extra=extra)
+    print_tables(rows, floors, profiles, vs, extra=extra)
     if args.json:
         data = {"rows": [{"template": r.template, "install": r.install, "a": [vars(s) for s in r.a.samples],
                           "b": [vars(s) for s in r.b.samples], "floor": [vars(s) for s in r.floor.samples]}

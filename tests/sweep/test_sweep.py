@@ -386,7 +386,7 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path):
 # -- command line ---------------------------------------------------------------------------------------------
 
 def test_cli_vary_values_parse_like_toml():
-    from fabricate.cli import _assignments
+    from fabricate.sweep.spec import assignments as _assignments
 
     got = _assignments(["a.b=0.1:0.3:3", "c=1,2.5,x", "d=[[1.0, 2.0], [3.0, 4.0]]", "e=7", 'f="s"'], "--vary",
                        True)
