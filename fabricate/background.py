@@ -36,6 +36,18 @@ def in_thread(job: Callable[[], dict[str, bytes]]) -> Callable[[], dict[str, byt
     return _Threaded(job)
 
 
+def preceded(first: Callable[[], object], job: Callable[[], dict[str, bytes]]) -> Callable[[], dict[str, bytes]]:
+    """``job`` run after ``first()`` (e.g. waiting for a :class:`Handoff`), in a thread of its own where ``job``
+    was marked so (:func:`in_thread`)."""
+    inner = job.job if isinstance(job, _Threaded) else job
+
+    def after() -> dict[str, bytes]:
+        first()
+        return inner()
+
+    return in_thread(after) if isinstance(job, _Threaded) else after
+
+
 def _run_jobs(jobs: list[Callable[[], dict[str, bytes]]]) -> dict[str, bytes]:
     answers: dict[int, tuple[bool, Any]] = {}
 
@@ -65,6 +77,92 @@ def _run_jobs(jobs: list[Callable[[], dict[str, bytes]]]) -> dict[str, bytes]:
     for k in range(len(jobs)):  # in the jobs' order, whichever finished first
         files.update(answers[k][1])
     return files
+
+
+class Handoff:
+    """A value this process sends a forked child after the fork, for the child's jobs to wait for.
+
+    The exports' child is forked before the parts exist, so that it imports what it needs while this process
+    makes them; its jobs then wait here for the part set. Made before the fork: :meth:`send` (this process)
+    pickles the value down a pipe, from a thread (a value larger than the pipe's buffer never makes this process
+    wait for the child to read it); :meth:`get` returns it in the child, waiting until it comes, or here (the
+    child failed and :class:`Background` runs its jobs in this process) the value kept by :meth:`send`.
+    """
+
+    def __init__(self) -> None:
+        self._owner = os.getpid()
+        self._read, self._write = os.pipe()
+        self._lock = threading.Lock()
+        self._sent = False
+        self._value: Any = None
+
+    def send(self, value: Any) -> None:
+        """Send ``value`` (once); a child that is gone is no error: its jobs run here with the value kept."""
+        import pickle
+        import struct
+
+        self._value, self._sent = value, True
+        data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+        write, self._write = self._write, -1
+        os.close(self._read)
+        self._read = -1
+
+        def writing() -> None:
+            view = memoryview(struct.pack("<Q", len(data)) + data)
+            try:
+                while view:
+                    view = view[os.write(write, view):]
+            except OSError:  # EPIPE: the child is gone (the jobs run here)
+                pass
+            finally:
+                os.close(write)
+
+        threading.Thread(target=writing, daemon=True).start()
+
+    def get(self) -> Any:
+        """The value sent: in a forked child, read from the pipe (once; any thread may ask); here, the value kept.
+
+        Raises
+        ------
+        EOFError
+            In a child whose parent closed the pipe without sending (the child's jobs fail; the parent's
+            :class:`Background` redoes them).
+        """
+        import pickle
+        import struct
+
+        with self._lock:
+            if self._sent:
+                return self._value
+            if os.getpid() == self._owner:
+                raise RuntimeError("Handoff.get before send, in the sending process")
+            if self._write >= 0:  # the fork's copy: the parent's close then ends the read (EOF), not a wait
+                os.close(self._write)
+                self._write = -1
+            size = struct.unpack("<Q", self._read_exactly(8))[0]
+            self._value, self._sent = pickle.loads(self._read_exactly(size)), True
+            return self._value
+
+    def _read_exactly(self, size: int) -> bytes:
+        chunks, left = [], size
+        while left:
+            chunk = os.read(self._read, min(left, 1 << 20))
+            if not chunk:
+                raise EOFError("the sending process closed the pipe before sending")
+            chunks.append(chunk)
+            left -= len(chunk)
+        return b"".join(chunks)
+
+    def close(self) -> None:
+        """Close this process's ends of the pipe where :meth:`send` has not (never sent: the build failed)."""
+        if os.getpid() != self._owner:
+            return
+        for name in ("_read", "_write"):
+            fd = getattr(self, name)
+            if fd >= 0:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+                setattr(self, name, -1)
 
 
 class Abandoned(Exception):

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 from fabricate import cache, stage_keys
 from fabricate.arguments import path_argument, type_name
-from fabricate.background import Background, can_fork, in_thread
+from fabricate.background import Background, Handoff, can_fork, in_thread, preceded
 from fabricate.bounds import blas_threads, rare_collections
 from fabricate.build_stages import BuildRun, Progress, _quiet, export_files
 from fabricate.build_stages import OptionalOutputs as OptionalOutputs  # run_build's argument: public here
@@ -229,24 +229,28 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
     draws exists (the method's figures after synthesis, the gear pictures after the gears) and, after the parts,
     one child makes the exports, then the previews and STEP files while this process runs the checks and draws
     their plots and the guide's pictures (the two halves take about as long: bench_build's per-stage table).
+    That child is forked after synthesis and imports the exporters (ezdxf, trimesh: ~0.3 s) while the gears and
+    parts are made, then waits for the part set (:class:`~fabricate.background.Handoff`).
     report.json's sections keep the order of a serial build.
     """
     jobs = _picture_jobs(run)
     children: list[Background | None] = []
     exports: Background | None = None
+    handoff: Handoff | None = None
+    # without pictures (--no-pictures), the exports' child makes the exports and the STEP files only
+    part_jobs = jobs[2:4] if run.draws else jobs[3:4]
     try:
         children.append(_start(run, jobs[:1], "synthesis_plots", stage_keys.synthesis_key(run.design)))
+        exports, handoff = _fork_exports(run, part_jobs)
         _make_gears(run)
         children.append(_start(run, jobs[1:2], "gear_pictures", stage_keys.pictures_key(run.design, "gear_pictures"),
                                bool(run.gear_pairs)))
-        # without pictures (--no-pictures), the exports' child makes the exports and the STEP files only
-        part_jobs = jobs[2:4] if run.draws else jobs[3:4]
         if run.design.parts.link_width_mm == "auto":
             _size_links(run)
         _make_parts(run)
         # inside the try: this may import OCP (slow), and a stop signal landing here must cancel the children
         with_step = _record_optional_outputs(run)
-        exports, exporting = _start_exports(run, with_step, part_jobs)
+        exports, exporting = _start_exports(run, with_step, part_jobs, exports, handoff)
         before_checks = set(run.report)
         try:
             _check(run)
@@ -271,6 +275,8 @@ def _build_stages(run: BuildRun) -> BuildOutcome:
         for child in [*children, exports]:
             if child is not None:
                 child.cancel()
+        if handoff is not None:
+            handoff.close()
     assert run.given is not None  # set in __post_init__
     return _finish(run.given, run.report, run.files, exit_code=0 if not run.failures else 1,
                    synthesis=run.synthesis, motion=run.motion, partset=run.partset, gear_pairs=run.gear_pairs,
@@ -329,23 +335,61 @@ def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
 _EXPORTED = "\0exports"
 
 
-def _start_exports(run: BuildRun, with_step: bool, pictures: list[Callable[[], dict[str, bytes]]]
-                   ) -> tuple[Background | None, bool]:
-    """A child making the exports, then the part set's pictures (previews, STEP, the guide's): ``(child, True)``;
-    or the exports made here now (their result stored, no fork here, a report-only build) and a child for the
-    pictures: ``(child, False)``, no child in a report-only build."""
-    stored = cache.stored("exports", stage_keys.exports_key(run.design, with_step))
-    if run.report_only or stored or not can_fork():
-        _export(run, with_step)
-        return _start(run, pictures, "previews", stage_keys.pictures_key(run.design, "previews"), hand_over=True), False
-    run.enter("exports")
+def _warm_exports() -> None:
+    """Import the exporters and their libraries (ezdxf, trimesh): the exports' child does, while the parts are made."""
+    import fabricate.export.dxf
+    import fabricate.export.kinematic
+    import fabricate.export.labels
+    import fabricate.export.stl
+    import fabricate.export.svg
+    import fabricate.parts.solids  # noqa: F401 - imported for the exports that follow
+
+
+def _fork_exports(run: BuildRun, pictures: list[Callable[[], dict[str, bytes]]]
+                  ) -> tuple[Background | None, Handoff | None]:
+    """The exports' child, forked now (after synthesis; none in a report-only build or where this process does
+    not fork): it imports the exporters while this process makes the gears and parts, then waits for the part
+    set (:func:`_start_exports` sends it) to make the exports (unless the cache holds them) and ``pictures``
+    (the previews, the STEP files)."""
+    if run.report_only or not can_fork():
+        return None, None
+    if run.pictures:
+        from fabricate.plotting import load_agg
+
+        load_agg()  # matplotlib imported once, before the fork: the child's previews and this process's plots
+    handoff = Handoff()
+
+    def received() -> tuple[bool, bool]:
+        """``(with_step, exporting)``; the design (link sizing may change it) and part set as made here."""
+        run.design, run.partset, with_step, exporting = handoff.get()
+        return with_step, exporting
 
     def exports_job() -> dict[str, bytes]:
+        _warm_exports()
+        with_step, exporting = received()
+        if not exporting:  # the cache holds them: made by the parent
+            return {}
         return {_EXPORTED: pickle.dumps(export_files(run, with_step), protocol=pickle.HIGHEST_PROTOCOL)}
 
-    # matplotlib imported before the fork (_start): the child's labels (TextPath) and pictures, this process's plots
-    return _start(run, [exports_job, *pictures], "exports", stage_keys.exports_key(run.design, with_step),
-                  hand_over=True), True
+    return Background([exports_job, *[preceded(received, job) for job in pictures]], hand_over=True), handoff
+
+
+def _start_exports(run: BuildRun, with_step: bool, pictures: list[Callable[[], dict[str, bytes]]],
+                   child: Background | None, handoff: Handoff | None) -> tuple[Background | None, bool]:
+    """The part set sent to the exports' ``child`` (:func:`_fork_exports`), which makes the exports, then the
+    part set's pictures (previews, STEP): ``(child, True)``; or the exports made here now (their result stored,
+    no child: a report-only build, no fork here) and the child, or a child for the pictures, drawing the rest:
+    ``(child, False)``, no child in a report-only build."""
+    stored = cache.stored("exports", stage_keys.exports_key(run.design, with_step))
+    if handoff is not None:
+        handoff.send((run.design, run.partset, with_step, not stored))
+    if child is None or stored:
+        _export(run, with_step)
+        if child is None:
+            child = _start(run, pictures, "previews", stage_keys.pictures_key(run.design, "previews"), hand_over=True)
+        return child, False
+    run.enter("exports")
+    return child, True
 
 
 def _collect_exports(run: BuildRun, with_step: bool, child: Background | None, exporting: bool,

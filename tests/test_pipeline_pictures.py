@@ -5,6 +5,7 @@ rebuilds a folder with the pictures its build drew."""
 from __future__ import annotations
 
 import json
+import os
 
 import pytest
 
@@ -80,3 +81,41 @@ def test_check_rebuilds_a_folder_with_the_pictures_its_build_drew(tmp_path, caps
 def test_the_api_takes_pictures_as_a_flag() -> None:
     with pytest.raises(SpecError, match="pictures"):
         fabricate.build("gear_pair_elliptic", pictures="no")  # type: ignore[arg-type]
+
+
+def test_the_exports_child_is_forked_before_the_gears(monkeypatch) -> None:
+    """The exports' child imports the exporters while this process cuts the gears and makes the parts: it is
+    forked before the gears (and before the gear pictures' child), and still makes the exports."""
+    import fabricate.pipeline as pipeline
+    from fabricate.background import Background
+    from fabricate.build_stages import OptionalOutputs
+
+    events: list[str] = []
+    real_gears = pipeline._make_gears
+
+    def spied(*args, **kwargs):
+        child = Background(*args, **kwargs)
+        events.append("exports child" if child.jobs and child.jobs[0].__name__ == "exports_job" else "child")
+        return child
+
+    monkeypatch.setattr(pipeline, "Background", spied)
+    monkeypatch.setattr(pipeline, "_make_gears", lambda run: events.append("gears") or real_gears(run))
+    built = run_build(load_design("gear_pair_elliptic"), optional=OptionalOutputs(step=False), pictures=False)
+    assert built.exit_code == 0 and "parts/gear_a.stl" in built.files
+    assert events.index("exports child") < events.index("gears")
+
+
+@pytest.mark.slow
+def test_a_build_without_pictures_never_imports_matplotlib_here(tmp_path) -> None:
+    """The build's own process imports no matplotlib without pictures (its import is a sixth of the import floor);
+    the exports' child imports what it needs itself."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom fabricate.cli import main\n"
+            f"code = main(['build', 'linkage_stephenson', '-o', {str(tmp_path / 'out')!r}, '-q', '--no-pictures'])\n"
+            "print('matplotlib' in sys.modules, code)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600,
+                          env={**os.environ, "FABRICATE_NO_CACHE": "1"})
+    assert done.stdout.split()[-2:] == ["False", "0"], done.stdout + done.stderr
+    assert (tmp_path / "out" / "parts").is_dir()

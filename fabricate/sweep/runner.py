@@ -216,33 +216,17 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     todo = deque((i, points[i], ids[i]) for i in order)
     start = time.perf_counter()
     client = cluster = None
-    interrupted = False
-    n_workers = tasks = 0
-    points_seconds = worker_cpu = 0.0
+    n_workers = 0
     if todo:  # a cluster that cannot be had is a usage error: nothing is written
         client, cluster, n_workers = _start_cluster(workers, scheduler, spec.stage)
     out.mkdir(parents=True, exist_ok=True)
     write_file(out / SWEEP_JSON, _json(sweep_record(spec, {"points": len(points), "done": resumed, "complete": False})))
-    journal = Journal(out / JOURNAL)
-    try:
-        if todo:
-            say(f"sweep {spec.name}: {len(points)} points ({resumed} done earlier), stage {spec.stage}, "
-                f"{n_workers} Dask worker{'s' if n_workers != 1 else ''}"
-                f"{' at ' + scheduler if scheduler else ' (local cluster)'}")
-            began, cpu = time.perf_counter(), _workers_cpu(client)
-            tasks = _run_points(client, spec, todo, done, journal, out, start, resumed, len(points), draw, say,
-                                cache)
-            points_seconds = time.perf_counter() - began
-            after = _workers_cpu(client)
-            worker_cpu = sum(after[w] - cpu[w] for w in after if w in cpu)
-        elif not quiet:
-            say(f"sweep {spec.name}: all {len(points)} points done earlier; writing the results")
-    except KeyboardInterrupt:
-        interrupted = True
-    finally:
-        journal.close()
-        if draw:
-            print(file=sys.stderr)
+    hello = (f"sweep {spec.name}: {len(points)} points ({resumed} done earlier), stage {spec.stage}, "
+             f"{n_workers} Dask worker{'s' if n_workers != 1 else ''}"
+             f"{' at ' + scheduler if scheduler else ' (local cluster)'}" if todo else
+             None if quiet else f"sweep {spec.name}: all {len(points)} points done earlier; writing the results")
+    tasks, points_seconds, worker_cpu, interrupted = _journalled(
+        client, spec, todo, done, out, (start, resumed, len(points)), draw, (say, hello), cache)
     if interrupted:
         # a stop can land between a row's journal write and its count: the journal is what a resume reads, so
         # the record counts what it holds (the same rows the resume will call "done earlier")
@@ -255,6 +239,34 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
                         counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers,
                         tasks=tasks, notes=notes, points_seconds=points_seconds, worker_peak_mb=worker_peak,
                         worker_cpu_seconds=worker_cpu)
+
+
+def _journalled(client: Any, spec: SweepSpec, todo: deque[tuple[int, dict[str, Any], str]],
+                done: dict[str, dict[str, Any]], out: Path, counts: tuple[float, int, int], draw: bool,
+                talk: tuple[Progress, str | None], cache: bool) -> tuple[int, float, float, bool]:
+    """Say ``talk``'s line, then run the ``todo`` points on ``client``, each row into the journal as it comes:
+    ``(tasks, seconds, the workers' CPU seconds, interrupted)``; a stop (Ctrl-C) ends the run with the rows done so
+    far journalled."""
+    start, resumed, total = counts
+    say, hello = talk
+    tasks, seconds, worker_cpu, interrupted = 0, 0.0, 0.0, False
+    journal = Journal(out / JOURNAL)
+    try:
+        if hello is not None:
+            say(hello)
+        if todo:
+            began, cpu = time.perf_counter(), _workers_cpu(client)
+            tasks = _run_points(client, spec, todo, done, journal, out, start, resumed, total, draw, say, cache)
+            seconds = time.perf_counter() - began
+            after = _workers_cpu(client)
+            worker_cpu = sum(after[w] - cpu[w] for w in after if w in cpu)
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        journal.close()
+        if draw:
+            print(file=sys.stderr)
+    return tasks, seconds, worker_cpu, interrupted
 
 
 def _journal_rows(out: Path, spec: SweepSpec, by_id: Mapping[str, int]) -> dict[str, dict[str, Any]]:
