@@ -418,11 +418,29 @@ def test_mjcf_contacts_find_the_collision_of_the_24_mm_link_six_bar(shared_stage
 
 
 @pytest.mark.slow
-def test_grasp_sim_example_matches_the_gripper_force_model(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_grasp_sim_example_matches_the_gripper_force_model(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                          monkeypatch: pytest.MonkeyPatch,
+                                                          shipped_build: Callable[..., BuildOutcome],
+                                                          shared_stage_cache: Callable[..., Any]) -> None:
     """examples/grasp_sim.py: the finger closed on the 85 mm can by its motor gives the pad force of the
     template's force model within 2 % (exit 0), and writes its GIF where MuJoCo can open an offscreen GL
-    context (EGL, else OSMesa); where it cannot, it says so and skips the GIF."""
+    context (EGL, else OSMesa); where it cannot, it says so and skips the GIF.
+
+    The example's own build (``fabricate.build`` of the shipped gripper) runs on the session's shared stage cache,
+    which ``shipped_build`` fills with that design (byte-identical to a cold build, tests/test_cache.py): what is
+    tested is the simulation of the build, not the build, which the session makes once."""
     import importlib.util
+
+    import fabricate.pipeline as pipeline
+
+    shipped_build("gripper_compliant")
+    real = pipeline.run_build
+
+    def served(*args: Any, **kwargs: Any) -> BuildOutcome:
+        with shared_stage_cache():  # fabricate.build's own use_cache(False) is outside this block
+            return real(*args, **kwargs)
+
+    monkeypatch.setattr(pipeline, "run_build", served)
 
     path = Path(__file__).resolve().parents[2] / "examples" / "grasp_sim.py"
     spec = importlib.util.spec_from_file_location("grasp_sim", path)
