@@ -345,13 +345,20 @@ def _warm_exports() -> None:
     import fabricate.parts.solids  # noqa: F401 - imported for the exports that follow
 
 
+def _exported(run: BuildRun, with_step: bool) -> dict[str, bytes]:
+    """The exports' child's answer: :func:`export_files`' result, pickled under :data:`_EXPORTED`."""
+    return {_EXPORTED: pickle.dumps(export_files(run, with_step), protocol=pickle.HIGHEST_PROTOCOL)}
+
+
 def _fork_exports(run: BuildRun, pictures: list[Callable[[], dict[str, bytes]]]
                   ) -> tuple[Background | None, Handoff | None]:
-    """The exports' child, forked now (after synthesis; none in a report-only build or where this process does
-    not fork): it imports the exporters while this process makes the gears and parts, then waits for the part
-    set (:func:`_start_exports` sends it) to make the exports (unless the cache holds them) and ``pictures``
-    (the previews, the STEP files)."""
-    if run.report_only or not can_fork():
+    """The exports' child, forked now (after synthesis): it imports the exporters while this process makes the
+    gears and parts, then waits for the part set (:func:`_start_exports` sends it) to make the exports and
+    ``pictures`` (the previews, the STEP files). None where this process does not fork, in a report-only build,
+    or where the cache holds the exports of the design as it is (a rebuild after a ``[load]`` edit: a child
+    forked after the parts draws the pictures)."""
+    if run.report_only or not can_fork() or any(
+            cache.stored("exports", stage_keys.exports_key(run.design, step)) for step in (False, True)):
         return None, None
     if run.pictures:
         from fabricate.plotting import load_agg
@@ -367,29 +374,36 @@ def _fork_exports(run: BuildRun, pictures: list[Callable[[], dict[str, bytes]]]
     def exports_job() -> dict[str, bytes]:
         _warm_exports()
         with_step, exporting = received()
-        if not exporting:  # the cache holds them: made by the parent
-            return {}
-        return {_EXPORTED: pickle.dumps(export_files(run, with_step), protocol=pickle.HIGHEST_PROTOCOL)}
+        return _exported(run, with_step) if exporting else {}  # not exporting: the cache holds them after all
 
     return Background([exports_job, *[preceded(received, job) for job in pictures]], hand_over=True), handoff
 
 
 def _start_exports(run: BuildRun, with_step: bool, pictures: list[Callable[[], dict[str, bytes]]],
                    child: Background | None, handoff: Handoff | None) -> tuple[Background | None, bool]:
-    """The part set sent to the exports' ``child`` (:func:`_fork_exports`), which makes the exports, then the
-    part set's pictures (previews, STEP): ``(child, True)``; or the exports made here now (their result stored,
-    no child: a report-only build, no fork here) and the child, or a child for the pictures, drawing the rest:
-    ``(child, False)``, no child in a report-only build."""
+    """The part set sent to the exports' ``child`` (:func:`_fork_exports`), or a child forked now, which makes
+    the exports, then the part set's pictures (previews, STEP): ``(child, True)``; or the exports made here now
+    (their result stored, no fork here, a report-only build) and a child for the pictures: ``(child, False)``, no
+    child in a report-only build."""
     stored = cache.stored("exports", stage_keys.exports_key(run.design, with_step))
     if handoff is not None:
         handoff.send((run.design, run.partset, with_step, not stored))
-    if child is None or stored:
+        if stored:
+            _export(run, with_step)
+        else:
+            run.enter("exports")
+        return child, not stored
+    if run.report_only or stored or not can_fork():
         _export(run, with_step)
-        if child is None:
-            child = _start(run, pictures, "previews", stage_keys.pictures_key(run.design, "previews"), hand_over=True)
-        return child, False
+        return _start(run, pictures, "previews", stage_keys.pictures_key(run.design, "previews"), hand_over=True), False
     run.enter("exports")
-    return child, True
+
+    def exports_job() -> dict[str, bytes]:
+        return _exported(run, with_step)
+
+    # matplotlib imported before the fork (_start): the child's labels (TextPath) and pictures, this process's plots
+    return _start(run, [exports_job, *pictures], "exports", stage_keys.exports_key(run.design, with_step),
+                  hand_over=True), True
 
 
 def _collect_exports(run: BuildRun, with_step: bool, child: Background | None, exporting: bool,

@@ -119,3 +119,24 @@ def test_a_build_without_pictures_never_imports_matplotlib_here(tmp_path) -> Non
                           env={**os.environ, "FABRICATE_NO_CACHE": "1"})
     assert done.stdout.split()[-2:] == ["False", "0"], done.stdout + done.stderr
     assert (tmp_path / "out" / "parts").is_dir()
+
+
+def test_no_early_exports_child_where_the_cache_holds_the_exports(shipped_build, shared_stage_cache, monkeypatch):
+    """A rebuild whose exports are stored (after a ``[load]`` edit, or none) forks no child to import the
+    exporters: the exports come from the cache here, and a child forked after the parts draws the pictures."""
+    import fabricate.pipeline as pipeline
+    from fabricate.background import Background
+
+    shipped_build("gear_pair_elliptic")  # fills the shared cache with every stage of this design
+    events: list[str] = []
+
+    def spied(*args, **kwargs):
+        child = Background(*args, **kwargs)
+        events.append("exports child" if child.jobs and child.jobs[0].__name__ == "exports_job" else "child")
+        return child
+
+    monkeypatch.setattr(pipeline, "Background", spied)
+    with shared_stage_cache():
+        again = run_build(load_design("gear_pair_elliptic"))
+    assert again.files == shipped_build("gear_pair_elliptic").files
+    assert "exports child" not in events
