@@ -5,12 +5,13 @@ from __future__ import annotations
 
 import os
 import sys
+from typing import NamedTuple
 
 import pytest
 
 from fabricate.background import Background
 from fabricate.design import load_design
-from fabricate.pipeline import run_build
+from fabricate.pipeline import BuildOutcome, run_build
 from fabricate.sweep.task import FILE_SECTIONS
 
 #: What a report-only build never makes: pictures (synthesis and gear plots, previews, the guide's) and STEP files.
@@ -61,16 +62,66 @@ def test_a_report_only_build_has_the_full_builds_report_without_pictures_or_step
     assert [m["path"] for m in lean.report["manifest"]] == sorted(made - {"report.json"})
 
 
+class Child(NamedTuple):
+    """One child a build made: the ``Background``, whether it forked when made, its ``hand_over`` and whether its
+    jobs make the STEP files."""
+
+    child: Background
+    forked: bool
+    hand_over: bool
+    step: bool
+
+
+class ForkedBuild(NamedTuple):
+    """A build of the elliptic pair on the forked schedule, the children it made, and what was left after it: the
+    warm and handed STEP workers (``background._WARM``, ``background._HANDED``) and this process's waiting ones."""
+
+    outcome: BuildOutcome
+    made: list[Child]
+    warm: dict
+    handed: list
+    waiting: list[int]
+
+
+@pytest.fixture(scope="module")
+def forked_build() -> ForkedBuild:
+    """The elliptic pair built once on the forked schedule with every child recorded, for the two tests that look at
+    that schedule (its children and its bytes; where the STEP worker goes): one build between them instead of one
+    each. What the build left is read right after it, before any other test runs."""
+    import fabricate.pipeline as pipeline
+    from fabricate import background
+
+    made: list[Child] = []
+
+    def spied(jobs, **kwargs):
+        child = Background(jobs, **kwargs)
+        made.append(Child(child, child.forked, kwargs.get("hand_over", True),
+                          any(isinstance(job, background._Threaded) for job in jobs)))
+        return child
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(pipeline, "Background", spied)
+        patch.delenv("FABRICATE_SERIAL", raising=False)
+        outcome = run_build(load_design("gear_pair_elliptic"))
+    waiting = _waiting_workers() if sys.platform.startswith("linux") else []  # /proc: its test skips elsewhere
+    return ForkedBuild(outcome, made, dict(background._WARM), list(background._HANDED), waiting)
+
+
 @pytest.mark.slow
-def test_the_forked_schedule_makes_the_serial_builds_bytes(monkeypatch):
+def test_the_forked_schedule_makes_the_serial_builds_bytes(forked_build, monkeypatch):
     """A build forks children while it runs its stages (the method's figures after synthesis, the gear pictures
     after the gears, the exports and the part set's pictures after the parts: ``pipeline._build_stages``); every
     file is the serial build's (``FABRICATE_SERIAL``: each job in this process when its result is asked for),
     report.json's bytes included, whose sections keep the serial order although the checks ran before the
-    exports' sections were known here."""
+    exports' sections were known here. The forked build is the module's (``forked_build``)."""
     import fabricate.pipeline as pipeline
 
-    made: list[tuple[Background, bool]] = []  # each child, and whether it forked when made
+    forked = forked_build.outcome
+    exporting = [c.forked for c in forked_build.made if c.child.jobs and c.child.jobs[0].__name__ == "exports_job"]
+    assert exporting == [True]
+    # the synthesis plots, the gear pictures, the exports and the part set's pictures, the strength and drive plots
+    assert sum(c.forked for c in forked_build.made) == 4
+    made: list[tuple[Background, bool]] = []  # each child of the serial build, and whether it forked when made
 
     def spied(*args, **kwargs):
         child = Background(*args, **kwargs)
@@ -78,15 +129,8 @@ def test_the_forked_schedule_makes_the_serial_builds_bytes(monkeypatch):
         return child
 
     monkeypatch.setattr(pipeline, "Background", spied)
-    design = load_design("gear_pair_elliptic")
-    forked = run_build(design)
-    exporting = [forked for child, forked in made if child.jobs and child.jobs[0].__name__ == "exports_job"]
-    assert exporting == [True]
-    # the synthesis plots, the gear pictures, the exports and the part set's pictures, the strength and drive plots
-    assert sum(forked for _, forked in made) == 4
     monkeypatch.setenv("FABRICATE_SERIAL", "1")
-    made.clear()
-    serial = run_build(design)
+    serial = run_build(load_design("gear_pair_elliptic"))
     assert made and not [child for child, forked in made if forked]
     assert not [child for child, _ in made if child.jobs and child.jobs[0].__name__ == "exports_job"]
     assert list(forked.report) == list(serial.report)
@@ -159,24 +203,14 @@ def _waiting_workers() -> list[int]:
 
 @pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
-def test_only_the_child_that_makes_the_step_files_takes_the_prestarted_worker(monkeypatch):
+def test_only_the_child_that_makes_the_step_files_takes_the_prestarted_worker(forked_build):
     """The STEP worker ``run_build`` prestarts goes to the one child whose jobs include the STEP job (the early
     children and the plots' child leave it: a child that takes it kills it when collected, and the STEP job would
-    start a cold one), and after the build no worker is left waiting or unreaped."""
-    import fabricate.pipeline as pipeline
-    from fabricate import background
-
-    made: list[tuple[bool, bool]] = []  # each child's hand_over, and whether its jobs make the STEP files
-
-    def spied(jobs, **kwargs):
-        made.append((kwargs.get("hand_over", True), any(isinstance(job, background._Threaded) for job in jobs)))
-        return Background(jobs, **kwargs)
-
-    monkeypatch.setattr(pipeline, "Background", spied)
-    monkeypatch.delenv("FABRICATE_SERIAL", raising=False)
-    outcome = run_build(load_design("gear_pair_elliptic"))
-    assert outcome.exit_code == 0
+    start a cold one), and after the build no worker is left waiting or unreaped. The build is the module's
+    (``forked_build``), what it left read right after it."""
+    made = [(c.hand_over, c.step) for c in forked_build.made]  # each child's hand_over, and whether it makes STEP
+    assert forked_build.outcome.exit_code == 0
     assert len(made) == 4 and sum(step for _, step in made) == 1  # two early children, the exports, the plots
     assert [hand_over for hand_over, _ in made] == [step for _, step in made]
-    assert background._WARM == {} and background._HANDED == []
-    assert _waiting_workers() == []
+    assert forked_build.warm == {} and forked_build.handed == []
+    assert forked_build.waiting == []
