@@ -11,18 +11,25 @@ from fabricate.sweep.task import EXIT_OK, evaluate
 from fabricate.tomlwrite import dumps
 from tests.test_not_checked import _tables
 
+#: The builds below run on the session's shared stage cache under the keys tests/test_not_checked.py builds the same
+#: four-bar with, so the session makes each of its two designs once (a served build is byte-identical to a cold one:
+#: tests/test_cache.py); what is tested here is the row's reason, not the build.
+SHARED_KEY = "tests/test_not_checked four_bar_nc load={load}"
+
 
 @pytest.mark.slow
-def test_a_point_built_without_a_load_says_strength_was_not_checked() -> None:
-    code, reason, report, _ = evaluate(dumps(_tables(load=False)), "build")
+def test_a_point_built_without_a_load_says_strength_was_not_checked(shared_stage_cache) -> None:
+    with shared_stage_cache(SHARED_KEY.format(load=False)):
+        code, reason, report, _ = evaluate(dumps(_tables(load=False)), "build")
     assert code == EXIT_OK
     assert report is not None and report["strength"]["passed"] is None
     assert "strength not checked: no [load] in the template" in reason
 
 
 @pytest.mark.slow
-def test_a_checked_point_has_no_reason_and_a_synth_point_no_not_checked_note() -> None:
-    code, reason, report, _ = evaluate(dumps(_tables(load=True)), "build")
+def test_a_checked_point_has_no_reason_and_a_synth_point_no_not_checked_note(shared_stage_cache) -> None:
+    with shared_stage_cache(SHARED_KEY.format(load=True)):
+        code, reason, report, _ = evaluate(dumps(_tables(load=True)), "build")
     assert (code, reason) == (EXIT_OK, "")
     assert report is not None and report["strength"]["passed"] is True
     code, reason, _, _ = evaluate(dumps(_tables(load=True)), "synth")
