@@ -620,13 +620,17 @@ def _plan_size(part, process) -> str:
 
 
 @pytest.mark.slow
-def test_the_gripper_palm_on_the_sl1s_fails_naming_it():
+def test_the_gripper_palm_on_the_sl1s_fails_naming_it(shipped_build, shared_stage_cache):
     """Issue 26's reproduction: the gripper built for the SL1S (--printer prusa_sl1s) exits 1, the palm named
-    with its size and the printer's area and margin, and no plate holds a part outside its bed."""
+    with its size and the printer's area and margin, and no plate holds a part outside its bed. Built on the
+    session's shared stage cache, which ``shipped_build`` fills with the gripper: its synthesis (no process field in
+    its key) is served, every stage that reads the printer runs."""
     from fabricate.design import load_design
     from fabricate.pipeline import run_build
 
-    outcome = run_build(load_design("gripper_compliant", None, "prusa_sl1s"))
+    shipped_build("gripper_compliant")
+    with shared_stage_cache():
+        outcome = run_build(load_design("gripper_compliant", None, "prusa_sl1s"))
     assert outcome.exit_code == 1
     size = _plan_size(next(p for p in outcome.partset.parts if p.name == "palm"), outcome.design.process)
     assert size.startswith("129.9 × ")  # the paper's 129.88 mm palm; its width follows the pin bosses
