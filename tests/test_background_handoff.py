@@ -4,6 +4,7 @@ exist, waits for the part set), and ``preceded``."""
 from __future__ import annotations
 
 import os
+import signal
 import threading
 
 import pytest
@@ -106,3 +107,37 @@ def test_preceded_runs_first_and_keeps_a_threaded_job_threaded() -> None:
     assert plain() == {"a": b"1"} and order == ["first", "job"]
     threaded = preceded(lambda: None, in_thread(lambda: {"b": b"2"}))
     assert type(threaded) is type(in_thread(lambda: {})) and threaded() == {"b": b"2"}
+
+
+#: A stop signal landing while a child is forked: a fork hook of this script's sends SIGINT to the process itself.
+STOP_IN_FORK = """
+import multiprocessing, os, signal
+from fabricate.background import Background
+
+class Stop(BaseException):
+    pass
+
+def stop(*args):
+    raise Stop()
+
+signal.signal(signal.SIGINT, stop)
+os.register_at_fork(after_in_parent=lambda: os.kill(os.getpid(), signal.SIGINT))
+try:
+    Background([lambda: {}])
+except Stop:
+    print("stopped", len(multiprocessing.active_children()))
+else:
+    print("not stopped")
+"""
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="needs pthread_sigmask")
+def test_a_stop_signal_during_a_fork_is_raised_after_it_and_the_child_reaped() -> None:
+    """The signal waits until the fork is done (no traceback of a fork hook on stderr, no stop dropped); the
+    exception comes from making the Background, whose child is killed and reaped first (none left)."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", STOP_IN_FORK], capture_output=True, text=True, timeout=300)
+    assert done.stdout.split() == ["stopped", "0"], done.stdout + done.stderr
+    assert done.stderr == ""
