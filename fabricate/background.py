@@ -245,10 +245,7 @@ def _child(jobs: list[Callable[[], dict[str, bytes]]], conn: Any, parent: int = 
         if parent:
             _die_with_parent(parent)
         _detach_from_caller()
-        import signal
-
-        if hasattr(signal, "pthread_sigmask"):  # held by the fork (Background): the defaults act from here on
-            signal.pthread_sigmask(signal.SIG_UNBLOCK, _stop_signals())
+        _release_stop_signals(None)  # held by the fork (Background): the defaults act from here on
         if receiver is not None:
             # the fork copied the parent's end of the pipe: holding it, this child would block forever on a
             # full pipe once the parent is gone, instead of failing with EPIPE
@@ -452,10 +449,15 @@ def _hold_stop_signals() -> Any:
 
 
 def _release_stop_signals(mask: Any) -> None:
-    """Restore ``mask``: a stop signal that came while held is handled now (its exception raised here)."""
+    """Restore ``mask`` (:func:`_hold_stop_signals`' return; None in a forked child: unblock the stop signals its
+    fork held): a stop signal that came while held is handled now (its exception raised here)."""
     import signal
 
-    if mask is not None:
+    if not hasattr(signal, "pthread_sigmask"):
+        return
+    if mask is None:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _stop_signals())
+    else:
         signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 

@@ -151,10 +151,10 @@ def record_optional_outputs(run: BuildRun) -> bool:
     run.report["notes"] = ([] if with_step else [STEP_SKIPPED]) + ([] if run.pictures else [PICTURES_SKIPPED])
     # optional outputs as written or skipped: `check` rebuilds with the same set, so its verdict does not
     # depend on the checker's install (fabricate/verify.py)
-    report_only = "skipped: a report-only build (a sweep point)"
+    sweep_point = "skipped: a report-only build (a sweep point)"
     run.report["outputs"] = {"step": "written" if with_step and not run.report_only else
-                             report_only if with_step else "skipped: OCP is not installed (extra 'cad')",
-                             "pictures": "written" if run.draws else report_only if run.pictures else
+                             sweep_point if with_step else "skipped: OCP is not installed (extra 'cad')",
+                             "pictures": "written" if run.draws else sweep_point if run.pictures else
                              "skipped: built with --no-pictures"}
     return with_step  # the exports name the STEP files a full build writes: a report-only one's parts are the same
 

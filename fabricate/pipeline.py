@@ -290,12 +290,20 @@ def _start(run: BuildRun, jobs: list[Callable[[], dict[str, bytes]]], stage: str
     the child makes the STEP files (Background)."""
     if run.report_only or not (run.pictures or hand_over):
         return None
-    fork = draws and not cache.stored(stage, key)
-    if fork and can_fork() and run.pictures:  # without pictures, an export child imports what its labels need
+    if draws and not cache.stored(stage, key):
+        return _fork(run, jobs, hand_over)
+    return Background(jobs, fork=False, hand_over=hand_over)
+
+
+def _fork(run: BuildRun, jobs: list[Callable[[], dict[str, bytes]]], hand_over: bool) -> Background:
+    """``jobs`` in a child forked now (:class:`Background`), matplotlib imported first where this build draws:
+    once, for the child's pictures and this process's plots (without pictures, an exports child imports what its
+    labels need itself)."""
+    if run.pictures and can_fork():
         from fabricate.plotting import load_agg
 
-        load_agg()  # matplotlib imported once, before the fork: the child's and this process's plots'
-    return Background(jobs, fork=fork, hand_over=hand_over)
+        load_agg()
+    return Background(jobs, hand_over=hand_over)
 
 
 def _picture_jobs(run: BuildRun) -> list[Callable[[], dict[str, bytes]]]:
@@ -345,25 +353,16 @@ def _warm_exports() -> None:
     import fabricate.parts.solids  # noqa: F401 - imported for the exports that follow
 
 
-def _exported(run: BuildRun, with_step: bool) -> dict[str, bytes]:
-    """The exports' child's answer: :func:`export_files`' result, pickled under :data:`_EXPORTED`."""
-    return {_EXPORTED: pickle.dumps(export_files(run, with_step), protocol=pickle.HIGHEST_PROTOCOL)}
-
-
-def _fork_exports(run: BuildRun, pictures: list[Callable[[], dict[str, bytes]]]
-                  ) -> tuple[Background | None, Handoff | None]:
+def _fork_exports(run: BuildRun, pictures: list[Callable[[], dict[str, bytes]]],
+                  steps: tuple[bool, ...] = (False, True)) -> tuple[Background | None, Handoff | None]:
     """The exports' child, forked now (after synthesis): it imports the exporters while this process makes the
     gears and parts, then waits for the part set (:func:`_start_exports` sends it) to make the exports and
     ``pictures`` (the previews, the STEP files). None where this process does not fork, in a report-only build,
-    or where the cache holds the exports of the design as it is (a rebuild after a ``[load]`` edit: a child
-    forked after the parts draws the pictures)."""
+    or where the cache holds the exports of the design as it is with STEP files or without (``steps``: a rebuild
+    after a ``[load]`` edit, whose child forked after the parts draws the pictures only)."""
     if run.report_only or not can_fork() or any(
-            cache.stored("exports", stage_keys.exports_key(run.design, step)) for step in (False, True)):
+            cache.stored("exports", stage_keys.exports_key(run.design, step)) for step in steps):
         return None, None
-    if run.pictures:
-        from fabricate.plotting import load_agg
-
-        load_agg()  # matplotlib imported once, before the fork: the child's previews and this process's plots
     handoff = Handoff()
 
     def received() -> tuple[bool, bool]:
@@ -374,36 +373,31 @@ def _fork_exports(run: BuildRun, pictures: list[Callable[[], dict[str, bytes]]]
     def exports_job() -> dict[str, bytes]:
         _warm_exports()
         with_step, exporting = received()
-        return _exported(run, with_step) if exporting else {}  # not exporting: the cache holds them after all
+        if not exporting:  # the cache holds them after all
+            return {}
+        return {_EXPORTED: pickle.dumps(export_files(run, with_step), protocol=pickle.HIGHEST_PROTOCOL)}
 
-    return Background([exports_job, *[preceded(received, job) for job in pictures]], hand_over=True), handoff
+    return _fork(run, [exports_job, *[preceded(received, job) for job in pictures]], hand_over=True), handoff
 
 
 def _start_exports(run: BuildRun, with_step: bool, pictures: list[Callable[[], dict[str, bytes]]],
                    child: Background | None, handoff: Handoff | None) -> tuple[Background | None, bool]:
-    """The part set sent to the exports' ``child`` (:func:`_fork_exports`), or a child forked now, which makes
-    the exports, then the part set's pictures (previews, STEP): ``(child, True)``; or the exports made here now
-    (their result stored, no fork here, a report-only build) and a child for the pictures: ``(child, False)``, no
-    child in a report-only build."""
+    """The part set sent to the exports' ``child`` (:func:`_fork_exports`; forked now where there was none and the
+    exports of the design as link sizing left it are not stored), which makes the exports, then the part set's
+    pictures (previews, STEP): ``(child, True)``; or the exports made here now (their result stored, no fork here,
+    a report-only build) and a child for the pictures: ``(child, False)``, no child in a report-only build."""
     stored = cache.stored("exports", stage_keys.exports_key(run.design, with_step))
-    if handoff is not None:
-        handoff.send((run.design, run.partset, with_step, not stored))
-        if stored:
-            _export(run, with_step)
-        else:
-            run.enter("exports")
-        return child, not stored
-    if run.report_only or stored or not can_fork():
+    if handoff is None and not stored:
+        child, handoff = _fork_exports(run, pictures, (with_step,))
+    if handoff is None:
         _export(run, with_step)
         return _start(run, pictures, "previews", stage_keys.pictures_key(run.design, "previews"), hand_over=True), False
-    run.enter("exports")
-
-    def exports_job() -> dict[str, bytes]:
-        return _exported(run, with_step)
-
-    # matplotlib imported before the fork (_start): the child's labels (TextPath) and pictures, this process's plots
-    return _start(run, [exports_job, *pictures], "exports", stage_keys.exports_key(run.design, with_step),
-                  hand_over=True), True
+    handoff.send((run.design, run.partset, with_step, not stored))
+    if stored:
+        _export(run, with_step)
+    else:
+        run.enter("exports")
+    return child, not stored
 
 
 def _collect_exports(run: BuildRun, with_step: bool, child: Background | None, exporting: bool,
@@ -457,12 +451,8 @@ def _plots(run: BuildRun) -> None:
     def taking(path: str, draw: Callable[[], bytes]) -> Callable[[], bytes]:
         return lambda: drawn[path] if path in drawn else draw()
 
-    if theirs:
-        from fabricate.plotting import load_agg
-
-        load_agg()  # matplotlib imported once, before the fork, for the child and this process
     # hand_over=False: a prestarted STEP worker waiting here (the exports stored) is for the pictures job, not these
-    child = Background([drawing(path) for path in theirs], hand_over=False) if theirs else None
+    child = _fork(run, [drawing(path) for path in theirs], hand_over=False) if theirs else None
     drawn: dict[str, bytes] = {}
     try:
         figures = cache.cached("check_figures", stage_keys.clearance_key(run.design), checks.figures)

@@ -79,7 +79,10 @@ def _alive(pgid: int) -> dict[int, str]:
     return {pid: state for pid, state in _group(pgid).items() if state not in ("Z", "X")}
 
 
-def _start_held_build(tmp_path: Path) -> tuple[subprocess.Popen, Path, int]:
+def _start_held_build(tmp_path: Path, script: str = HOLD_IN_CHILD, which: str = "picture"
+                      ) -> tuple[subprocess.Popen, Path, int]:
+    """``script`` run in a session of its own over a previous output in ``tmp_path / "out"``, once the child it
+    holds (the ``which`` child) has written its pid: ``(the run, the output folder, the child's pid)``."""
     out = tmp_path / "out"
     write_output(_previous_output(), out)
     marker = tmp_path / "child.pid"
@@ -89,14 +92,14 @@ def _start_held_build(tmp_path: Path) -> tuple[subprocess.Popen, Path, int]:
         for number in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
             signal.signal(number, signal.SIG_DFL)
 
-    run = subprocess.Popen([sys.executable, "-c", HOLD_IN_CHILD, str(marker), str(out)], cwd=tmp_path, env=env,
+    run = subprocess.Popen([sys.executable, "-c", script, str(marker), str(out)], cwd=tmp_path, env=env,
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
                            preexec_fn=default_signals)
     deadline = time.monotonic() + 300
     while not marker.exists():
         if run.poll() is not None or time.monotonic() > deadline:
             run.kill()
-            pytest.fail(f"the picture child never started: {run.communicate()}")
+            pytest.fail(f"the {which} child never started: {run.communicate()}")
         time.sleep(0.05)
     child = int(marker.read_text())
     assert child != run.pid and _group(run.pid).get(child) not in (None, "Z")  # alive, in the run's group
@@ -488,20 +491,7 @@ sys.exit(main(["build", "gear_pair_elliptic", "-o", sys.argv[2]]))
 @pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_a_signal_while_the_export_child_works_leaves_no_process_and_the_previous_output(tmp_path):
-    out, marker = tmp_path / "out", tmp_path / "child.pid"
-    write_output(_previous_output(), out)
-    env = {k: v for k, v in os.environ.items() if k != "FABRICATE_SERIAL"}
-    run = subprocess.Popen([sys.executable, "-c", HOLD_IN_EXPORT_CHILD, str(marker), str(out)], cwd=tmp_path, env=env,
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
-                           preexec_fn=lambda: signal.signal(signal.SIGTERM, signal.SIG_DFL))
-    deadline = time.monotonic() + 300
-    while not marker.exists():
-        if run.poll() is not None or time.monotonic() > deadline:
-            run.kill()
-            pytest.fail(f"the export child never started: {run.communicate()}")
-        time.sleep(0.05)
-    child = int(marker.read_text())
-    assert child != run.pid and _group(run.pid).get(child) not in (None, "Z")
+    run, out, child = _start_held_build(tmp_path, HOLD_IN_EXPORT_CHILD, "export")
     os.kill(run.pid, signal.SIGTERM)  # only the parent hears it: it must kill the child (and the STEP worker)
     stdout, stderr = run.communicate(timeout=600)
     assert run.returncode == 143, (stdout, stderr)

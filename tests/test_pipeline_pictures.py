@@ -10,6 +10,7 @@ import os
 import pytest
 
 import fabricate
+from fabricate.build_stages import PICTURES_SKIPPED
 from fabricate.cli import main
 from fabricate.design import load_design
 from fabricate.errors import SpecError
@@ -47,8 +48,7 @@ def test_a_build_without_pictures_makes_every_other_file_of_the_full_build(
         assert quick.report[section] == full.report[section], section
     assert full.report["outputs"]["pictures"] == "written"
     assert quick.report["outputs"] == {**full.report["outputs"], "pictures": "skipped: built with --no-pictures"}
-    assert [n for n in quick.report["notes"] if n not in full.report["notes"]] == [
-        n for n in quick.report["notes"] if n.startswith("pictures skipped")]
+    assert quick.report["notes"] == [*full.report["notes"], PICTURES_SKIPPED]
     assert [m["path"] for m in quick.report["manifest"]] == sorted(set(quick.files) - {"report.json"})
 
     # assembly.md: the same steps, parts and words, no picture links (each of the full guide's names a picture)
@@ -145,3 +145,33 @@ def test_no_early_exports_child_where_the_cache_holds_the_exports(shipped_build,
         again = run_build(load_design("gear_pair_elliptic"))
     assert again.files == shipped_build("gear_pair_elliptic").files
     assert "exports child" not in events
+
+
+@pytest.mark.slow
+def test_the_exports_child_is_forked_after_the_parts_where_the_stored_exports_were_another_builds(
+        tmp_path, monkeypatch) -> None:
+    """Exports stored for the build with STEP files, asked for without: no child is forked early (the cache held
+    exports of this design), and after the parts, whose exports are not stored, the exports' child is forked then;
+    the files are those of a build without the cache."""
+    import fabricate.pipeline as pipeline
+    from fabricate.background import Background
+    from fabricate.build_stages import OptionalOutputs
+    from tests.conftest import _stage_cache_in
+
+    design = load_design("gear_pair_elliptic")
+    events: list[str] = []
+    real_gears = pipeline._make_gears
+
+    def spied(*args, **kwargs):
+        child = Background(*args, **kwargs)
+        events.append("exports child" if child.jobs and child.jobs[0].__name__ == "exports_job" else "child")
+        return child
+
+    with _stage_cache_in(tmp_path):
+        run_build(design, optional=OptionalOutputs(step=True, step_files={}), pictures=False)
+        monkeypatch.setattr(pipeline, "Background", spied)
+        monkeypatch.setattr(pipeline, "_make_gears", lambda run: events.append("gears") or real_gears(run))
+        late = run_build(design, optional=OptionalOutputs(step=False), pictures=False)
+    assert events.count("exports child") == 1 and events.index("exports child") > events.index("gears")
+    cold = run_build(design, optional=OptionalOutputs(step=False), pictures=False)
+    assert late.files == cold.files
