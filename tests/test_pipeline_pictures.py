@@ -84,33 +84,6 @@ def test_the_api_takes_pictures_as_a_flag() -> None:
 
 
 @pytest.mark.slow
-def test_the_exports_child_is_forked_before_the_gears(shipped_build, monkeypatch) -> None:
-    """The exports' child imports the exporters while this process cuts the gears and makes the parts: it is
-    forked before the gears (and before the gear pictures' child), and makes the full build's exports (a cold
-    build: the child waits for the part set, then exports it)."""
-    import fabricate.pipeline as pipeline
-    from fabricate.background import Background
-    from fabricate.build_stages import OptionalOutputs
-
-    events: list[str] = []
-    real_gears = pipeline._make_gears
-
-    def spied(*args, **kwargs):
-        child = Background(*args, **kwargs)
-        events.append("exports child" if child.jobs and child.jobs[0].__name__ == "exports_job" else "child")
-        return child
-
-    monkeypatch.setattr(pipeline, "Background", spied)
-    monkeypatch.setattr(pipeline, "_make_gears", lambda run: events.append("gears") or real_gears(run))
-    built = run_build(load_design("gear_pair_elliptic"), optional=OptionalOutputs(step=False), pictures=False)
-    assert events.index("exports child") < events.index("gears")
-    full = shipped_build("gear_pair_elliptic")
-    made = {rel for rel in built.files if rel not in CHANGED}
-    assert made and made == {rel for rel in full.files if not rel.endswith((*PICTURES, ".step"))} - CHANGED
-    assert [rel for rel in made if built.files[rel] != full.files[rel]] == []
-
-
-@pytest.mark.slow
 def test_a_build_without_pictures_never_imports_matplotlib_here(tmp_path) -> None:
     """The build's own process imports no matplotlib without pictures (its import is a sixth of the import floor);
     the exports' child imports what it needs itself."""
@@ -126,39 +99,13 @@ def test_a_build_without_pictures_never_imports_matplotlib_here(tmp_path) -> Non
     assert (tmp_path / "out" / "parts").is_dir()
 
 
-def test_no_early_exports_child_where_the_cache_holds_the_exports(shipped_build, shared_stage_cache, monkeypatch):
-    """A rebuild whose exports are stored (after a ``[load]`` edit, or none) forks no child to import the
-    exporters: the exports come from the cache here, and a child forked after the parts draws the pictures."""
+@pytest.fixture
+def schedule(monkeypatch) -> list[str]:
+    """What the build forks and when, in order: "exports child" (its first job is the exports'), "child" (any
+    other), "gears" (the gear stage begins)."""
     import fabricate.pipeline as pipeline
     from fabricate.background import Background
 
-    shipped_build("gear_pair_elliptic")  # fills the shared cache with every stage of this design
-    events: list[str] = []
-
-    def spied(*args, **kwargs):
-        child = Background(*args, **kwargs)
-        events.append("exports child" if child.jobs and child.jobs[0].__name__ == "exports_job" else "child")
-        return child
-
-    monkeypatch.setattr(pipeline, "Background", spied)
-    with shared_stage_cache():
-        again = run_build(load_design("gear_pair_elliptic"))
-    assert again.files == shipped_build("gear_pair_elliptic").files
-    assert "exports child" not in events
-
-
-@pytest.mark.slow
-def test_the_exports_child_is_forked_after_the_parts_where_the_stored_exports_were_another_builds(
-        tmp_path, monkeypatch) -> None:
-    """Exports stored for the build with STEP files, asked for without: no child is forked early (the cache held
-    exports of this design), and after the parts, whose exports are not stored, the exports' child is forked then;
-    the files are those of a build without the cache."""
-    import fabricate.pipeline as pipeline
-    from fabricate.background import Background
-    from fabricate.build_stages import OptionalOutputs
-    from tests.conftest import _stage_cache_in
-
-    design = load_design("gear_pair_elliptic")
     events: list[str] = []
     real_gears = pipeline._make_gears
 
@@ -167,11 +114,44 @@ def test_the_exports_child_is_forked_after_the_parts_where_the_stored_exports_we
         events.append("exports child" if child.jobs and child.jobs[0].__name__ == "exports_job" else "child")
         return child
 
+    monkeypatch.setattr(pipeline, "Background", spied)
+    monkeypatch.setattr(pipeline, "_make_gears", lambda run: events.append("gears") or real_gears(run))
+    return events
+
+
+@pytest.mark.slow
+def test_the_exports_child_is_forked_before_the_gears_or_else_after_the_parts(schedule, shipped_build,
+                                                                              tmp_path) -> None:
+    """A cold build forks the exports' child before the gears, to import the exporters while this process cuts
+    the gears and makes the parts; the child waits for the part set and makes the full build's exports. Where the
+    cache holds this design's exports for the other STEP choice (stored with STEP files, asked for without), no
+    child is forked early, and after the parts, whose exports are not stored, the child is forked then: the files
+    are the cold build's."""
+    from fabricate.build_stages import OptionalOutputs
+    from tests.conftest import _stage_cache_in
+
+    design = load_design("gear_pair_elliptic")
+    cold = run_build(design, optional=OptionalOutputs(step=False), pictures=False)
+    assert schedule.count("exports child") == 1 and schedule.index("exports child") < schedule.index("gears")
+    full = shipped_build("gear_pair_elliptic")
+    made = {rel for rel in cold.files if rel not in CHANGED}
+    assert made and made == {rel for rel in full.files if not rel.endswith((*PICTURES, ".step"))} - CHANGED
+    assert [rel for rel in made if cold.files[rel] != full.files[rel]] == []
+
     with _stage_cache_in(tmp_path):
         run_build(design, optional=OptionalOutputs(step=True, step_files={}), pictures=False)
-        monkeypatch.setattr(pipeline, "Background", spied)
-        monkeypatch.setattr(pipeline, "_make_gears", lambda run: events.append("gears") or real_gears(run))
+        schedule.clear()
         late = run_build(design, optional=OptionalOutputs(step=False), pictures=False)
-    assert events.count("exports child") == 1 and events.index("exports child") > events.index("gears")
-    cold = run_build(design, optional=OptionalOutputs(step=False), pictures=False)
+    assert schedule.count("exports child") == 1 and schedule.index("exports child") > schedule.index("gears")
     assert late.files == cold.files
+
+
+def test_no_early_exports_child_where_the_cache_holds_the_exports(schedule, shipped_build, shared_stage_cache):
+    """A rebuild whose exports are stored (after a ``[load]`` edit, or none) forks no child to import the
+    exporters: the exports come from the cache here, and a child forked after the parts draws the pictures."""
+    shipped_build("gear_pair_elliptic")  # fills the shared cache with every stage of this design
+    schedule.clear()
+    with shared_stage_cache():
+        again = run_build(load_design("gear_pair_elliptic"))
+    assert again.files == shipped_build("gear_pair_elliptic").files
+    assert "exports child" not in schedule
