@@ -29,6 +29,7 @@ import math
 import os
 import sys
 import time
+import warnings
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -106,6 +107,7 @@ def connect(workers: int | None, scheduler: str | None) -> tuple[Any, Any]:
     for name in ("distributed", "distributed.nanny", "distributed.scheduler", "distributed.worker",
                  "distributed.core", "distributed.client"):
         logging.getLogger(name).setLevel(logging.ERROR)
+    _quiet_event_loops()
     if scheduler:
         try:
             client = Client(scheduler, timeout="15s")
@@ -129,8 +131,13 @@ def connect(workers: int | None, scheduler: str | None) -> tuple[Any, Any]:
     try:
         with dask.config.set({f"distributed.nanny.pre-spawn-environ.{name}": value
                               for name, value in environ.items()}):
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                   silence_logs=logging.ERROR)
+            # the scheduler serves its HTTP routes even without a dashboard, on port 8787 where free: a second
+            # sweep (or any Dask cluster) on this machine makes it warn "Port 8787 is already in use" on the
+            # user's terminal, and it takes another port anyway
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message="Port 8787 is already in use", category=UserWarning)
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                       silence_logs=logging.ERROR)
     finally:
         for name, value in kept.items():
             if value is None:
@@ -384,11 +391,17 @@ def _takes_n_workers(client: Any) -> bool:
 EVENT_LOOP_LOGGERS = ("tornado.application", "tornado.general", "asyncio")
 
 
-def _close(client: Any, cluster: Any) -> None:
-    # from here on a traceback the loops log is teardown noise, and none may reach the user: kept quiet for the
-    # rest of the process (the loop thread can log after close() returns)
+def _quiet_event_loops() -> None:
+    """Keep the event loops' tracebacks from the user once a client can exist: a Ctrl-C while distributed's
+    ``sync`` waits queues a ``cancel`` on the loop thread, which raises where the call had not begun (2026.8: a
+    NameError on ``future``) and tornado logs at once, before the sweep's handler runs. The sweep records its
+    outcome itself; quiet for the rest of the process (the loop thread can log after ``close()`` returns)."""
     for name in EVENT_LOOP_LOGGERS:
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+
+
+def _close(client: Any, cluster: Any) -> None:
+    _quiet_event_loops()  # a client made outside connect() too
     for thing in (client, cluster):
         if thing is not None:
             try:
