@@ -20,6 +20,11 @@ def entry() -> None:
     ordinary way; so does an exception (argparse's ``--help`` and usage errors).
     """
     code = main()
+    if code > 128:
+        # stopped by a signal: a library the stop interrupted midway can complain from a destructor or a garbage
+        # collector's callback as the interpreter goes down (distributed's GC timer asserts from then on); the
+        # run's outcome is told, and this process only exits now
+        sys.unraisablehook = lambda _unraisable: None
     try:
         for stream in (sys.stdout, sys.stderr):  # None where the stream was not open at all
             if stream is not None:

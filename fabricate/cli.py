@@ -64,9 +64,19 @@ def _stop_on_signals() -> Iterator[list[int]]:
     first one started can finish (SIGKILL still ends the process, and its children die with it). A signal
     the caller ignores stays ignored (``nohup``, a background job) and a handler the caller installed (a
     program calling :func:`main`) stays in place. Only the main thread can have handlers.
+
+    The handler can raise where Python cannot pass an exception on (a destructor, a garbage-collector callback:
+    distributed registers one), and Python would print "Exception ignored in ..." with a traceback. While the
+    command runs, such an exception is dropped once a stop is received (it is recorded here, and the run stops
+    at its next stage or says it ended); every other one goes to the hook that was in place.
     """
     received: list[int] = []
     closing = [False]
+    previous_hook = sys.unraisablehook
+
+    def unraisable(unraisable: Any) -> None:
+        if not (received or isinstance(unraisable.exc_value, Stopped)):
+            previous_hook(unraisable)
 
     def stop(signum: int, _frame: Any) -> None:
         if received or closing[0]:
@@ -83,12 +93,14 @@ def _stop_on_signals() -> Iterator[list[int]]:
             previous[number] = signal.signal(number, stop)
         except ValueError:  # not the main thread
             break
+    sys.unraisablehook = unraisable
     try:
         yield received
     finally:
         closing[0] = True  # a signal now is too late to stop anything: the handlers go back as they were
         for number, handler in previous.items():
             signal.signal(number, handler)
+        sys.unraisablehook = previous_hook
 
 
 class _Stream:

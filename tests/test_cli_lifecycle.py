@@ -158,12 +158,29 @@ sys.exit(main(["build", "gear_pair_elliptic", "-o", sys.argv[1], "-q"]))
 """
 
 
+# The same stop raised where Python cannot pass it on: in a destructor (distributed's garbage-collector callback
+# was one, in a sweep), where Python prints "Exception ignored in ..." and a traceback
+IN_A_DESTRUCTOR = SWALLOWED.replace("""    try:
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(60)  # the handler raises Stopped out of the sleep at once
+    except BaseException:
+        pass
+""", """    class Held:
+        def __del__(self):
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(60)  # the handler raises Stopped out of the sleep, and out of this destructor
+    Held()
+""")
+
+
 @pytest.mark.slow
-def test_a_stop_a_library_swallowed_still_stops_the_run_before_anything_is_written(tmp_path):
+@pytest.mark.parametrize("script", [SWALLOWED, IN_A_DESTRUCTOR], ids=["caught", "in_a_destructor"])
+def test_a_stop_a_library_swallowed_still_stops_the_run_before_anything_is_written(tmp_path, script):
+    assert script.count("Held()") == (script is IN_A_DESTRUCTOR)
     out = tmp_path / "out"
     write_output(_previous_output(), out)
     env = {k: v for k, v in os.environ.items() if k != "FABRICATE_SERIAL"}
-    run = subprocess.run([sys.executable, "-c", SWALLOWED, str(out)], cwd=tmp_path, env=env, capture_output=True,
+    run = subprocess.run([sys.executable, "-c", script, str(out)], cwd=tmp_path, env=env, capture_output=True,
                          text=True, timeout=600, start_new_session=True,
                          preexec_fn=lambda: signal.signal(signal.SIGTERM, signal.SIG_DFL))
     assert run.returncode == 143, (run.stdout, run.stderr)
@@ -309,8 +326,10 @@ def test_a_full_stdout_is_named_and_exits_2():
 
 def test_main_gives_the_signal_handlers_back():
     before = {n: signal.getsignal(n) for n in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    hook = sys.unraisablehook
     assert main(["list"]) == 0
     assert {n: signal.getsignal(n) for n in before} == before
+    assert sys.unraisablehook is hook
 
 
 def test_a_stop_signal_inside_a_command_exits_128_plus_its_number(monkeypatch, capsys):
@@ -500,3 +519,28 @@ def test_a_signal_while_the_export_child_works_leaves_no_process_and_the_previou
     assert _wait_until_gone(run.pid) == {}
     assert child not in _group(run.pid)  # reaped, not even a zombie
     assert _tree(out) == _previous_output()
+
+
+# entry() after main(): an object whose destructor raises when the interpreter goes down (a library left midway
+# by the stop), and a thread, so that entry takes the ordinary exit (as with Dask loaded) rather than os._exit
+LOUD_TEARDOWN = """
+import sys, threading
+import fabricate.__main__ as program
+class Loud:
+    def __del__(self):
+        raise AssertionError("a library's state, left midway by the stop")
+kept = Loud()
+program.main = lambda: int(sys.argv[1])
+threading.Thread(target=threading.Event().wait, args=(0.2,)).start()
+program.entry()
+"""
+
+
+@pytest.mark.parametrize(("code", "quiet"), [(130, True), (0, False)])
+def test_after_a_stop_the_teardown_prints_nothing(code, quiet):
+    run = subprocess.run([sys.executable, "-c", LOUD_TEARDOWN, str(code)], capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == code
+    # a run that was not stopped keeps Python's report: the same script is seen to print it
+    assert ("Exception ignored" not in run.stderr) is quiet, run.stderr
+    assert ("AssertionError" in run.stderr) is not quiet

@@ -24,22 +24,20 @@ group once per worker instead of once per point.
 from __future__ import annotations
 
 import json
-import logging
 import math
 import os
 import sys
 import time
-import warnings
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fabricate.errors import SpecError
+from fabricate.sweep.cluster import close_cluster, connect, start_cluster, worker_count, worker_peak_mb, workers_cpu
 from fabricate.sweep.folder import JOURNAL, SWEEP_JSON, Journal, prepare_folder, read_journal, sweep_record, write_file
 from fabricate.sweep.spec import SweepSpec
-from fabricate.sweep.task import EXIT_INTERNAL, build_point, peak_rss_mb, run_batch, synthesis_group, warm
+from fabricate.sweep.task import EXIT_INTERNAL, build_point, run_batch, synthesis_group
 
 #: Results are rewritten at most this often while a sweep runs (and always at its end).
 FLUSH_SECONDS = 5.0
@@ -91,69 +89,6 @@ class SweepOutcome:
 
 
 # -- Dask ----------------------------------------------------------------------------------------------------
-
-def connect(workers: int | None, scheduler: str | None) -> tuple[Any, Any]:
-    """A Dask client and the local cluster it owns (None with ``scheduler``).
-
-    Raises
-    ------
-    SpecError
-        Dask is not installed, or the scheduler cannot be reached.
-    """
-    try:
-        from distributed import Client, LocalCluster
-    except ImportError:
-        raise SpecError("sweep", "needs Dask distributed and pyarrow: pip install \"fabricate[sweep]\"") from None
-    for name in ("distributed", "distributed.nanny", "distributed.scheduler", "distributed.worker",
-                 "distributed.core", "distributed.client"):
-        logging.getLogger(name).setLevel(logging.ERROR)
-    _quiet_event_loops()
-    if scheduler:
-        try:
-            client = Client(scheduler, timeout="15s")
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise SpecError("--scheduler", f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-        return client, None
-    n = workers or default_workers()
-    # one single-threaded process per core: a point is CPU-bound Python; the memory limit is Dask's share
-    # of this machine per worker (a point stays within the template bounds' 4 GB)
-    import dask
-
-    # Dask starts its workers with MALLOC_TRIM_THRESHOLD_=65536, which turns glibc's dynamic mmap threshold off: a
-    # point's large numpy arrays are mapped and unmapped again every time (6x the page faults), and a build point
-    # took 6-7 % more CPU in a worker than in this process. The local cluster's workers get a build's own thresholds
-    # instead (fabricate.bounds.ROOMY_HEAP, as glibc's environment variables; distributed is imported above, so the
-    # context restores Dask's setting)
-    from fabricate.bounds import roomy_heap_environ
-
-    environ = roomy_heap_environ()
-    kept = {name: os.environ.get(name) for name in environ}  # the nanny sets them in this process's environment
-    try:
-        with dask.config.set({f"distributed.nanny.pre-spawn-environ.{name}": value
-                              for name, value in environ.items()}):
-            # the scheduler serves its HTTP routes even without a dashboard, on port 8787 where free: a second
-            # sweep (or any Dask cluster) on this machine makes it warn "Port 8787 is already in use" on the
-            # user's terminal, and it takes another port anyway
-            with warnings.catch_warnings():
-                warnings.filterwarnings("ignore", message="Port 8787 is already in use", category=UserWarning)
-                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                       silence_logs=logging.ERROR)
-    finally:
-        for name, value in kept.items():
-            if value is None:
-                os.environ.pop(name, None)
-            else:
-                os.environ[name] = value
-    client = Client(cluster)
-    return client, cluster
-
-
-def default_workers() -> int:
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # macOS, Windows
-        return max(1, os.cpu_count() or 1)
-
 
 def _bar(done: int, total: int, counts: Mapping[str, int], start: float, resumed: int) -> str:
     width = 28
@@ -225,7 +160,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
     client = cluster = None
     n_workers = 0
     if todo:  # a cluster that cannot be had is a usage error: nothing is written
-        client, cluster, n_workers = _start_cluster(workers, scheduler, spec.stage)
+        client, cluster, n_workers = start_cluster(workers, scheduler, spec.stage)
     out.mkdir(parents=True, exist_ok=True)
     write_file(out / SWEEP_JSON, _json(sweep_record(spec, {"points": len(points), "done": resumed, "complete": False})))
     hello = (f"sweep {spec.name}: {len(points)} points ({resumed} done earlier), stage {spec.stage}, "
@@ -262,10 +197,10 @@ def _journalled(client: Any, spec: SweepSpec, todo: deque[tuple[int, dict[str, A
         if hello is not None:
             say(hello)
         if todo:
-            began, cpu = time.perf_counter(), _workers_cpu(client)
+            began, cpu = time.perf_counter(), workers_cpu(client)
             tasks = _run_points(client, spec, todo, done, journal, out, start, resumed, total, draw, say, cache)
             seconds = time.perf_counter() - began
-            after = _workers_cpu(client)
+            after = workers_cpu(client)
             worker_cpu = sum(after[w] - cpu[w] for w in after if w in cpu)
     except KeyboardInterrupt:
         interrupted = True
@@ -280,19 +215,6 @@ def _journal_rows(out: Path, spec: SweepSpec, by_id: Mapping[str, int]) -> dict[
     """The journal's rows of this spec's points that are done (not an internal error: those run again)."""
     return {pid: row for pid, row in read_journal(out, spec).items()
             if pid in by_id and row["exit_code"] != EXIT_INTERNAL}
-
-
-def _start_cluster(workers: int | None, scheduler: str | None, stage: str) -> tuple[Any, Any, int]:
-    """Client and (local) cluster with their workers up and warm for ``stage``'s points, and how many workers;
-    closed again when that fails."""
-    client, cluster = connect(workers, scheduler)
-    try:
-        n_workers = _wait_for_workers(client, scheduler)
-        _warm(client, stage)
-    except BaseException:
-        _close(client, cluster)
-        raise
-    return client, cluster, n_workers
 
 
 def _finish(out: Path, spec: SweepSpec, rows: list[dict[str, Any]], done: Mapping[str, Mapping[str, Any]],
@@ -324,8 +246,8 @@ def _finish(out: Path, spec: SweepSpec, rows: list[dict[str, Any]], done: Mappin
         interrupted = True
         counts, best, notes = _counts(done), [], []
     finally:
-        worker_peak = _worker_peak_mb(client) if client is not None and not interrupted else 0.0
-        _close(client, cluster)
+        worker_peak = worker_peak_mb(client) if client is not None and not interrupted else 0.0
+        close_cluster(client, cluster)
     return counts, best, notes, worker_peak, interrupted
 
 
@@ -341,73 +263,6 @@ def group_order(fields: Sequence[tuple[str, Sequence[str | int]]], points: Seque
 
 def _json(data: Any) -> bytes:
     return (json.dumps(data, indent=1, sort_keys=False, allow_nan=False, default=str) + "\n").encode()
-
-
-def _wait_for_workers(client: Any, scheduler: str | None) -> int:
-    deadline = time.monotonic() + 60.0
-    while True:
-        n = len(client.scheduler_info(n_workers=-1).get("workers", {})) if _takes_n_workers(client) \
-            else len(client.scheduler_info().get("workers", {}))
-        if n:
-            return n
-        if time.monotonic() > deadline:
-            raise SpecError("--scheduler" if scheduler else "--workers", "no Dask worker joined within 60 s")
-        time.sleep(0.2)
-
-
-def _warm(client: Any, stage: str) -> None:
-    """Every worker imports what a point of ``stage`` runs now, side by side, instead of in its first point."""
-    try:
-        client.run(warm, stage)
-    except Exception:  # noqa: BLE001 - a worker that cannot run it will show why in its first point
-        pass
-
-
-def _workers_cpu(client: Any) -> dict[str, float]:
-    """``{worker address: its process's CPU seconds so far}`` (empty when they cannot say)."""
-    try:
-        return {str(k): float(v) for k, v in client.run(time.process_time).items()}
-    except Exception:  # noqa: BLE001 - a figure for benchmarks
-        return {}
-
-
-def _worker_peak_mb(client: Any) -> float:
-    """The largest peak resident memory of the cluster's workers (MB), 0 when they cannot say."""
-    try:
-        peaks = client.run(peak_rss_mb)
-        return max((float(v) for v in peaks.values()), default=0.0)
-    except Exception:  # noqa: BLE001 - a figure for benchmarks, never a reason to fail a finished sweep
-        return 0.0
-
-
-def _takes_n_workers(client: Any) -> bool:
-    import inspect
-
-    return "n_workers" in inspect.signature(client.scheduler_info).parameters
-
-
-#: The event loops' own loggers: tearing a cluster down (after Ctrl-C above all) can make a pending callback
-#: raise, which tornado and asyncio log with a traceback; the sweep's outcome is already recorded by then.
-EVENT_LOOP_LOGGERS = ("tornado.application", "tornado.general", "asyncio")
-
-
-def _quiet_event_loops() -> None:
-    """Keep the event loops' tracebacks from the user once a client can exist: a Ctrl-C while distributed's
-    ``sync`` waits queues a ``cancel`` on the loop thread, which raises where the call had not begun (2026.8: a
-    NameError on ``future``) and tornado logs at once, before the sweep's handler runs. The sweep records its
-    outcome itself; quiet for the rest of the process (the loop thread can log after ``close()`` returns)."""
-    for name in EVENT_LOOP_LOGGERS:
-        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
-
-
-def _close(client: Any, cluster: Any) -> None:
-    _quiet_event_loops()  # a client made outside connect() too
-    for thing in (client, cluster):
-        if thing is not None:
-            try:
-                thing.close()
-            except Exception:  # noqa: BLE001 - closing a broken cluster must not hide the sweep's outcome
-                pass
 
 
 def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[str, Any]], journal: Journal,
@@ -432,8 +287,7 @@ def _run_points(client: Any, spec: SweepSpec, todo: deque, done: dict[str, dict[
 
     def workers_now() -> int:
         try:
-            return max(1, len(client.scheduler_info(n_workers=-1)["workers"]) if _takes_n_workers(client)
-                       else len(client.scheduler_info()["workers"]))
+            return max(1, worker_count(client))
         except Exception:  # noqa: BLE001
             return 1
 

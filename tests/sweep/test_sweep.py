@@ -540,28 +540,3 @@ def test_cli_vary_nan_exits_2_naming_the_flag(tmp_path, capsys, value):
     assert "expected finite values" in err and "--vary gears.module_mm" in err, err
     assert "Traceback" not in err and "internal error" not in err
     assert not out.exists()
-
-
-@pytest.mark.slow
-def test_a_local_clusters_workers_keep_freed_memory_as_a_build_does():
-    """The local cluster's workers run with a build's glibc thresholds (fabricate.bounds.ROOMY_HEAP, set through
-    glibc's environment variables), not Dask's MALLOC_TRIM_THRESHOLD_=65536 (which maps and unmaps a point's
-    arrays again and again); Dask's own setting is restored after the cluster starts."""
-    import dask
-
-    from fabricate.bounds import roomy_heap_environ
-    from fabricate.sweep.runner import connect
-
-    before = dask.config.get("distributed.nanny.pre-spawn-environ")
-    environ = {name: value for name, value in os.environ.items() if name.startswith("MALLOC_")}
-    client, cluster = connect(1, None)
-    try:
-        seen = client.run(lambda: (os.environ.get("MALLOC_TRIM_THRESHOLD_"), os.environ.get("MALLOC_MMAP_THRESHOLD_")))
-    finally:
-        client.close()
-        cluster.close()
-    heap = roomy_heap_environ()
-    assert list(seen.values()) == [(heap["MALLOC_TRIM_THRESHOLD_"], heap["MALLOC_MMAP_THRESHOLD_"])]
-    assert dask.config.get("distributed.nanny.pre-spawn-environ") == before
-    # this process's environment as it was (the nanny writes the variables into it to pass them on)
-    assert {name: value for name, value in os.environ.items() if name.startswith("MALLOC_")} == environ
