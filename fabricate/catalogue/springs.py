@@ -201,59 +201,81 @@ def torsion_spring(rate_nmm_per_deg: float, max_angle_deg: float, preload_nmm: f
         raise SpecError("material", f"expected one of {list(MATERIALS)}, got {material!r}")
 
     preload_deg = m0 / k
-    theta = preload_deg + work                  # total deflection from free at the end of the motion
-    turns_wound = theta / 360.0
-    m_max = k * theta
-    k_turn = k * 360.0
-    c_lo, c_hi = INDEX_RANGE
+    duty = _Duty(rate=k, preload=m0, preload_deg=preload_deg, theta=preload_deg + work, pin=pin, legs=legs,
+                 material=material)
     reasons: list[str] = []
     for d_in, sut_ksi in MUSIC_WIRE_IN_KSI:
-        d = d_in * INCH_MM
-        e = music_wire_modulus_mpa(d_in)
-        sut = sut_ksi * KSI_MPA
-        allow = ALLOWABLE_FRACTION * sut
-        # D N is fixed by the rate (N = A / D), so the wound mean diameter A D / (A + θ D) rises with D
-        a = e * d**4 / (10.8 * k_turn)
-        need = d + pin / ARBOR_RATIO            # least wound mean diameter: pin / ratio inside, plus d
-        d_lo = c_lo * d
-        d_hi = min(c_hi * d, a / MIN_TURNS)
-        if a <= need * turns_wound:
-            reasons.append(f"Ø{d:.3f}: coil cannot clear the pin wound up")
-            continue
-        d_lo = max(d_lo, need * a / (a - need * turns_wound))
-
-        def stress(mean_d: float, d: float = d) -> float:
-            return curvature_factor(mean_d / d) * 32.0 * m_max / (math.pi * d**3)
-
-        if d_lo > d_hi:
-            reasons.append(f"Ø{d:.3f}: no coil between index {c_lo:g}..{c_hi:g} with >= {MIN_TURNS:g} turns "
-                           "clears the pin")
-            continue
-        if stress(d_hi) > allow:
-            reasons.append(f"Ø{d:.3f}: {stress(d_hi):.0f} MPa over {allow:.0f} MPa allowable")
-            continue
-        lo, hi = d_lo, d_hi
-        if stress(lo) > allow:                  # K_B falls as C grows: the smallest coil within the stress
-            for _ in range(100):
-                mid = 0.5 * (lo + hi)
-                lo, hi = (mid, hi) if stress(mid) > allow else (lo, mid)
-            lo = hi
-        mean_d = math.ceil(lo * 100.0 - 1e-9) / 100.0   # a coil diameter to 0.01 mm, rounded up
-        if mean_d > d_hi + 1e-12:
-            mean_d = lo
-        turns = a / mean_d
-        wound_mean = mean_d * turns / (turns + turns_wound)
-        return TorsionSpring(
-            material=material, wire_d_mm=d, wire_d_in=d_in, mean_d_mm=mean_d, active_turns=turns,
-            leg_lengths_mm=legs, rate_nmm_per_deg=rate_per_deg(e, d, mean_d, turns), preload_nmm=m0,
-            preload_angle_deg=preload_deg, max_deflection_deg=theta, max_torque_nmm=m_max,
-            inner_d_wound_mm=wound_mean - d, pin_diameter_mm=pin,
-            body_length_free_mm=d * (turns + 1.0), body_length_wound_mm=d * (turns + 1.0 + turns_wound),
-            index=mean_d / d, curvature_factor=curvature_factor(mean_d / d), stress_mpa=stress(mean_d),
-            allowable_mpa=allow, tensile_min_mpa=sut, modulus_mpa=e,
-            sources=(RATE_SOURCE, STRESS_SOURCE, WINDUP_SOURCE, BODY_SOURCE, ARBOR_SOURCE, INDEX_SOURCE,
-                     MODULUS_SOURCE, ALLOWABLE_SOURCE, WIRE_SOURCE))
+        spring = _on_wire(duty, d_in, sut_ksi)
+        if isinstance(spring, TorsionSpring):
+            return spring
+        reasons.append(spring)
+    theta = duty.theta
     raise SpecError("rate_nmm_per_deg", f"no {material} torsion spring of {k:g} N·mm/° over {theta:g}° "
                     f"(preload {m0:g} N·mm) on a Ø{pin:g} mm pin from wire "
                     f"{MUSIC_WIRE_IN_KSI[0][0] * INCH_MM:.3f}-{MUSIC_WIRE_IN_KSI[-1][0] * INCH_MM:.3f} mm: "
                     + "; ".join(reasons[-3:]))
+
+
+@dataclass(frozen=True)
+class _Duty:
+    """What a torsion spring must do: rate (N·mm/°), preload torque (N·mm) and its wind-up (°), the total
+    deflection from free at the end of the motion (°), the pin (mm), the legs (mm) and the material."""
+
+    rate: float
+    preload: float
+    preload_deg: float
+    theta: float
+    pin: float
+    legs: tuple[float, float]
+    material: str
+
+
+def _on_wire(duty: _Duty, d_in: float, sut_ksi: float) -> TorsionSpring | str:
+    """The smallest coil of wire ``d_in`` (inch; minimum tensile ``sut_ksi``) that does ``duty``, or why none
+    does."""
+    k, m0, preload_deg, theta, pin = duty.rate, duty.preload, duty.preload_deg, duty.theta, duty.pin
+    turns_wound = theta / 360.0
+    m_max = k * theta
+    k_turn = k * 360.0
+    c_lo, c_hi = INDEX_RANGE
+    d = d_in * INCH_MM
+    e = music_wire_modulus_mpa(d_in)
+    sut = sut_ksi * KSI_MPA
+    allow = ALLOWABLE_FRACTION * sut
+    # D N is fixed by the rate (N = A / D), so the wound mean diameter A D / (A + θ D) rises with D
+    a = e * d**4 / (10.8 * k_turn)
+    need = d + pin / ARBOR_RATIO            # least wound mean diameter: pin / ratio inside, plus d
+    d_lo = c_lo * d
+    d_hi = min(c_hi * d, a / MIN_TURNS)
+    if a <= need * turns_wound:
+        return f"Ø{d:.3f}: coil cannot clear the pin wound up"
+    d_lo = max(d_lo, need * a / (a - need * turns_wound))
+
+    def stress(mean_d: float) -> float:
+        return curvature_factor(mean_d / d) * 32.0 * m_max / (math.pi * d**3)
+
+    if d_lo > d_hi:
+        return f"Ø{d:.3f}: no coil between index {c_lo:g}..{c_hi:g} with >= {MIN_TURNS:g} turns clears the pin"
+    if stress(d_hi) > allow:
+        return f"Ø{d:.3f}: {stress(d_hi):.0f} MPa over {allow:.0f} MPa allowable"
+    lo, hi = d_lo, d_hi
+    if stress(lo) > allow:                  # K_B falls as C grows: the smallest coil within the stress
+        for _ in range(100):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if stress(mid) > allow else (lo, mid)
+        lo = hi
+    mean_d = math.ceil(lo * 100.0 - 1e-9) / 100.0   # a coil diameter to 0.01 mm, rounded up
+    if mean_d > d_hi + 1e-12:
+        mean_d = lo
+    turns = a / mean_d
+    wound_mean = mean_d * turns / (turns + turns_wound)
+    return TorsionSpring(
+        material=duty.material, wire_d_mm=d, wire_d_in=d_in, mean_d_mm=mean_d, active_turns=turns,
+        leg_lengths_mm=duty.legs, rate_nmm_per_deg=rate_per_deg(e, d, mean_d, turns), preload_nmm=m0,
+        preload_angle_deg=preload_deg, max_deflection_deg=theta, max_torque_nmm=m_max,
+        inner_d_wound_mm=wound_mean - d, pin_diameter_mm=pin,
+        body_length_free_mm=d * (turns + 1.0), body_length_wound_mm=d * (turns + 1.0 + turns_wound),
+        index=mean_d / d, curvature_factor=curvature_factor(mean_d / d), stress_mpa=stress(mean_d),
+        allowable_mpa=allow, tensile_min_mpa=sut, modulus_mpa=e,
+        sources=(RATE_SOURCE, STRESS_SOURCE, WINDUP_SOURCE, BODY_SOURCE, ARBOR_SOURCE, INDEX_SOURCE,
+                 MODULUS_SOURCE, ALLOWABLE_SOURCE, WIRE_SOURCE))

@@ -18,6 +18,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import shapely
@@ -312,8 +313,15 @@ def order_layers(layers: Mapping[str, int], crossings: Sequence[tuple[str, str, 
     bad, best = _best_order(layers, *args)
     if bad == 0 or not split:
         return best
-    # no order of the colours works: give one body of a shared layer a layer of its own (a legal colouring
-    # still: the conflict graph only asks for different layers), the first that works in body order
+    return _best_split(layers, args, bad, best)
+
+
+def _best_split(layers: Mapping[str, int], args: tuple[Any, ...], bad: int, best: dict[str, int]) -> dict[str, int]:
+    """No order of the colours works (``bad`` violations in ``best``): give one body of a shared layer a layer of
+    its own (a legal colouring still: the conflict graph only asks for different layers), the split with the
+    fewest violations, then layers, in body order; ``best`` where none does better. ``args``:
+    :func:`_best_order`'s after ``layers`` (``max_layers`` second)."""
+    max_layers = args[1]
     count = 1 + max(layers.values(), default=0)
     height = 1 + max(best.values(), default=0)
     key = (bad, height)

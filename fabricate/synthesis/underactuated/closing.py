@@ -87,15 +87,7 @@ def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: i
             if event:
                 events.append(s_new)
             if with_object:
-                pose = finger_pose(d, q)
-                assert pose is not None  # the settler only accepts poses that close
-                touch = face_clearance(d, pose, spec.cylinder_centre, spec.cylinder_radius)[0] < 1e-4
-                touch[:frozen] = True
-                hit = np.nonzero(touch)[0]
-                if hit.size:
-                    # the chapter's assumption: a phalanx stopped by the object no longer turns (it
-                    # sticks), so it and every joint proximal to it hold their angles from here on
-                    frozen = max(frozen, int(hit.max()) + 1)
+                touch, frozen = _touching(spec, q, frozen)
             touching.append(touch)
             if with_object and (touch.all() or not ok):
                 locked = True                         # every phalanx on the object: the stroke ends
@@ -109,15 +101,39 @@ def closing_motion(spec: UnderactuatedSpec, with_object: bool = True, samples: i
         if locked:
             break
     strokes_arr, qs_arr, touching_arr = np.array(strokes), np.array(qs), np.array(touching)
+    order, at = _contact_order(strokes_arr, touching_arr)
+    return ClosingMotion(strokes_arr, qs_arr, touching_arr, order, at, with_object, settler.fallbacks,
+                         tuple(events))
+
+
+def _touching(spec: UnderactuatedSpec, q: np.ndarray, frozen: int) -> tuple[np.ndarray, int]:
+    """Which phalanges touch the object at joint angles ``q`` (n,), rad, and how many joints are frozen then.
+
+    The chapter's assumption: a phalanx stopped by the object no longer turns (it sticks), so it and every
+    joint proximal to it hold their angles from then on; the frozen ones count as touching.
+    """
+    d = spec.design
+    pose = finger_pose(d, q)
+    assert pose is not None  # the settler only accepts poses that close
+    touch = face_clearance(d, pose, spec.cylinder_centre, spec.cylinder_radius)[0] < 1e-4
+    touch[:frozen] = True
+    hit = np.nonzero(touch)[0]
+    if hit.size:
+        frozen = max(frozen, int(hit.max()) + 1)
+    return touch, frozen
+
+
+def _contact_order(strokes: np.ndarray, touching: np.ndarray) -> tuple[list[int], list[float]]:
+    """The phalanges in the order they first touch, and the strokes (mm) where they do (``strokes`` (m,),
+    ``touching`` (m, n) bool)."""
     order, at = [], []
-    for i in range(d.n):
-        hits = np.nonzero(touching_arr[:, i])[0]
+    for i in range(touching.shape[1]):
+        hits = np.nonzero(touching[:, i])[0]
         if hits.size:
             order.append(i)
-            at.append(float(strokes_arr[hits[0]]))
+            at.append(float(strokes[hits[0]]))
     ranked = sorted(zip(at, order, strict=True))
-    return ClosingMotion(strokes_arr, qs_arr, touching_arr, [i for _, i in ranked], [s for s, _ in ranked],
-                         with_object, settler.fallbacks, tuple(events))
+    return [i for _, i in ranked], [s for s, _ in ranked]
 
 
 def final_contact_forces(spec: UnderactuatedSpec, motion: ClosingMotion) -> dict:
