@@ -6,8 +6,6 @@ import os
 import sys
 import threading
 
-from fabricate.cli import main
-
 
 def entry() -> None:
     """Run :func:`fabricate.cli.main` as a program, then leave without tearing the interpreter down.
@@ -19,6 +17,13 @@ def entry() -> None:
     threads, or with Dask loaded (``sweep``: its client and cluster close in their own exit hooks), exits the
     ordinary way; so does an exception (argparse's ``--help`` and usage errors).
     """
+    try:
+        from fabricate.cli import main
+    except KeyboardInterrupt:
+        # Ctrl-C in the first ~50 ms, while the command line loads and before its own handlers are in place:
+        # Python's default handler would print a traceback from the middle of an import
+        sys.stderr.write("fabricate: interrupted; nothing was written (a previous output is unchanged)\n")
+        sys.exit(130)
     code = main()
     if code > 128:
         # stopped by a signal: a library the stop interrupted midway can complain from a destructor or a garbage

@@ -529,28 +529,3 @@ def test_a_signal_while_the_export_child_works_leaves_no_process_and_the_previou
     assert _wait_until_gone(run.pid) == {}
     assert child not in _group(run.pid)  # reaped, not even a zombie
     assert _tree(out) == _previous_output()
-
-
-# entry() after main(): an object whose destructor raises when the interpreter goes down (a library left midway
-# by the stop), and a thread, so that entry takes the ordinary exit (as with Dask loaded) rather than os._exit
-LOUD_TEARDOWN = """
-import sys, threading
-import fabricate.__main__ as program
-class Loud:
-    def __del__(self):
-        raise AssertionError("a library's state, left midway by the stop")
-kept = Loud()
-program.main = lambda: int(sys.argv[1])
-threading.Thread(target=threading.Event().wait, args=(0.2,)).start()
-program.entry()
-"""
-
-
-@pytest.mark.parametrize(("code", "quiet"), [(130, True), (0, False)])
-def test_after_a_stop_the_teardown_prints_nothing(code, quiet):
-    run = subprocess.run([sys.executable, "-c", LOUD_TEARDOWN, str(code)], capture_output=True, text=True,
-                         timeout=120)
-    assert run.returncode == code
-    # a run that was not stopped keeps Python's report: the same script is seen to print it
-    assert ("Exception ignored" not in run.stderr) is quiet, run.stderr
-    assert ("AssertionError" in run.stderr) is not quiet

@@ -44,3 +44,49 @@ def test_an_error_keeps_its_exit_code_and_message_and_another_thread_the_ordinar
     assert run.stderr.startswith("fabricate: error:") and missing in run.stderr
     run, torn = _entry(tmp_path, "thread", "check", missing)
     assert (run.returncode, torn) == (2, True)
+
+
+# entry() after main(): an object whose destructor raises when the interpreter goes down (a library left midway
+# by the stop), and a thread, so that entry takes the ordinary exit (as with Dask loaded) rather than os._exit
+LOUD_TEARDOWN = """
+import sys, threading
+import fabricate.cli
+from fabricate.__main__ import entry
+class Loud:
+    def __del__(self):
+        raise AssertionError("a library's state, left midway by the stop")
+kept = Loud()
+fabricate.cli.main = lambda: int(sys.argv[1])
+threading.Thread(target=threading.Event().wait, args=(0.2,)).start()
+entry()
+"""
+
+
+@pytest.mark.parametrize(("code", "quiet"), [(130, True), (0, False)])
+def test_after_a_stop_the_teardown_prints_nothing(code, quiet):
+    run = subprocess.run([sys.executable, "-c", LOUD_TEARDOWN, str(code)], capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == code
+    # a run that was not stopped keeps Python's report: the same script is seen to print it
+    assert ("Exception ignored" not in run.stderr) is quiet, run.stderr
+    assert ("AssertionError" in run.stderr) is not quiet
+
+
+# a Ctrl-C that lands while the command line still loads, before main() puts its handlers in place
+EARLY_CTRL_C = """
+import sys
+class CtrlC:
+    def find_spec(self, name, path=None, target=None):
+        if name == "fabricate.cli":
+            raise KeyboardInterrupt
+sys.meta_path.insert(0, CtrlC())
+from fabricate.__main__ import entry
+entry()
+"""
+
+
+def test_a_ctrl_c_while_the_command_loads_is_one_line_and_exit_130():
+    run = subprocess.run([sys.executable, "-c", EARLY_CTRL_C], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 130
+    assert run.stderr.splitlines() == ["fabricate: interrupted; nothing was written (a previous output is "
+                                       "unchanged)"]
