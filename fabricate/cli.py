@@ -27,80 +27,16 @@ from typing import Any, NoReturn, TextIO
 from fabricate import __version__
 from fabricate.cache import use_cache
 from fabricate.errors import FabricateError, SpecError
+from fabricate.stops import STOP_SIGNALS, Stopped, stop_on_signals
 
 DEFAULT_TEMPLATE = "finger_five_bar_ncg"
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 #: Signals that stop a run cleanly (exit 128 + the signal's number), and how the last line names them.
-STOP_SIGNALS = {"SIGINT": "interrupted", "SIGTERM": "terminated (SIGTERM)", "SIGHUP": "hung up (SIGHUP)"}
 HELP_EPILOG = ("exit codes: 0 every check passed; 1 the design fails a check (files are written, the report says "
                "why) or 'check' found a problem; 2 invalid input or usage (nothing is written); 3 a bug in "
                "fabricate (please report it); 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP (128 + the signal: a previous "
                "output is left as it was, nothing half-written). -q hides progress only: the result line and "
                "any failures are always printed.")
-
-
-class Stopped(KeyboardInterrupt):
-    """A stopping signal (SIGINT, SIGTERM, SIGHUP) raised like Ctrl-C's KeyboardInterrupt.
-
-    Being a KeyboardInterrupt, it runs every ``finally`` (the picture child is killed, a temporary folder
-    removed) and stops cleanly whatever already stops cleanly on Ctrl-C (a sweep records its points).
-
-    Parameters
-    ----------
-    signum : int
-        The signal's number; the exit code is 128 + ``signum``.
-    """
-
-    def __init__(self, signum: int) -> None:
-        super().__init__(signal.Signals(signum).name)
-        self.signum = signum
-
-
-@contextlib.contextmanager
-def _stop_on_signals() -> Iterator[list[int]]:
-    """Raise :class:`Stopped` on the first SIGINT, SIGTERM or SIGHUP while the command runs.
-
-    Yields the list the received signal's number is put in. Later signals are ignored so the cleanup the
-    first one started can finish (SIGKILL still ends the process, and its children die with it). A signal
-    the caller ignores stays ignored (``nohup``, a background job) and a handler the caller installed (a
-    program calling :func:`main`) stays in place. Only the main thread can have handlers.
-
-    The handler can raise where Python cannot pass an exception on (a destructor, a garbage-collector callback:
-    distributed registers one), and Python would print "Exception ignored in ..." with a traceback. While the
-    command runs, such an exception is dropped once a stop is received (it is recorded here, and the run stops
-    at its next stage or says it ended); every other one goes to the hook that was in place.
-    """
-    received: list[int] = []
-    closing = [False]
-    previous_hook = sys.unraisablehook
-
-    def unraisable(unraisable: Any) -> None:
-        if not (received or isinstance(unraisable.exc_value, Stopped)):
-            previous_hook(unraisable)
-
-    def stop(signum: int, _frame: Any) -> None:
-        if received or closing[0]:
-            return
-        received.append(signum)
-        raise Stopped(signum)
-
-    previous: dict[int, Any] = {}
-    for name in STOP_SIGNALS:
-        number = getattr(signal, name, None)
-        if number is None or signal.getsignal(number) not in (signal.SIG_DFL, signal.default_int_handler):
-            continue
-        try:
-            previous[number] = signal.signal(number, stop)
-        except ValueError:  # not the main thread
-            break
-    sys.unraisablehook = unraisable
-    try:
-        yield received
-    finally:
-        closing[0] = True  # a signal now is too late to stop anything: the handlers go back as they were
-        for number, handler in previous.items():
-            signal.signal(number, handler)
-        sys.unraisablehook = previous_hook
 
 
 class _Stream:
@@ -571,7 +507,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run one command; its exit code is returned (see the module docstring), one line on stderr at most
     for an error, never a traceback. Only argparse's SystemExit (``--help``, ``--version``, a usage error)
     leaves by an exception."""
-    with _guarded_streams() as (out, _err), _stop_on_signals() as received:
+    with _guarded_streams() as (out, _err), stop_on_signals() as received:
         code = _run(argv, received)
         if received and code != 128 + received[0]:
             # the signal's exception was swallowed on its way (it hit a destructor): the run ended anyway

@@ -236,8 +236,21 @@ class _Lock:
 
 
 @contextlib.contextmanager
-def _locked(parent: Path, name: str) -> Iterator[_Lock]:
-    """Hold the exclusive lock of output ``parent/name`` (nothing is locked where there are no POSIX locks)."""
+def folder_lock(out: Path, waiting: Callable[[], None] | None = None) -> Iterator[None]:
+    """Hold the lock the writers of output folder ``out`` share (``.NAME.lock`` beside it) for a whole run.
+
+    A sweep holds it from the check of its folder to its last file, so that a second sweep into the folder waits
+    and then resumes what the first recorded, instead of appending to the same journal; a build into the folder
+    waits too. ``out``'s parent must exist. ``waiting`` is called once where another run holds the lock.
+    """
+    with _locked(out.parent, out.name, waiting):
+        yield
+
+
+@contextlib.contextmanager
+def _locked(parent: Path, name: str, waiting: Callable[[], None] | None = None) -> Iterator[_Lock]:
+    """Hold the exclusive lock of output ``parent/name`` (nothing is locked where there are no POSIX locks);
+    ``waiting`` is called once before blocking on another holder."""
     path = parent / f".{name}.lock"
     if fcntl is None:  # pragma: no cover
         yield _Lock(None, path)
@@ -255,7 +268,13 @@ def _locked(parent: Path, name: str) -> Iterator[_Lock]:
                 os.close(fd)
             raise _refuse(parent / name, f"its lock file {path} is not a plain file; fabricate makes it and "
                                          "removes it after writing: remove what is there")
-        fcntl.flock(fd, fcntl.LOCK_EX)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            if waiting is not None:
+                waiting()
+                waiting = None
+            fcntl.flock(fd, fcntl.LOCK_EX)
         if _identity(path) == (st.st_dev, st.st_ino):
             break
         os.close(fd)  # the holder before us removed this lock file: lock the new one

@@ -359,6 +359,35 @@ def test_a_stop_raised_in_a_destructor_prints_no_traceback(monkeypatch, capsys):
     assert sys.unraisablehook == unraised.append  # given back
 
 
+def test_a_stop_during_an_import_stops_the_command_once_the_import_is_done(monkeypatch, capsys, tmp_path):
+    """Raised inside an import, the stop can fail a C extension's initialisation midway, which some abort on
+    (CI: a held build's parent ended by SIGSEGV, and by SIGABRT with the stop raised from enum.py inside an
+    extension's exec_module). The handler sends the signal again until the import is done."""
+    if signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL or threading.current_thread() is not \
+            threading.main_thread():
+        pytest.skip("the test runner handles SIGTERM itself, or runs tests outside the main thread")
+    (tmp_path / "fabricate_test_slow_import.py").write_text(
+        "import os, signal, time\nos.kill(os.getpid(), signal.SIGTERM)\ntime.sleep(0.2)\ndone = True\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    imported = []
+
+    def listed() -> int:
+        import fabricate_test_slow_import
+
+        imported.append(fabricate_test_slow_import.done)
+        time.sleep(60)  # the signal, sent again, stops the command in here
+        return 0
+
+    monkeypatch.setattr(cli, "_list", listed)
+    try:
+        assert main(["list"]) == 143
+    finally:
+        sys.modules.pop("fabricate_test_slow_import", None)
+    assert imported == [True]  # the module's code ran to its end
+    assert capsys.readouterr().err.strip().splitlines() == [
+        "fabricate: terminated (SIGTERM); nothing was written (a previous output is unchanged)"]
+
+
 def test_an_ignored_signal_stays_ignored(monkeypatch):
     if signal.getsignal(signal.SIGHUP) is not signal.SIG_DFL:
         pytest.skip("the test runner handles SIGHUP itself")

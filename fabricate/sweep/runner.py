@@ -23,6 +23,7 @@ group once per worker instead of once per point.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -34,6 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fabricate.output import folder_lock
 from fabricate.sweep.cluster import close_cluster, connect, start_cluster, worker_count, worker_peak_mb, workers_cpu
 from fabricate.sweep.folder import JOURNAL, SWEEP_JSON, Journal, prepare_folder, read_journal, sweep_record, write_file
 from fabricate.sweep.spec import SweepSpec
@@ -141,19 +143,34 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
 
         check_workers(workers)
     out = Path(os.path.abspath(out))
-    resuming = prepare_folder(out, spec, protect)
+    prepare_folder(out, spec, protect)  # bad input is refused before any wait, and before anything is written
+    say = log or (lambda msg: None if quiet else print(msg, file=sys.stderr, flush=True))
+    draw = (not quiet) and (sys.stderr.isatty() if progress_bar is None else progress_bar)
+    if cache is None:
+        from fabricate.cache import enabled
+
+        cache = enabled()
+    # one sweep writes a folder at a time: a second one waits, then resumes from the first one's journal (two
+    # appending to one journal ran every point twice, and one's resume could cut the other's line in half).
+    # A folder under folders that do not exist yet is nobody else's: nothing is made before the work starts
+    held = folder_lock(out, lambda: say(f"sweep {spec.name}: waiting for another run writing {out}")) \
+        if out.parent.is_dir() else contextlib.nullcontext()
+    with held:
+        return _sweep_in(spec, out, (workers, scheduler), protect, cache, (say, draw, quiet))
+
+
+def _sweep_in(spec: SweepSpec, out: Path, connect_to: tuple[int | None, str | None], protect: Sequence[Path],
+              cache: bool, talk: tuple[Progress, bool, bool]) -> SweepOutcome:
+    """:func:`run_sweep` once it holds the folder (``connect_to``: its workers and scheduler; ``talk``: how it
+    says what it does, whether it draws a progress bar, whether it is quiet)."""
+    workers, scheduler = connect_to
+    say, draw, quiet = talk
+    resuming = prepare_folder(out, spec, protect)  # again: what a run that held the folder before left
     points = spec.points()
     ids = [spec.point_id(values) for values in points]
     by_id = dict(zip(ids, range(len(points)), strict=True))
     done = _journal_rows(out, spec, by_id) if resuming else {}
     resumed = len(done)
-    say = log or (lambda msg: None if quiet else print(msg, file=sys.stderr, flush=True))
-    draw = (not quiet) and (sys.stderr.isatty() if progress_bar is None else progress_bar)
-
-    if cache is None:
-        from fabricate.cache import enabled
-
-        cache = enabled()
     order = group_order(spec.field_parts(), points, [i for i in range(len(points)) if ids[i] not in done])
     todo = deque((i, points[i], ids[i]) for i in order)
     start = time.perf_counter()
@@ -175,7 +192,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None, s
         done = _journal_rows(out, spec, by_id)
     rows = [done[pid] for pid in ids if pid in done]
     counts, best, notes, worker_peak, interrupted = _finish(
-        out, spec, rows, done, len(points), interrupted, (client, cluster), (workers, scheduler), say, protect, cache)
+        out, spec, rows, done, len(points), interrupted, (client, cluster), connect_to, say, protect, cache)
     code = 130 if interrupted else (1 if counts.get(str(EXIT_INTERNAL)) else 0)
     return SweepOutcome(exit_code=code, out=out, total=len(points), done=len(rows), resumed=resumed,
                         counts=counts, best=best, seconds=time.perf_counter() - start, workers=n_workers,

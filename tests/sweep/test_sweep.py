@@ -540,3 +540,32 @@ def test_cli_vary_nan_exits_2_naming_the_flag(tmp_path, capsys, value):
     assert "expected finite values" in err and "--vary gears.module_mm" in err, err
     assert "Traceback" not in err and "internal error" not in err
     assert not out.exists()
+
+
+@pytest.mark.slow
+def test_a_second_sweep_into_a_folder_waits_then_resumes_what_the_first_recorded(tmp_path):
+    """Two sweeps into one folder appended to one journal (every point ran twice, and a resume could cut the
+    other's line in half). A sweep holds the folder's lock: the second waits, saying so, then resumes from the
+    journal the first left. Here the test holds the lock as the first run and records two points meanwhile."""
+    from fabricate.output import folder_lock
+    from fabricate.sweep.folder import JOURNAL, SWEEP_JSON, sweep_record
+    from fabricate.sweep.task import row_json
+    from fabricate.tomlwrite import dumps
+
+    tables = gear_tables(eccentricities=(0.1, 0.2, 0.3), modules=(1.0,))
+    spec_file = tmp_path / "gears.toml"
+    spec_file.write_text(dumps(tables))
+    spec = sweep_from_tables(tables)
+    out = tmp_path / "out"
+    with folder_lock(out):
+        second = _cli("sweep", str(spec_file), "--workers", "1", "-o", str(out))
+        heard = second.stderr.readline()
+        assert "waiting for another run writing" in heard and str(out) in heard, (heard, second.communicate())
+        out.mkdir()  # what the first run records while the second waits: two points of the three
+        first = reference_rows(spec)[:2]
+        (out / JOURNAL).write_text("".join(row_json(row) + "\n" for row in first))
+        (out / SWEEP_JSON).write_text(json.dumps(sweep_record(spec, {"points": 3, "done": 2, "complete": False})))
+    stdout, stderr = second.communicate(timeout=600)
+    assert second.returncode == 0, (stdout, stderr)
+    assert "(2 done earlier)" in stdout
+    assert sorted(_journal_points(out / JOURNAL)) == [0, 1, 2], "every point once: the two recorded are not rerun"

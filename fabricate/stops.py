@@ -1,0 +1,108 @@
+"""Stop signals as exceptions: SIGINT, SIGTERM and SIGHUP end a command like Ctrl-C does, with every ``finally`` run.
+
+The command line (:func:`fabricate.cli.main`) holds :func:`stop_on_signals` while a command runs.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import sys
+from collections.abc import Iterator
+from typing import Any
+
+#: The signals that stop a command, and how its one line on stderr names each.
+STOP_SIGNALS = {"SIGINT": "interrupted", "SIGTERM": "terminated (SIGTERM)", "SIGHUP": "hung up (SIGHUP)"}
+
+
+class Stopped(KeyboardInterrupt):
+    """A stopping signal (SIGINT, SIGTERM, SIGHUP) raised like Ctrl-C's KeyboardInterrupt.
+
+    Being a KeyboardInterrupt, it runs every ``finally`` (the picture child is killed, a temporary folder
+    removed) and stops cleanly whatever already stops cleanly on Ctrl-C (a sweep records its points).
+
+    Parameters
+    ----------
+    signum : int
+        The signal's number; the exit code is 128 + ``signum``.
+    """
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def stop_on_signals() -> Iterator[list[int]]:
+    """Raise :class:`Stopped` on the first SIGINT, SIGTERM or SIGHUP while the command runs.
+
+    Yields the list the received signal's number is put in. Later signals are ignored so the cleanup the
+    first one started can finish (SIGKILL still ends the process, and its children die with it). A signal
+    the caller ignores stays ignored (``nohup``, a background job) and a handler the caller installed (a
+    program calling :func:`main`) stays in place. Only the main thread can have handlers.
+
+    The handler can raise where Python cannot pass an exception on (a destructor, a garbage-collector callback:
+    distributed registers one), and Python would print "Exception ignored in ..." with a traceback. While the
+    command runs, such an exception is dropped once a stop is received (it is recorded here, and the run stops
+    at its next stage or says it ended); every other one goes to the hook that was in place.
+    """
+    received: list[int] = []
+    closing = [False]
+    previous_hook = sys.unraisablehook
+
+    def unraisable(unraisable: Any) -> None:
+        if not (received or isinstance(unraisable.exc_value, Stopped)):
+            previous_hook(unraisable)
+
+    def stop(signum: int, frame: Any) -> None:
+        if received or closing[0]:
+            return
+        if _importing(frame):
+            # raised inside an import, it can fail a C extension's initialisation midway, and some abort the
+            # process on that (nanobind and pybind11 modules make their enums through Python's enum module: a
+            # SIGABRT or SIGSEGV instead of exit 143). The signal is sent again until the import is done
+            _again(signum, closing)
+            return
+        received.append(signum)
+        raise Stopped(signum)
+
+    previous: dict[int, Any] = {}
+    for name in STOP_SIGNALS:
+        number = getattr(signal, name, None)
+        if number is None or signal.getsignal(number) not in (signal.SIG_DFL, signal.default_int_handler):
+            continue
+        try:
+            previous[number] = signal.signal(number, stop)
+        except ValueError:  # not the main thread
+            break
+    sys.unraisablehook = unraisable
+    try:
+        yield received
+    finally:
+        closing[0] = True  # a signal now is too late to stop anything: the handlers go back as they were
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+        sys.unraisablehook = previous_hook
+
+
+def _importing(frame: Any) -> bool:
+    """Whether ``frame`` (a signal handler's) runs inside an import."""
+    while frame is not None:
+        if frame.f_code.co_filename.startswith("<frozen importlib._bootstrap"):
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _again(signum: int, closing: list[bool]) -> None:
+    """Send ``signum`` to this process again in 10 ms, unless the command is over by then."""
+    import threading
+
+    def send() -> None:
+        if not closing[0]:
+            os.kill(os.getpid(), signum)
+
+    timer = threading.Timer(0.01, send)
+    timer.daemon = True
+    timer.start()
