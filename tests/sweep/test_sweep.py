@@ -562,7 +562,8 @@ def test_a_second_sweep_into_a_folder_waits_then_resumes_what_the_first_recorded
         heard = second.stderr.readline()
         assert "waiting for another run writing" in heard and str(out) in heard, (heard, second.communicate())
         out.mkdir()  # what the first run records while the second waits: two points of the three
-        first = reference_rows(spec)[:2]
+        first = [run_point(i, values, spec.point_id(values), spec.base, spec.field_parts(), spec.stage,
+                           list(spec.metrics)) for i, values in enumerate(spec.points()[:2])]
         (out / JOURNAL).write_text("".join(row_json(row) + "\n" for row in first))
         (out / SWEEP_JSON).write_text(json.dumps(sweep_record(spec, {"points": 3, "done": 2, "complete": False})))
     stdout, stderr = second.communicate(timeout=600)
