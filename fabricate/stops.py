@@ -40,7 +40,7 @@ def stop_on_signals() -> Iterator[list[int]]:
     Yields the list the received signal's number is put in. Later signals are ignored so the cleanup the
     first one started can finish (SIGKILL still ends the process, and its children die with it). A signal
     the caller ignores stays ignored (``nohup``, a background job) and a handler the caller installed (a
-    program calling :func:`main`) stays in place. Only the main thread can have handlers.
+    program calling :func:`fabricate.cli.main`) stays in place. Only the main thread can have handlers.
 
     The handler can raise where Python cannot pass an exception on (a destructor, a garbage-collector callback:
     distributed registers one), and Python would print "Exception ignored in ..." with a traceback. While the
