@@ -15,6 +15,8 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
+from fabricate.stops import signals_deferred
+
 
 class _Threaded:
     """A job that :func:`_run_jobs` starts in a thread of its own before the others (:func:`in_thread`)."""
@@ -245,7 +247,6 @@ def _child(jobs: list[Callable[[], dict[str, bytes]]], conn: Any, parent: int = 
         if parent:
             _die_with_parent(parent)
         _detach_from_caller()
-        _release_stop_signals(None)  # held by the fork (Background): the defaults act from here on
         if receiver is not None:
             # the fork copied the parent's end of the pipe: holding it, this child would block forever on a
             # full pipe once the parent is gone, instead of failing with EPIPE
@@ -300,23 +301,18 @@ class Background:
         _KEEP_WORKERS[0] = not hand_over
         # a stop signal (Ctrl-C) waits until the fork is done: its exception never lands in a fork hook (printed
         # with a traceback and dropped) nor leaves a child no one holds; the child is killed and reaped first
-        held = _hold_stop_signals()
         try:
-            try:
-                self._process.start()
-                # the workers this fork handed over are this child's: reaped with it, not with another child
-                self._handed = [proc for proc in _HANDED if id(proc) not in before]
-            except OSError:  # no fork now (EAGAIN, ENOMEM): the jobs run here when asked for
-                self._process = None
-                self._conn.close()
-            finally:
-                _KEEP_WORKERS[0] = False
-                sender.close()
-                _release_stop_signals(held)
-            if _STOPPED_IN_FORK:
-                stopped = _STOPPED_IN_FORK[0]
-                _STOPPED_IN_FORK.clear()
-                raise stopped
+            with signals_deferred():
+                try:
+                    self._process.start()
+                    # the workers this fork handed over are this child's: reaped with it, not with another child
+                    self._handed = [proc for proc in _HANDED if id(proc) not in before]
+                except OSError:  # no fork now (EAGAIN, ENOMEM): the jobs run here when asked for
+                    self._process = None
+                    self._conn.close()
+                finally:
+                    _KEEP_WORKERS[0] = False
+                    sender.close()
         except BaseException:
             self.cancel()
             raise
@@ -415,50 +411,14 @@ def prestart(module: str, warm_up: str = "") -> None:
 def _hand_over() -> None:
     """After a fork, in the parent: the waiting workers are the child's now (their pipes closed here), unless
     that child was forked with ``hand_over=False``."""
-    try:
-        if _KEEP_WORKERS[0]:
-            return
-        for proc, _ in _WARM.values():
-            for pipe in (proc.stdin, proc.stdout):
-                with contextlib.suppress(OSError):
-                    pipe.close()
-            _HANDED.append(proc)
-        _WARM.clear()
-    except BaseException as exc:  # noqa: BLE001 - Python prints and drops an exception of a fork hook
-        _STOPPED_IN_FORK.append(exc)  # a stop signal's (another thread took it): Background raises it
-
-
-#: A stop signal's exception that landed in :func:`_hand_over`, for :class:`Background` to raise after the fork.
-_STOPPED_IN_FORK: list[BaseException] = []
-
-
-def _stop_signals() -> set[int]:
-    """The signals the command line raises as exceptions (SIGINT, SIGTERM, SIGHUP), those this platform has."""
-    import signal
-
-    return {getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name)}
-
-
-def _hold_stop_signals() -> Any:
-    """Block the stop signals in this thread (the fork's hooks then run no handler); the mask to restore."""
-    import signal
-
-    if not hasattr(signal, "pthread_sigmask"):
-        return None
-    return signal.pthread_sigmask(signal.SIG_BLOCK, _stop_signals())
-
-
-def _release_stop_signals(mask: Any) -> None:
-    """Restore ``mask`` (:func:`_hold_stop_signals`' return; None in a forked child: unblock the stop signals its
-    fork held): a stop signal that came while held is handled now (its exception raised here)."""
-    import signal
-
-    if not hasattr(signal, "pthread_sigmask"):
+    if _KEEP_WORKERS[0]:
         return
-    if mask is None:
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, _stop_signals())
-    else:
-        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+    for proc, _ in _WARM.values():
+        for pipe in (proc.stdin, proc.stdout):
+            with contextlib.suppress(OSError):
+                pipe.close()
+        _HANDED.append(proc)
+    _WARM.clear()
 
 
 if hasattr(os, "register_at_fork"):

@@ -31,7 +31,6 @@ from fabricate.stops import STOP_SIGNALS, Stopped, stop_on_signals
 
 DEFAULT_TEMPLATE = "finger_five_bar_ncg"
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
-#: Signals that stop a run cleanly (exit 128 + the signal's number), and how the last line names them.
 HELP_EPILOG = ("exit codes: 0 every check passed; 1 the design fails a check (files are written, the report says "
                "why) or 'check' found a problem; 2 invalid input or usage (nothing is written); 3 a bug in "
                "fabricate (please report it); 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP (128 + the signal: a previous "

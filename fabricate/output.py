@@ -32,7 +32,6 @@ import os
 import re
 import secrets
 import shutil
-import signal
 import stat
 import tempfile
 import warnings
@@ -43,6 +42,7 @@ from typing import Any
 
 from fabricate.errors import SpecError
 from fabricate.output_read import CLOEXEC, NOFOLLOW, NONBLOCK, REPORT, foreign_entries, not_regular, previous_output
+from fabricate.stops import signals_deferred
 
 try:  # POSIX advisory locks; elsewhere writers are not serialised (documented in the README)
     import fcntl
@@ -404,39 +404,6 @@ def _rename_new(a: Path, b: Path) -> None:
     os.rename(a, b)
 
 
-@contextlib.contextmanager
-def _no_interrupt() -> Iterator[None]:
-    """Hold the stop signals (Ctrl-C's SIGINT, SIGTERM, SIGHUP) off for a few system calls; they are
-    delivered right after, so a stop between the two renames of the fallback swap never leaves the
-    output folder missing.
-
-    The signals are deferred at Python's level (a handler that only records them, then the old handlers
-    back and the recorded signals raised again), not by ``pthread_sigmask``: a mask holds only for the
-    calling thread, and a process-directed signal is delivered to any other thread (BLAS's workers) whose
-    mask lets it through, whose C handler then runs the Python handler in the main thread at once.
-    """
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield  # Python runs signal handlers in the main thread only: this thread is never interrupted
-        return
-    stops = [signal.SIGINT] + [getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)]
-    held: list[int] = []
-    old = {}
-    for signum in stops:
-        current = signal.getsignal(signum)
-        if current in (signal.SIG_IGN, None):  # ignored by the caller (nohup), or set outside Python
-            continue
-        old[signum] = signal.signal(signum, lambda s, _f: held.append(s))
-    try:
-        yield
-    finally:
-        for signum, handler in old.items():
-            signal.signal(signum, handler)
-        for signum in dict.fromkeys(held):
-            signal.raise_signal(signum)
-
-
 def _write_tree(files: Mapping[str, bytes], root: Path) -> None:
     for rel, data in sorted(files.items()):
         rel_path = Path(rel)
@@ -515,7 +482,7 @@ def _swap_in(files: Mapping[str, bytes], out_dir: Path, lock: _Lock, checked: Id
     lock.record(token, ours)
     try:
         _write_tree(files, tmp)
-        with _no_interrupt():
+        with signals_deferred():
             previous = _swap(tmp, ours, out_dir, checked, lock)
     except BaseException:
         _remove_ours(tmp, ours, lock)  # only if the folder there is still the one made here

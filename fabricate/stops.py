@@ -9,7 +9,7 @@ import contextlib
 import os
 import signal
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from typing import Any
 
 #: The signals that stop a command, and how its one line on stderr names each.
@@ -106,3 +106,59 @@ def _again(signum: int, closing: list[bool]) -> None:
     timer = threading.Timer(0.01, send)
     timer.daemon = True
     timer.start()
+
+
+def signal_numbers(names: Iterable[str] = STOP_SIGNALS) -> set[int]:
+    """The numbers of the signals ``names`` (``"SIGINT"``, ...) this platform has."""
+    return {getattr(signal, name) for name in names if hasattr(signal, name)}
+
+
+@contextlib.contextmanager
+def signals_deferred() -> Iterator[None]:
+    """Hold the stop signals off for a few system calls (a fork, a folder swap); they are handled right after.
+
+    A stop between the two renames of the fallback swap never leaves the output folder missing, and one during a
+    fork never lands in a fork hook (where Python prints its exception with a traceback and drops it) nor leaves
+    a child no one holds.
+
+    The signals are deferred at Python's level (a handler that only records them, then the old handlers back and
+    the recorded signals raised again), not by ``pthread_sigmask``: a mask holds only for the calling thread, and a
+    process-directed signal is delivered to any other thread (BLAS's workers) whose mask lets it through, whose C
+    handler then runs the Python handler in the main thread at once. A forked child inherits the recording
+    handler: it sets its own (:mod:`fabricate.background`).
+    """
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield  # Python runs signal handlers in the main thread only: this thread is never interrupted
+        return
+    held: list[int] = []
+    old = {}
+    for signum in sorted(signal_numbers()):
+        current = signal.getsignal(signum)
+        if current in (signal.SIG_IGN, None):  # ignored by the caller (nohup), or set outside Python
+            continue
+        old[signum] = signal.signal(signum, lambda s, _f: held.append(s))
+    try:
+        yield
+    finally:
+        for signum, handler in old.items():
+            signal.signal(signum, handler)
+        for signum in dict.fromkeys(held):
+            signal.raise_signal(signum)
+
+
+@contextlib.contextmanager
+def signals_held(names: Iterable[str]) -> Iterator[None]:
+    """Block the signals ``names`` in this thread for the block, for the threads it starts (they inherit the mask)
+    and the processes those start (they keep it across ``exec``). A signal that comes meanwhile waits and is
+    handled as the mask is restored (or by another thread that lets it through: :func:`signals_deferred`). Nothing
+    is blocked where there is no ``pthread_sigmask``."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, signal_numbers(names))
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)

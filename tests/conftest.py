@@ -238,6 +238,27 @@ def shared_stage_cache(tmp_path_factory: pytest.TempPathFactory) -> Callable[...
     return block
 
 
+@pytest.fixture
+def serve_builds(monkeypatch: pytest.MonkeyPatch,
+                 shared_stage_cache: Callable[..., AbstractContextManager[None]]) -> Callable[[], None]:
+    """``serve_builds()``: from then on in the test, ``pipeline.run_build`` runs on the session's shared stage cache
+    (:func:`shared_stage_cache`), also where its caller turns the cache off (``fabricate check``'s rebuild,
+    ``fabricate.build``): for a test of what a build's caller does with a design the session built already (a
+    served build is byte-identical to a cold one: tests/test_cache.py). Called after the test's own builds."""
+    import fabricate.pipeline as pipeline
+
+    def serve() -> None:
+        real = pipeline.run_build
+
+        def served(*args, **kwargs):
+            with shared_stage_cache():  # the caller's own use_cache(False) is outside this block
+                return real(*args, **kwargs)
+
+        monkeypatch.setattr(pipeline, "run_build", served)
+
+    return serve
+
+
 class BuiltFolder(NamedTuple):
     """An output folder as ``fabricate build NAME -o DIR -q`` wrote it, that command's exit code, and what it
     printed (standard output, then standard error)."""

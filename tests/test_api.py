@@ -22,23 +22,16 @@ def _example() -> str:
 
 
 @pytest.mark.slow
-def test_readme_api_example_runs_and_writes_its_files(tmp_path, capsys, monkeypatch, shipped_build, shared_stage_cache):
+def test_readme_api_example_runs_and_writes_its_files(tmp_path, capsys, shipped_build, serve_builds):
     """README's example as written; the folder it writes holds exactly the build's files (the CLI writes
     through the same run_build and write_output), and its motion.csv is the mechanism's sweep.
 
     The example's ``fabricate.build`` runs on the session's shared stage cache, which ``shipped_build`` fills with
     the same shipped finger (byte-identical to a cold build: tests/test_cache.py): the example's code path runs as
     written, the finger's stages are not computed a second time."""
-    import fabricate.pipeline as pipeline
 
     shipped_build("finger_underactuated")
-    real = pipeline.run_build
-
-    def served(*args, **kwargs):
-        with shared_stage_cache():  # fabricate.build's own use_cache(False) is outside this block
-            return real(*args, **kwargs)
-
-    monkeypatch.setattr(pipeline, "run_build", served)
+    serve_builds()
     here = os.getcwd()
     os.chdir(tmp_path)
     scope: dict = {}

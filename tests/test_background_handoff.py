@@ -4,7 +4,6 @@ exist, waits for the part set), and ``preceded``."""
 from __future__ import annotations
 
 import os
-import signal
 import threading
 
 import pytest
@@ -131,7 +130,6 @@ else:
 """
 
 
-@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="needs pthread_sigmask")
 def test_a_stop_signal_during_a_fork_is_raised_after_it_and_the_child_reaped() -> None:
     """The signal waits until the fork is done (no traceback of a fork hook on stderr, no stop dropped); the
     exception comes from making the Background, whose child is killed and reaped first (none left)."""

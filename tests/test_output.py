@@ -563,12 +563,12 @@ def test_the_cli_refuses_a_fifo_report_with_exit_2(tmp_path):
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
 def test_stop_signals_wait_until_the_swap_is_done(signum: int) -> None:
     """A stop signal sent between the swap's renames is delivered only after them (issue 23 item 2)."""
-    from fabricate.output import _no_interrupt
+    from fabricate.stops import signals_deferred
 
     seen: list[int] = []
     old = signal.signal(signum, lambda s, _f: seen.append(s))
     try:
-        with _no_interrupt():
+        with signals_deferred():
             os.kill(os.getpid(), signum)
             assert seen == []  # held off while the folder is being swapped
         assert seen == [signum]  # and delivered right after

@@ -100,11 +100,10 @@ def test_a_bad_process_is_named(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_check_rebuilds_with_the_process_it_was_built_with(tmp_path, capsys, monkeypatch, shared_stage_cache):
+def test_check_rebuilds_with_the_process_it_was_built_with(tmp_path, capsys, shared_stage_cache, serve_builds):
     """The build's stages go to the session's shared stage cache and check's rebuild is served from it (as in
     tests/test_verify.py): every stage's key holds the process (fabricate/stage_keys.py), so a rebuild with any
     other process (the template's own 3 mm SLA, say) misses, runs, and its 3 mm parts differ from the folder's."""
-    import fabricate.pipeline as pipeline
 
     profile = tmp_path / "thick.toml"
     profile.write_text((TEMPLATE_DIR / "process_laser.toml").read_text()
@@ -118,13 +117,7 @@ def test_check_rebuilds_with_the_process_it_was_built_with(tmp_path, capsys, mon
     assert report["design"]["process_override"] == {"source": "thick.toml", "text": profile.read_text()}
     assert {p["thickness_mm"] for p in report["parts"]} == {4.0}
     profile.unlink()  # check needs nothing but the folder
-    real = pipeline.run_build
-
-    def served(*args, **kwargs):
-        with shared_stage_cache():  # check's own use_cache(False) is outside this block
-            return real(*args, **kwargs)
-
-    monkeypatch.setattr(pipeline, "run_build", served)
+    serve_builds()
     assert main(["check", str(out), "-q"]) == code
     assert "differs" not in capsys.readouterr().out
     assert main(["check", str(out), "--process", "sla"]) == 2

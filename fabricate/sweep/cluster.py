@@ -17,6 +17,7 @@ from collections.abc import Iterator
 from typing import Any
 
 from fabricate.errors import SpecError
+from fabricate.stops import signals_held
 from fabricate.sweep.task import peak_rss_mb, warm
 
 
@@ -96,24 +97,18 @@ def _deaf_to_the_terminal() -> Iterator[None]:
     closes the cluster (the nanny stops its workers with SIGTERM, which stays open, and a worker exits when its
     parent dies). A signal that comes meanwhile waits, and is handled when the mask is restored.
     """
-    import signal
-
-    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    numbers = {getattr(signal, name) for name in TERMINAL_SIGNALS if hasattr(signal, name)}
-    mask = signal.pthread_sigmask(signal.SIG_BLOCK, numbers)
-    try:
+    with signals_held(TERMINAL_SIGNALS):
         # the tracker first, from here: starting it (CPython 3.11-3.13) unblocks SIGINT and SIGTERM in the thread
         # that starts it, which would otherwise be the thread that goes on to start the workers
         with contextlib.suppress(ImportError, AttributeError, OSError):
             from multiprocessing import resource_tracker
 
             resource_tracker.ensure_running()
-        signal.pthread_sigmask(signal.SIG_BLOCK, numbers)
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+        with signals_held(TERMINAL_SIGNALS):  # again, after the tracker's start
+            yield
 
 
 def default_workers() -> int:
@@ -199,7 +194,6 @@ def _quiet_event_loops() -> None:
 
 
 def close_cluster(client: Any, cluster: Any) -> None:
-    _quiet_event_loops()  # a client made outside connect() too
     for thing in (client, cluster):
         if thing is not None:
             try:

@@ -86,8 +86,7 @@ def test_each_sheet_holds_parts_of_one_thickness():
 
 
 @pytest.mark.slow
-def test_the_laser_default_finger_cuts_its_3mm_plate_on_a_3mm_sheet(tmp_path, capsys, monkeypatch, shipped_build,
-                                                                    shared_stage_cache):
+def test_the_laser_default_finger_cuts_its_3mm_plate_on_a_3mm_sheet(tmp_path, capsys, shipped_build, serve_builds):
     """``--process laser`` of the default finger (the session's build, shared with test_mount, test_auto and
     test_bom): its links are 6 mm, its actuator plate is cut from the 3 mm stock. The build exits 0, the plate is on
     a sheet of thickness 3 with no 6 mm part, every sheet's parts are as thick as it, and ``fabricate check`` passes
@@ -97,16 +96,9 @@ def test_the_laser_default_finger_cuts_its_3mm_plate_on_a_3mm_sheet(tmp_path, ca
     design (as in tests/test_verify.py and test_process_override's check test): the rebuild goes through check's
     own path (the embedded template and profile read back into a design, whose stage keys must be the build's to be
     served; a key that missed would build cold and still be compared), without building the finger a third time."""
-    import fabricate.pipeline as pipeline
 
     outcome = shipped_build("finger_five_bar_ncg", "laser")
-    real = pipeline.run_build
-
-    def served(*args, **kwargs):
-        with shared_stage_cache():  # check's own use_cache(False) is outside this block
-            return real(*args, **kwargs)
-
-    monkeypatch.setattr(pipeline, "run_build", served)
+    serve_builds()
     assert outcome.exit_code == 0, outcome.failures
     out = outcome.write(tmp_path / "out")
     report = json.loads((out / "report.json").read_text())

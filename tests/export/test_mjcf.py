@@ -419,9 +419,8 @@ def test_mjcf_contacts_find_the_collision_of_the_24_mm_link_six_bar(shared_stage
 
 @pytest.mark.slow
 def test_grasp_sim_example_matches_the_gripper_force_model(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                                          monkeypatch: pytest.MonkeyPatch,
                                                           shipped_build: Callable[..., BuildOutcome],
-                                                          shared_stage_cache: Callable[..., Any]) -> None:
+                                                          serve_builds: Callable[[], None]) -> None:
     """examples/grasp_sim.py: the finger closed on the 85 mm can by its motor gives the pad force of the
     template's force model within 2 % (exit 0), and writes its GIF where MuJoCo can open an offscreen GL
     context (EGL, else OSMesa); where it cannot, it says so and skips the GIF.
@@ -431,16 +430,9 @@ def test_grasp_sim_example_matches_the_gripper_force_model(tmp_path: Path, capsy
     tested is the simulation of the build, not the build, which the session makes once."""
     import importlib.util
 
-    import fabricate.pipeline as pipeline
 
     shipped_build("gripper_compliant")
-    real = pipeline.run_build
-
-    def served(*args: Any, **kwargs: Any) -> BuildOutcome:
-        with shared_stage_cache():  # fabricate.build's own use_cache(False) is outside this block
-            return real(*args, **kwargs)
-
-    monkeypatch.setattr(pipeline, "run_build", served)
+    serve_builds()
 
     path = Path(__file__).resolve().parents[2] / "examples" / "grasp_sim.py"
     spec = importlib.util.spec_from_file_location("grasp_sim", path)
